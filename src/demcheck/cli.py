@@ -1,0 +1,220 @@
+"""Command line: ``demcheck models | collide | sweep | verify`` (DESIGN.md "Command line").
+
+Exit codes: 0 success, 1 an unexpected disagreement or a failed run, 2 bad input or usage.
+``--json`` prints one JSON object on stdout and nothing else there.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import click
+
+from . import __version__
+from .errors import ConfigError, DemcheckError
+
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+
+
+def _jsonable(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if hasattr(obj, "item"):
+        return _jsonable(obj.item())
+    return obj
+
+
+def emit_json(obj) -> None:
+    click.echo(json.dumps(_jsonable(obj), indent=2, allow_nan=False))
+
+
+def _load(case_path: str, overrides) -> "object":
+    from . import case as case_mod
+
+    return case_mod.load(case_path, list(overrides))
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="demcheck")
+def cli():
+    """Verify DEM contact force models: a Python reference against LAMMPS and LIGGGHTS."""
+
+
+# ----------------------------------------------------------------------------- models
+
+
+@cli.command()
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def models(as_json):
+    """Registered models: ids, seed names, formulas, sources, parameters."""
+    from .reference import normal, tangential
+
+    def rows(registry, slot):
+        out = []
+        for m in registry.values():
+            out.append({"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
+                        "title": m.title, "formula": m.formula, "source": m.source,
+                        "params": {p.name: p.meaning for p in m.params}})
+        return out
+
+    table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
+    try:
+        from .inputs import mapping
+    except ImportError:  # pragma: no cover - engines not yet wired
+        mapping = None
+    if mapping is not None:
+        for row in table:
+            row["engines"] = mapping.describe(row["slot"], row["id"])
+    if as_json:
+        emit_json({"models": table})
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table(title="demcheck models", show_lines=True)
+    for col in ("slot", "id", "seed", "formula", "source"):
+        t.add_column(col)
+    if mapping is not None:
+        t.add_column("engines")
+    for row in table:
+        cells = [row["slot"], row["id"], row["seed_name"], row["formula"], row["source"]]
+        if mapping is not None:
+            cells.append("\n".join(f"{k}: {v['fidelity']}" for k, v in row["engines"].items()))
+        t.add_row(*cells)
+    Console().print(t)
+
+
+# ----------------------------------------------------------------------------- collide
+
+_set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
+                           help="override a case key (dotted, e.g. contact.normal=tti); repeatable")
+
+
+@cli.command()
+@click.argument("case_path", metavar="CASE")
+@click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
+              help="reference method (default: the case's run.method, adaptive)")
+@click.option("--dt", type=float, default=None, help="time step of the verlet method (s)")
+@_set_option
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--plot", type=click.Path(dir_okay=False), default=None, help="write force–overlap and force–time panels")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="write the contact time series")
+def collide(case_path, method, dt, overrides, as_json, plot, csv_path):
+    """Solve one collision case and print its metrics."""
+    from .reference.collision import collide as run
+
+    case = _load(case_path, overrides)
+    if dt is not None and not dt > 0:
+        raise ConfigError("--dt", dt, "must be > 0 (s)")
+    result = run(case, method=method, dt=dt)
+    if csv_path:
+        result.contact.to_csv(csv_path, index=False, float_format="%.17g")
+    if plot:
+        from .comparisons.plots import collision_panels
+
+        collision_panels([result], plot)
+    summary = result.summary()
+    if as_json:
+        emit_json(summary)
+    else:
+        _print_summary(summary)
+    if not result.ok:
+        click.echo(f"demcheck: {result.status}: {result.message}", err=True)
+        sys.exit(1)
+
+
+def _fmt(v):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    if isinstance(v, float):
+        return f"{v:.10g}"
+    return str(v)
+
+
+def _print_summary(s: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    m = s["model"]
+    head = f"[bold]{s['case']}[/]  normal={m['normal']} tangential={m['tangential']}"
+    head += f" limit_force={m['limit_force']}  method={s['method']}"
+    head += f"  dt={_fmt(s['dt'])}" if s["dt"] else f"  rtol={_fmt(s['rtol'])}"
+    con.print(head)
+    t = Table(show_header=True)
+    t.add_column("metric")
+    t.add_column("value", justify="right")
+    for k, v in s["metrics"].items():
+        t.add_row(k, _fmt(v))
+    p = Table(show_header=True)
+    p.add_column("parameter")
+    p.add_column("value", justify="right")
+    for k, v in s["params"].items():
+        p.add_row(k, _fmt(v))
+    con.print(t)
+    con.print(p)
+
+
+# ----------------------------------------------------------------------------- verify
+
+
+@cli.command()
+@click.argument("paths", nargs=-1, metavar="[CASE|DIR]...")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports",
+              help="where reports/<run-id> and reports/latest go")
+def verify(paths, as_json, report_dir):
+    """Run the verification suite (default: the built-in cases/) and report."""
+    from .comparisons.suite import run_suite
+
+    files = _case_files(paths)
+    summary = run_suite(files, Path(report_dir), quiet=as_json)
+    if as_json:
+        emit_json(summary)
+    sys.exit(0 if summary["failed"] == 0 else 1)
+
+
+def _case_files(paths) -> list[Path]:
+    if not paths:
+        paths = [str(CASES_DIR)]
+    files: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            files.extend(sorted(p.glob("*.toml")))
+        elif p.is_file():
+            files.append(p)
+        else:
+            raise ConfigError("CASE", str(p), "no such case file or directory")
+    if not files:
+        raise ConfigError("CASE", ", ".join(map(str, paths)), "no *.toml case files found")
+    return files
+
+
+# ----------------------------------------------------------------------------- entry point
+
+
+def main(argv=None) -> None:
+    try:
+        cli.main(args=argv, prog_name="demcheck", standalone_mode=False)
+    except click.exceptions.Abort:
+        click.echo("demcheck: interrupted", err=True)
+        sys.exit(130)
+    except click.exceptions.ClickException as exc:
+        exc.show()
+        sys.exit(2 if isinstance(exc, click.UsageError) else exc.exit_code)
+    except click.exceptions.Exit as exc:
+        sys.exit(exc.exit_code)
+    except DemcheckError as exc:
+        click.echo(f"demcheck: error: {exc}", err=True)
+        sys.exit(exc.exit_code)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,197 @@
+"""Two-body collision solver: a particle–particle or particle–wall impact.
+
+Methods (DESIGN.md "The reference solver"):
+
+* ``adaptive`` integrates to a relative tolerance with embedded Dormand–Prince 5(4), locating contact
+  start, contact end, the force end, the maximum overlap, the peak force and every loading/unloading
+  switch as events (kernels.adaptive_normal);
+* ``verlet`` is the engines' velocity-Verlet scheme at a given dt (kernels.verlet_normal).
+
+What a scene does not need is skipped: when nothing can move the contact off the line of centres
+(no tangential force, and a wall, or a head-on pair) the problem is solved in 1-D along the normal.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pandas as pd
+
+from ..case import Case
+from ..errors import ConfigError
+from ..result import Result
+from . import kernels
+from .model import ResolvedModel, resolve
+
+STATUS = {
+    kernels.ST_OK: "ok",
+    kernels.ST_TOLERANCE: "tolerance",
+    kernels.ST_STEPS: "too-many-steps",
+    kernels.ST_NO_CONTACT: "no-contact",
+    kernels.ST_NO_SEPARATION: "no-separation",
+    kernels.ST_UNRESOLVED: "unresolved",
+}
+MESSAGES = {
+    "tolerance": "the adaptive method could not meet its tolerance (step size underflow)",
+    "too-many-steps": "the solver ran out of room for output points",
+    "no-contact": "the bodies never touched",
+    "no-separation": "the contact did not end within the time limit",
+    "unresolved": "the time step does not resolve the contact: the state became NaN or infinite",
+}
+
+
+class Geometry1D:
+    """The line of centres of a two-body scene and the 1-D initial state along it."""
+
+    def __init__(self, case: Case):
+        p0 = case.particles[0]
+        x0, v0 = np.asarray(p0.position), np.asarray(p0.velocity)
+        g = np.asarray(case.run.gravity)
+        self.wall = len(case.particles) == 1
+        if self.wall:
+            w = case.walls[0]
+            self.n = -np.asarray(w.normal)  # from the particle into the wall
+            self.delta0 = p0.radius - float((x0 - np.asarray(w.point)) @ np.asarray(w.normal))
+            self.rate0 = float(v0 @ self.n)
+            self.an = float(g @ self.n)
+            self.tangential_velocity = v0 - self.rate0 * self.n
+        else:
+            p1 = case.particles[1]
+            x1, v1 = np.asarray(p1.position), np.asarray(p1.velocity)
+            sep = x1 - x0
+            dist = float(np.linalg.norm(sep))
+            self.n = sep / dist
+            self.delta0 = p0.radius + p1.radius - dist
+            v_rel = v0 - v1
+            self.rate0 = float(v_rel @ self.n)
+            self.an = 0.0
+            self.tangential_velocity = v_rel - self.rate0 * self.n
+
+
+def is_one_dimensional(case: Case, model: ResolvedModel) -> bool:
+    """True when the normal solve alone is exact: no tangential force, and the contact normal cannot turn
+    (a plane wall, or a pair whose relative velocity lies on the line of centres)."""
+    if model.tangential.id != "none":
+        return False
+    if len(case.particles) == 1:
+        return True
+    geo = Geometry1D(case)
+    return float(np.linalg.norm(geo.tangential_velocity)) <= 1e-12 * max(abs(geo.rate0), 1e-300)
+
+
+def characteristic_time(model: ResolvedModel) -> float:
+    v = model.pair.impact_speed
+    if not (v > 0):
+        raise ConfigError("particles", "(initial state)", "the bodies never meet: no collision to solve")
+    return model.normal_law.characteristic_time(model.pair.m_eff, v)
+
+
+def auto_dt(case: Case, model: ResolvedModel | None = None) -> float:
+    """dt = contact time / steps_per_contact (the elastic contact time of the law at the impact speed)."""
+    model = model or resolve(case)
+    return characteristic_time(model) / case.run.steps_per_contact
+
+
+def collide(case: Case, method: str | None = None, dt: float | None = None,
+            rtol: float | None = None) -> Result:
+    method = method or case.run.method
+    if method not in ("adaptive", "verlet"):
+        raise ConfigError("--method", method, "must be adaptive or verlet")
+    model = resolve(case)
+    if not is_one_dimensional(case, model):
+        from . import collision3d
+
+        return collision3d.collide(case, model, method, dt=dt, rtol=rtol)
+    geo = Geometry1D(case)
+    law = model.normal_law.array()
+    m = model.pair.m_eff
+    t_c = characteristic_time(model)
+    v = model.pair.impact_speed
+    t_contact = max(-geo.delta0, 0.0) / v if geo.rate0 > 0 else 0.0
+    if geo.an > 0 and geo.delta0 < 0:  # falling onto the wall
+        t_contact = (-geo.rate0 + math.sqrt(geo.rate0**2 - 2 * geo.an * geo.delta0)) / geo.an
+    t_max = t_contact + 200.0 * t_c
+    started = time.perf_counter()
+    if method == "adaptive":
+        rtol = rtol or case.run.rtol
+        out = kernels.adaptive_normal(law, m, geo.an, geo.delta0, geo.rate0, rtol, t_c, v * t_c, v, t_max,
+                                      1_000_000)
+        status, n, T, D, R, F, ne, ET, EC, ED, ER, EF = out
+        events = pd.DataFrame({
+            "t": ET, "event": [kernels.EVENT_NAMES.get(abs(int(c)), "?") if c > 0 else "force_end_again"
+                               for c in EC],
+            "delta": ED, "delta_dot": ER, "fn": EF})
+        used_dt = None
+    else:
+        dt = dt or case.run.dt or auto_dt(case, model)
+        if not (dt > 0):
+            raise ConfigError("--dt", dt, "must be > 0 (s)")
+        capacity = int(min(t_max / dt + 4, 50_000_000))
+        status, n, T, D, R, F = kernels.verlet_normal(law, m, geo.an, geo.delta0, geo.rate0, dt, t_max, capacity)
+        events = None
+        used_dt, rtol = dt, None
+    wall_time = time.perf_counter() - started
+    contact = pd.DataFrame({"t": T, "delta": D, "delta_dot": R, "fn": F})
+    status_name = STATUS[status]
+    result = Result(
+        source="reference", method=method, case_name=case.name, case_hash=case.hash,
+        model=model.describe(), params=dict(model.params), contact=contact, events=events,
+        dt=used_dt, rtol=rtol, wall_time=wall_time, status=status_name,
+        message=MESSAGES.get(status_name, ""),
+        meta={"solver": "1d-normal", "steps": int(n)},
+    )
+    result.particles = _particles_1d(case, geo, contact)
+    if method == "verlet" and status_name == "ok":
+        _flag_unresolved(result, t_c)
+    return result
+
+
+def _particles_1d(case: Case, geo: Geometry1D, contact: pd.DataFrame) -> pd.DataFrame:
+    """Rebuild both bodies' centres and velocities from the 1-D solution (the centre of mass of a pair
+    moves uniformly; a particle keeps its velocity along a wall)."""
+    t = contact["t"].to_numpy()
+    d = contact["delta"].to_numpy()
+    r = contact["delta_dot"].to_numpy()
+    frames = []
+    p0 = case.particles[0]
+    x0, v0 = np.asarray(p0.position), np.asarray(p0.velocity)
+    g = np.asarray(case.run.gravity)
+    if geo.wall:
+        vt = geo.tangential_velocity
+        gt = g - (g @ geo.n) * geo.n
+        pos = x0 + np.outer(t, vt) + 0.5 * np.outer(t * t, gt) + np.outer(d - geo.delta0, geo.n)
+        vel = vt + np.outer(t, gt) + np.outer(r, geo.n)
+        frames.append(_frame(t, 0, pos, vel, p0.angular_velocity))
+    else:
+        p1 = case.particles[1]
+        m0, m1 = case.mass(0), case.mass(1)
+        mt = m0 + m1
+        x1, v1 = np.asarray(p1.position), np.asarray(p1.velocity)
+        xc = (m0 * x0 + m1 * x1) / mt
+        vc = (m0 * v0 + m1 * v1) / mt
+        com = xc + np.outer(t, vc) + 0.5 * np.outer(t * t, g)
+        vcom = vc + np.outer(t, g)
+        sep = p0.radius + p1.radius - d  # distance between centres
+        frames.append(_frame(t, 0, com - np.outer(sep * m1 / mt, geo.n), vcom + np.outer(r * m1 / mt, geo.n),
+                             p0.angular_velocity))
+        frames.append(_frame(t, 1, com + np.outer(sep * m0 / mt, geo.n), vcom - np.outer(r * m0 / mt, geo.n),
+                             p1.angular_velocity))
+    return pd.concat(frames, ignore_index=True)
+
+
+def _frame(t, pid, pos, vel, omega):
+    return pd.DataFrame({"t": t, "id": pid, "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
+                         "vx": vel[:, 0], "vy": vel[:, 1], "vz": vel[:, 2],
+                         "wx": omega[0], "wy": omega[1], "wz": omega[2]})
+
+
+def _flag_unresolved(result: Result, t_c: float) -> None:
+    """A verlet run with too few steps in the contact is not trusted silently."""
+    c = result.contact
+    inside = int((c["delta"] > 0).sum())
+    if inside < 5:
+        result.status = "unresolved"
+        result.message = (f"only {inside} steps inside the contact (dt = {result.dt:.3g} s, elastic contact "
+                          f"time {t_c:.3g} s): the time step does not resolve the collision")

@@ -1,0 +1,387 @@
+"""Compiled (numba, cached on disk) pure force laws and the 1-D normal-impact integrators.
+
+The law array is ``NormalLaw.array()``: [kind, k, a, eta, b, kl, ku, s, limit].
+
+State of the 1-D problem: δ (overlap, > 0 in contact) and r = δ̇ (approach rate); m̄ δ̈ = −F + m̄ a_n.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+L_KIND, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
+
+# modes of the piecewise-smooth normal law (adaptive method)
+M_PRE, M_VE, M_LOAD, M_UNLOAD, M_FREE = 0, 1, 2, 3, 4
+# event codes
+EV_START, EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER = 1, 2, 3, 4, 5, 6, 7
+EVENT_NAMES = {EV_START: "contact_start", EV_END: "contact_end", EV_FORCE_END: "force_end",
+               EV_MAX_OVERLAP: "max_overlap", EV_PEAK: "peak_force", EV_RELOAD: "reload",
+               EV_REENTER: "force_restart"}
+# status codes
+ST_OK, ST_TOLERANCE, ST_STEPS, ST_NO_CONTACT, ST_NO_SEPARATION, ST_UNRESOLVED = 0, 1, 2, 3, 4, 5
+
+
+@njit(cache=True, inline="always")
+def spow(x, p):
+    """Sign-preserving power; p = 0 gives 1 (so LSD's dashpot stays linear through δ = 0)."""
+    if p == 0.0:
+        return 1.0
+    if x >= 0.0:
+        return x**p
+    return -((-x) ** p)
+
+
+@njit(cache=True, inline="always")
+def hls_unloading(law, dmax):
+    """(K_U, δ₀) for the largest overlap reached so far."""
+    kl = law[L_KL]
+    ku = law[L_KU] if law[L_KU] > 0.0 else kl + law[L_S] * kl * dmax
+    return ku, dmax * (1.0 - kl / ku)
+
+
+@njit(cache=True)
+def viscoelastic_force(law, delta, rate):
+    return law[L_K] * spow(delta, law[L_A]) + law[L_ETA] * spow(delta, law[L_B]) * rate
+
+
+@njit(cache=True)
+def normal_force(law, delta, rate, dmax):
+    """Total normal force (+ repulsive) of a contact with overlap δ > 0, approach rate δ̇ and, for the
+    hysteretic law, the largest overlap so far (the history). No force without overlap."""
+    if delta <= 0.0:
+        return 0.0
+    if law[L_KIND] == 1.0:
+        ku, d0 = hls_unloading(law, dmax)
+        f = min(law[L_KL] * delta, ku * (delta - d0))
+        return max(f, 0.0)
+    f = viscoelastic_force(law, delta, rate)
+    if law[L_LIMIT] != 0.0 and f < 0.0:
+        return 0.0
+    return f
+
+
+# ----------------------------------------------------------------------------- adaptive (DP5(4))
+
+
+@njit(cache=True, inline="always")
+def _mode_force(law, mode, d, r, dmax):
+    if mode == M_VE:
+        return viscoelastic_force(law, d, r)
+    if mode == M_LOAD:
+        return law[L_KL] * d
+    if mode == M_UNLOAD:
+        ku, d0 = hls_unloading(law, dmax)
+        return ku * (d - d0)
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _acc(law, mode, d, r, dmax, m, an):
+    return -_mode_force(law, mode, d, r, dmax) / m + an
+
+
+@njit(cache=True)
+def _dp5(law, mode, d, r, h, dmax, m, an):
+    """One Dormand–Prince 5(4) step of (δ, δ̇); returns the 5th-order state and the error estimate."""
+    k1d, k1r = r, _acc(law, mode, d, r, dmax, m, an)
+    d2, r2 = d + h * (k1d / 5), r + h * (k1r / 5)
+    k2d, k2r = r2, _acc(law, mode, d2, r2, dmax, m, an)
+    d3 = d + h * (3 / 40 * k1d + 9 / 40 * k2d)
+    r3 = r + h * (3 / 40 * k1r + 9 / 40 * k2r)
+    k3d, k3r = r3, _acc(law, mode, d3, r3, dmax, m, an)
+    d4 = d + h * (44 / 45 * k1d - 56 / 15 * k2d + 32 / 9 * k3d)
+    r4 = r + h * (44 / 45 * k1r - 56 / 15 * k2r + 32 / 9 * k3r)
+    k4d, k4r = r4, _acc(law, mode, d4, r4, dmax, m, an)
+    d5 = d + h * (19372 / 6561 * k1d - 25360 / 2187 * k2d + 64448 / 6561 * k3d - 212 / 729 * k4d)
+    r5 = r + h * (19372 / 6561 * k1r - 25360 / 2187 * k2r + 64448 / 6561 * k3r - 212 / 729 * k4r)
+    k5d, k5r = r5, _acc(law, mode, d5, r5, dmax, m, an)
+    d6 = d + h * (9017 / 3168 * k1d - 355 / 33 * k2d + 46732 / 5247 * k3d + 49 / 176 * k4d
+                  - 5103 / 18656 * k5d)
+    r6 = r + h * (9017 / 3168 * k1r - 355 / 33 * k2r + 46732 / 5247 * k3r + 49 / 176 * k4r
+                  - 5103 / 18656 * k5r)
+    k6d, k6r = r6, _acc(law, mode, d6, r6, dmax, m, an)
+    dn = d + h * (35 / 384 * k1d + 500 / 1113 * k3d + 125 / 192 * k4d - 2187 / 6784 * k5d + 11 / 84 * k6d)
+    rn = r + h * (35 / 384 * k1r + 500 / 1113 * k3r + 125 / 192 * k4r - 2187 / 6784 * k5r + 11 / 84 * k6r)
+    k7d, k7r = rn, _acc(law, mode, dn, rn, dmax, m, an)
+    e1, e3, e4, e5, e6, e7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
+    ed = h * (e1 * k1d + e3 * k3d + e4 * k4d + e5 * k5d + e6 * k6d + e7 * k7d)
+    er = h * (e1 * k1r + e3 * k3r + e4 * k4r + e5 * k5r + e6 * k6r + e7 * k7r)
+    return dn, rn, ed, er
+
+
+@njit(cache=True)
+def _event_value(law, mode, slot, d, r, dmax, m, an):
+    """Value of event function ``slot`` in ``mode`` (see _ACTIVE for which are live)."""
+    if slot == 0:
+        return d
+    if slot == 1:  # the force of the law, unclipped (VE), or of the unloading branch (HLS)
+        if mode == M_FREE:
+            if law[L_KIND] == 1.0:
+                return _mode_force(law, M_UNLOAD, d, r, dmax)
+            return viscoelastic_force(law, d, r)
+        return _mode_force(law, mode, d, r, dmax)
+    if slot == 2:
+        return r
+    if slot == 3:  # dF/dt of the viscoelastic law
+        acc = _acc(law, mode, d, r, dmax, m, an)
+        ad = abs(d)
+        a, b = law[L_A], law[L_B]
+        dfd = law[L_K] * (r if a == 1.0 else a * ad ** (a - 1.0) * r)
+        if b == 0.0:
+            dfv = law[L_ETA] * acc
+        else:
+            dfv = law[L_ETA] * (b * ad ** (b - 1.0) * r * r + spow(d, b) * acc)
+        return dfd + dfv
+    return d - dmax  # slot 4
+
+
+@njit(cache=True)
+def _crossed(g0, g1, direction):
+    if direction < 0:
+        return g0 > 0.0 and g1 <= 0.0
+    return g0 < 0.0 and g1 >= 0.0
+
+
+@njit(cache=True)
+def _slot_direction(law, mode, slot):
+    """+1 / −1 for a live event of this mode, 0 for none."""
+    hls = law[L_KIND] == 1.0
+    if mode == M_PRE:
+        return 1 if slot == 0 else 0
+    if mode == M_VE:
+        if slot == 0 or slot == 1 or slot == 2:
+            return -1
+        if slot == 3 and law[L_ETA] != 0.0:
+            return -1
+        return 0
+    if mode == M_LOAD:
+        return -1 if (slot == 0 or slot == 2) else 0
+    if mode == M_UNLOAD:
+        if slot == 0 or slot == 1:
+            return -1
+        return 1 if slot == 4 else 0
+    if mode == M_FREE:
+        if slot == 0:
+            return -1
+        if slot == 1:
+            return 1
+        return 0
+    return 0
+
+
+@njit(cache=True)
+def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta):
+    """Root of event ``slot`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
+    bisection fallback, each trial evaluated by a fresh RK step of length θh (5th-order accurate)."""
+    lo, hi, glo, ghi = 0.0, 1.0, g0, g1
+    side = 0
+    for _ in range(200):
+        if hi - lo <= tol_theta:
+            break
+        theta = lo - glo * (hi - lo) / (ghi - glo) if (math.isfinite(glo) and math.isfinite(ghi)
+                                                        and ghi != glo) else 0.5 * (lo + hi)
+        if not (lo < theta < hi) or not math.isfinite(theta):
+            theta = 0.5 * (lo + hi)
+        dt_, rt_, _, _ = _dp5(law, mode, d, r, theta * h, dmax, m, an)
+        g = _event_value(law, mode, slot, dt_, rt_, dmax, m, an)
+        if _crossed(glo, g, direction) or g == 0.0:
+            hi, ghi = theta, g
+            if side == -1:
+                glo *= 0.5
+            side = -1
+        else:
+            lo, glo = theta, g
+            if side == 1:
+                ghi *= 0.5
+            side = 1
+    return hi
+
+
+@njit(cache=True)
+def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale, t_max, capacity):
+    """Integrate the 1-D normal impact to relative tolerance ``rtol``.
+
+    Returns (status, n_points, T, D, R, F, n_events, ET, EC, ED, ER, EF). Points are the accepted steps
+    and the events; F is the total normal force (after limit_force) at each point."""
+    T = np.empty(capacity)
+    D = np.empty(capacity)
+    R = np.empty(capacity)
+    F = np.empty(capacity)
+    ET = np.empty(64)
+    EC = np.empty(64, dtype=np.int64)
+    ED = np.empty(64)
+    ER = np.empty(64)
+    EF = np.empty(64)
+    atol_d, atol_r = rtol * l_scale, rtol * v_scale
+    tol_theta = 1e-15
+    d, r, t = d_init, r_init, 0.0
+    mode = M_PRE if d <= 0.0 else (M_LOAD if law[L_KIND] == 1.0 else M_VE)
+    dmax = max(d, 0.0)
+    force_ended = False
+    n, ne = 0, 0
+    T[0], D[0], R[0], F[0] = t, d, r, normal_force(law, d, r, dmax)
+    n = 1
+    h = 1e-3 * t_scale
+    if mode == M_PRE and r > 0.0:
+        h = min(h, 0.5 * (-d) / r) if d < 0 else h
+        h = max(h, 1e-6 * t_scale)
+    h_min = 1e-14 * t_scale
+    status = ST_NO_SEPARATION
+    for _ in range(10_000_000):
+        if t >= t_max:
+            status = ST_NO_SEPARATION
+            break
+        if n >= capacity - 2 or ne >= 60:
+            status = ST_STEPS
+            break
+        h = min(h, t_max - t)
+        dn, rn, ed, er = _dp5(law, mode, d, r, h, dmax, m, an)
+        err = max(abs(ed) / (atol_d + rtol * max(abs(d), abs(dn))),
+                  abs(er) / (atol_r + rtol * max(abs(r), abs(rn))))
+        if not (err <= 1.0):
+            if not math.isfinite(err):
+                fac = 0.1
+            else:
+                fac = max(0.1, 0.9 * err ** -0.2)
+            h *= fac
+            if h < h_min:
+                status = ST_TOLERANCE
+                break
+            continue
+        # accepted: look for the earliest live event in the step
+        best_theta, best_slot, best_dir = 2.0, -1, 0
+        for slot in range(5):
+            direction = _slot_direction(law, mode, slot)
+            if direction == 0:
+                continue
+            g0 = _event_value(law, mode, slot, d, r, dmax, m, an)
+            g1 = _event_value(law, mode, slot, dn, rn, dmax, m, an)
+            if _crossed(g0, g1, direction):
+                theta = _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
+                if theta < best_theta:
+                    best_theta, best_slot, best_dir = theta, slot, direction
+        if best_slot < 0:
+            t += h
+            d, r = dn, rn
+            if mode == M_LOAD:
+                dmax = max(dmax, d)
+            T[n], D[n], R[n] = t, d, r
+            F[n] = max(_mode_force(law, mode, d, r, dmax), 0.0) if (law[L_LIMIT] != 0.0 or mode != M_VE) \
+                else _mode_force(law, mode, d, r, dmax)
+            n += 1
+            fac = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** -0.2))
+            h *= fac
+            continue
+        # advance exactly to the event
+        he = best_theta * h
+        d, r, _, _ = _dp5(law, mode, d, r, he, dmax, m, an)
+        t += he
+        code = 0
+        terminal = False
+        if best_slot == 0 and best_dir > 0:
+            code = EV_START
+            d = 0.0
+            mode = M_LOAD if law[L_KIND] == 1.0 else M_VE
+            dmax = 0.0
+        elif best_slot == 0:
+            code = EV_END
+            d = 0.0
+            terminal = True
+        elif best_slot == 1 and best_dir < 0:
+            code = EV_FORCE_END
+            if not force_ended:
+                force_ended = True
+            else:
+                code = -EV_FORCE_END  # a later force end, kept but not the first
+            if law[L_KIND] == 1.0 or law[L_LIMIT] != 0.0:
+                mode = M_FREE
+        elif best_slot == 1:
+            code = EV_REENTER
+            mode = M_UNLOAD if law[L_KIND] == 1.0 else M_VE
+        elif best_slot == 2:
+            code = EV_MAX_OVERLAP
+            if mode == M_LOAD:
+                dmax = d
+                mode = M_UNLOAD
+            r = 0.0
+        elif best_slot == 3:
+            code = EV_PEAK
+        elif best_slot == 4:
+            code = EV_RELOAD
+            mode = M_LOAD
+            dmax = d
+        fv = _mode_force(law, mode, d, r, dmax)
+        if mode == M_VE and law[L_LIMIT] != 0.0:
+            fv = max(fv, 0.0)
+        if code == EV_FORCE_END or code == -EV_FORCE_END:
+            fv = 0.0
+        if code == EV_END:
+            fv = 0.0
+        T[n], D[n], R[n], F[n] = t, d, r, fv
+        n += 1
+        ET[ne], EC[ne], ED[ne], ER[ne], EF[ne] = t, code, d, r, fv
+        ne += 1
+        if terminal:
+            status = ST_OK
+            break
+        h = max(h * (1.0 - best_theta), 1e-6 * t_scale) if best_theta < 1.0 else h
+    return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy(), ne, \
+        ET[:ne].copy(), EC[:ne].copy(), ED[:ne].copy(), ER[:ne].copy(), EF[:ne].copy()
+
+
+# ----------------------------------------------------------------------------- velocity Verlet
+
+
+@njit(cache=True)
+def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity):
+    """The engines' scheme (fix nve/sphere) on the 1-D normal problem: v += ½dt a; x += dt v; forces from
+    full-step positions and half-step velocities; v += ½dt a. History (δ_max) is updated with each force
+    evaluation of a step, not at setup; it is forgotten when the overlap ends. Stops at the first step
+    after the contact has ended. Returns (status, n, T, D, R, F); R holds full-step rates."""
+    T = np.empty(capacity)
+    D = np.empty(capacity)
+    R = np.empty(capacity)
+    F = np.empty(capacity)
+    d, r = d_init, r_init
+    dmax = 0.0
+    f = normal_force(law, d, r, max(d, 0.0))  # setup: no history update
+    T[0], D[0], R[0], F[0] = 0.0, d, r, f
+    n = 1
+    touched = d > 0.0
+    status = ST_NO_SEPARATION
+    step = 0
+    while n < capacity:
+        step += 1
+        t = step * dt
+        if t > t_max:
+            status = ST_NO_SEPARATION if touched else ST_NO_CONTACT
+            break
+        r_half = r + 0.5 * dt * (-f / m + an)
+        d = d + dt * r_half
+        if d > 0.0:
+            if d > dmax:
+                dmax = d
+            f = normal_force(law, d, r_half, dmax)
+        else:
+            f = 0.0
+            dmax = 0.0
+        r = r_half + 0.5 * dt * (-f / m + an)
+        if not (math.isfinite(d) and math.isfinite(r)):
+            T[n], D[n], R[n], F[n] = t, d, r, f
+            n += 1
+            status = ST_UNRESOLVED
+            break
+        T[n], D[n], R[n], F[n] = t, d, r, f
+        n += 1
+        if d > 0.0:
+            touched = True
+        elif touched:
+            status = ST_OK
+            break
+    else:
+        status = ST_STEPS
+    return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()

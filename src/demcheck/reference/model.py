@@ -1,0 +1,84 @@
+"""A contact model = one normal model + one tangential model + options, resolved for a pair."""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+
+from ..case import Case
+from ..errors import ConfigError
+from . import normal as _normal
+from . import tangential as _tangential
+from .contact import Pair, pair_of
+
+# keys of [contact] that belong to the pair rather than to a model
+PAIR_KEYS = {"restitution", "friction", "friction_kinetic", "tangential_restitution"}
+
+
+@dataclass(frozen=True)
+class ResolvedModel:
+    normal: _normal.NormalModel
+    tangential: _tangential.TangentialModel
+    pair: Pair
+    normal_law: _normal.NormalLaw
+    tangential_law: _tangential.TangentialLaw
+    params: dict
+    limit_force: bool
+
+    def describe(self) -> dict:
+        return {"normal": self.normal.id, "tangential": self.tangential.id, "limit_force": self.limit_force}
+
+
+def _lookup(registry_lookup, names, slot: str, value: str):
+    try:
+        return registry_lookup(value)
+    except KeyError:
+        near = difflib.get_close_matches(value.lower(), names, n=1, cutoff=0.5)
+        hint = f"; did you mean '{near[0]}'?" if near else ""
+        raise ConfigError(f"contact.{slot}", value,
+                          f"unknown {slot} model{hint} (known: {', '.join(sorted(names))})") from None
+
+
+def models_of(case: Case):
+    normal = _lookup(_normal.lookup, _all_names(_normal.REGISTRY), "normal", case.contact.normal)
+    tangential = _lookup(_tangential.lookup, _all_names(_tangential.REGISTRY), "tangential",
+                         case.contact.tangential)
+    return normal, tangential
+
+
+def _all_names(registry) -> list[str]:
+    names = []
+    for m in registry.values():
+        names.append(m.id)
+        names.extend(a.lower() for a in m.aliases)
+    return names
+
+
+def resolve(case: Case, i: int = 0, j: int | None = 1) -> ResolvedModel:
+    normal, tangential = models_of(case)
+    if len(case.particles) == 1:
+        j = None
+    pair = pair_of(case, i, j)
+    params = case.contact.params
+    normal_law, normal_out = normal.resolve(pair, params, case.contact.limit_force)
+    tangential_law, tangential_out = tangential.resolve(pair, params, normal_law)
+    resolved = {"m_eff": pair.m_eff, "r_eff": pair.r_eff, "e_eff": pair.e_eff, "g_eff": pair.g_eff,
+                "impact_speed": pair.impact_speed, **normal_out, **tangential_out}
+    if pair.restitution is not None:
+        resolved.setdefault("restitution", pair.restitution)
+    return ResolvedModel(normal, tangential, pair, normal_law, tangential_law, resolved,
+                         case.contact.limit_force)
+
+
+def check_contact(case: Case) -> None:
+    """Validate model ids and parameters: unknown keys (with the nearest known one), missing values."""
+    normal, tangential = models_of(case)
+    allowed = PAIR_KEYS | {p.name for p in normal.params} | {p.name for p in tangential.params}
+    for key, value in case.contact.params.items():
+        if key not in allowed:
+            near = difflib.get_close_matches(key, sorted(allowed), n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else ""
+            raise ConfigError(f"contact.{key}", value,
+                              f"is not a parameter of normal '{normal.id}' or tangential '{tangential.id}'{hint}")
+    if case.kind == "collision":
+        resolve(case)

@@ -1,0 +1,307 @@
+"""Normal contact models (seed 000 §3, seed 001), as a registry.
+
+Each model turns a pair's effective properties and the case's ``[contact]`` parameters into a
+:class:`NormalLaw`: plain numbers that the compiled kernels (``kernels.py``) evaluate. Two families
+cover every law of the notes:
+
+* viscoelastic power law   F = k δ^a + η δ^b δ̇        (LSDn a=1 b=0; Hertz η=0; BSHPn, KKn b=½; TTIn b=¼)
+* hysteretic linear spring F = min(K_L δ, K_U (δ − δ₀)) ≥ 0, δ₀ = δ_max (1 − K_L/K_U)
+
+``limit_force`` (the "collision time reduction") clips the total F at 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ConfigError
+from . import analytic
+from .contact import Pair
+
+VISCOELASTIC = 0
+HYSTERETIC = 1
+
+
+@dataclass(frozen=True)
+class NormalLaw:
+    kind: int
+    k: float = 0.0
+    a: float = 1.0
+    eta: float = 0.0
+    b: float = 0.0
+    kl: float = 0.0
+    ku: float = 0.0  # > 0: constant unloading stiffness; 0: K_U = K_L + s·F_max
+    s: float = 0.0
+    limit: bool = False
+
+    def array(self) -> np.ndarray:
+        return np.array([self.kind, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s,
+                         1.0 if self.limit else 0.0])
+
+    @property
+    def elastic(self) -> bool:
+        return self.kind == VISCOELASTIC and self.eta == 0.0
+
+    def characteristic_time(self, m: float, v: float) -> float:
+        """The elastic contact time of the law's spring at speed v (for dt = auto and solver scales)."""
+        if self.kind == HYSTERETIC:
+            return analytic.power_law_duration(self.kl, 1.0, m, v)
+        return analytic.power_law_duration(self.k, self.a, m, v)
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    meaning: str
+    default: object = None
+
+
+@dataclass(frozen=True)
+class NormalModel:
+    id: str
+    seed_name: str
+    title: str
+    formula: str
+    source: str
+    params: tuple[Param, ...]
+    resolve: Callable[[Pair, dict, bool], tuple[NormalLaw, dict]] = field(repr=False)
+    aliases: tuple[str, ...] = ()
+    dissipative: bool = True
+    velocity_dependent_restitution: bool = False
+    example: dict = field(default_factory=dict)  # [contact] parameters of a typical use (docs, contract tests)
+
+
+REGISTRY: dict[str, NormalModel] = {}
+
+
+def register(model: NormalModel) -> NormalModel:
+    for key in (model.id, *model.aliases):
+        if key in REGISTRY:
+            raise ValueError(f"normal model id {key!r} registered twice")
+    REGISTRY[model.id] = model
+    return model
+
+
+def lookup(name: str) -> NormalModel:
+    key = name.strip().lower()
+    for m in REGISTRY.values():
+        if key == m.id or key in (a.lower() for a in m.aliases):
+            return m
+    raise KeyError(name)
+
+
+# ----------------------------------------------------------------------------- parameter helpers
+
+
+def _get(params: dict, key: str, *, rule: str, check=None, required_by: str | None = None):
+    v = params.get(key)
+    if v is None:
+        if required_by:
+            raise ConfigError(f"contact.{key}", None, f"missing: required by normal model '{required_by}'")
+        return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ConfigError(f"contact.{key}", v, "must be a finite number")
+    if check is not None and not check(v):
+        raise ConfigError(f"contact.{key}", v, rule)
+    return float(v)
+
+
+def _restitution(pair: Pair, model: str) -> float:
+    if pair.restitution is None:
+        raise ConfigError("materials.*.restitution", None,
+                          f"missing: normal model '{model}' needs a restitution (or contact.eta_n)")
+    return pair.restitution
+
+
+def _reference_velocity(pair: Pair, params: dict, model: str) -> float:
+    v = _get(params, "reference_velocity", rule="must be > 0 (m/s)", check=lambda x: x > 0)
+    if v is None:
+        v = pair.impact_speed
+        if not (v > 0):
+            raise ConfigError("contact.reference_velocity", None,
+                              f"missing: model '{model}' calibrates its stiffness at a reference velocity, "
+                              "and the bodies of this case never meet")
+    return v
+
+
+def _method(params: dict, model: str) -> str:
+    method = params.get("stiffness_method")
+    if method not in analytic.STIFFNESS_METHODS:
+        raise ConfigError("contact.stiffness_method", method,
+                          f"must be one of {', '.join(analytic.STIFFNESS_METHODS)} (or give contact.kn/kl)")
+    return method
+
+
+def _duration_constant(params: dict) -> float:
+    c = params.get("duration_constant", "exact")
+    if c == "exact":
+        return analytic.HERTZ_DURATION_CONSTANT
+    if c == "notes":
+        return analytic.HERTZ_DURATION_CONSTANT_NOTES
+    return _get(params, "duration_constant", rule="must be \"exact\", \"notes\" or a number > 0",
+                check=lambda x: x > 0)
+
+
+def _positive(x):
+    return x > 0
+
+
+def _nonneg(x):
+    return x >= 0
+
+
+# ----------------------------------------------------------------------------- the models
+
+
+def _resolve_lsd(pair: Pair, params: dict, limit: bool):
+    kn = _get(params, "kn", rule="must be > 0 (N/m)", check=_positive)
+    out = {}
+    if kn is None:
+        method = _method(params, "lsd")
+        v = _reference_velocity(pair, params, "lsd")
+        e = _restitution(pair, "lsd") if params.get("eta_n") is None else (pair.restitution or 1.0)
+        kn = analytic.lsd_stiffness(method, pair.m_eff, pair.r_eff, pair.e_eff, v, e, _duration_constant(params))
+        out.update(stiffness_method=method, reference_velocity=v)
+    eta = _get(params, "eta_n", rule="must be >= 0 (N·s/m)", check=_nonneg)
+    if eta is None:
+        eta = analytic.lsd_eta_from_restitution(pair.m_eff, kn, _restitution(pair, "lsd"))
+    elif eta * eta >= 4.0 * pair.m_eff * kn:
+        raise ConfigError("contact.eta_n", eta,
+                          f"must be below the critical damping 2√(m̄Kn) = {2 * math.sqrt(pair.m_eff * kn):.6g}")
+    out.update(kn=kn, eta_n=eta)
+    return NormalLaw(VISCOELASTIC, k=kn, a=1.0, eta=eta, b=0.0, limit=limit), out
+
+
+def _resolve_hertz(pair: Pair, params: dict, limit: bool):
+    k = analytic.hertz_stiffness(pair.r_eff, pair.e_eff)
+    return NormalLaw(VISCOELASTIC, k=k, a=1.5, limit=limit), {"k_hz": k}
+
+
+def _resolve_bshp(pair: Pair, params: dict, limit: bool):
+    k = analytic.hertz_stiffness(pair.r_eff, pair.e_eff)
+    a_bar = _get(params, "dissipative_constant", rule="must be >= 0 (s)", check=_nonneg)
+    if a_bar is None:
+        a_bar = pair.dissipative_constant
+    if a_bar is None:
+        raise ConfigError("materials.*.dissipative_constant", None,
+                          "missing: normal model 'bshp' needs the materials' dissipative constant A (s)")
+    return (NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=k * a_bar, b=0.5, limit=limit),
+            {"k_hz": k, "dissipative_constant": a_bar, "eta_n": k * a_bar})
+
+
+def _resolve_kk(pair: Pair, params: dict, limit: bool):
+    k = analytic.hertz_stiffness(pair.r_eff, pair.e_eff)
+    eta = _get(params, "eta_n", rule="must be >= 0 (N·s/m^1.5)", check=_nonneg)
+    if eta is None:
+        if pair.dissipative_constant is None:
+            raise ConfigError("contact.eta_n", None,
+                              "missing: required by normal model 'kk' (or the materials' dissipative_constant)")
+        eta = k * pair.dissipative_constant
+    return NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=eta, b=0.5, limit=limit), {"k_hz": k, "eta_n": eta}
+
+
+def _resolve_tti(pair: Pair, params: dict, limit: bool):
+    k = analytic.hertz_stiffness(pair.r_eff, pair.e_eff)
+    eta = _get(params, "eta_n", rule="must be >= 0 (N·s/m^1.25)", check=_nonneg)
+    if eta is None:
+        eta = analytic.tti_eta_from_restitution(pair.m_eff, k, _restitution(pair, "tti"))
+    return NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=eta, b=0.25, limit=limit), {"k_hz": k, "eta_n": eta}
+
+
+def _resolve_hls(pair: Pair, params: dict, limit: bool):
+    unloading = params.get("unloading", "constant")
+    if unloading not in ("constant", "variable"):
+        raise ConfigError("contact.unloading", unloading, "must be constant or variable")
+    s = None
+    e = None
+    if unloading == "variable":
+        s = _get(params, "S", rule="must be > 0 (1/m)", check=_positive, required_by="hls")
+    else:
+        e = _restitution(pair, "hls")
+    kl = _get(params, "kl", rule="must be > 0 (N/m)", check=_positive)
+    out = {"unloading": unloading}
+    if kl is None:
+        method = _method(params, "hls")
+        v = _reference_velocity(pair, params, "hls")
+        kl = analytic.hls_stiffness(method, pair.m_eff, pair.r_eff, pair.e_eff, v, e=e, s=s,
+                                    duration_constant=_duration_constant(params))
+        out.update(stiffness_method=method, reference_velocity=v)
+    out["kl"] = kl
+    if s is not None:
+        out["S"] = s
+        law = NormalLaw(HYSTERETIC, kl=kl, ku=0.0, s=s, limit=limit)
+    else:
+        ku = kl / (e * e)
+        out["ku"] = ku
+        law = NormalLaw(HYSTERETIC, kl=kl, ku=ku, limit=limit)
+    return law, out
+
+
+_COMMON = (Param("restitution", "normal coefficient of restitution of the pair (default: the materials')"),)
+
+register(NormalModel(
+    id="lsd", seed_name="LSDn", aliases=("lsdn", "linear", "hooke"),
+    title="Linear spring-dashpot",
+    formula="F = Kn δ + ηn δ̇; ηn = −2 ln ε √(m̄Kn)/√(ln²ε + π²)",
+    source="seed 000 §3.3 'Normal Linear Spring-Dashpot (LSDn)'; seed 001 'Damped Linear Spring'",
+    params=(Param("kn", "spring stiffness Kn (N/m)"),
+            Param("stiffness_method", "calibrate Kn to Hertz: duration | overlap | energy"),
+            Param("reference_velocity", "impact speed of the calibration (m/s; default: the case's)"),
+            Param("duration_constant", "Hertz duration constant of the duration calibration", "exact"),
+            Param("eta_n", "damping ηn (N·s/m; default: from restitution)"), *_COMMON),
+    resolve=_resolve_lsd,
+    example={"stiffness_method": "energy"},
+))
+register(NormalModel(
+    id="hertz", seed_name="Hertz", aliases=("nsdn-elastic",),
+    title="Hertz (elastic)",
+    formula="F = K_HZ δ^{3/2}, K_HZ = (4/3) Ē √R̄",
+    source="seed 000 §3.4 'Nonlinear elastic force'; seed 001 'Hertzian Contact'",
+    params=(), resolve=_resolve_hertz, dissipative=False,
+    example={},
+))
+register(NormalModel(
+    id="bshp", seed_name="BSHPn", aliases=("bshpn",),
+    title="Brilliantov et al. damped Hertz",
+    formula="F = K_HZ δ^{3/2} + K_HZ Ā δ^{1/2} δ̇, Ā = (A₁ + A₂)/2",
+    source="seed 000 §3.4 '1) BSHPn Model'",
+    params=(Param("dissipative_constant", "Ā (s); default: mean of the materials' dissipative_constant"),),
+    resolve=_resolve_bshp, velocity_dependent_restitution=True,
+    example={"dissipative_constant": 1e-7},
+))
+register(NormalModel(
+    id="kk", seed_name="KKn", aliases=("kkn",),
+    title="Kuwabara & Kono damped Hertz",
+    formula="F = K_HZ δ^{3/2} + ηn δ^{1/2} δ̇",
+    source="seed 000 §3.4 '2) KKn Model'",
+    params=(Param("eta_n", "damping ηn (N·s/m^{3/2}); default: K_HZ·Ā from the materials"),),
+    resolve=_resolve_kk, velocity_dependent_restitution=True,
+    example={"eta_n": 20.0},
+))
+register(NormalModel(
+    id="tti", seed_name="TTIn", aliases=("ttin",),
+    title="Tsuji et al. damped Hertz",
+    formula="F = K_HZ δ^{3/2} + ηn δ^{1/4} δ̇; ηn = −2.2664 ln ε √(m̄K_HZ)/√(ln²ε + 10.1354) (Norouzi)",
+    source="seed 000 §3.4 '3) TTIn Model'",
+    params=(Param("eta_n", "damping ηn (N·s/m^{5/4}); default: Norouzi's correlation"), *_COMMON),
+    resolve=_resolve_tti,
+    example={},
+))
+register(NormalModel(
+    id="hls", seed_name="HLS", aliases=("hysteretic",),
+    title="Hysteretic linear spring (elastic–perfectly plastic)",
+    formula="F = min(K_L δ, K_U (δ − δ_res)) ≥ 0; K_U = K_L/ε² (constant) or K_L + S F_max (variable)",
+    source="seed 000 §3.5 'Hysteric Linear Spring (HLS)'",
+    params=(Param("kl", "loading stiffness K_L (N/m)"),
+            Param("stiffness_method", "calibrate K_L to Hertz: duration | overlap | energy"),
+            Param("reference_velocity", "impact speed of the calibration (m/s; default: the case's)"),
+            Param("duration_constant", "Hertz duration constant of the duration calibration", "exact"),
+            Param("unloading", "constant | variable", "constant"),
+            Param("S", "variable unloading: K_U = K_L + S·F_max (1/m)"), *_COMMON),
+    resolve=_resolve_hls,
+    example={"stiffness_method": "overlap"},
+))

@@ -1,0 +1,63 @@
+"""Result: what any source (the reference, LAMMPS, LIGGGHTS) returns for a case.
+
+Tidy pandas tables in SI units plus metadata:
+
+* ``contact``: one row per output time of the contact of interest:
+  t, delta (overlap, > 0 in contact), delta_dot (approach rate of the contact points along the normal),
+  fn (normal force on the pair, + repulsive); 3-D runs add tangential columns.
+* ``particles``: t, id, x, y, z, vx, vy, vz, wx, wy, wz (and fx.. when the source has them).
+* ``events``: exact event points of the adaptive method (t, event, delta, delta_dot, fn), else empty.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import pandas as pd
+
+
+@dataclass
+class Result:
+    source: str  # reference | lammps | liggghts
+    method: str  # adaptive | verlet | engine
+    case_name: str
+    case_hash: str
+    model: dict
+    params: dict
+    contact: pd.DataFrame
+    particles: pd.DataFrame | None = None
+    events: pd.DataFrame | None = None
+    dt: float | None = None
+    rtol: float | None = None
+    wall_time: float = 0.0
+    engine_version: str | None = None
+    status: str = "ok"  # ok | failed | unresolved | tolerance | no-contact | no-separation
+    message: str = ""
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def metrics(self) -> dict:
+        from .comparisons.metrics import compute
+
+        return compute(self)
+
+    def summary(self) -> dict:
+        """JSON-ready: metrics under their DESIGN names, the model, the resolved parameters, method, dt."""
+        return {
+            "source": self.source,
+            "method": self.method,
+            "case": self.case_name,
+            "case_hash": self.case_hash,
+            "model": self.model,
+            "params": self.params,
+            "dt": self.dt,
+            "rtol": self.rtol,
+            "engine_version": self.engine_version,
+            "status": self.status,
+            "message": self.message,
+            "wall_time": self.wall_time,
+            "metrics": self.metrics(),
+        }

@@ -1,0 +1,34 @@
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+settings.register_profile("ci", derandomize=True, deadline=None, max_examples=40,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("dev", deadline=None, max_examples=25)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "dev"))
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ROOT / "cases"
+
+
+def pytest_collection_modifyitems(config, items):
+    """Engine tests run for real where the engine is installed. Under DEMCHECK_REQUIRE_ENGINES=1 a missing
+    engine is a failure, never a skip."""
+    from demcheck.engines import discovery
+
+    require = os.environ.get("DEMCHECK_REQUIRE_ENGINES") == "1"
+    for item in items:
+        marker = item.get_closest_marker("engine")
+        if marker is None:
+            continue
+        name = marker.args[0]
+        if discovery.find(name) is None and not require:
+            item.add_marker(pytest.mark.skip(reason=f"{name} not installed ({discovery.HOW_TO_INSTALL[name]})"))
+
+
+@pytest.fixture
+def glass_pair():
+    return CASES / "glass-pair.toml"

@@ -1,0 +1,42 @@
+"""Small builders shared by the tests."""
+
+from demcheck import case as C
+
+GLASS = """
+name = "t"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 71e9
+poisson_ratio = 0.22
+restitution = {restitution}
+
+[[particles]]
+material = "glass"
+radius = 1.59e-3
+{second}
+[impact]
+speed = {speed}
+
+[contact]
+normal = "{normal}"
+"""
+PAIR = """
+[[particles]]
+material = "glass"
+radius = 1.59e-3
+"""
+WALL = """
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+"""
+
+
+def glass_case(normal="hertz", params=None, *, wall=False, speed=1.0, restitution=0.97, overrides=()):
+    text = GLASS.format(restitution=restitution, second=WALL if wall else PAIR, speed=speed, normal=normal)
+    sets = [f"contact.{k}={_toml(v)}" for k, v in (params or {}).items()]
+    return C.loads(text, sets + list(overrides))
+
+
+def _toml(v):
+    return f'"{v}"' if isinstance(v, str) else repr(v).lower() if isinstance(v, bool) else repr(v)

@@ -1,0 +1,74 @@
+"""The command line, run as a user runs it (a subprocess)."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import CASES, ROOT
+
+
+def demcheck(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "demcheck", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=300)
+
+
+def test_collide_json_has_metrics_model_params_method_and_dt():
+    p = demcheck("collide", CASES / "glass-pair.toml", "--set", "contact.normal=lsd",
+                 "--set", "contact.stiffness_method=energy", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["model"] == {"normal": "lsd", "tangential": "none", "limit_force": False}
+    assert out["method"] == "adaptive" and out["rtol"] == 1e-11
+    assert out["params"]["kn"] == pytest.approx(2.0166e6, rel=1e-4)
+    assert set(out["metrics"]) >= {"restitution", "contact_time", "force_contact_time", "max_overlap",
+                                   "peak_force", "energy_dissipated"}
+    assert out["metrics"]["restitution"] == pytest.approx(0.97, rel=1e-9)
+
+
+def test_collide_verlet_plot_and_csv(tmp_path):
+    png, csv = tmp_path / "f.png", tmp_path / "c.csv"
+    p = demcheck("collide", CASES / "hls-constant-pair.toml", "--method", "verlet", "--dt", "5e-8",
+                 "--plot", png, "--csv", csv, "--json")
+    assert p.returncode == 0, p.stderr
+    assert json.loads(p.stdout)["dt"] == 5e-8
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    header = csv.read_text().splitlines()[0]
+    assert header == "t,delta,delta_dot,fn"
+
+
+def test_models_json_lists_every_model():
+    p = demcheck("models", "--json")
+    assert p.returncode == 0, p.stderr
+    ids = {(m["slot"], m["id"]) for m in json.loads(p.stdout)["models"]}
+    assert {("normal", i) for i in ("lsd", "hertz", "bshp", "kk", "tti", "hls")} <= ids
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["--set", "contact.normal=hertzz"], "contact.normal = 'hertzz': unknown normal model; did you mean 'hertz'?"),
+    (["--set", "materials.glass.restitution=1.2"], "materials.glass.restitution = 1.2: must be in (0, 1]"),
+    (["--dt", "-1"], "--dt = -1.0: must be > 0"),
+])
+def test_bad_input_is_one_line_and_exit_2(args, needle):
+    p = demcheck("collide", CASES / "glass-pair.toml", *args)
+    assert p.returncode == 2
+    assert p.stdout == ""
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], p.stderr
+
+
+def test_missing_case_file_exit_2():
+    p = demcheck("collide", "no/such.toml")
+    assert p.returncode == 2 and "no such case file" in p.stderr
+
+
+def test_verify_writes_reports_atomically(tmp_path):
+    p = demcheck("verify", CASES / "glass-pair.toml", CASES / "hls-variable-wall.toml", "--report", tmp_path, "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["failed"] == 0 and not out["partial"]
+    latest = tmp_path / "latest"
+    assert json.loads((latest / "results.json").read_text())["run_id"] == out["run_id"]
+    assert "glass-pair" in (latest / "report.md").read_text()
+    assert not list(tmp_path.rglob("*.tmp"))
