@@ -37,14 +37,16 @@ def test_restitution_falls_as_impact_speed_rises(model_id, params, v1, ratio):
 @given(e=restitutions, v1=speeds, v2=speeds)
 @settings(max_examples=15)
 def test_restitution_does_not_depend_on_speed(model_id, params, e, v1, v2):
-    """LSD and constant-unloading HLS by construction; TTI because δ^{1/4}δ̇ scales exactly like Hertz."""
+    """LSD and constant-unloading HLS by construction; TTI because δ^{1/4}δ̇ scales exactly like Hertz.
+    Restitution is a ratio of rates whose error the solver bounds relative to the impact rate, so it is
+    held to 1e-9 absolute (a 1e-10 error is 1e-9 relative at ε = 0.1)."""
     r1 = collide(glass_case(model_id, params, speed=v1, restitution=e)).metrics()["restitution"]
     r2 = collide(glass_case(model_id, params, speed=v2, restitution=e)).metrics()["restitution"]
-    assert r1 == pytest.approx(r2, rel=1e-9)
+    assert r1 == pytest.approx(r2, abs=1e-9)
 
 
 @given(e=restitutions, v=speeds)
 @settings(max_examples=15)
 def test_lsd_restitution_is_the_input(e, v):
     assert collide(glass_case("lsd", {"stiffness_method": "energy"}, speed=v, restitution=e)).metrics()[
-        "restitution"] == pytest.approx(e, rel=1e-9)
+        "restitution"] == pytest.approx(e, abs=1e-9)
