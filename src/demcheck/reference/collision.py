@@ -143,6 +143,7 @@ def collide(case: Case, method: str | None = None, dt: float | None = None,
         meta={"solver": "1d-normal", "steps": int(n)},
     )
     result.particles = _particles_1d(case, geo, contact)
+    _add_frame_columns(result, case, geo)
     if method == "verlet" and status_name == "ok":
         _flag_unresolved(result, t_c)
     return result
@@ -179,6 +180,18 @@ def _particles_1d(case: Case, geo: Geometry1D, contact: pd.DataFrame) -> pd.Data
         frames.append(_frame(t, 1, com + np.outer(sep * m0 / mt, geo.n), vcom - np.outer(r * m0 / mt, geo.n),
                              p1.angular_velocity))
     return pd.concat(frames, ignore_index=True)
+
+
+def _add_frame_columns(result: Result, case: Case, geo: Geometry1D) -> None:
+    """The relative centre velocity, the (fixed) normal and body 0's spin, for the tangential metrics."""
+    p = result.particles
+    c = result.contact
+    v0 = p[p["id"] == 0][["vx", "vy", "vz"]].to_numpy()
+    vr = v0 - p[p["id"] == 1][["vx", "vy", "vz"]].to_numpy() if not geo.wall else v0
+    for i, axis in enumerate("xyz"):
+        c[f"vr{axis}"] = vr[:, i]
+        c[f"n{axis}"] = geo.n[i]
+        c[f"w0{axis}"] = case.particles[0].angular_velocity[i]
 
 
 def _frame(t, pid, pos, vel, omega):

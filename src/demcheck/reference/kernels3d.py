@@ -1,0 +1,805 @@
+"""Compiled 3-D two-body contact: kinematics of seed 000 §2, every tangential family, and both methods.
+
+State y (21): x0 v0 ω0 x1 v1 ω1 h, with h the tangential history (ξ, a displacement; for Walton the load L).
+Body 1 is a particle, or a fixed plane wall (its state is then unused). n points from body 0 into body 1
+(into the wall); δ > 0 in contact; the relative velocity at the contact point is v_r = v_c0 − v_c1, its
+normal part δ̇ = v_r·n (> 0 approaching) and its tangential part v_t (the slip velocity). The force on body 0
+is −Fn n + Ft; body 1 takes the opposite force. Torques: τ0 = (a0 n) × Ft, τ1 = (a1 n) × Ft with the torque
+arms a = R − δ/2 (or R, by rule).
+
+Continuous-time history (adaptive method): ξ̇ = v_t − (ξ·ṅ) n keeps ξ in the tangent plane as the normal
+turns (projection and rotation coincide in continuous time). While slipping, ξ̇ = ξ̇_stick − λ w, where λ
+keeps the state on the slip surface ψ = 0; λ < 0 means the contact sticks again. The engines' discrete
+rules (verlet method) are chosen by ``rules``: rotation (none, project, project + rescale), lever arms.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
+                      L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
+                      ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
+                      normal_force, spow, viscoelastic_force)
+from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_G, T_K0, T_KIND, T_KT,
+                         T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
+                         VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
+
+EV_STICK_SLIP, EV_SLIP_STICK, EV_REVERSAL, EV_KINK = 8, 9, 10, 11
+EVENT_NAMES_3D = {EV_STICK_SLIP: "slip_start", EV_SLIP_STICK: "stick_start", EV_REVERSAL: "slip_reversal",
+                  EV_KINK: "viscous_sliding_switch"}
+
+# geometry array
+G_WALL, G_R0, G_R1, G_M0, G_M1, G_I0, G_I1, G_PX, G_NX, G_GX, G_TS = 0, 1, 2, 3, 4, 5, 6, 7, 10, 13, 16
+G_SIZE = 17
+# rules array
+R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION = 0, 1, 2, 3
+ARM_CONTACT, ARM_RADIUS = 0, 1
+ROT_NONE, ROT_PROJECT, ROT_RESCALE = 0, 1, 2
+# aux array: dmax, L*(3), t_ref(3), normal mode, tangential mode (0 stick, 1 slip)
+A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
+A_SIZE = 9
+STICK, SLIP = 0.0, 1.0
+# record columns
+NCOL = 32
+C_T, C_X0, C_V0, C_W0, C_X1, C_V1, C_W1, C_D, C_R, C_FN, C_FT, C_VT, C_N, C_E = 0, 1, 4, 7, 10, 13, 16, 19, 20, 21, 22, 25, 28, 31
+
+
+@njit(cache=True, inline="always")
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True, inline="always")
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit(cache=True, inline="always")
+def _norm(a):
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@njit(cache=True)
+def kinematics(y, geo, rules):
+    """(δ, δ̇, n, ṅ, v_t, slip arms a0s a1s, torque arms a0t a1t)."""
+    r0 = geo[G_R0]
+    x0, v0, w0 = y[0:3], y[3:6], y[6:9]
+    if geo[G_WALL] != 0.0:
+        nw = geo[G_NX:G_NX + 3]
+        n = -nw
+        delta = r0 - _dot(x0 - geo[G_PX:G_PX + 3], nw)
+        ndot = np.zeros(3)
+        a0c = r0 - 0.5 * delta
+        a0s = r0 if rules[R_SLIP_ARM] == ARM_RADIUS else a0c
+        a0t = r0 if rules[R_WALL_TORQUE_ARM] == ARM_RADIUS else a0c
+        vr = v0 + _cross(w0, a0s * n)
+        a1s, a1t = 0.0, 0.0
+    else:
+        r1 = geo[G_R1]
+        x1, v1, w1 = y[9:12], y[12:15], y[15:18]
+        d = x1 - x0
+        dist = _norm(d)
+        n = d / dist
+        delta = r0 + r1 - dist
+        dd = v1 - v0
+        ndot = (dd - _dot(dd, n) * n) / dist
+        if rules[R_SLIP_ARM] == ARM_RADIUS:
+            a0s, a1s = r0, r1
+        else:
+            a0s, a1s = r0 - 0.5 * delta, r1 - 0.5 * delta
+        if rules[R_TORQUE_ARM] == ARM_RADIUS:
+            a0t, a1t = r0, r1
+        else:
+            a0t, a1t = r0 - 0.5 * delta, r1 - 0.5 * delta
+        vr = (v0 + _cross(w0, a0s * n)) - (v1 + _cross(w1, -a1s * n))
+    rate = _dot(vr, n)
+    vt = vr - rate * n
+    return delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t
+
+
+# ----------------------------------------------------------------------------- tangential laws
+
+
+@njit(cache=True, inline="always")
+def kt_of(tl, delta):
+    if tl[T_KT_SQRT] != 0.0:
+        return tl[T_KT] * math.sqrt(tl[T_R] * max(delta, 0.0))
+    return tl[T_KT]
+
+
+@njit(cache=True, inline="always")
+def eta_of(tl, nl, delta):
+    if tl[T_ETA_NORMAL] != 0.0:
+        if nl[L_KIND] == 1.0:
+            return 0.0
+        return tl[T_ETA] * nl[L_ETA] * spow(max(delta, 0.0), nl[L_B])
+    return tl[T_ETA]
+
+
+@njit(cache=True)
+def _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, mu):
+    xm = tl[T_XI] * max(delta, 0.0)
+    hn = _norm(h)
+    f = np.zeros(3)
+    if xm <= 0.0 or mu * fn_abs <= 0.0:
+        return f
+    u = min(hn, xm) / xm
+    root = math.sqrt(max(1.0 - u, 0.0))
+    if hn > 0.0:
+        f = -(mu * fn_abs * (1.0 - (1.0 - u) ** 1.5) / hn) * h
+    if kind == LTH:
+        f = f - tl[T_ETA] * math.sqrt(6.0 * tl[T_M] * mu * fn_abs * root / xm) * vt
+    else:
+        c = tl[T_ETA1] / (2.0 * tl[T_G] * xm)
+        f = f - c * (1.0 - 0.4 * c * _norm(vt)) * (1.5 * mu * fn_abs * root) * vt
+    fm = _norm(f)
+    cap = mu * fn_abs
+    if fm > cap:
+        f = f * (cap / fm)
+    return f
+
+
+@njit(cache=True)
+def slip_surface(tl, nl, h, vt, fn_abs, delta, mu):
+    """(ψ, w, D): the slip function of the history laws (ψ ≤ 0 sticks), the direction w in history space
+    along which a slip reduces ψ, and D = ∇_hψ·w."""
+    kind = tl[T_KIND]
+    hn = _norm(h)
+    w = h / hn if hn > 0.0 else np.zeros(3)
+    cap = mu * fn_abs
+    if kind == SPRING:
+        kt = kt_of(tl, delta)
+        eta = eta_of(tl, nl, delta)
+        if tl[T_TRUNC] == TRUNC_SPRING:
+            return kt * hn - cap, w, kt
+        s = kt * h + eta * vt
+        sn = _norm(s)
+        return sn - cap, (s / sn if sn > 0.0 else w), kt
+    if kind == LTH or kind == ZZY:
+        return hn - tl[T_XI] * max(delta, 0.0), w, 1.0
+    if kind == WALTON:
+        return hn - cap, w, 1.0
+    return -1.0, w, 1.0
+
+
+@njit(cache=True)
+def return_map(tl, nl, h, vt, fn_abs, delta, mu):
+    """The history on the slip surface of friction coefficient mu (Coulomb truncation)."""
+    kind = tl[T_KIND]
+    hn = _norm(h)
+    cap = mu * fn_abs
+    if kind == SPRING:
+        kt = kt_of(tl, delta)
+        if kt <= 0.0:
+            return np.zeros(3)
+        eta = eta_of(tl, nl, delta)
+        trunc = tl[T_TRUNC]
+        if trunc == TRUNC_CAP:  # the force is capped, the spring keeps its extension
+            return h
+        if trunc == TRUNC_MAW:  # spring + dashpot = μ|Fn| along the trial force
+            s = -kt * h - eta * vt
+            sn = _norm(s)
+            f = s * (cap / sn) if sn > 0.0 else np.zeros(3)
+            return -(f + eta * vt) / kt
+        return h * (cap / (kt * hn)) if hn > 0.0 else h
+    if hn == 0.0:
+        return h
+    if kind == LTH or kind == ZZY:
+        return h * (tl[T_XI] * max(delta, 0.0) / hn)
+    return h * (cap / hn)  # WALTON
+
+
+@njit(cache=True)
+def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
+    """Force on body 0 of the tangential law, in its stick or slip state (SLIDING's stick force is the
+    constraint force, computed by the caller)."""
+    kind = tl[T_KIND]
+    if kind == NONE:
+        return np.zeros(3)
+    mu = tl[T_MU_K] if slipping else tl[T_MU_S]
+    vn = _norm(vt)
+    if kind == VISCOUS:
+        return -tl[T_ETA] * vt
+    if kind == VISCOUS_SLIDING:
+        if vn == 0.0:
+            return np.zeros(3)
+        return -(min(tl[T_ETA] * vn, tl[T_MU_K] * fn_abs) / vn) * vt
+    if kind == SLIDING:
+        if vn > 0.0:
+            return -(tl[T_MU_K] * fn_abs / vn) * vt
+        return -(tl[T_MU_K] * fn_abs) * tref
+    if kind == WALTON:
+        return -h
+    if kind == LTH or kind == ZZY:
+        return _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, tl[T_MU_K])
+    # SPRING
+    kt = kt_of(tl, delta)
+    eta = eta_of(tl, nl, delta)
+    trial = -kt * h - eta * vt
+    if not slipping:
+        return trial
+    trunc = tl[T_TRUNC]
+    cap = mu * fn_abs
+    if trunc != TRUNC_SPRING:
+        tn = _norm(trial)
+        return trial * (cap / tn) if tn > 0.0 else trial
+    hn = _norm(h)
+    return -(cap / hn) * h if hn > 0.0 else np.zeros(3)
+
+
+@njit(cache=True)
+def walton_stiffness(tl, h, vt, fn_abs, lstar):
+    """Kt = K0 (1 − (T − T*)/(μ|Fn| − T*))^{1/3} with T, T* the load and the load at the last reversal,
+    both measured along the current slip direction (docs/models.md: the 3-D definition)."""
+    vn = _norm(vt)
+    if vn == 0.0:
+        return 0.0
+    t = vt / vn
+    tt, ts = _dot(h, t), _dot(lstar, t)
+    den = tl[T_MU_K] * fn_abs - ts
+    if den <= 0.0:
+        return 0.0
+    x = 1.0 - (tt - ts) / den
+    if x <= 0.0:
+        return 0.0
+    return tl[T_K0] * x ** (1.0 / 3.0)
+
+
+# ----------------------------------------------------------------------------- the continuous system
+
+
+@njit(cache=True)
+def _normal_mode_force(nl, nmode, delta, rate, dmax):
+    if nmode == M_VE:
+        return viscoelastic_force(nl, delta, rate)
+    if nmode == M_LOAD:
+        return nl[L_KL] * delta
+    if nmode == M_UNLOAD:
+        ku, d0 = hls_unloading(nl, dmax)
+        return ku * (delta - d0)
+    return 0.0
+
+
+@njit(cache=True)
+def _accelerations(y, geo, fvec0, tau0, tau1, dy):
+    g = geo[G_GX:G_GX + 3]
+    dy[0:3] = y[3:6]
+    dy[3:6] = fvec0 / geo[G_M0] + g
+    dy[6:9] = tau0 / geo[G_I0]
+    if geo[G_WALL] == 0.0:
+        dy[9:12] = y[12:15]
+        dy[12:15] = -fvec0 / geo[G_M1] + g
+        dy[15:18] = tau1 / geo[G_I1]
+    else:
+        dy[9:18] = 0.0
+
+
+@njit(cache=True)
+def _psi_at(y, aux, nl, tl, geo, rules, mu):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    psi, w, d = slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, mu)
+    return psi
+
+
+@njit(cache=True)
+def _fn_at(y, aux, nl, geo, rules):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    return _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+
+
+@njit(cache=True)
+def _vt_at(y, geo, rules):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    return vt
+
+
+@njit(cache=True)
+def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
+    """Tangential part of dv_t/dt with no tangential force (the normal force and gravity act along n for a
+    pair; a wall sees gravity's tangential part): b in v̇_t = A F_t + b."""
+    vr_n = rate
+    adot0 = 0.0 if rules[R_SLIP_ARM] == ARM_RADIUS else -0.5 * rate
+    acc = _cross(y[6:9], adot0 * n + a0s * ndot)
+    if geo[G_WALL] != 0.0:
+        acc = acc + geo[G_GX:G_GX + 3]
+    else:
+        acc = acc + _cross(y[15:18], adot0 * n + a1s * ndot)
+    b = acc - _dot(acc, n) * n - vr_n * ndot
+    return b
+
+
+@njit(cache=True)
+def rhs(y, aux, nl, tl, geo, rules, dy):
+    """dy ← f(y). Returns (λ, Fn, |F_req| − μs|Fn| for SLIDING in stick, the tangential force (3))."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    nmode = aux[A_NMODE]
+    contact = nmode != M_PRE
+    fn = _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
+    if contact and nl[L_LIMIT] != 0.0 and nmode == M_VE and fn < 0.0:
+        fn = 0.0
+    fabs = abs(fn)
+    kind = tl[T_KIND]
+    slipping = aux[A_TMODE] == SLIP
+    h = y[18:21]
+    ft = np.zeros(3)
+    req_margin = -1.0
+    lam = 0.0
+    ts = geo[G_TS]
+    if contact and kind != NONE:
+        if kind == SLIDING and not slipping:
+            # constraint force keeping v_t = 0: v̇_t = A F + b
+            amob = 1.0 / geo[G_M0] + a0t * a0s / geo[G_I0]
+            if geo[G_WALL] == 0.0:
+                amob += 1.0 / geo[G_M1] + a1t * a1s / geo[G_I1]
+            b = _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s)
+            ft = -b / amob
+            req_margin = _norm(ft) - tl[T_MU_S] * fabs
+        else:
+            ft = tangential_force(tl, nl, h, vt, fabs, delta, slipping, aux[A_TREF:A_TREF + 3])
+    fvec0 = -fn * n + ft
+    tau0 = _cross(a0t * n, ft)
+    tau1 = _cross(a1t * n, ft)
+    _accelerations(y, geo, fvec0, tau0, tau1, dy)
+    dy[18:21] = 0.0
+    if contact and (kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON):
+        rot = _dot(h, ndot) * n
+        if kind == WALTON:
+            dy[18:21] = walton_stiffness(tl, h, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+        else:
+            dy[18:21] = vt - rot
+        if slipping and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            mu = tl[T_MU_K]
+            psi, w, dpsi = slip_surface(tl, nl, h, vt, fabs, delta, mu)
+            s = 1e-7 * ts
+            psid = (_psi_at(y + s * dy, aux, nl, tl, geo, rules, mu)
+                    - _psi_at(y - s * dy, aux, nl, tl, geo, rules, mu)) / (2.0 * s)
+            lam = psid / dpsi if dpsi > 0.0 else 0.0
+            dy[18:21] = dy[18:21] - lam * w
+    return lam, fn, req_margin, ft
+
+
+@njit(cache=True)
+def _dp5_3(y, aux, nl, tl, geo, rules, h):
+    n = y.shape[0]
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    rhs(y, aux, nl, tl, geo, rules, k1)
+    rhs(y + h * (k1 / 5), aux, nl, tl, geo, rules, k2)
+    rhs(y + h * (3 / 40 * k1 + 9 / 40 * k2), aux, nl, tl, geo, rules, k3)
+    rhs(y + h * (44 / 45 * k1 - 56 / 15 * k2 + 32 / 9 * k3), aux, nl, tl, geo, rules, k4)
+    rhs(y + h * (19372 / 6561 * k1 - 25360 / 2187 * k2 + 64448 / 6561 * k3 - 212 / 729 * k4),
+        aux, nl, tl, geo, rules, k5)
+    rhs(y + h * (9017 / 3168 * k1 - 355 / 33 * k2 + 46732 / 5247 * k3 + 49 / 176 * k4 - 5103 / 18656 * k5),
+        aux, nl, tl, geo, rules, k6)
+    yn = y + h * (35 / 384 * k1 + 500 / 1113 * k3 + 125 / 192 * k4 - 2187 / 6784 * k5 + 11 / 84 * k6)
+    rhs(yn, aux, nl, tl, geo, rules, k7)
+    err = h * (71 / 57600 * k1 - 71 / 16695 * k3 + 71 / 1920 * k4 - 17253 / 339200 * k5 + 22 / 525 * k6
+               - 1 / 40 * k7)
+    return yn, err
+
+
+NSLOT = 8
+
+
+@njit(cache=True)
+def _slot_direction(nl, tl, aux, slot):
+    nmode = aux[A_NMODE]
+    kind = tl[T_KIND]
+    slipping = aux[A_TMODE] == SLIP
+    in_contact = nmode != M_PRE
+    if slot == 0:
+        return 1 if nmode == M_PRE else -1
+    if not in_contact:
+        return 0
+    if slot == 1:
+        if nmode == M_VE or nmode == M_UNLOAD:
+            return -1
+        if nmode == M_FREE:
+            return 1
+        return 0
+    if slot == 2:
+        return -1 if (nmode == M_VE or nmode == M_LOAD) else 0
+    if slot == 3:
+        return -1 if (nmode == M_VE and nl[L_ETA] != 0.0) else 0
+    if slot == 4:
+        return 1 if nmode == M_UNLOAD else 0
+    history = kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON
+    if slot == 5:
+        return 1 if ((history or kind == SLIDING) and not slipping) else 0
+    if slot == 6:
+        return -1 if ((history or kind == SLIDING) and slipping) else 0
+    if slot == 7:
+        return 2 if (kind == WALTON or kind == VISCOUS_SLIDING) else 0
+    return 0
+
+
+@njit(cache=True)
+def _event_value(y, aux, nl, tl, geo, rules, slot):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    nmode = aux[A_NMODE]
+    if slot == 0:
+        return delta
+    if slot == 1:
+        if nmode == M_FREE:
+            if nl[L_KIND] == 1.0:
+                return _normal_mode_force(nl, M_UNLOAD, delta, rate, aux[A_DMAX])
+            return viscoelastic_force(nl, delta, rate)
+        return _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX])
+    if slot == 2:
+        return rate
+    if slot == 4:
+        return delta - aux[A_DMAX]
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    if slot == 3:
+        s = 1e-7 * geo[G_TS]
+        return (_fn_at(y + s * dy, aux, nl, geo, rules) - _fn_at(y - s * dy, aux, nl, geo, rules)) / (2 * s)
+    kind = tl[T_KIND]
+    if slot == 5:
+        if kind == SLIDING:
+            return req
+        psi, w, d = slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_S])
+        return psi
+    if slot == 6:
+        if kind == SLIDING:
+            return _dot(vt, aux[A_TREF:A_TREF + 3])
+        if kind == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
+            return slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_K])[0]
+        return lam
+    if slot == 7:
+        if kind == WALTON:
+            return _dot(vt, y[18:21])
+        return tl[T_ETA] * _norm(vt) - tl[T_MU_K] * abs(fn)
+    return 1.0
+
+
+@njit(cache=True)
+def _crossed(g0, g1, direction):
+    if direction == 2:
+        return (g0 > 0.0 and g1 <= 0.0) or (g0 < 0.0 and g1 >= 0.0)
+    if direction < 0:
+        return g0 > 0.0 and g1 <= 0.0
+    return g0 < 0.0 and g1 >= 0.0
+
+
+@njit(cache=True)
+def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
+    lo, hi, glo, ghi = 0.0, 1.0, g0, g1
+    side = 0
+    for _ in range(200):
+        if hi - lo <= 1e-15:
+            break
+        theta = lo - glo * (hi - lo) / (ghi - glo) if ghi != glo else 0.5 * (lo + hi)
+        if not (lo < theta < hi) or not math.isfinite(theta):
+            theta = 0.5 * (lo + hi)
+        yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
+        g = _event_value(yt, aux, nl, tl, geo, rules, slot)
+        if _crossed(glo, g, direction) or g == 0.0:
+            hi, ghi = theta, g
+            if side == -1:
+                glo *= 0.5
+            side = -1
+        else:
+            lo, glo = theta, g
+            if side == 1:
+                ghi *= 0.5
+            side = 1
+    return hi
+
+
+@njit(cache=True)
+def energy(y, geo):
+    """Kinetic (translation + rotation) plus gravitational potential energy of the bodies."""
+    g = geo[G_GX:G_GX + 3]
+    e = 0.5 * geo[G_M0] * _dot(y[3:6], y[3:6]) + 0.5 * geo[G_I0] * _dot(y[6:9], y[6:9]) - geo[G_M0] * _dot(g, y[0:3])
+    if geo[G_WALL] == 0.0:
+        e += 0.5 * geo[G_M1] * _dot(y[12:15], y[12:15]) + 0.5 * geo[G_I1] * _dot(y[15:18], y[15:18]) \
+            - geo[G_M1] * _dot(g, y[9:12])
+    return e
+
+
+@njit(cache=True)
+def _record(rec, i, t, y, aux, nl, tl, geo, rules):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    rec[i, C_T] = t
+    rec[i, C_X0:C_X0 + 18] = y[0:18]
+    rec[i, C_D] = delta
+    rec[i, C_R] = rate
+    rec[i, C_FN] = fn
+    rec[i, C_FT:C_FT + 3] = ft
+    rec[i, C_VT:C_VT + 3] = vt
+    rec[i, C_N:C_N + 3] = n
+    rec[i, C_E] = energy(y, geo)
+
+
+@njit(cache=True)
+def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
+    """Integrate to relative tolerance ``rtol`` with event location (contact start/end, force end, maximum
+    overlap, peak force, loading/unloading, stick→slip, slip→stick, slip reversal). ``scales`` (21) are the
+    absolute scales of the state components. Returns (status, n, rec, ne, ev_t, ev_code)."""
+    rec = np.empty((capacity, NCOL))
+    ev_t = np.empty(256)
+    ev_c = np.empty(256, dtype=np.int64)
+    aux = np.zeros(A_SIZE)
+    y = y0.copy()
+    delta0 = kinematics(y, geo, rules)[0]
+    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_KIND] == 1.0 else M_VE)
+    t = 0.0
+    _record(rec, 0, t, y, aux, nl, tl, geo, rules)
+    n, ne = 1, 0
+    ts = geo[G_TS]
+    hstep = 1e-3 * ts
+    status = ST_NO_SEPARATION
+    force_ended = False
+    for _ in range(10_000_000):
+        if t >= t_max:
+            break
+        if n >= capacity - 2 or ne >= 250:
+            status = ST_STEPS
+            break
+        hstep = min(hstep, t_max - t)
+        yn, err = _dp5_3(y, aux, nl, tl, geo, rules, hstep)
+        emax = 0.0
+        for i in range(21):  # absolute, physical scales: positions are ~10³ times the overlap
+            sc = scales[i] * rtol
+            if sc > 0.0:
+                emax = max(emax, abs(err[i]) / sc)
+        if not (emax <= 1.0):
+            hstep *= 0.1 if not math.isfinite(emax) else max(0.1, 0.9 * emax ** -0.2)
+            if hstep < 1e-14 * ts:
+                status = ST_TOLERANCE
+                break
+            continue
+        best_theta, best_slot, best_dir = 2.0, -1, 0
+        for slot in range(NSLOT):
+            direction = _slot_direction(nl, tl, aux, slot)
+            if direction == 0:
+                continue
+            g0 = _event_value(y, aux, nl, tl, geo, rules, slot)
+            g1 = _event_value(yn, aux, nl, tl, geo, rules, slot)
+            if _crossed(g0, g1, direction):
+                theta = _locate(y, aux, nl, tl, geo, rules, hstep, slot, direction, g0, g1)
+                if theta < best_theta:
+                    best_theta, best_slot, best_dir = theta, slot, direction
+        if best_slot < 0:
+            t += hstep
+            y = yn
+            if aux[A_NMODE] == M_LOAD:
+                aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
+            if tl[T_KIND] == SLIDING and aux[A_TMODE] == SLIP:
+                vt = kinematics(y, geo, rules)[4]
+                vn = _norm(vt)
+                if vn > 0.0:
+                    aux[A_TREF:A_TREF + 3] = vt / vn
+            _record(rec, n, t, y, aux, nl, tl, geo, rules)
+            n += 1
+            hstep *= 5.0 if emax == 0.0 else min(5.0, max(0.2, 0.9 * emax ** -0.2))
+            continue
+        he = best_theta * hstep
+        y, _ = _dp5_3(y, aux, nl, tl, geo, rules, he)
+        t += he
+        delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+        code = 0
+        terminal = False
+        kind = tl[T_KIND]
+        if best_slot == 0 and best_dir > 0:
+            code = EV_START
+            aux[A_NMODE] = M_LOAD if nl[L_KIND] == 1.0 else M_VE
+            aux[A_DMAX] = 0.0
+            y[18:21] = 0.0
+            aux[A_LSTAR:A_LSTAR + 3] = 0.0
+            aux[A_TMODE] = STICK
+            vn = _norm(vt)
+            if kind == SLIDING and vn > 0.0:
+                aux[A_TMODE] = SLIP
+                aux[A_TREF:A_TREF + 3] = vt / vn
+            elif kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
+                fn0 = _normal_mode_force(nl, aux[A_NMODE], delta, rate, 0.0)
+                if slip_surface(tl, nl, y[18:21], vt, abs(fn0), delta, tl[T_MU_S])[0] > 0.0:
+                    aux[A_TMODE] = SLIP  # already past the threshold as the contact begins
+                    y[18:21] = return_map(tl, nl, y[18:21], vt, abs(fn0), delta, tl[T_MU_K])
+        elif best_slot == 0:
+            code = EV_END
+            terminal = True
+        elif best_slot == 1 and best_dir < 0:
+            code = EV_FORCE_END if not force_ended else -EV_FORCE_END
+            force_ended = True
+            if nl[L_KIND] == 1.0 or nl[L_LIMIT] != 0.0:
+                aux[A_NMODE] = M_FREE
+        elif best_slot == 1:
+            code = EV_REENTER
+            aux[A_NMODE] = M_UNLOAD if nl[L_KIND] == 1.0 else M_VE
+        elif best_slot == 2:
+            code = EV_MAX_OVERLAP
+            if aux[A_NMODE] == M_LOAD:
+                aux[A_DMAX] = delta
+                aux[A_NMODE] = M_UNLOAD
+        elif best_slot == 3:
+            code = EV_PEAK
+        elif best_slot == 4:
+            code = EV_RELOAD
+            aux[A_NMODE] = M_LOAD
+            aux[A_DMAX] = delta
+        elif best_slot == 5:
+            code = EV_STICK_SLIP
+            dy = np.empty(21)
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            aux[A_TMODE] = SLIP
+            if kind == SLIDING:
+                fnorm = _norm(ft)
+                if fnorm > 0.0:
+                    aux[A_TREF:A_TREF + 3] = -ft / fnorm
+            else:
+                y[18:21] = return_map(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_K])
+        elif best_slot == 6:
+            code = EV_SLIP_STICK
+            aux[A_TMODE] = STICK
+        elif best_slot == 7:
+            if kind == WALTON:
+                code = EV_REVERSAL
+                aux[A_LSTAR:A_LSTAR + 3] = y[18:21]
+            else:
+                code = EV_KINK
+        _record(rec, n, t, y, aux, nl, tl, geo, rules)
+        if code == EV_END:
+            rec[n, C_FN] = 0.0
+            rec[n, C_FT:C_FT + 3] = 0.0
+        n += 1
+        ev_t[ne], ev_c[ne] = t, code
+        ne += 1
+        if terminal:
+            status = ST_OK
+            break
+        hstep = max(hstep * (1.0 - best_theta), 1e-6 * ts) if best_theta < 1.0 else hstep
+    return status, n, rec[:n].copy(), ne, ev_t[:ne].copy(), ev_c[:ne].copy()
+
+
+# ----------------------------------------------------------------------------- velocity Verlet (engines)
+
+
+@njit(cache=True)
+def _rotate_history(h, n, mode):
+    if mode == ROT_NONE:
+        return h
+    old = _norm(h)
+    hp = h - _dot(h, n) * n
+    if mode == ROT_RESCALE:
+        new = _norm(hp)
+        if new > 0.0:
+            hp = hp * (old / new)
+    return hp
+
+
+@njit(cache=True)
+def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
+    """The engines' scheme (fix nve/sphere, I = 0.4 m R²): half kick, drift, forces from full-step positions
+    and half-step velocities with the history updated once per step (not at setup), half kick. History
+    rules: rotation of ξ into the new tangent plane (none, project after the increment as LIGGGHTS, or
+    project and rescale before it as LAMMPS), then ξ += v_t dt, then the law's Coulomb truncation.
+    Stops at the first step after the contact has ended."""
+    rec = np.empty((capacity, NCOL))
+    y = y0.copy()
+    aux = np.zeros(A_SIZE)
+    aux[A_NMODE] = M_VE
+    hist = np.zeros(3)
+    lstar = np.zeros(3)
+    prev_vl = 0.0
+    dmax = 0.0
+    sliding = False
+    kind = tl[T_KIND]
+    wall = geo[G_WALL] != 0.0
+    touched = False
+    status = ST_NO_SEPARATION
+
+    fvec0 = np.zeros(3)
+    tau0 = np.zeros(3)
+    tau1 = np.zeros(3)
+    # setup: forces of the initial state, no history update
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = 0.0
+    if delta > 0.0:
+        fn = normal_force(nl, delta, rate, delta)
+        fvec0 = -fn * n
+    rec[0, C_T] = 0.0
+    rec[0, C_X0:C_X0 + 18] = y[0:18]
+    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, fn
+    rec[0, C_FT:C_FT + 3] = 0.0
+    rec[0, C_VT:C_VT + 3] = vt
+    rec[0, C_N:C_N + 3] = n
+    rec[0, C_E] = energy(y, geo)
+    g = geo[G_GX:G_GX + 3]
+    i = 1
+    step = 0
+    while i < capacity:
+        step += 1
+        t = step * dt
+        if t > t_max:
+            status = ST_NO_SEPARATION if touched else ST_NO_CONTACT
+            break
+        # initial_integrate
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        y[0:3] += dt * y[3:6]
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            y[9:12] += dt * y[12:15]
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+        # forces
+        delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+        ft = np.zeros(3)
+        fn = 0.0
+        if delta > 0.0:
+            if delta > dmax:
+                dmax = delta
+            fn = normal_force(nl, delta, rate, dmax)
+            fabs = abs(fn)
+            if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
+                if rules[R_ROTATION] == ROT_RESCALE:
+                    hist = _rotate_history(hist, n, ROT_RESCALE)
+                if kind == WALTON:
+                    vl = _dot(vt, hist)
+                    if (vl < 0.0 and prev_vl > 0.0) or (vl > 0.0 and prev_vl < 0.0):
+                        lstar = hist.copy()
+                    if vl != 0.0:
+                        prev_vl = vl
+                    hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
+                else:
+                    hist = hist + vt * dt
+                if rules[R_ROTATION] == ROT_PROJECT:
+                    hist = _rotate_history(hist, n, ROT_PROJECT)
+                mu = tl[T_MU_K] if sliding else tl[T_MU_S]
+                psi, w, d = slip_surface(tl, nl, hist, vt, fabs, delta, mu)
+                if psi > 0.0:
+                    sliding = True
+                    hist = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+                else:
+                    sliding = False
+                ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
+            elif kind != NONE:
+                ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, aux[A_TREF:A_TREF + 3])
+        else:
+            hist[:] = 0.0
+            lstar[:] = 0.0
+            prev_vl = 0.0
+            dmax = 0.0
+            sliding = False
+        fvec0 = -fn * n + ft
+        tau0 = _cross(a0t * n, ft)
+        tau1 = _cross(a1t * n, ft)
+        # final_integrate
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+        rec[i, C_T] = t
+        rec[i, C_X0:C_X0 + 18] = y[0:18]
+        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
+        rec[i, C_FT:C_FT + 3] = ft
+        rec[i, C_VT:C_VT + 3] = vt
+        rec[i, C_N:C_N + 3] = n
+        rec[i, C_E] = energy(y, geo)
+        i += 1
+        if not np.all(np.isfinite(y[0:18])):
+            status = ST_UNRESOLVED
+            break
+        if delta > 0.0:
+            touched = True
+        elif touched:
+            status = ST_OK
+            break
+    else:
+        status = ST_STEPS
+    return status, i, rec[:i].copy()
