@@ -120,6 +120,8 @@ def _event_value(law, mode, slot, d, r, dmax, m, an):
         return d
     if slot == 1:  # the force of the law, unclipped (VE), or of the unloading branch (HLS)
         if mode == M_FREE:
+            if d <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
+                return -1.0
             if law[L_KIND] == 1.0:
                 return _mode_force(law, M_UNLOAD, d, r, dmax)
             return viscoelastic_force(law, d, r)

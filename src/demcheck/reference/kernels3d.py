@@ -431,6 +431,8 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
         return delta
     if slot == 1:
         if nmode == M_FREE:
+            if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
+                return -1.0
             if nl[L_KIND] == 1.0:
                 return _normal_mode_force(nl, M_UNLOAD, delta, rate, aux[A_DMAX])
             return viscoelastic_force(nl, delta, rate)
