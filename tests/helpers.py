@@ -40,3 +40,18 @@ def glass_case(normal="hertz", params=None, *, wall=False, speed=1.0, restitutio
 
 def _toml(v):
     return f'"{v}"' if isinstance(v, str) else repr(v).lower() if isinstance(v, bool) else repr(v)
+
+
+def oblique_case(tangential, params=None, *, normal="lsd", normal_params=None, wall=True, speed=1.0, angle=45.0,
+                 spin=0.0, restitution=0.9, friction=0.3, overrides=()):
+    """An oblique impact of a glass sphere on a rigid wall (or a pair) with a tangential law."""
+    from demcheck.reference import normal as _normal, tangential as _tangential
+
+    nparams = dict(_normal.REGISTRY[normal].example if normal_params is None else normal_params)
+    tparams = dict(_tangential.REGISTRY[tangential].example if params is None else params)
+    tparams.pop("friction", None)
+    text = GLASS.format(restitution=restitution, second=WALL if wall else PAIR, speed=speed, normal=normal)
+    text = text.replace("[impact]", f"[impact]\nangle = {angle}\nspin = {spin}")
+    text = text.replace("restitution = ", f"friction = {friction}\nrestitution = ", 1)
+    sets = [f"contact.{k}={_toml(v)}" for k, v in {**nparams, **tparams}.items()]
+    return C.loads(text, sets + [f"contact.tangential={tangential}"] + list(overrides))

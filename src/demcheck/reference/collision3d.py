@@ -127,7 +127,7 @@ def tables(rec: np.ndarray, wall: bool) -> tuple[pd.DataFrame, pd.DataFrame]:
         "nx": rec[:, k3.C_N], "ny": rec[:, k3.C_N + 1], "nz": rec[:, k3.C_N + 2],
         "vrx": vr[:, 0], "vry": vr[:, 1], "vrz": vr[:, 2],
         "w0x": rec[:, k3.C_W0], "w0y": rec[:, k3.C_W0 + 1], "w0z": rec[:, k3.C_W0 + 2],
-        "energy": rec[:, k3.C_E],
+        "energy": rec[:, k3.C_E], "slipping": rec[:, k3.C_SLIP].astype(bool),
     })
     frames = []
     for pid, (cx, cv, cw) in enumerate([(k3.C_X0, k3.C_V0, k3.C_W0), (k3.C_X1, k3.C_V1, k3.C_W1)]):

@@ -327,6 +327,11 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
         n += 1
         ET[ne], EC[ne], ED[ne], ER[ne], EF[ne] = t, code, d, r, fv
         ne += 1
+        if not terminal and code != EV_START and mode != M_PRE and d <= 0.0 and r < 0.0:
+            # a simultaneous root (elastic Hertz: force and overlap vanish together) landed past δ = 0
+            ET[ne], EC[ne], ED[ne], ER[ne], EF[ne] = t, EV_END, d, r, 0.0
+            ne += 1
+            terminal = True
         if terminal:
             status = ST_OK
             break

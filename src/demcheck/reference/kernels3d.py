@@ -44,8 +44,9 @@ A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
 A_SIZE = 9
 STICK, SLIP = 0.0, 1.0
 # record columns
-NCOL = 32
-C_T, C_X0, C_V0, C_W0, C_X1, C_V1, C_W1, C_D, C_R, C_FN, C_FT, C_VT, C_N, C_E = 0, 1, 4, 7, 10, 13, 16, 19, 20, 21, 22, 25, 28, 31
+NCOL = 33
+C_T, C_X0, C_V0, C_W0, C_X1, C_V1, C_W1, C_D, C_R, C_FN, C_FT, C_VT, C_N, C_E, C_SLIP = (
+    0, 1, 4, 7, 10, 13, 16, 19, 20, 21, 22, 25, 28, 31, 32)
 
 
 @njit(cache=True, inline="always")
@@ -161,8 +162,7 @@ def slip_surface(tl, nl, h, vt, fn_abs, delta, mu):
         return sn - cap, (s / sn if sn > 0.0 else w), kt
     if kind == LTH or kind == ZZY:
         return hn - tl[T_XI] * max(delta, 0.0), w, 1.0
-    if kind == WALTON:
-        return hn - cap, w, 1.0
+    # WALTON saturates by itself (Kt → 0 at μ|Fn|) and has no slip state: its force is capped instead
     return -1.0, w, 1.0
 
 
@@ -212,8 +212,10 @@ def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
         if vn > 0.0:
             return -(tl[T_MU_K] * fn_abs / vn) * vt
         return -(tl[T_MU_K] * fn_abs) * tref
-    if kind == WALTON:
-        return -h
+    if kind == WALTON:  # −L, limited to μ|Fn| when a falling normal force drops the limit below |L|
+        hn = _norm(h)
+        cap = tl[T_MU_K] * fn_abs
+        return -(cap / hn) * h if hn > cap else -h
     if kind == LTH or kind == ZZY:
         return _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, tl[T_MU_K])
     # SPRING
@@ -278,12 +280,26 @@ def _accelerations(y, geo, fvec0, tau0, tau1, dy):
         dy[9:18] = 0.0
 
 
+@njit(cache=True, inline="always")
+def _tangent_history(y, n):
+    """The history in the current tangent plane: exact in continuous time, and immune to numerical drift."""
+    h = y[18:21]
+    return h - _dot(h, n) * n
+
+
 @njit(cache=True)
 def _psi_at(y, aux, nl, tl, geo, rules, mu):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
-    psi, w, d = slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, mu)
+    psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, mu)
     return psi
+
+
+@njit(cache=True)
+def _mapped_at(y, aux, nl, tl, geo, rules, mu):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    return return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, mu)
 
 
 @njit(cache=True)
@@ -325,7 +341,7 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     fabs = abs(fn)
     kind = tl[T_KIND]
     slipping = aux[A_TMODE] == SLIP
-    h = y[18:21]
+    h = _tangent_history(y, n)
     ft = np.zeros(3)
     req_margin = -1.0
     lam = 0.0
@@ -355,11 +371,20 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
         if slipping and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
             mu = tl[T_MU_K]
             psi, w, dpsi = slip_surface(tl, nl, h, vt, fabs, delta, mu)
+            # one-sided (forward, second order) along the flow: |ξ| has a kink at ξ = 0, where every slip
+            # begins at contact start, and a central difference would straddle it
             s = 1e-7 * ts
-            psid = (_psi_at(y + s * dy, aux, nl, tl, geo, rules, mu)
-                    - _psi_at(y - s * dy, aux, nl, tl, geo, rules, mu)) / (2.0 * s)
-            lam = psid / dpsi if dpsi > 0.0 else 0.0
-            dy[18:21] = dy[18:21] - lam * w
+            psid = (-3.0 * psi + 4.0 * _psi_at(y + s * dy, aux, nl, tl, geo, rules, mu)
+                    - _psi_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu)) / (2.0 * s)
+            # λ = ψ̇/D: the rate at which sticking would push past the surface; its sign decides stick or
+            # slip. While slipping the history follows its return-mapped value along the flow (the
+            # continuous limit of the engines' "increment, then truncate"), differentiated one-sidedly;
+            # unlike ξ̇ = v_t − λw this does not divide by Kt, which vanishes with δ for DDt and TTIt.
+            lam = psid / dpsi if dpsi > 0.0 else psid
+            h0 = _mapped_at(y, aux, nl, tl, geo, rules, mu)
+            ha = _mapped_at(y + s * dy, aux, nl, tl, geo, rules, mu)
+            hb = _mapped_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu)
+            dy[18:21] = (-3.0 * h0 + 4.0 * ha - hb) / (2.0 * s)
     return lam, fn, req_margin, ft
 
 
@@ -392,6 +417,41 @@ NSLOT = 8
 
 
 @njit(cache=True)
+def _settle(y, aux, nl, tl, geo, rules):
+    """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
+    is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
+    fall inside one step there)."""
+    kind = tl[T_KIND]
+    if aux[A_NMODE] == M_PRE or kind == NONE:
+        return
+    if not (kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON or kind == SLIDING):
+        return
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    if aux[A_TMODE] == SLIP:
+        if kind != SLIDING and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            # back onto the slip surface (the multiplier is least accurate at |Fn|'s kink); a slip that
+            # would unload the history (λ < 0) sticks from there
+            y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            if lam < 0.0:
+                aux[A_TMODE] = STICK
+        return
+    if kind == SLIDING:
+        if req > 0.0:
+            aux[A_TMODE] = SLIP
+            fnorm = _norm(ft)
+            if fnorm > 0.0:
+                aux[A_TREF:A_TREF + 3] = -ft / fnorm
+        return
+    psi = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])[0]
+    if psi > 1e-12 * max(tl[T_MU_S] * abs(fn), 1e-300):
+        aux[A_TMODE] = SLIP
+        y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+
+
+@njit(cache=True)
 def _slot_direction(nl, tl, aux, slot):
     nmode = aux[A_NMODE]
     kind = tl[T_KIND]
@@ -413,7 +473,7 @@ def _slot_direction(nl, tl, aux, slot):
         return -1 if (nmode == M_VE and nl[L_ETA] != 0.0) else 0
     if slot == 4:
         return 1 if nmode == M_UNLOAD else 0
-    history = kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON
+    history = kind == SPRING or kind == LTH or kind == ZZY
     if slot == 5:
         return 1 if ((history or kind == SLIDING) and not slipping) else 0
     if slot == 6:
@@ -450,17 +510,17 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
     if slot == 5:
         if kind == SLIDING:
             return req
-        psi, w, d = slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_S])
+        psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])
         return psi
     if slot == 6:
         if kind == SLIDING:
             return _dot(vt, aux[A_TREF:A_TREF + 3])
         if kind == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
-            return slip_surface(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_K])[0]
+            return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
         return lam
     if slot == 7:
         if kind == WALTON:
-            return _dot(vt, y[18:21])
+            return _dot(vt, _tangent_history(y, n))
         return tl[T_ETA] * _norm(vt) - tl[T_MU_K] * abs(fn)
     return 1.0
 
@@ -471,7 +531,8 @@ def _crossed(g0, g1, direction):
         return (g0 > 0.0 and g1 <= 0.0) or (g0 < 0.0 and g1 >= 0.0)
     if direction < 0:
         return g0 > 0.0 and g1 <= 0.0
-    return g0 < 0.0 and g1 >= 0.0
+    # rising from exactly 0 counts: at contact start the slip function of a fresh history is 0
+    return (g0 < 0.0 and g1 >= 0.0) or (g0 == 0.0 and g1 > 0.0)
 
 
 @njit(cache=True)
@@ -524,6 +585,7 @@ def _record(rec, i, t, y, aux, nl, tl, geo, rules):
     rec[i, C_VT:C_VT + 3] = vt
     rec[i, C_N:C_N + 3] = n
     rec[i, C_E] = energy(y, geo)
+    rec[i, C_SLIP] = aux[A_TMODE]
 
 
 @njit(cache=True)
@@ -554,7 +616,11 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         hstep = min(hstep, t_max - t)
         yn, err = _dp5_3(y, aux, nl, tl, geo, rules, hstep)
         emax = 0.0
-        for i in range(21):  # absolute, physical scales: positions are ~10³ times the overlap
+        # absolute, physical scales (positions are ~10³ times the overlap). While slipping the history is
+        # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
+        # so only the bodies' state is error-controlled then.
+        n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
+        for i in range(n_ctrl):
             sc = scales[i] * rtol
             if sc > 0.0:
                 emax = max(emax, abs(err[i]) / sc)
@@ -607,11 +673,6 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             if kind == SLIDING and vn > 0.0:
                 aux[A_TMODE] = SLIP
                 aux[A_TREF:A_TREF + 3] = vt / vn
-            elif kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
-                fn0 = _normal_mode_force(nl, aux[A_NMODE], delta, rate, 0.0)
-                if slip_surface(tl, nl, y[18:21], vt, abs(fn0), delta, tl[T_MU_S])[0] > 0.0:
-                    aux[A_TMODE] = SLIP  # already past the threshold as the contact begins
-                    y[18:21] = return_map(tl, nl, y[18:21], vt, abs(fn0), delta, tl[T_MU_K])
         elif best_slot == 0:
             code = EV_END
             terminal = True
@@ -644,16 +705,27 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 if fnorm > 0.0:
                     aux[A_TREF:A_TREF + 3] = -ft / fnorm
             else:
-                y[18:21] = return_map(tl, nl, y[18:21], vt, abs(fn), delta, tl[T_MU_K])
+                y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
+                if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+                    # slip only where sticking would push past the surface (λ > 0); else it is a graze
+                    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+                    if lam < 0.0:
+                        aux[A_TMODE] = STICK
         elif best_slot == 6:
             code = EV_SLIP_STICK
+            if kind != SLIDING:  # stick from exactly on the surface
+                dy = np.empty(21)
+                lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+                y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
             aux[A_TMODE] = STICK
         elif best_slot == 7:
             if kind == WALTON:
                 code = EV_REVERSAL
-                aux[A_LSTAR:A_LSTAR + 3] = y[18:21]
+                aux[A_LSTAR:A_LSTAR + 3] = _tangent_history(y, nvec)
             else:
                 code = EV_KINK
+        if not terminal and code != EV_STICK_SLIP and code != EV_SLIP_STICK:
+            _settle(y, aux, nl, tl, geo, rules)
         _record(rec, n, t, y, aux, nl, tl, geo, rules)
         if code == EV_END:
             rec[n, C_FN] = 0.0
@@ -661,6 +733,11 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         n += 1
         ev_t[ne], ev_c[ne] = t, code
         ne += 1
+        if not terminal and code != EV_START and aux[A_NMODE] != M_PRE and delta <= 0.0 and rate < 0.0:
+            # a simultaneous root (elastic Hertz: force and overlap vanish together) landed past δ = 0
+            ev_t[ne], ev_c[ne] = t, EV_END
+            ne += 1
+            terminal = True
         if terminal:
             status = ST_OK
             break
@@ -721,6 +798,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     rec[0, C_VT:C_VT + 3] = vt
     rec[0, C_N:C_N + 3] = n
     rec[0, C_E] = energy(y, geo)
+    rec[0, C_SLIP] = 0.0
     g = geo[G_GX:G_GX + 3]
     i = 1
     step = 0
@@ -793,6 +871,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
         rec[i, C_VT:C_VT + 3] = vt
         rec[i, C_N:C_N + 3] = n
         rec[i, C_E] = energy(y, geo)
+        rec[i, C_SLIP] = 1.0 if sliding else 0.0
         i += 1
         if not np.all(np.isfinite(y[0:18])):
             status = ST_UNRESOLVED

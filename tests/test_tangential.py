@@ -1,0 +1,228 @@
+"""Tangential laws and the 3-D solver (seed 000 §2 and §4)."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from demcheck import case as C
+from demcheck.errors import ConfigError
+from demcheck.reference import collision3d, tangential
+from demcheck.reference.collision import auto_dt, collide
+from demcheck.reference.model import resolve
+
+from .helpers import oblique_case
+
+LAWS = sorted(m for m in tangential.REGISTRY if m != "none")
+# Known gap, open in the tangential issue (docs/models.md "Known gaps"): the adaptive slip dynamics of the
+# Maw-truncated spring laws in spinning impacts that stick and slip again, and TTIt's onset where its
+# dashpot ηn δ^¼ v_t exceeds the vanishing cap, do not yet reproduce the converged verlet answer.
+KNOWN_GAP = pytest.mark.xfail(strict=True, reason="adaptive slip of Maw-truncated springs: open, see docs/models.md")
+
+
+def gap(law, *laws):
+    return pytest.param(law, marks=KNOWN_GAP) if law in laws else law
+CAPPING = ["sliding", "viscous_sliding", "spring_sliding", "lsd_sliding", "ddt", "lth", "zzy", "tti", "walton"]
+RADIUS_ARMS = {"slip_arm": "radius", "torque_arm": "radius", "wall_torque_arm": "radius"}
+
+
+def law_case(law, **kw):
+    normal = "tti" if law == "tti" else "lsd"
+    return oblique_case(law, normal=normal, normal_params={} if normal == "tti" else None, **kw)
+
+
+def test_every_model_has_a_contract_entry():
+    assert set(LAWS) | {"none"} == set(tangential.REGISTRY)
+    assert set(CAPPING) < set(LAWS)
+
+
+# ----------------------------------------------------------------------------- the rigid-body limit
+
+def gross_sliding_params(law):
+    """Parameters that put each capping law in gross sliding for the whole contact: a viscous slider far
+    above the cap, stiff springs (the initial stick lasts ~μFn/(Kt v_t), a vanishing part of the contact)."""
+    return {"viscous_sliding": {"eta_t": 1e6}, "spring_sliding": {"kt": 1e12}, "ddt": {},
+            "lsd_sliding": {"kt": 1e12, "eta_t": 0.0}, "lth": {"eta_t": 0.0}, "zzy": {"eta_1": 0.0},
+            "tti": {}, "walton": {"kt": 1e12}, "sliding": {}}[law]
+
+
+@pytest.mark.parametrize("law", [gap(law, "tti") for law in CAPPING])
+@pytest.mark.parametrize("angle", [70.0, 85.0])
+def test_gross_sliding_limit_at_a_wall(law, angle):
+    """tan θ ≥ 3.5 μ(1+e): tangential restitution 1 − μ(1+e)/tan θ and rebound spin (5/2)μ(1+e) v cos θ / R.
+    Exact for a rigid body; the contact model adds the lever arm R − δ/2 (O(δ_max/R)) and, for a spring,
+    the initial stick before the spring reaches the cap. Normal law: elastic Hertz (Fn ≥ 0), or TTI's with
+    limit_force, so the friction impulse is μ times the normal impulse."""
+    mu = 0.3
+    normal = "tti" if law == "tti" else "hertz"
+    case = oblique_case(law, gross_sliding_params(law), normal=normal, normal_params={}, angle=angle, friction=mu,
+                        overrides=["contact.limit_force=true"] if law == "tti" else [])
+    model = resolve(case)
+    assert math.tan(math.radians(angle)) >= 3.5 * mu * 2
+    for rules, tol in ((RADIUS_ARMS, 1e-6), (None, 5e-3)):
+        res = collision3d.collide(case, model, "adaptive", rules=rules)
+        m = res.metrics()
+        e = m["restitution"]
+        th = math.radians(angle)
+        assert m["tangential_restitution"] == pytest.approx(1 - mu * (1 + e) / math.tan(th), rel=tol)
+        spin = 2.5 * mu * (1 + e) * math.cos(th) / 1.59e-3
+        assert m["rebound_angular_velocity"] == pytest.approx(spin, rel=tol)
+
+
+def test_gross_sliding_limit_is_exact_for_the_slider():
+    """With the rigid body's lever arms the simple slider reproduces the closed form to the solver's tolerance."""
+    case = oblique_case("sliding", normal="hertz", normal_params={}, angle=75.0)
+    m = collision3d.collide(case, resolve(case), "adaptive", rules=RADIUS_ARMS).metrics()
+    th = math.radians(75.0)
+    assert m["tangential_restitution"] == pytest.approx(1 - 0.3 * 2 / math.tan(th), abs=1e-9)
+    assert m["rebound_angular_velocity"] * 1.59e-3 == pytest.approx(2.5 * 0.3 * 2 * math.cos(th), abs=1e-9)
+
+
+# ----------------------------------------------------------------------------- properties of every law
+
+@pytest.mark.parametrize("law", CAPPING)
+@pytest.mark.parametrize("angle", [10.0, 45.0, 80.0])
+@pytest.mark.parametrize("method", ["adaptive", "verlet"])
+def test_coulomb_bound(law, angle, method):
+    res = collide(law_case(law, angle=angle), method)
+    c = res.contact
+    ft = np.hypot(np.hypot(c["ftx"], c["fty"]), c["ftz"])
+    bound = 0.3 * c["fn"].abs()
+    assert (ft <= bound * (1 + 1e-9) + 1e-15).all()
+
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("angle,spin", [(20.0, 0.0), (60.0, 0.0), (30.0, -2000.0)])
+def test_friction_never_creates_energy(law, angle, spin):
+    """With an elastic normal law every joule lost is the tangential law's."""
+    normal = "tti" if law == "tti" else "hertz"
+    params = dict(tangential.REGISTRY[law].example)
+    if law in ("spring_sliding", "lsd_sliding", "walton"):
+        params["kt"] = 1e6
+    case = oblique_case(law, params, normal=normal, normal_params={}, angle=angle, spin=spin)
+    res = collide(case)
+    ke = 0.5 * case.mass(0) * 1.0
+    assert res.metrics()["energy_dissipated"] >= -1e-9 * ke
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_purely_normal_impact_has_no_tangential_force(law):
+    res = collide(law_case(law, angle=0.0, wall=False))
+    c = res.contact
+    assert (c[["ftx", "fty", "ftz"]].to_numpy() == 0.0).all()
+    assert res.metrics()["rebound_angle"] == 0.0
+
+
+@pytest.mark.parametrize("law,method", [pytest.param(law, m, marks=KNOWN_GAP) if (law, m) == ("tti", "adaptive")
+                                        else (law, m) for law in LAWS for m in ("adaptive", "verlet")])
+def test_history_stays_in_the_tangent_plane(law, method):
+    """A pair at 50°: the normal turns during contact; the force (and the history behind it) stays ⊥ n."""
+    c = collide(law_case(law, angle=50.0, wall=False, spin=3000.0), method).contact
+    ft = c[["ftx", "fty", "ftz"]].to_numpy()
+    n = c[["nx", "ny", "nz"]].to_numpy()
+    assert np.all(np.abs(np.einsum("ij,ij->i", ft, n)) <= 1e-9 * np.linalg.norm(ft, axis=1) + 1e-18)
+
+
+@pytest.mark.parametrize("law", LAWS)
+def test_identical_spheres_collide_mirror_symmetrically(law):
+    res = collide(law_case(law, angle=40.0, wall=False))
+    p = res.particles
+    last = p["t"].max()
+    a = p[(p["t"] == last) & (p["id"] == 0)].iloc[0]
+    b = p[(p["t"] == last) & (p["id"] == 1)].iloc[0]
+    v_scale = 1.0
+    for k in ("vx", "vy", "vz"):
+        assert a[k] == pytest.approx(-b[k], abs=1e-9 * v_scale)
+    for k in ("wx", "wy", "wz"):
+        assert a[k] == pytest.approx(b[k], abs=1e-9 * v_scale / 1.59e-3)
+
+
+def _rotation(q):
+    q = np.asarray(q, float)
+    q = q / np.linalg.norm(q)
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+@pytest.mark.parametrize("law,wall", [(law, wall) for law in ("lsd_sliding", "walton", "sliding") for wall in (True, False)]
+                         + [pytest.param("tti", True, marks=KNOWN_GAP), ("tti", False)])
+@given(q=st.tuples(*[st.floats(-1, 1)] * 4).filter(lambda q: np.linalg.norm(q) > 0.1))
+@settings(max_examples=8)
+def test_rotating_the_scene_rotates_the_result(law, wall, q):
+    base = law_case(law, angle=35.0, spin=1500.0, wall=wall)
+    rot = _rotation(q)
+    raw = dict(base.raw)
+    parts = []
+    for p in raw["particles"]:
+        parts.append({**p, "position": list(rot @ p["position"]), "velocity": list(rot @ p["velocity"]),
+                      "angular_velocity": list(rot @ p["angular_velocity"])})
+    raw["particles"] = parts
+    if wall:
+        raw["walls"] = [{"point": list(rot @ np.zeros(3)), "normal": list(rot @ np.array([0.0, 0.0, 1.0]))}]
+    turned = C.from_dict(raw)
+    m0, m1 = collide(base).metrics(), collide(turned).metrics()
+    for k, v in m0.items():
+        assert m1[k] == pytest.approx(v, rel=1e-7, abs=1e-9 * (abs(v) + 1e-30)), k
+
+
+@pytest.mark.parametrize("law", [gap(law, "ddt", "spring_sliding", "tti") for law in LAWS])
+def test_verlet_converges_to_adaptive(law):
+    """Tangential metrics and contact time (the LSD normal law's restitution carries a phase-dependent O(dt)
+    term, see test_convergence.py, and would hide the tangential convergence)."""
+    case = law_case(law, angle=30.0, spin=500.0)
+    ref = collide(case).metrics()
+    keys = ("contact_time", "tangential_restitution", "rebound_angular_velocity")
+    errs = []
+    for spc in (100, 1600):
+        m = collide(case, "verlet", dt=auto_dt(case) * case.run.steps_per_contact / spc).metrics()
+        errs.append(max(abs(m[k] - ref[k]) / max(abs(ref[k]), 1e-3) for k in keys))
+    assert errs[1] < errs[0] / 4 and errs[1] < 1e-3, errs
+
+
+def test_static_and_kinetic_friction():
+    """μk < μs: once slipping the force is μk|Fn|, so a sphere at gross sliding loses less tangential speed."""
+    one = collide(law_case("spring_sliding", angle=80.0)).metrics()
+    two = collide(law_case("spring_sliding", angle=80.0, overrides=["contact.friction_kinetic=0.2"])).metrics()
+    assert two["tangential_restitution"] > one["tangential_restitution"]
+    assert two["rebound_angular_velocity"] == pytest.approx(one["rebound_angular_velocity"] * 2 / 3, rel=5e-3)
+
+
+def test_walton_returns_to_k0_at_reversal_and_saturates():
+    from demcheck.reference.kernels3d import walton_stiffness
+
+    tl = resolve(law_case("walton")).tangential_law.array()
+    k0 = tl[tangential.T_K0]
+    v = np.array([1.0, 0.0, 0.0])
+    # virgin loading: K0 at zero load, zero at μ|Fn|
+    assert walton_stiffness(tl, np.zeros(3), v, 10.0, np.zeros(3)) == pytest.approx(k0)
+    assert walton_stiffness(tl, np.array([3.0, 0, 0]), v, 10.0, np.zeros(3)) == 0.0
+    # reversal at load 2: the stiffness starts again at K0 and vanishes at −μ|Fn|
+    L = np.array([2.0, 0, 0])
+    assert walton_stiffness(tl, L, -v, 10.0, L) == pytest.approx(k0)
+    assert walton_stiffness(tl, np.array([-3.0, 0, 0]), -v, 10.0, L) == 0.0
+    # Walton & Braun's unloading law: K0 (1 − (T* − T)/(μN + T*))^{1/3}
+    T = 0.5
+    assert walton_stiffness(tl, np.array([T, 0, 0]), -v, 10.0, L) == pytest.approx(
+        k0 * (1 - (2.0 - T) / (3.0 + 2.0)) ** (1 / 3))
+
+
+BAD = [
+    (["contact.tangential=sliding", "materials.glass.friction=-0.1"], "materials.glass.friction", ">= 0"),
+    (["contact.tangential=lsd_sliding", "contact.eta_t=1.0", "contact.truncation=\"cap\""], "contact.truncation",
+     "force, overlap"),
+    (["contact.tangential=lsd_sliding"], "contact.eta_t", "missing"),
+    (["contact.tangential=zzy"], "contact.eta_1", "missing"),
+    (["contact.tangential=spring_sliding", "contact.friction_kinetic=0.5"], "contact.friction_kinetic", "exceed"),
+    (["contact.tangential=slidng"], "contact.tangential", "did you mean 'sliding'"),
+]
+
+
+@pytest.mark.parametrize("overrides,key,rule", BAD)
+def test_bad_tangential_input(overrides, key, rule):
+    with pytest.raises(ConfigError) as info:
+        oblique_case("none", {}, overrides=overrides)
+    assert info.value.key == key and rule in str(info.value) and info.value.exit_code == 2
