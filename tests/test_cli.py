@@ -72,3 +72,27 @@ def test_verify_writes_reports_atomically(tmp_path):
     assert json.loads((latest / "results.json").read_text())["run_id"] == out["run_id"]
     assert "glass-pair" in (latest / "report.md").read_text()
     assert not list(tmp_path.rglob("*.tmp"))
+
+
+def test_sweep_over_incidence_angle_is_one_line(tmp_path):
+    csv = tmp_path / "s.csv"
+    p = demcheck("sweep", CASES / "oblique-lsd-wall.toml", "--vary", "impact.angle=10:80:3", "--json",
+                 "--csv", csv, "--plot", tmp_path / "s.png")
+    assert p.returncode == 0, p.stderr
+    rows = json.loads(p.stdout)["rows"]
+    assert [r["impact.angle"] for r in rows] == [10.0, 45.0, 80.0]
+    assert all(r["status"] == "ok" for r in rows)
+    # a wall impact under LSDn keeps its restitution at every angle; grazing keeps most tangential speed
+    assert all(abs(r["restitution"] - 0.9) < 1e-9 for r in rows)
+    assert rows[2]["tangential_restitution"] > rows[1]["tangential_restitution"]
+    assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG"
+    assert csv.read_text().splitlines()[0].startswith("impact.angle,restitution")
+
+
+def test_sweep_grid_and_bad_vary():
+    p = demcheck("sweep", CASES / "glass-pair.toml", "--vary", "impact.speed=0.5,2", "--vary",
+                 "contact.normal=hertz,tti", "--json")
+    assert p.returncode == 0, p.stderr
+    assert len(json.loads(p.stdout)["rows"]) == 4
+    bad = demcheck("sweep", CASES / "glass-pair.toml", "--vary", "impact.speed=1:2:x")
+    assert bad.returncode == 2 and "--vary impact.speed = '1:2:x': START and STOP must be numbers" in bad.stderr

@@ -162,6 +162,56 @@ def _print_summary(s: dict) -> None:
     con.print(p)
 
 
+# ----------------------------------------------------------------------------- sweep
+
+
+@cli.command()
+@click.argument("case_path", metavar="CASE")
+@click.option("--vary", "varies", multiple=True, required=True, metavar="KEY=START:STOP:N",
+              help="a case key and its values (N evenly spaced, or KEY=a,b,c); several make a grid")
+@click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None)
+@click.option("--dt", type=float, default=None, help="time step of the verlet method (s)")
+@_set_option
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="write the table")
+@click.option("--plot", type=click.Path(dir_okay=False), default=None, help="plot metrics against the first key")
+def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
+    """Metrics of a collision over one or more case keys, e.g. --vary impact.angle=5:85:17."""
+    from rich.progress import Progress
+
+    from .comparisons.sweep import parse_vary, plot_sweep, run_sweep
+
+    if dt is not None and not dt > 0:
+        raise ConfigError("--dt", dt, "must be > 0 (s)")
+    total = 1
+    for v in varies:
+        total *= len(parse_vary(v)[1])
+    with Progress(transient=True, disable=as_json) as progress:
+        task = progress.add_task("sweep", total=total)
+        table = run_sweep(case_path, overrides, list(varies), method, dt, lambda: progress.advance(task))
+    if csv_path:
+        from .io import atomic_path
+
+        with atomic_path(csv_path) as tmp:
+            table.to_csv(tmp, index=False, float_format="%.12g")
+    if plot:
+        plot_sweep(table, parse_vary(varies[0])[0], plot)
+    if as_json:
+        emit_json({"vary": [parse_vary(v)[0] for v in varies], "rows": table.to_dict(orient="records")})
+    else:
+        from rich.console import Console
+        from rich.table import Table
+
+        t = Table()
+        for c in table.columns:
+            t.add_column(c, justify="right")
+        for _, row in table.iterrows():
+            t.add_row(*[_fmt(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
+        Console().print(t)
+    if (table["status"] != "ok").any():
+        sys.exit(1)
+
+
 # ----------------------------------------------------------------------------- verify
 
 
