@@ -20,7 +20,7 @@ def test_collide_json_has_metrics_model_params_method_and_dt():
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
     assert out["model"] == {"normal": "lsd", "tangential": "none", "limit_force": False}
-    assert out["method"] == "adaptive" and out["rtol"] == 1e-12
+    assert out["method"] == "adaptive" and out["rtol"] == 1e-13
     assert out["params"]["kn"] == pytest.approx(2.0166e6, rel=1e-4)
     assert set(out["metrics"]) >= {"restitution", "contact_time", "force_contact_time", "max_overlap",
                                    "peak_force", "energy_dissipated"}

@@ -70,7 +70,7 @@ class Run:
     dt: float | None = None  # None = auto (contact time / steps_per_contact)
     steps_per_contact: int = 200
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    rtol: float = 1e-12
+    rtol: float = 1e-13
     method: str = "adaptive"
 
 
@@ -328,7 +328,7 @@ def from_dict(raw: dict) -> Case:
         dt=dt,
         steps_per_contact=spc,
         gravity=_vector(run_raw, "gravity", "run", default=(0.0, 0.0, 0.0)),
-        rtol=_number(run_raw, "rtol", "run", required=False, default=1e-12,
+        rtol=_number(run_raw, "rtol", "run", required=False, default=1e-13,
                      rule="must be in [1e-14, 1e-2]", check=lambda v: 1e-14 <= v <= 1e-2),
         method=method,
     )

@@ -25,7 +25,7 @@ from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.model import resolve
 
-CLOSED_FORM_RTOL = 1e-8  # the adaptive method at rtol 1e-12 against an exact solution
+CLOSED_FORM_RTOL = 1e-8  # the adaptive method at rtol 1e-13 against an exact solution
 
 
 def _rel(a, b):
