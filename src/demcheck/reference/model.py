@@ -40,18 +40,9 @@ def _lookup(registry_lookup, names, slot: str, value: str):
 
 
 def models_of(case: Case):
-    normal = _lookup(_normal.lookup, _all_names(_normal.REGISTRY), "normal", case.contact.normal)
-    tangential = _lookup(_tangential.lookup, _all_names(_tangential.REGISTRY), "tangential",
-                         case.contact.tangential)
+    normal = _lookup(_normal.lookup, _normal.REGISTRY.names(), "normal", case.contact.normal)
+    tangential = _lookup(_tangential.lookup, _tangential.REGISTRY.names(), "tangential", case.contact.tangential)
     return normal, tangential
-
-
-def _all_names(registry) -> list[str]:
-    names = []
-    for m in registry.values():
-        names.append(m.id)
-        names.extend(a.lower() for a in m.aliases)
-    return names
 
 
 def resolve(case: Case, i: int = 0, j: int | None = 1) -> ResolvedModel:

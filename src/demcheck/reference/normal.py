@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import ConfigError
 from . import analytic
 from .contact import Pair
+from .registry import Registry
 
 VISCOELASTIC = 0
 HYSTERETIC = 1
@@ -75,23 +76,9 @@ class NormalModel:
     example: dict = field(default_factory=dict)  # [contact] parameters of a typical use (docs, contract tests)
 
 
-REGISTRY: dict[str, NormalModel] = {}
-
-
-def register(model: NormalModel) -> NormalModel:
-    for key in (model.id, *model.aliases):
-        if key in REGISTRY:
-            raise ValueError(f"normal model id {key!r} registered twice")
-    REGISTRY[model.id] = model
-    return model
-
-
-def lookup(name: str) -> NormalModel:
-    key = name.strip().lower()
-    for m in REGISTRY.values():
-        if key == m.id or key in (a.lower() for a in m.aliases):
-            return m
-    raise KeyError(name)
+REGISTRY = Registry("normal")
+register = REGISTRY.register
+lookup = REGISTRY.lookup
 
 
 # ----------------------------------------------------------------------------- parameter helpers

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from .contact import Pair
+from .registry import Registry
 from .normal import HYSTERETIC, NormalLaw, Param
 
 NONE, SLIDING, VISCOUS, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON = range(8)
@@ -84,23 +85,9 @@ class TangentialModel:
     example: dict = field(default_factory=dict)
 
 
-REGISTRY: dict[str, TangentialModel] = {}
-
-
-def register(model: TangentialModel) -> TangentialModel:
-    for key in (model.id, *model.aliases):
-        if key in REGISTRY:
-            raise ValueError(f"tangential model id {key!r} registered twice")
-    REGISTRY[model.id] = model
-    return model
-
-
-def lookup(name: str) -> TangentialModel:
-    key = name.strip().lower()
-    for m in REGISTRY.values():
-        if key == m.id or key in (a.lower() for a in m.aliases):
-            return m
-    raise KeyError(name)
+REGISTRY = Registry("tangential")
+register = REGISTRY.register
+lookup = REGISTRY.lookup
 
 
 # ----------------------------------------------------------------------------- parameter helpers
