@@ -288,18 +288,20 @@ def _tangent_history(y, n):
 
 
 @njit(cache=True)
-def _psi_at(y, aux, nl, tl, geo, rules, mu):
+def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
+    """ψ at a nearby state, with |Fn| taken on the branch of the base point (fsign·Fn), so that a one-sided
+    difference does not straddle the kink of |Fn| where a viscous normal force changes sign."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
-    psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, mu)
+    psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
     return psi
 
 
 @njit(cache=True)
-def _mapped_at(y, aux, nl, tl, geo, rules, mu):
+def _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
-    return return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, mu)
+    return return_map(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
 
 
 @njit(cache=True)
@@ -374,16 +376,17 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
             # one-sided (forward, second order) along the flow: |ξ| has a kink at ξ = 0, where every slip
             # begins at contact start, and a central difference would straddle it
             s = 1e-7 * ts
-            psid = (-3.0 * psi + 4.0 * _psi_at(y + s * dy, aux, nl, tl, geo, rules, mu)
-                    - _psi_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu)) / (2.0 * s)
+            fsign = 1.0 if fn >= 0.0 else -1.0
+            psid = (-3.0 * psi + 4.0 * _psi_at(y + s * dy, aux, nl, tl, geo, rules, mu, fsign)
+                    - _psi_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu, fsign)) / (2.0 * s)
             # λ = ψ̇/D: the rate at which sticking would push past the surface; its sign decides stick or
             # slip. While slipping the history follows its return-mapped value along the flow (the
             # continuous limit of the engines' "increment, then truncate"), differentiated one-sidedly;
             # unlike ξ̇ = v_t − λw this does not divide by Kt, which vanishes with δ for DDt and TTIt.
             lam = psid / dpsi if dpsi > 0.0 else psid
-            h0 = _mapped_at(y, aux, nl, tl, geo, rules, mu)
-            ha = _mapped_at(y + s * dy, aux, nl, tl, geo, rules, mu)
-            hb = _mapped_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu)
+            h0 = _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign)
+            ha = _mapped_at(y + s * dy, aux, nl, tl, geo, rules, mu, fsign)
+            hb = _mapped_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu, fsign)
             dy[18:21] = (-3.0 * h0 + 4.0 * ha - hb) / (2.0 * s)
     return lam, fn, req_margin, ft
 
