@@ -5,7 +5,11 @@ Run: .venv/bin/python benchmarks/bench_adaptive.py  (writes benchmarks/results/b
 1. Per model: an adaptive collision at rtol = 1e-10, warm: the compiled kernel alone and the whole
    `collide()` (tables, metrics). Median of repeated runs; the machine is shared, so the numbers to read
    are the ratios within one run.
-2. A command-line call with the on-disk compilation cache warm, against one with an empty cache (what every
+2. The 3-D solver (oblique impact at a wall, 45°, spin) per tangential law: adaptive (rtol 1e-10) and
+   verlet at t_c/200, warm.
+3. The 1-D skip: one frictionless oblique wall impact solved along the normal (what demcheck does) and by
+   the full 3-D solver, side by side, and the two answers' agreement.
+4. A command-line call with the on-disk compilation cache warm, against one with an empty cache (what every
    call would cost without numba's cache=True).
 """
 
@@ -23,7 +27,10 @@ sys.path.insert(0, str(ROOT))
 from demcheck.reference import kernels  # noqa: E402
 from demcheck.reference.collision import Geometry1D, characteristic_time, collide  # noqa: E402
 from demcheck.reference.model import resolve  # noqa: E402
-from tests.helpers import glass_case  # noqa: E402
+from demcheck.reference import collision3d  # noqa: E402
+from tests.helpers import glass_case, oblique_case  # noqa: E402
+
+TANGENTIAL = ["sliding", "viscous_sliding", "lsd_sliding", "ddt", "lth", "walton"]
 
 MODELS = {
     "lsd": {"stiffness_method": "energy"}, "hertz": {}, "bshp": {"dissipative_constant": 1e-7},
@@ -59,6 +66,25 @@ def main():
         full = median_time(lambda: collide(case, "adaptive", rtol=1e-10))
         steps = kernel()[1]
         lines.append(f"{name:8s} {k * 1e3:12.3f} {full * 1e3:15.3f} {steps:6d}")
+
+    lines += ["", "3-D solver, oblique wall impact 45°, spin 500 rad/s, LSDn normal (median of 20)",
+              f"{'tangential':16s} {'adaptive (ms)':>14s} {'verlet (ms)':>12s}"]
+    for law in TANGENTIAL:
+        case = oblique_case(law, angle=45.0, spin=500.0)
+        a = median_time(lambda: collide(case, "adaptive", rtol=1e-10), repeat=20)
+        v = median_time(lambda: collide(case, "verlet"), repeat=20)
+        lines.append(f"{law:16s} {a * 1e3:14.2f} {v * 1e3:12.2f}")
+
+    case = oblique_case("none", {}, angle=40.0)
+    model = resolve(case)
+    one = median_time(lambda: collide(case, "adaptive", rtol=1e-10), repeat=50)
+    three = median_time(lambda: collision3d.collide(case, model, "adaptive", rtol=1e-10), repeat=50)
+    m1 = collide(case, "adaptive").metrics()
+    m3 = collision3d.collide(case, model, "adaptive").metrics()
+    worst = max(abs(m1[k] / m3[k] - 1) for k in ("restitution", "contact_time", "max_overlap", "peak_force"))
+    lines += ["", "the 1-D skip: frictionless oblique wall impact (40°), adaptive rtol 1e-10, median of 50",
+              f"1-D normal solve: {one * 1e3:.3f} ms   3-D solver: {three * 1e3:.3f} ms   "
+              f"ratio 3-D/1-D: {three / one:.1f}x   largest relative difference of the normal metrics: {worst:.1e}"]
 
     cmd = [sys.executable, "-m", "demcheck", "collide", str(ROOT / "cases" / "glass-pair.toml"), "--json"]
     def cli(env):
