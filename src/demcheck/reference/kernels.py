@@ -151,7 +151,6 @@ def _crossed(g0, g1, direction):
 @njit(cache=True)
 def _slot_direction(law, mode, slot):
     """+1 / −1 for a live event of this mode, 0 for none."""
-    hls = law[L_KIND] == 1.0
     if mode == M_PRE:
         return 1 if slot == 0 else 0
     if mode == M_VE:

@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import ConfigError
 from . import analytic
 from .contact import Pair
-from .registry import Registry
+from .registry import Registry, contact_number
 
 VISCOELASTIC = 0
 HYSTERETIC = 1
@@ -85,16 +85,8 @@ lookup = REGISTRY.lookup
 
 
 def _get(params: dict, key: str, *, rule: str, check=None, required_by: str | None = None):
-    v = params.get(key)
-    if v is None:
-        if required_by:
-            raise ConfigError(f"contact.{key}", None, f"missing: required by normal model '{required_by}'")
-        return None
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise ConfigError(f"contact.{key}", v, "must be a finite number")
-    if check is not None and not check(v):
-        raise ConfigError(f"contact.{key}", v, rule)
-    return float(v)
+    return contact_number(params, key, rule=rule, check=check,
+                          required_by=f"normal model '{required_by}'" if required_by else None)
 
 
 def _restitution(pair: Pair, model: str) -> float:

@@ -1,6 +1,26 @@
-"""A registry of models of one slot (normal or tangential): ids and aliases, unique, case-insensitive."""
+"""A registry of models of one slot (normal or tangential): ids and aliases, unique, case-insensitive; and the
+reader of the models' numeric ``[contact]`` parameters."""
 
 from __future__ import annotations
+
+import math
+
+from ..errors import ConfigError
+
+
+def contact_number(params: dict, key: str, *, rule: str, check=None, required_by: str | None = None):
+    """``[contact].key`` as a float, None when absent; a missing required or bad value is a ConfigError naming
+    the key, the value and the rule. ``required_by`` reads like "normal model 'kk'"."""
+    v = params.get(key)
+    if v is None:
+        if required_by:
+            raise ConfigError(f"contact.{key}", None, f"missing: required by {required_by}")
+        return None
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ConfigError(f"contact.{key}", v, "must be a finite number")
+    if check is not None and not check(v):
+        raise ConfigError(f"contact.{key}", v, rule)
+    return float(v)
 
 
 class Registry(dict):

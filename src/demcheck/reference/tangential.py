@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from .contact import Pair
-from .registry import Registry
+from .registry import Registry, contact_number
 from .normal import HYSTERETIC, NormalLaw, Param
 
 NONE, SLIDING, VISCOUS, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON = range(8)
@@ -94,16 +94,8 @@ lookup = REGISTRY.lookup
 
 
 def _num(params: dict, key: str, rule: str, check, *, required_by: str | None = None):
-    v = params.get(key)
-    if v is None:
-        if required_by:
-            raise ConfigError(f"contact.{key}", None, f"missing: required by tangential model '{required_by}'")
-        return None
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise ConfigError(f"contact.{key}", v, "must be a finite number")
-    if not check(v):
-        raise ConfigError(f"contact.{key}", v, rule)
-    return float(v)
+    return contact_number(params, key, rule=rule, check=check,
+                          required_by=f"tangential model '{required_by}'" if required_by else None)
 
 
 def _friction(pair: Pair, model: str) -> tuple[float, float]:
