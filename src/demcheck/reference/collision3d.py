@@ -13,6 +13,7 @@ from ..errors import ConfigError
 from ..result import Result
 from . import kernels, kernels3d as k3
 from .model import ResolvedModel
+from .tangential import TRUNC_MAW
 
 # The seed's own rules: lever arms to the contact point (R − δ/2) for slip velocity and torque; in the
 # verlet method the history is rotated into the new tangent plane keeping its length.
@@ -109,6 +110,11 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         meta={"solver": "3d", "steps": int(n), "rules": {**SEED_RULES, **(rules or {})},
               "radius0": r0},
     )
+    tlaw = model.tangential_law
+    if tlaw.kt_sqrt and tlaw.eta > 0 and tlaw.truncation == TRUNC_MAW and not result.message:
+        result.message = ("truncation=overlap with a Kt that vanishes at contact onset: where the dashpot exceeds "
+                          "the cap the Maw overlap grows like δ^(-1/4) and the friction can push along the slip "
+                          "(docs/models.md, finding 9); truncation=force is the seed's formulation")
     if method == "verlet" and status_name == "ok":
         from .collision import _flag_unresolved
 

@@ -267,6 +267,15 @@ def _normal_mode_force(nl, nmode, delta, rate, dmax):
 
 
 @njit(cache=True)
+def _contact_force(nl, nmode, delta, rate, dmax):
+    """The normal force the contact applies: the mode's law, held at 0 where limit_force forbids attraction."""
+    fn = _normal_mode_force(nl, nmode, delta, rate, dmax)
+    if nl[L_LIMIT] != 0.0 and nmode == M_VE and fn < 0.0:
+        return 0.0
+    return fn
+
+
+@njit(cache=True)
 def _accelerations(y, geo, fvec0, tau0, tau1, dy):
     g = geo[G_GX:G_GX + 3]
     dy[0:3] = y[3:6]
@@ -292,7 +301,7 @@ def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
     """ψ at a nearby state, with |Fn| taken on the branch of the base point (fsign·Fn), so that a one-sided
     difference does not straddle the kink of |Fn| where a viscous normal force changes sign."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
     psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
     return psi
 
@@ -300,7 +309,7 @@ def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
 @njit(cache=True)
 def _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    fn = _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
     return return_map(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
 
 
@@ -337,9 +346,7 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     nmode = aux[A_NMODE]
     contact = nmode != M_PRE
-    fn = _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
-    if contact and nl[L_LIMIT] != 0.0 and nmode == M_VE and fn < 0.0:
-        fn = 0.0
+    fn = _contact_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
     fabs = abs(fn)
     kind = tl[T_KIND]
     slipping = aux[A_TMODE] == SLIP
@@ -438,7 +445,7 @@ def _settle(y, aux, nl, tl, geo, rules):
             # would unload the history (λ < 0) sticks from there
             y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-            if lam < 0.0:
+            if lam < 0.0 and fn != 0.0:
                 aux[A_TMODE] = STICK
         return
     if kind == SLIDING:
@@ -452,6 +459,11 @@ def _settle(y, aux, nl, tl, geo, rules):
     if psi > 1e-12 * max(tl[T_MU_S] * abs(fn), 1e-300):
         aux[A_TMODE] = SLIP
         y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+        if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            # as at a stick→slip event: from the surface, a slip that would unload the history sticks
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            if lam < 0.0 and fn != 0.0:
+                aux[A_TMODE] = STICK
 
 
 @njit(cache=True)
@@ -520,6 +532,8 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
             return _dot(vt, aux[A_TREF:A_TREF + 3])
         if kind == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
             return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
+        if fn == 0.0:  # a zero cap (limit_force, force ended) admits only the slip state's zero force
+            return 1.0
         return lam
     if slot == 7:
         if kind == WALTON:

@@ -247,9 +247,11 @@ def _tti(pair, params, normal):
     c = 8.0 * pair.g_eff  # = √(2R)E/((2−ν)(1+ν)) √δn for like spheres of radius R (seed 000)
     if normal.kind == HYSTERETIC:
         raise ConfigError("contact.normal", "hls", "tangential model 'tti' takes ηt = ηn from a viscoelastic normal model")
-    return (TangentialLaw(SPRING, kt=c, kt_sqrt=True, eta=1.0, eta_normal=True, truncation=TRUNC_MAW,
+    trunc = _truncation(params)
+    return (TangentialLaw(SPRING, kt=c, kt_sqrt=True, eta=1.0, eta_normal=True, truncation=trunc,
                           **_base(pair, mu)),
-            {"kt_coefficient": c, "eta_t": "eta_n", "friction": mu[0], "friction_kinetic": mu[1]})
+            {"kt_coefficient": c, "eta_t": "eta_n", "truncation": params.get("truncation", "force"),
+             "friction": mu[0], "friction_kinetic": mu[1]})
 
 
 def _walton(pair, params, normal):
@@ -319,7 +321,8 @@ register(TangentialModel(
 register(TangentialModel(
     id="tti", seed_name="TTIt", aliases=("ttit",), title="Tsuji, Tanaka & Ishida tangential",
     formula="Ft = −Kt ξ − ηn δn^{b} v_t, Kt = 8Ḡ√(R̄δn) (= √(2R)E/((2−ν)(1+ν))√δn for like spheres), |Ft| ≤ μ|Fn|",
-    source="seed 000 §4.7 '4) TTIt model'", params=_MU, resolve=_tti, example={"friction": 0.3},
+    source="seed 000 §4.7 '4) TTIt model'", params=(Param("truncation", "force | overlap | spring", "force"), *_MU),
+    resolve=_tti, example={"friction": 0.3},
 ))
 register(TangentialModel(
     id="walton", seed_name="Incrementally slipping friction", aliases=("walton_braun",),
