@@ -1,4 +1,4 @@
-"""Command line: ``demcheck models | collide | sweep | verify`` (DESIGN.md "Command line").
+"""Command line: ``demcheck models | collide | deck | sweep | verify`` (DESIGN.md "Command line").
 
 Exit codes: 0 success, 1 an unexpected disagreement or a failed run, 2 bad input or usage.
 ``--json`` prints one JSON object on stdout and nothing else there.
@@ -64,29 +64,32 @@ def models(as_json):
                         "params": {p.name: p.meaning for p in m.params}})
         return out
 
+    from .inputs import mapping
+
     table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
-    try:
-        from .inputs import mapping
-    except ImportError:  # pragma: no cover - engines not yet wired
-        mapping = None
-    if mapping is not None:
-        for row in table:
-            row["engines"] = mapping.describe(row["slot"], row["id"])
+    engines = mapping.by_model()
+    for row in table:
+        row["engines"] = engines[(row["slot"], row["id"])]
     if as_json:
         emit_json({"models": table})
         return
     from rich.console import Console
     from rich.table import Table
 
-    t = Table(title="demcheck models", show_lines=True)
-    for col in ("slot", "id", "seed", "formula", "source"):
+    t = Table(title="demcheck models (engine mapping of each model, on a glass pair, with the partner shown)",
+              show_lines=True)
+    for col in ("slot", "id", "seed", "formula", "source", "lammps 22Jul2025", "liggghts 3.8.0"):
         t.add_column(col)
-    if mapping is not None:
-        t.add_column("engines")
     for row in table:
         cells = [row["slot"], row["id"], row["seed_name"], row["formula"], row["source"]]
-        if mapping is not None:
-            cells.append("\n".join(f"{k}: {v['fidelity']}" for k, v in row["engines"].items()))
+        for e in mapping.ENGINES:
+            m = row["engines"][e]
+            text = f"[bold]{m['fidelity']}[/] ({m['with']})"
+            if m["config"]:
+                text += f"\n{m['config']}"
+            if m["reason"]:
+                text += f"\n{m['reason']}"
+            cells.append(text)
         t.add_row(*cells)
     Console().print(t)
 
@@ -99,35 +102,124 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
+@click.option("--engine", "engine", type=click.Choice(["reference", "lammps", "liggghts", "all"]),
+              default="reference", show_default=True,
+              help="the source(s): the reference, an engine (its deck run for real), or all side by side")
 @click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
               help="reference method (default: the case's run.method, adaptive)")
-@click.option("--dt", type=float, default=None, help="time step of the verlet method (s)")
+@click.option("--dt", type=float, default=None, help="time step of the verlet method and of the engines (s)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--plot", type=click.Path(dir_okay=False), default=None, help="write force–overlap and force–time panels")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="write the contact time series")
-def collide(case_path, method, dt, overrides, as_json, plot, csv_path):
-    """Solve one collision case and print its metrics."""
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
+              help="write the contact time series (of the first source)")
+@click.option("--timeout", type=float, default=600.0, show_default=True, help="engine run timeout (s)")
+def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout):
+    """Solve one collision case and print its metrics (per source, side by side)."""
+    from .errors import EngineNotFound, UnsupportedByEngine
     from .reference.collision import collide as run
 
     case = _load(case_path, overrides)
     if dt is not None and not dt > 0:
         raise ConfigError("--dt", dt, "must be > 0 (s)")
-    result = run(case, method=method, dt=dt)
-    if csv_path:
-        result.contact.to_csv(csv_path, index=False, float_format="%.17g")
-    if plot:
+    if timeout <= 0:
+        raise ConfigError("--timeout", timeout, "must be > 0 (s)")
+    sources = ["reference", "lammps", "liggghts"] if engine == "all" else [engine]
+    results, skipped = {}, {}
+    for src in sources:
+        if src == "reference":
+            results[src] = run(case, method=method, dt=dt)
+            continue
+        from .engines.collide import collide as run_engine
+
+        try:
+            results[src] = run_engine(case, src, dt=dt, timeout=timeout)
+        except (UnsupportedByEngine, EngineNotFound) as exc:
+            if engine != "all":
+                raise
+            skipped[src] = str(exc)
+    first = next(iter(results.values()), None)
+    if csv_path and first is not None:
+        from .io import atomic_path
+
+        with atomic_path(csv_path) as tmp:
+            first.contact.to_csv(tmp, index=False, float_format="%.17g")
+    if plot and results:
         from .comparisons.plots import collision_panels
 
-        collision_panels([result], plot)
-    summary = result.summary()
+        collision_panels(list(results.values()), plot)
+    summaries = {k: r.summary() for k, r in results.items()}
     if as_json:
-        emit_json(summary)
+        if engine == "reference" or (engine != "all" and len(summaries) == 1):
+            emit_json(next(iter(summaries.values())))
+        else:
+            emit_json({**summaries, **{k: {"source": k, "status": "skipped", "message": v}
+                                       for k, v in skipped.items()}})
+    elif len(summaries) == 1 and not skipped:
+        _print_summary(next(iter(summaries.values())))
     else:
-        _print_summary(summary)
-    if not result.ok:
-        click.echo(f"demcheck: {result.status}: {result.message}", err=True)
+        _print_side_by_side(summaries, skipped)
+    bad = [r for r in results.values() if not r.ok]
+    for r in bad:
+        click.echo(f"demcheck: {r.source}: {r.status}: {r.message}", err=True)
+    if bad:
         sys.exit(1)
+
+
+def _print_side_by_side(summaries: dict, skipped: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    first = next(iter(summaries.values()), None)
+    if first is not None:
+        m = first["model"]
+        con.print(f"[bold]{first['case']}[/]  normal={m['normal']} tangential={m['tangential']} "
+                  f"limit_force={m['limit_force']}")
+    t = Table(show_header=True)
+    t.add_column("metric")
+    for name, s in summaries.items():
+        label = name if s["source"] == "reference" else f"{name} ({s['engine_version']})"
+        t.add_column(label, justify="right")
+    keys = list(first["metrics"]) if first else []
+    for k in keys:
+        t.add_row(k, *[_fmt(s["metrics"].get(k)) for s in summaries.values()])
+    t.add_row("dt / rtol", *[_fmt(s["dt"] or s["rtol"]) for s in summaries.values()])
+    t.add_row("mapping", *[str(s["params"].get("mapping", "—")) for s in summaries.values()])
+    con.print(t)
+    for name, s in summaries.items():
+        if s["source"] != "reference" and s["message"]:
+            con.print(f"{name}: {s['message']}")
+    for name, why in skipped.items():
+        con.print(f"{name}: skipped — {why}")
+
+
+# ----------------------------------------------------------------------------- deck
+
+
+@cli.command()
+@click.argument("case_path", metavar="CASE")
+@click.option("--engine", type=click.Choice(["lammps", "liggghts"]), required=True)
+@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+              help="write the deck here (files it reads go beside it); default: stdout")
+@click.option("--dt", type=float, default=None, help="time step (s); default: the case's")
+@_set_option
+def deck(case_path, engine, output, dt, overrides):
+    """Write the engine's input deck of a collision case (runnable by hand: lmp -in / liggghts -in)."""
+    from .engines.collide import deck as make_deck
+
+    case = _load(case_path, overrides)
+    if dt is not None and not dt > 0:
+        raise ConfigError("--dt", dt, "must be > 0 (s)")
+    dk = make_deck(case, engine, dt)
+    if output:
+        for path in dk.write(output):
+            click.echo(f"wrote {path}", err=True)
+    else:
+        click.echo(dk.text, nl=False)
+        for name, text in dk.files.items():
+            click.echo(f"# --- {name} (read by the deck; written beside it with -o) ---\n"
+                       + "\n".join(f"# {line}" for line in text.splitlines()))
 
 
 def _fmt(v):

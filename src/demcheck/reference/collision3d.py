@@ -19,7 +19,7 @@ from .tangential import TRUNC_MAW
 # verlet method the history is rotated into the new tangent plane keeping its length.
 SEED_RULES = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "rescale"}
 _ARMS = {"contact": k3.ARM_CONTACT, "radius": k3.ARM_RADIUS}
-_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE}
+_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE, "lammps": k3.ROT_LAMMPS}
 
 
 def rules_array(rules: dict | None = None) -> np.ndarray:

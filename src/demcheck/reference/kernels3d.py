@@ -38,7 +38,7 @@ G_SIZE = 17
 # rules array
 R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION = 0, 1, 2, 3
 ARM_CONTACT, ARM_RADIUS = 0, 1
-ROT_NONE, ROT_PROJECT, ROT_RESCALE = 0, 1, 2
+ROT_NONE, ROT_PROJECT, ROT_RESCALE, ROT_LAMMPS = 0, 1, 2, 3
 # aux array: dmax, L*(3), t_ref(3), normal mode, tangential mode (0 stick, 1 slip)
 A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
 A_SIZE = 9
@@ -203,11 +203,11 @@ def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
     mu = tl[T_MU_K] if slipping else tl[T_MU_S]
     vn = _norm(vt)
     if kind == VISCOUS:
-        return -tl[T_ETA] * vt
+        return -eta_of(tl, nl, delta) * vt
     if kind == VISCOUS_SLIDING:
         if vn == 0.0:
             return np.zeros(3)
-        return -(min(tl[T_ETA] * vn, tl[T_MU_K] * fn_abs) / vn) * vt
+        return -(min(eta_of(tl, nl, delta) * vn, tl[T_MU_K] * fn_abs) / vn) * vt
     if kind == SLIDING:
         if vn > 0.0:
             return -(tl[T_MU_K] * fn_abs / vn) * vt
@@ -538,7 +538,7 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
     if slot == 7:
         if kind == WALTON:
             return _dot(vt, _tangent_history(y, n))
-        return tl[T_ETA] * _norm(vt) - tl[T_MU_K] * abs(fn)
+        return eta_of(tl, nl, delta) * _norm(vt) - tl[T_MU_K] * abs(fn)
     return 1.0
 
 
@@ -845,6 +845,10 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
                 if rules[R_ROTATION] == ROT_RESCALE:
                     hist = _rotate_history(hist, n, ROT_RESCALE)
+                elif rules[R_ROTATION] == ROT_LAMMPS:
+                    # LAMMPS turns the history only when its normal part matters: |ξ·n| Kt > 1e-10 μ|Fn|
+                    if abs(_dot(hist, n)) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs:
+                        hist = _rotate_history(hist, n, ROT_RESCALE)
                 if kind == WALTON:
                     vl = _dot(vt, hist)
                     if (vl < 0.0 and prev_vl > 0.0) or (vl > 0.0 and prev_vl < 0.0):

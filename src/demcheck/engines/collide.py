@@ -1,0 +1,107 @@
+"""One collision case in an engine: deck → run → dump → Result (with the engine's version)."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..case import Case
+from ..errors import EngineFailed
+from ..inputs import common, lammps as lammps_deck, liggghts as liggghts_deck
+from ..result import Result
+from . import dumps, run as runner, states
+
+WRITERS = {"lammps": lammps_deck.deck, "liggghts": liggghts_deck.deck}
+
+
+def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, native=None,
+         **options) -> common.Deck:
+    return WRITERS[engine](case, dt, length, native=native, **options)
+
+
+def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
+            timeout: float = runner.DEFAULT_TIMEOUT, native=None, **options) -> Result:
+    """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
+    four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
+    ``options`` go to the deck writer."""
+    mp = common.contact_mapping(case, engine, native)
+    native = mp.require()
+    started = time.perf_counter()
+    length = 1.0
+    for _ in range(4):
+        dk = deck(case, engine, dt, length, native=native, **options)
+        text = dk.text
+        out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files)
+        table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
+        particles = _particles(table, case, _dt_of(text))
+        contact = states.trim(states.from_particles(particles, case))
+        d = contact["delta"].to_numpy()
+        if (d > 0).any() and d[-1] <= 0:
+            break
+        length *= 4.0
+    else:
+        raise EngineFailed(f"{engine}: the contact had not ended after {length / 4:g}× the expected duration; "
+                           f"work directory kept: {out.workdir}")
+    used_dt = _dt_of(text)
+    sc = common.scene(case, dt, length)
+    return Result(
+        source=engine, method="engine", case_name=case.name, case_hash=case.hash,
+        model={"normal": case.contact.normal, "tangential": case.contact.tangential,
+               "limit_force": case.contact.limit_force},
+        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(native)},
+        contact=contact, particles=particles, dt=used_dt, wall_time=time.perf_counter() - started,
+        engine_version=out.version, status="ok",
+        message="; ".join(mp.reasons),
+        meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": text, "fidelity": mp.fidelity},
+    )
+
+
+def _dt_of(text: str) -> float:
+    for line in text.splitlines():
+        if line.startswith("timestep "):
+            return float(line.split()[1])
+    raise ValueError("deck without a timestep")
+
+
+def _particles(table: pd.DataFrame, case: Case, dt: float) -> pd.DataFrame:
+    out = pd.DataFrame({
+        "t": table["step"].to_numpy() * dt, "id": table["id"].to_numpy() - 1,
+        "x": table["x"], "y": table["y"], "z": table["z"], "vx": table["vx"], "vy": table["vy"], "vz": table["vz"],
+        "wx": table["omegax"], "wy": table["omegay"], "wz": table["omegaz"],
+        "fx": table["fx"], "fy": table["fy"], "fz": table["fz"], "tx": table["tqx"], "ty": table["tqy"],
+        "tz": table["tqz"]})
+    return out.reset_index(drop=True)
+
+
+def _native_summary(native) -> dict:
+    from ..inputs.mapping import native_summary
+
+    return {"engine": native.engine, "config": native_summary(native)}
+
+
+def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
+    """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
+    off its states exactly as an engine's is."""
+    from ..inputs.mapping import RULES, twin_model
+    from ..reference import collision3d
+    from ..reference.model import resolve
+
+    mp = common.contact_mapping(case, engine, native)
+    model = twin_model(resolve(case), mp.require())
+    res = collision3d.collide(case, model, "verlet", dt=dt, rules=RULES[engine])
+    c = res.contact
+    parts = res.particles.copy()
+    f0 = -c["fn"].to_numpy()[:, None] * c[["nx", "ny", "nz"]].to_numpy() + c[["ftx", "fty", "ftz"]].to_numpy()
+    p0 = parts["id"] == 0
+    for k, col in enumerate(("fx", "fy", "fz")):
+        parts[col] = np.nan
+        parts.loc[p0, col] = f0[:, k]
+    res.contact = states.trim(states.from_particles(parts, case))
+    res.particles = parts
+    res.source = f"{engine}-twin"
+    res.meta["fidelity"] = mp.fidelity
+    return res

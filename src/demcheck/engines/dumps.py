@@ -1,0 +1,121 @@
+"""Reading the engines' text dumps.
+
+Both engines write LAMMPS's ``dump custom`` format: blocks of ``ITEM: TIMESTEP``, ``ITEM: NUMBER OF
+ATOMS``, ``ITEM: BOX BOUNDS``, ``ITEM: ATOMS <columns>``, then one row per atom. The column names come
+from the block's own header, so decks may order or extend them freely, and the number of rows may change
+from block to block.
+
+Two readers:
+
+* :func:`read_dump` — demcheck's float64 parser. Two-body comparisons need it: positions are ~10³ times the
+  overlap, so the float32 coordinates of a general-purpose reader keep only ~4 digits of δ.
+* :func:`read_dump_mdanalysis` — MDAnalysis's LAMMPS ``DumpReader`` (float32 positions), for packings
+  where positions matter to ~1e-7 of the box and the reader's trajectory tools are worth having.
+
+Files may be gzip-compressed (``.gz``). A malformed file raises :class:`ParseError` naming the file, the
+line and what was expected.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ParseError
+
+
+def _open(path: Path):
+    if path.suffix == ".gz":
+        return io.TextIOWrapper(gzip.open(path, "rb"), encoding="ascii", errors="replace")
+    return open(path, encoding="ascii", errors="replace")
+
+
+def read_dump(path, columns: tuple[str, ...] | None = None) -> pd.DataFrame:
+    """All blocks of a dump as one float64 table with a ``step`` column (the engine's timestep) and the
+    dump's own columns (``id`` and ``type`` as integers). ``columns``: ones that must be present."""
+    path = Path(path)
+    if not path.exists():
+        raise ParseError(f"{path}: no such dump file")
+    steps, blocks, names = [], [], None
+    with _open(path) as fh:
+        lines = iter(enumerate(fh, start=1))
+
+        def expect(prefix: str) -> tuple[int, str]:
+            try:
+                no, line = next(lines)
+            except StopIteration:
+                raise ParseError(f"{path}: ended early; expected '{prefix}'") from None
+            if not line.startswith(prefix):
+                raise ParseError(f"{path}:{no}: expected '{prefix}', found {line.strip()[:60]!r}")
+            return no, line
+
+        def value_line(what: str) -> tuple[int, str]:
+            try:
+                return next(lines)
+            except StopIteration:
+                raise ParseError(f"{path}: ended early inside a block; expected {what}") from None
+
+        while True:
+            try:
+                no, line = next(lines)
+            except StopIteration:
+                break
+            if not line.strip():
+                continue
+            if not line.startswith("ITEM: TIMESTEP"):
+                raise ParseError(f"{path}:{no}: expected 'ITEM: TIMESTEP', found {line.strip()[:60]!r}")
+            no, line = value_line("a timestep")
+            try:
+                step = int(line.split()[0])
+            except (ValueError, IndexError):
+                raise ParseError(f"{path}:{no}: timestep is not an integer: {line.strip()[:60]!r}") from None
+            expect("ITEM: NUMBER OF ATOMS")
+            no, line = value_line("a number of atoms")
+            try:
+                natoms = int(line.split()[0])
+            except (ValueError, IndexError):
+                raise ParseError(f"{path}:{no}: number of atoms is not an integer: {line.strip()[:60]!r}") from None
+            no, line = expect("ITEM: BOX BOUNDS")
+            for _ in range(3):
+                value_line("box bounds")
+            no, line = expect("ITEM: ATOMS")
+            cols = tuple(line.split()[2:])
+            if names is None:
+                names = cols
+            elif cols != names:
+                raise ParseError(f"{path}:{no}: columns changed from {' '.join(names)} to {' '.join(cols)}")
+            rows = []
+            for _ in range(natoms):
+                no, line = value_line(f"{natoms} atom rows")
+                parts = line.split()
+                if len(parts) != len(cols):
+                    raise ParseError(f"{path}:{no}: {len(parts)} values for {len(cols)} columns")
+                try:
+                    rows.append([float(x) for x in parts])
+                except ValueError:
+                    raise ParseError(f"{path}:{no}: not a number in {line.strip()[:60]!r}") from None
+            steps.append(np.full(natoms, step, dtype=np.int64))
+            blocks.append(np.array(rows, dtype=np.float64).reshape(natoms, len(cols)))
+    if names is None:
+        raise ParseError(f"{path}: empty dump (no ITEM: TIMESTEP block)")
+    missing = [c for c in (columns or ()) if c not in names]
+    if missing:
+        raise ParseError(f"{path}: missing column(s) {', '.join(missing)} (has {' '.join(names)})")
+    table = pd.DataFrame(np.concatenate(blocks) if blocks else np.empty((0, len(names))), columns=list(names))
+    for c in ("id", "type"):
+        if c in table:
+            table[c] = table[c].astype(np.int64)
+    table.insert(0, "step", np.concatenate(steps))
+    return table
+
+
+def read_dump_mdanalysis(path):
+    """The dump as an MDAnalysis Universe (float32 positions; see the module docstring for when that is
+    enough)."""
+    import MDAnalysis as mda
+
+    return mda.Universe(str(path), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled")

@@ -1,0 +1,94 @@
+"""Running an engine: one subprocess per run, in its own work directory, with a timeout.
+
+LAMMPS and LIGGGHTS export the same C symbols, so they never share a process. A failed run keeps its work
+directory and its error names it and quotes the tail of the log; a run past its timeout is killed and
+reported as such.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import EngineFailed, EngineNotFound
+from . import discovery
+
+DEFAULT_TIMEOUT = 600.0
+# the engines' own warnings, as they print them
+_WARNING = re.compile(r"^WARNING:?\s*(.*)$", re.M)
+_ERROR = re.compile(r"^(?:ERROR|ERROR on proc \d+):?\s*(.*)$", re.M)
+
+
+class EngineTimeout(EngineFailed):
+    pass
+
+
+@dataclass
+class RunOutput:
+    engine: str
+    version: str
+    workdir: Path
+    log: str
+    wall_time: float
+    warnings: list[str] = field(default_factory=list)
+
+
+def log_tail(text: str, lines: int = 15) -> str:
+    return "\n".join(text.rstrip().splitlines()[-lines:])
+
+
+def warnings_of(log: str) -> list[str]:
+    return [w.strip() for w in _WARNING.findall(log)]
+
+
+def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: float = DEFAULT_TIMEOUT,
+        files: dict[str, str] | None = None) -> RunOutput:
+    """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it."""
+    info = discovery.find(engine)
+    if info is None:
+        raise EngineNotFound(f"{engine} is not installed: {discovery.HOW_TO_INSTALL[engine]}")
+    wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
+    wd.mkdir(parents=True, exist_ok=True)
+    (wd / "in.deck").write_text(deck)
+    for name, text in (files or {}).items():
+        (wd / name).write_text(text)
+    cmd = [info.executable, "-in", "in.deck", "-log", "log.txt", "-screen", "screen.txt"]
+    if engine == "liggghts":
+        cmd += ["-echo", "none"]
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    started = time.perf_counter()
+    proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        log = _read_log(wd, out)
+        raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
+                            f"kept: {wd}\n{log_tail(log)}") from None
+    wall = time.perf_counter() - started
+    log = _read_log(wd, out)
+    errors = _ERROR.findall(log)
+    if proc.returncode != 0 or errors:
+        what = errors[0] if errors else f"exit code {proc.returncode}"
+        raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
+    return RunOutput(engine, info.version, wd, log, wall, warnings_of(log))
+
+
+def _read_log(wd: Path, out: str | None) -> str:
+    parts = []
+    for name in ("log.txt", "screen.txt"):
+        p = wd / name
+        if p.exists():
+            parts.append(p.read_text(errors="replace"))
+    if out:
+        parts.append(out)
+    # the log and the screen carry the same lines; keep the longer account
+    return max(parts, key=len) if parts else ""

@@ -1,0 +1,79 @@
+"""Contact tables from the bodies' states, the same way for every time-stepped source.
+
+An engine's dump gives, per step, the end-of-step positions, velocities, angular velocities and the forces
+of that step; a two-body contact is read off them (per-contact output would be re-evaluated at output
+time, ENGINES.md §1.6 and §2.4). The reference's verlet twin is read off its own states through the same
+function, so engine and twin are compared quantity by quantity with nothing but the engine in between.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+
+def contact_table(t, x0, v0, w0, f0, r0, m0, *, x1=None, v1=None, w1=None, r1=None, m1=None,
+                  wall_point=None, wall_normal=None) -> pd.DataFrame:
+    """Columns as the reference's 3-D tables: δ, δ̇ (end-of-step velocities), Fn (= −F0·n, repulsive > 0),
+    Ft (F0's tangential part), slip velocity (arms R − δ/2), n, relative velocity, ω0, kinetic energy."""
+    t = np.asarray(t, float)
+    x0, v0, w0, f0 = (np.asarray(a, float) for a in (x0, v0, w0, f0))
+    if wall_normal is not None:
+        nw = np.asarray(wall_normal, float)
+        n = np.broadcast_to(-nw, x0.shape).copy()
+        dist = (x0 - np.asarray(wall_point, float)) @ nw
+        delta = r0 - dist
+        vr = v0.copy()
+        a0 = r0 - 0.5 * delta
+        vc = v0 + np.cross(w0, a0[:, None] * n)
+        energy = 0.5 * m0 * np.einsum("ij,ij->i", v0, v0) + 0.5 * (0.4 * m0 * r0 * r0) * np.einsum("ij,ij->i", w0, w0)
+    else:
+        x1, v1, w1 = (np.asarray(a, float) for a in (x1, v1, w1))
+        d = x1 - x0
+        dist = np.linalg.norm(d, axis=1)
+        n = d / dist[:, None]
+        delta = r0 + r1 - dist
+        vr = v0 - v1
+        a0, a1 = r0 - 0.5 * delta, r1 - 0.5 * delta
+        vc = v0 + np.cross(w0, a0[:, None] * n) - (v1 + np.cross(w1, -a1[:, None] * n))
+        energy = (0.5 * m0 * np.einsum("ij,ij->i", v0, v0) + 0.5 * (0.4 * m0 * r0 * r0) * np.einsum("ij,ij->i", w0, w0)
+                  + 0.5 * m1 * np.einsum("ij,ij->i", v1, v1) + 0.5 * (0.4 * m1 * r1 * r1) * np.einsum("ij,ij->i", w1, w1))
+    rate = np.einsum("ij,ij->i", vr, n)
+    fn = -np.einsum("ij,ij->i", f0, n)
+    ft = f0 + fn[:, None] * n
+    vt = vc - np.einsum("ij,ij->i", vc, n)[:, None] * n
+    return pd.DataFrame({
+        "t": t, "delta": delta, "delta_dot": rate, "fn": fn,
+        "ftx": ft[:, 0], "fty": ft[:, 1], "ftz": ft[:, 2], "vtx": vt[:, 0], "vty": vt[:, 1], "vtz": vt[:, 2],
+        "nx": n[:, 0], "ny": n[:, 1], "nz": n[:, 2], "vrx": vr[:, 0], "vry": vr[:, 1], "vrz": vr[:, 2],
+        "w0x": w0[:, 0], "w0y": w0[:, 1], "w0z": w0[:, 2], "energy": energy,
+    })
+
+
+def trim(table: pd.DataFrame) -> pd.DataFrame:
+    """Up to the first step after the contact ended (as the reference's verlet method stops)."""
+    d = table["delta"].to_numpy()
+    inside = np.flatnonzero(d > 0)
+    if not inside.size:
+        return table
+    after = np.flatnonzero(d[inside[0]:] <= 0)
+    if not after.size:
+        return table
+    return table.iloc[: inside[0] + int(after[0]) + 1].reset_index(drop=True)
+
+
+def from_particles(particles: pd.DataFrame, case) -> pd.DataFrame:
+    """The contact table of a case's two bodies from a particles table with forces (t, id, x.., v.., w..,
+    fx..) — ids 0 and 1 in the case's order."""
+    p0 = particles[particles["id"] == 0].sort_values("t")
+    t = p0["t"].to_numpy()
+    r0, m0 = case.particles[0].radius, case.mass(0)
+    cols = (["x", "y", "z"], ["vx", "vy", "vz"], ["wx", "wy", "wz"], ["fx", "fy", "fz"])
+    a0 = [p0[c].to_numpy() for c in cols]
+    if case.walls:
+        w = case.walls[0]
+        return contact_table(t, *a0, r0, m0, wall_point=w.point, wall_normal=w.normal)
+    p1 = particles[particles["id"] == 1].sort_values("t")
+    a1 = [p1[c].to_numpy() for c in cols[:3]]
+    return contact_table(t, *a0, r0, m0, x1=a1[0], v1=a1[1], w1=a1[2], r1=case.particles[1].radius,
+                         m1=case.mass(1))

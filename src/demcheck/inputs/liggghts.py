@@ -1,0 +1,134 @@
+"""LIGGGHTS decks (`pair_style gran`, `fix wall/gran … primitive`), for LIGGGHTS-PUBLIC 3.8.0.
+
+Per-pair coefficients go into ``fix property/global … peratomtypepair`` matrices, one atom type per
+particle and, for a wall, one more type for the wall primitive. LIGGGHTS checks Young's moduli against
+5e6 ≤ E ≤ 1e9 Pa; ``hard_particles yes`` (or ``soft_particles yes``) is written when a modulus is outside.
+A rigid wall is a wall type of modulus 1e30 Pa: E* then equals the particle's E/(1−ν²) to round-off.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..case import Case
+from ..errors import UnsupportedByEngine
+from . import common
+from .common import fmt
+
+VERSION_NOTE = "written for LIGGGHTS-PUBLIC 3.8.0 (pair_style gran)"
+RIGID_WALL_MODULUS = 1e30
+
+
+def _matrix(name: str, values: np.ndarray) -> str:
+    n = values.shape[0]
+    return (f"fix m_{name} all property/global {name} peratomtypepair {n} "
+            + " ".join(fmt(x) for x in values.ravel()))
+
+
+def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
+         data_name: str = "data.lmp") -> common.Deck:
+    """The deck of a collision case (``native``: one configuration for every type pair instead of the case's
+    mapped model)."""
+    sc = common.scene(case, dt, length)
+    mp = common.contact_mapping(case, "liggghts", native)
+    nat = mp.require()
+    n = len(case.particles)
+    ntypes = n + (1 if case.walls else 0)
+    lo, hi = sc.box
+    lines = common.header("liggghts", sc, mp, VERSION_NOTE)
+    for c in nat.comments:
+        lines.append(f"#   {c}")
+    # every type pair's configuration (the wall type pairs with each particle)
+    natives = {}
+    for i, j in common.type_pairs(case):
+        pm = common.pair_mapping(case, "liggghts", i, j, native)
+        if pm.native is None:
+            raise UnsupportedByEngine(f"type pair {i + 1} {j + 1 if j is not None else 'wall'}: "
+                                      f"{'; '.join(pm.reasons)}")
+        if pm.native.normal != nat.normal or pm.native.tangential != nat.tangential:
+            raise UnsupportedByEngine("LIGGGHTS has one gran model per pair style: type pairs map differently")
+        natives[(i, n if j is None else j)] = pm.native
+    props = sorted({k for v in natives.values() for k in v.props if k not in ("youngs_eff", "shear_eff", "kl")})
+    names = {"kn": "kn", "kt": "kt", "gamman": "gamman", "gammat": "gammat", "friction": "coefficientFriction",
+             "restitution": "coefficientRestitution", "unloading": "UnloadingStiffness",
+             "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy"}
+    matrices = {}
+    for key in props:
+        # pairs that never meet (the wall type with itself) take the contact's own value: LIGGGHTS checks
+        # every entry against its sanity limits
+        mat = np.full((ntypes, ntypes), nat.props.get(key, 0.0))
+        for (i, j), v in natives.items():
+            mat[i, j] = mat[j, i] = v.props.get(key, 0.0)
+        matrices[names[key]] = mat
+    if nat.tangential != "off" and "coefficientFriction" not in matrices:
+        matrices["coefficientFriction"] = np.zeros((ntypes, ntypes))
+    moduli = []
+    if nat.normal == "edinburgh":
+        # K_L = 2E*R̄ of the contact: equal moduli E for the particles give E* = E/(2(1−ν²)); a rigid wall
+        # type of modulus 1e30 gives E* = E/(1−ν²)
+        nu = case.materials[case.particles[0].material].poisson_ratio
+        r_eff = sc.model.pair.r_eff
+        if case.walls:
+            if not case.walls[0].rigid:
+                raise UnsupportedByEngine("edinburgh (HLS) decks are written for rigid walls")
+            e_part = (1.0 - nu * nu) * nat.props["kl"] / (2.0 * r_eff)
+            moduli, ratios = [e_part] * n + [RIGID_WALL_MODULUS], [nu] * (n + 1)
+        else:
+            moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * n, [nu] * n
+    if nat.normal == "hertz":
+        mats = [case.materials[p.material] for p in case.particles]
+        moduli = [m.youngs_modulus for m in mats]
+        ratios = [m.poisson_ratio for m in mats]
+        if case.walls:
+            w = case.walls[0]
+            if w.rigid:
+                moduli.append(RIGID_WALL_MODULUS)
+                ratios.append(ratios[0])
+            else:
+                wm = case.materials[w.material]
+                moduli.append(wm.youngs_modulus)
+                ratios.append(wm.poisson_ratio)
+    lines += ["", "units si", "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+              "communicate single vel yes",
+              f"read_data {data_name}"]
+    # read_data sets the angular velocities (3.8.0's set has no omega); masses are then set exactly
+    for k in range(1, n + 1):
+        lines.append(f"set atom {k} mass {fmt(case.mass(k - 1))}")
+    rmax = max(p.radius for p in case.particles)
+    lines += ["", f"neighbor {fmt(rmax)} bin", "neigh_modify delay 0", ""]
+    if moduli:
+        lines.append(f"fix m_E all property/global youngsModulus peratomtype {' '.join(fmt(x) for x in moduli)}")
+        lines.append(f"fix m_nu all property/global poissonsRatio peratomtype {' '.join(fmt(x) for x in ratios)}")
+    for name, mat in matrices.items():
+        lines.append(_matrix(name, mat))
+    if nat.normal == "edinburgh":
+        lines += ["fix m_cex all property/global adhesionExponent scalar 1",
+                  "fix m_dex all property/global overlapExponent scalar 1"]
+    style = f"model {nat.normal}"
+    style += f" tangential {'off' if nat.tangential == 'off' else nat.tangential}"
+    flags = ["fixKc on"] if nat.normal == "edinburgh" else []
+    if nat.tangential == "history" and not nat.tangential_damping:
+        flags.append("tangential_damping off")
+    flags.append(f"limitForce {'on' if nat.limit else 'off'}")
+    if moduli and max(moduli) > 1e9:
+        lines.append("hard_particles yes  # a Young's modulus above LIGGGHTS's 1e9 Pa sanity limit")
+    if moduli and min(moduli) < 5e6:
+        lines.append("soft_particles yes  # a Young's modulus below LIGGGHTS's 5e6 Pa sanity limit")
+    lines += [f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
+    if case.walls:
+        axis = "xyz"[sc.wall_axis]
+        lines += ["", f"# the wall: primitive of type {ntypes}",
+                  f"fix wall all wall/gran {style} primitive type {ntypes} {axis}plane {fmt(sc.wall_position)} "
+                  f"{' '.join(flags)}"]
+    g = list(case.run.gravity)
+    gn = sum(x * x for x in g) ** 0.5
+    if gn > 0:
+        lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(x / gn) for x in g)}")
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(common.DUMP_COLUMNS) - 2))
+    lines += ["", "fix integrate all nve/sphere", f"timestep {fmt(sc.dt)}",
+              f"dump state all custom 1 {common.DUMP_FILE} {' '.join(common.DUMP_COLUMNS)}",
+              f'dump_modify state format "{fmt_line}" sort id',
+              "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
+              f"run {sc.steps}", ""]
+    data = common.data_file(case, ntypes, sc.box, f"demcheck: case {case.name} (hash {case.hash})")
+    return common.Deck("liggghts", "\n".join(lines), {data_name: data})
