@@ -96,3 +96,54 @@ def test_sweep_grid_and_bad_vary():
     assert len(json.loads(p.stdout)["rows"]) == 4
     bad = demcheck("sweep", CASES / "glass-pair.toml", "--vary", "impact.speed=1:2:x")
     assert bad.returncode == 2 and "--vary impact.speed = '1:2:x': START and STOP must be numbers" in bad.stderr
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("liggghts")
+def test_collide_all_sources_side_by_side_in_json():
+    p = demcheck("collide", CASES / "oblique-viscous-sliding-pair.toml", "--engine", "all", "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert set(out) == {"reference", "lammps", "liggghts"}
+    assert "22 Jul 2025" in out["lammps"]["engine_version"]
+    assert out["liggghts"]["engine_version"].startswith("LIGGGHTS-PUBLIC 3.8.0")
+    assert out["lammps"]["params"]["mapping"] == "exact"
+    # the same collision: the engines at the case's dt against the converged reference
+    for src in ("lammps", "liggghts"):
+        assert out[src]["metrics"]["restitution"] == pytest.approx(out["reference"]["metrics"]["restitution"],
+                                                                   rel=1e-2)
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("liggghts")
+def test_collide_all_prints_a_table_and_says_what_is_not_expressible():
+    p = demcheck("collide", CASES / "hls-constant-pair.toml", "--engine", "all")
+    assert p.returncode == 0, p.stderr
+    assert "lammps: skipped — lammps cannot express this model" in " ".join(p.stdout.split())
+    assert "liggghts (LIGGGHTS-PUBLIC 3.8.0)" in " ".join(p.stdout.split()) or "LIGGGHTS-PUBLIC" in p.stdout
+
+
+def test_deck_to_stdout_and_to_a_file(tmp_path):
+    p = demcheck("deck", CASES / "oblique-lsd-wall.toml", "--engine", "lammps")
+    assert p.returncode == 0, p.stderr
+    assert "pair_style granular" in p.stdout and "fix wall all wall/gran granular" in p.stdout
+    assert "# mapping fidelity: approximate" in p.stdout
+    out = tmp_path / "in.oblique"
+    p = demcheck("deck", CASES / "oblique-lsd-wall.toml", "--engine", "liggghts", "-o", out)
+    assert p.returncode == 0, p.stderr
+    assert "read_data data.lmp" in out.read_text()
+    assert (tmp_path / "data.lmp").read_text().splitlines()[0].startswith("# demcheck: case oblique-lsd-wall")
+
+
+def test_deck_bad_engine_is_a_usage_error():
+    p = demcheck("deck", CASES / "glass-pair.toml", "--engine", "gromacs")
+    assert p.returncode == 2 and "gromacs" in p.stderr
+
+
+def test_models_shows_the_engine_mapping():
+    p = demcheck("models", "--json")
+    assert p.returncode == 0, p.stderr
+    rows = {(r["slot"], r["id"]): r for r in json.loads(p.stdout)["models"]}
+    assert rows[("normal", "hls")]["engines"]["lammps"]["fidelity"] == "none"
+    assert rows[("normal", "hls")]["engines"]["liggghts"]["fidelity"] == "exact"
+    assert rows[("tangential", "ddt")]["engines"]["lammps"]["config"].endswith("tangential mindlin")

@@ -26,7 +26,9 @@ _ERROR = re.compile(r"^(?:ERROR|ERROR on proc \d+):?\s*(.*)$", re.M)
 
 
 class EngineTimeout(EngineFailed):
-    pass
+    def __init__(self, message: str, pid: int | None = None):
+        super().__init__(message)
+        self.pid = pid  # the engine's process (killed, with its process group)
 
 
 @dataclass
@@ -72,7 +74,7 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         out, _ = proc.communicate()
         log = _read_log(wd, out)
         raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
-                            f"kept: {wd}\n{log_tail(log)}") from None
+                            f"kept: {wd}\n{log_tail(log)}", pid=proc.pid) from None
     wall = time.perf_counter() - started
     log = _read_log(wd, out)
     errors = _ERROR.findall(log)

@@ -442,16 +442,18 @@ def table(examples: list[tuple[str, str]] | None = None) -> list[dict]:
 
     base = tomllib.loads(_TABLE_CASE)
     rows = []
-    combos = examples or ([(n, "none") for n in N.REGISTRY] + [
-        (_PARTNER.get(t, "lsd"), t) for t in T.REGISTRY if t != "none"])
-    for normal, tangential in combos:
-        params = {**N.REGISTRY[normal].example, **T.REGISTRY[tangential].example}
+    combos = examples or ([(n, "none", {}) for n in N.REGISTRY] + [
+        (_PARTNER.get(t, "lsd"), t, {}) for t in T.REGISTRY if t != "none"] + _VARIANTS)
+    for combo in combos:
+        normal, tangential, extra = combo if len(combo) == 3 else (*combo, {})
+        params = {**N.REGISTRY[normal].example, **T.REGISTRY[tangential].example, **extra}
         params.pop("friction", None)
         sets = [f"contact.normal={normal}", f"contact.tangential={tangential}"]
-        sets += [f"contact.{k}={v!r}".replace("'", '"') for k, v in params.items()]
+        sets += [f"contact.{k}={_toml(v)}" for k, v in params.items()]
         case = C.from_dict(C.apply_overrides(copy.deepcopy(base), sets))
         model = resolve(case)
-        row = {"normal": normal, "tangential": tangential}
+        row = {"normal": normal, "tangential": tangential,
+               "variant": ", ".join(f"{k} = {_toml(v)}" for k, v in extra.items())}
         for engine in ENGINES:
             mp = map_model(model, engine, case.contact.params)
             row[engine] = mp.fidelity
@@ -462,6 +464,11 @@ def table(examples: list[tuple[str, str]] | None = None) -> list[dict]:
 
 
 _PARTNER = {"tti": "tti", "ddt": "hertz"}
+# parameter variants whose mapping differs from the model's default row
+_VARIANTS = [("hls", "none", {"unloading": "variable", "S": 1e4, "kl": 3e6}),
+             ("lsd", "viscous", {"limit_force": True}),
+             ("lsd", "lsd_sliding", {"truncation": "overlap"}), ("lsd", "lsd_sliding", {"truncation": "spring"}),
+             ("tti", "tti", {"truncation": "overlap"}), ("kk", "ddt", {})]
 _TABLE_CASE = """
 name = "mapping-table"
 [materials.glass]
@@ -486,11 +493,19 @@ normal = "lsd"
 """
 
 
+def _toml(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return f'"{v}"' if isinstance(v, str) else repr(v)
+
+
 def by_model() -> dict:
     """{(slot, id): {engine: {fidelity, config, reason, with}}} from :func:`table` (``with``: the partner
     model of the other slot the row was evaluated with)."""
     out = {}
     for row in table():
+        if row["variant"] or (row["tangential"] == "ddt" and row["normal"] != "hertz"):
+            continue
         for slot, other in (("normal", "tangential"), ("tangential", "normal")):
             if slot == "normal" and row["tangential"] != "none":
                 continue
@@ -514,3 +529,20 @@ def native_summary(nat: Native) -> str:
     if nat.limit:
         parts.append("limitForce on")
     return " ".join(parts)
+
+
+def markdown_table() -> str:
+    """The mapping table as docs/models.md carries it (tests/test_docs.py keeps the two equal)."""
+    lines = ["| normal | tangential | LAMMPS 22Jul2025 | LIGGGHTS 3.8.0 |", "|---|---|---|---|"]
+    for row in table():
+        cells = []
+        for e in ENGINES:
+            text = f"**{row[e]}**"
+            if row[f"{e}_config"]:
+                text += f": `{row[f'{e}_config']}`"
+            if row[f"{e}_reason"]:
+                text += f" — {row[f'{e}_reason']}"
+            cells.append(text.replace("|", "\\|"))
+        variant = f" ({row['variant']})" if row["variant"] else ""
+        lines.append(f"| `{row['normal']}` | `{row['tangential']}`{variant} | {cells[0]} | {cells[1]} |")
+    return "\n".join(lines) + "\n"
