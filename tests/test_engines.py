@@ -175,3 +175,42 @@ def test_lammps_result_records_version_deck_and_work_directory(tmp_path):
     assert "22 Jul 2025" in res.engine_version
     assert (tmp_path / "run" / "in.deck").read_text() == res.meta["deck"]
     assert (tmp_path / "run" / "dump.txt").exists()
+
+
+# ----------------------------------------------------------------------------- twins no seed model maps to
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.parametrize("style", ["mindlin/force", "mindlin_rescale", "mindlin_rescale/force"])
+@pytest.mark.parametrize("wall", [False, True], ids=["pair", "wall"])
+def test_lammps_mindlin_variants_match_their_twins(style, wall):
+    """Thornton et al.'s incremental-force and rescaled histories, with a dashpot (x_t = 1 on TTIn's
+    damping): they differ from plain mindlin, and the twin reproduces each."""
+    case = oblique_case("tti", {"truncation": "overlap"}, normal="tti", normal_params={}, wall=wall, angle=30.0,
+                        spin=500.0)
+    base = common.contact_mapping(case, "lammps").native
+    nat = Native("lammps", base.normal, base.normal_args, damping=base.damping, damping_coeff=base.damping_coeff,
+                 tangential=style, tangential_args=base.tangential_args)
+    res = collide(case, "lammps", native=nat)
+    m = _agree(res, twin_states(case, "lammps", res.dt, native=nat), OBLIQUE_KEYS)
+    plain = collide(case, "lammps").metrics()
+    assert abs(m["tangential_restitution"] - plain["tangential_restitution"]) > 1e-6
+
+
+@pytest.mark.engine("liggghts")
+@pytest.mark.parametrize("wall", [False, True], ids=["pair", "wall"])
+def test_liggghts_hooke_with_characteristic_velocity_matches_its_twin(wall):
+    """LIGGGHTS hooke: Kn from Hertz's energy at characteristicVelocity — the notes' equal-energy
+    calibration of LSD (1.053 = (16/15)^{4/5}) — with Kt = Kn and γt = γn."""
+    from demcheck.reference.model import resolve
+
+    case = oblique_case("spring_sliding", None, normal="lsd", wall=wall, angle=30.0, spin=500.0)
+    model = resolve(case)
+    nat = Native("liggghts", "hooke", tangential="history",
+                 props={"restitution": 0.9, "youngs_eff": model.pair.e_eff, "friction": 0.3,
+                        "characteristic_velocity": model.pair.impact_speed})
+    nl, tl = nat.twin(model.pair.m_eff, model.pair.r_eff)
+    assert nl.k == pytest.approx(model.normal_law.k, rel=1e-13)  # the seed's energy calibration (example)
+    assert tl.kt == nl.k and tl.eta == nl.eta
+    res = collide(case, "liggghts", native=nat)
+    _agree(res, twin_states(case, "liggghts", res.dt, native=nat), OBLIQUE_KEYS)

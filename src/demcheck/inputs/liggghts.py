@@ -48,7 +48,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         if pm.native.normal != nat.normal or pm.native.tangential != nat.tangential:
             raise UnsupportedByEngine("LIGGGHTS has one gran model per pair style: type pairs map differently")
         natives[(i, n if j is None else j)] = pm.native
-    props = sorted({k for v in natives.values() for k in v.props if k not in ("youngs_eff", "shear_eff", "kl")})
+    props = sorted({k for v in natives.values() for k in v.props
+                    if k not in ("youngs_eff", "shear_eff", "kl", "characteristic_velocity")})
     names = {"kn": "kn", "kt": "kt", "gamman": "gamman", "gammat": "gammat", "friction": "coefficientFriction",
              "restitution": "coefficientRestitution", "unloading": "UnloadingStiffness",
              "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy"}
@@ -75,7 +76,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
             moduli, ratios = [e_part] * n + [RIGID_WALL_MODULUS], [nu] * (n + 1)
         else:
             moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * n, [nu] * n
-    if nat.normal == "hertz":
+    if nat.normal in ("hertz", "hooke"):
         mats = [case.materials[p.material] for p in case.particles]
         moduli = [m.youngs_modulus for m in mats]
         ratios = [m.poisson_ratio for m in mats]
@@ -101,6 +102,9 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         lines.append(f"fix m_nu all property/global poissonsRatio peratomtype {' '.join(fmt(x) for x in ratios)}")
     for name, mat in matrices.items():
         lines.append(_matrix(name, mat))
+    if nat.normal == "hooke":
+        lines.append(f"fix m_vc all property/global characteristicVelocity scalar "
+                     f"{fmt(nat.props['characteristic_velocity'])}")
     if nat.normal == "edinburgh":
         lines += ["fix m_cex all property/global adhesionExponent scalar 1",
                   "fix m_dex all property/global overlapExponent scalar 1"]

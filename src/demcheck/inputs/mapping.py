@@ -108,7 +108,7 @@ def _twin_lammps(nat: Native, m: float, r: float) -> tuple[NormalLaw, Tangential
     elif nat.tangential == "linear_history":
         kt, x_t, mu = args
         tl = twins.tangential_spring(kt, False, x_t, mu, TRUNC_MAW, r, m)
-    elif nat.tangential == "mindlin":
+    elif nat.tangential in ("mindlin", "mindlin/force", "mindlin_rescale", "mindlin_rescale/force"):
         kt, x_t, mu = args
         if kt is None:  # NULL: k_t = 8G* from hertz/material's E and ν, G* = E/(4(2−ν)(1+ν)) (pair and wall)
             if nat.normal != "hertz/material":
@@ -116,6 +116,8 @@ def _twin_lammps(nat: Native, m: float, r: float) -> tuple[NormalLaw, Tangential
             e_mod, nu = nat.normal_args
             kt = 8.0 * e_mod / (4.0 * (2.0 - nu) * (1.0 + nu))
         tl = twins.tangential_spring(kt, True, x_t, mu, TRUNC_MAW, r, m)
+        tl = replace(tl, force_history=nat.tangential.endswith("/force"),
+                     rescale_history=nat.tangential.startswith("mindlin_rescale"))
     else:
         raise ValueError(f"no twin for LAMMPS tangential {nat.tangential!r}")
     return nl, tl
@@ -131,6 +133,11 @@ def _twin_liggghts(nat: Native, m: float, r: float) -> tuple[NormalLaw, Tangenti
         k_el, a = p["kn"] * math.sqrt(r), 1.5
         c, b = twins.damping("stiffness_hertz", p["gamman"], k_el, a, m, r)
         kt, sqrt_law, eta_t = p["kt"], True, None  # γt = gammat m̄ √(R̄δ): the normal law's δ^½
+    elif nat.normal == "hooke":  # characteristic velocity v_c: Kn from Hertz's energy at v_c; Kt = Kn, γt = γn
+        y_eff, vc = p["youngs_eff"], p["characteristic_velocity"]
+        k_el, a = 16.0 / 15.0 * math.sqrt(r) * y_eff * (15.0 * m * vc * vc / (16.0 * math.sqrt(r) * y_eff)) ** 0.2, 1.0
+        c, b = twins.damping("restitution_hooke", p["restitution"], k_el, a, m, r)
+        kt, sqrt_law, eta_t = k_el, False, c
     elif nat.normal == "edinburgh":
         kl = p["kl"]
         return (NormalLaw(HYSTERETIC, kl=kl, ku=kl * p["unloading"], limit=nat.limit), twins.no_friction())
@@ -148,7 +155,7 @@ def _twin_liggghts(nat: Native, m: float, r: float) -> tuple[NormalLaw, Tangenti
     # the tangential dashpot: constant (hooke/stiffness), or a factor of the normal η(δ)
     if not nat.tangential_damping:
         factor, const = 0.0, 0.0
-    elif nat.normal == "hooke/stiffness":
+    elif nat.normal in ("hooke/stiffness", "hooke"):
         factor, const = None, eta_t
     elif nat.normal == "hertz/stiffness":
         factor = p["gammat"] / p["gamman"] if p["gamman"] > 0 else math.nan

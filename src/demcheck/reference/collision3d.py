@@ -79,6 +79,9 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         t_max = max(t_max, math.sqrt(2 * gap / g) + 200.0 * t_c)
     started = time.perf_counter()
     if method == "adaptive":
+        if model.tangential_law.force_history or model.tangential_law.rescale_history:
+            raise ConfigError("--method", method, "the twins of LAMMPS mindlin/force and mindlin_rescale are "
+                              "defined for the engines' scheme only: use the verlet method")
         rtol = rtol or case.run.rtol
         l_scale = 0.3 * v * t_c
         f_scale = model.pair.m_eff * v / t_c

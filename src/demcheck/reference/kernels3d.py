@@ -24,7 +24,8 @@ from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, 
                       L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
                       normal_force, spow, viscoelastic_force)
-from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_G, T_K0, T_KIND, T_KT,
+from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_KIND, T_KT,
+                         T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
                          VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
 
@@ -792,6 +793,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     hist = np.zeros(3)
     lstar = np.zeros(3)
     prev_vl = 0.0
+    a_prev = 0.0
     dmax = 0.0
     sliding = False
     kind = tl[T_KIND]
@@ -842,13 +844,39 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 dmax = delta
             fn = normal_force(nl, delta, rate, dmax)
             fabs = abs(fn)
+            force_hist = kind == SPRING and tl[T_FORCE] != 0.0
+            if kind == SPRING and tl[T_RESCALE] != 0.0:
+                # mindlin_rescale: a shrinking contact radius scales the history by a/a_prev first
+                a_now = math.sqrt(tl[T_R] * delta)
+                if a_now < a_prev:
+                    hist = hist * (a_now / a_prev)
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
                 if rules[R_ROTATION] == ROT_RESCALE:
                     hist = _rotate_history(hist, n, ROT_RESCALE)
                 elif rules[R_ROTATION] == ROT_LAMMPS:
                     # LAMMPS turns the history only when its normal part matters: |ξ·n| Kt > 1e-10 μ|Fn|
-                    if abs(_dot(hist, n)) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs:
+                    # (|F·n| > 1e-10 μ|Fn| for a force history)
+                    scale = 1.0 if force_hist else kt_of(tl, delta)
+                    if abs(_dot(hist, n)) * scale > 1e-10 * tl[T_MU_K] * fabs:
                         hist = _rotate_history(hist, n, ROT_RESCALE)
+            if force_hist:
+                # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the
+                # history keeps the elastic part of the capped force
+                eta = eta_of(tl, nl, delta)
+                hist = hist - kt_of(tl, delta) * dt * vt
+                if tl[T_RESCALE] != 0.0:
+                    a_prev = math.sqrt(tl[T_R] * delta)
+                ft = hist - eta * vt
+                fm = _norm(ft)
+                cap = tl[T_MU_K] * fabs
+                sliding = fm > cap
+                if sliding:
+                    if _norm(hist) != 0.0:
+                        ft = ft * (cap / fm)
+                        hist = ft + eta * vt
+                    else:
+                        ft = np.zeros(3)
+            elif kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
                 if kind == WALTON:
                     vl = _dot(vt, hist)
                     if (vl < 0.0 and prev_vl > 0.0) or (vl > 0.0 and prev_vl < 0.0):
@@ -858,6 +886,8 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
                 else:
                     hist = hist + vt * dt
+                if kind == SPRING and tl[T_RESCALE] != 0.0:
+                    a_prev = math.sqrt(tl[T_R] * delta)
                 if rules[R_ROTATION] == ROT_PROJECT:
                     hist = _rotate_history(hist, n, ROT_PROJECT)
                 mu = tl[T_MU_K] if sliding else tl[T_MU_S]
@@ -873,6 +903,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
         else:
             hist[:] = 0.0
             lstar[:] = 0.0
+            a_prev = 0.0
             prev_vl = 0.0
             dmax = 0.0
             sliding = False

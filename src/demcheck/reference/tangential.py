@@ -37,7 +37,10 @@ TRUNCATIONS = {"force": TRUNC_CAP, "overlap": TRUNC_MAW, "spring": TRUNC_SPRING}
 
 # layout of TangentialLaw.array()
 T_KIND, T_KT, T_KT_SQRT, T_ETA, T_ETA_NORMAL, T_MU_S, T_MU_K, T_TRUNC, T_R, T_M, T_XI, T_ETA1, T_G, T_K0 = range(14)
-T_SIZE = 14
+# engine-twin variants of SPRING (verlet method only): the history stores the elastic force (LAMMPS
+# mindlin/force), and is scaled by a/a_prev when the contact radius shrinks (mindlin_rescale)
+T_FORCE, T_RESCALE = 14, 15
+T_SIZE = 16
 
 
 @dataclass(frozen=True)
@@ -56,11 +59,13 @@ class TangentialLaw:
     eta1: float = 0.0  # ZZY viscosity η₁
     g_i: float = 0.0  # ZZY shear modulus G_i
     k0: float = 0.0  # Walton initial stiffness
+    force_history: bool = False  # engine twin: the history is the elastic force, incremented by −Kt v_t dt
+    rescale_history: bool = False  # engine twin: history × a/a_prev when the contact radius a shrinks
 
     def array(self) -> np.ndarray:
         return np.array([self.kind, self.kt, float(self.kt_sqrt), self.eta, float(self.eta_normal), self.mu_s,
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
-                         self.k0])
+                         self.k0, float(self.force_history), float(self.rescale_history)])
 
     @property
     def has_history(self) -> bool:
