@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import difflib
 import hashlib
+import itertools
 import json
 import math
 import tomllib
@@ -110,6 +111,43 @@ def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
         raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
     raw.setdefault("name", path.stem)
     return from_dict(apply_overrides(raw, overrides))
+
+
+def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> list[Case]:
+    """The cases of a file: one, or with a ``[variants]`` table one per combination of its values
+    (``"impact.speed" = [0.1, 1.0, 10.0]``: dotted keys as in ``--set``, each a non-empty list). Each
+    variant is named ``name[key=value,…]`` after the last part of its keys."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError("CASE", str(path), "no such case file")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
+    raw.setdefault("name", path.stem)
+    raw = apply_overrides(raw, overrides)
+    variants = raw.pop("variants", None) or {}
+    if not isinstance(variants, dict):
+        raise ConfigError("variants", variants, "must be a table of dotted keys to lists of values")
+    for key, values in variants.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"variants.{key}", values, "must be a non-empty list of values")
+    if not variants:
+        return [from_dict(raw)]
+    cases = []
+    keys = list(variants)
+    for combo in itertools.product(*(variants[k] for k in keys)):
+        r = copy.deepcopy(raw)
+        for key, value in zip(keys, combo):
+            set_path(r, key, value)
+        label = ",".join(f"{k.rsplit('.', 1)[-1]}={_label(v)}" for k, v in zip(keys, combo))
+        r["name"] = f"{raw['name']}[{label}]"
+        cases.append(from_dict(r))
+    return cases
+
+
+def _label(v) -> str:
+    return f"{v:g}" if isinstance(v, float) else str(v).lower() if isinstance(v, bool) else str(v)
 
 
 def loads(text: str, overrides: list[str] | tuple[str, ...] = (), name: str = "case") -> Case:
@@ -215,7 +253,7 @@ PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity
 WALL_KEYS = {"point", "normal", "rigid", "material"}
 RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method"}
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
-TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description"}
+TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants"}
 
 
 def _material(name: str, d: dict) -> Material:

@@ -309,17 +309,44 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
 
 @cli.command()
 @click.argument("paths", nargs=-1, metavar="[CASE|DIR]...")
-@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports",
+@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST",
+              help="comma-separated engines to compare (lammps, liggghts), or 'none' for the reference alone")
+@click.option("--jobs", "-j", type=int, default=2, show_default=True, help="cases run in parallel")
+@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest go")
-def verify(paths, as_json, report_dir):
-    """Run the verification suite (default: the built-in cases/) and report."""
-    from .comparisons.suite import run_suite
+@click.option("--junit", "junit", type=click.Path(dir_okay=False), default=None, help="also write JUnit XML here")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again (ignore the run cache)")
+@click.option("--timeout", type=float, default=600.0, show_default=True, help="per engine run (s)")
+def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
+    """Run the verification suite (default: the built-in cases/) and report where each source agrees with
+    the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
+    a failed run, 2 on bad input."""
+    from .comparisons.suite import Options, run_suite
+    from .engines.cache import Cache
 
+    names = [] if engines.strip().lower() == "none" else [e.strip() for e in engines.split(",") if e.strip()]
+    for e in names:
+        if e not in ("lammps", "liggghts"):
+            raise ConfigError("--engines", e, "must be lammps, liggghts (comma-separated) or none")
+    if jobs < 1:
+        raise ConfigError("--jobs", jobs, "must be >= 1")
+    if timeout <= 0:
+        raise ConfigError("--timeout", timeout, "must be > 0 (s)")
     files = _case_files(paths)
-    summary = run_suite(files, Path(report_dir), quiet=as_json)
+    opts = Options(engines=tuple(names), jobs=jobs, cache=None if no_cache else Cache(), timeout=timeout)
+    try:
+        summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
+                            argv=["demcheck", "verify", *sys.argv[2:]])
+    except KeyboardInterrupt:
+        click.echo("demcheck: interrupted; the finished cases are in the partial report "
+                   f"{Path(report_dir) / 'latest'}", err=True)
+        sys.exit(130)
     if as_json:
-        emit_json(summary)
+        from .comparisons.report import clean
+
+        emit_json(clean({k: v for k, v in summary.items() if k != "cases"}
+                        | {"cases": [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]}))
     sys.exit(0 if summary["failed"] == 0 else 1)
 
 
@@ -329,7 +356,7 @@ def _case_files(paths) -> list[Path]:
     files: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
-            files.extend(sorted(p.glob("*.toml")))
+            files.extend(sorted(p.rglob("*.toml")))
         elif p.is_file():
             files.append(p)
         else:

@@ -40,9 +40,14 @@ class Result:
         return self.status == "ok"
 
     def metrics(self) -> dict:
+        """The metrics (computed once per contact table: a pure function of it)."""
         from .comparisons.metrics import compute
 
-        return compute(self)
+        memo = self.__dict__.get("_metrics_memo")
+        if memo is None or memo[0] is not self.contact or memo[1] is not self.events:
+            memo = (self.contact, self.events, compute(self))
+            self.__dict__["_metrics_memo"] = memo
+        return dict(memo[2])
 
     def summary(self) -> dict:
         """JSON-ready: metrics under their DESIGN names, the model, the resolved parameters, method, dt."""

@@ -1,154 +1,284 @@
 """The verification suite run by ``demcheck verify``.
 
-For every case: the reference's adaptive method (converged), checked against the model's closed forms
-where the notes derive them, and the verlet method at the case's time step, compared with the adaptive
-answer. Reports go to <report>/<run-id>/ (results.json, report.md) and <report>/latest, written
-atomically; finished results are kept if the run is interrupted.
+For every case (a file, or each variant of a file's ``[variants]`` table):
+
+* the reference's adaptive method — the seed model's converged answer — checked against the model's closed
+  forms where the notes derive them;
+* the reference's verlet method at the case's time step (the time step's own error);
+* each engine the mapping allows: its deck run for real (or taken from the engine-run cache), its twin at
+  the engine's dt, and every metric judged against the converged answer (comparisons/verdicts.py), with the
+  distances between the force–time and force–overlap curves.
+
+Reports go to <report>/<run-id>/ and <report>/latest (comparisons/report.py), written atomically. An
+interrupted run keeps every finished case and writes a report marked partial.
 """
 
 from __future__ import annotations
 
+import concurrent.futures as cf
 import datetime as _dt
 import math
 import os
+import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from rich.console import Console
-from rich.progress import Progress
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from .. import __version__
-from ..case import load
+from ..case import Case, expand
 from ..errors import DemcheckError
-from ..io import write_json, write_text
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.model import resolve
+from . import curves, verdicts as V
 
-CLOSED_FORM_RTOL = 1e-8  # the adaptive method at rtol 1e-13 against an exact solution
-
-
-def _rel(a, b):
-    if a is None or b is None or not (math.isfinite(a) and math.isfinite(b)):
-        return math.nan
-    scale = max(abs(a), abs(b))
-    return 0.0 if scale == 0 else abs(a - b) / scale
+ENGINES = ("lammps", "liggghts")
+SERIES_POINTS = 400
 
 
-def run_case(path: Path) -> dict:
-    case = load(path)
-    entry = {"case": case.name, "file": str(path), "case_hash": case.hash, "kind": case.kind, "checks": []}
+@dataclass
+class Options:
+    engines: tuple[str, ...] = ENGINES
+    jobs: int = 1
+    cache: object | None = None  # engines.cache.Cache
+    timeout: float = 600.0
+    tolerances: V.Tolerances = field(default_factory=V.Tolerances.load)
+    expected: list = field(default_factory=V.load_expected)
+
+
+def discover(engines) -> dict:
+    from ..engines import discovery
+
+    out = {}
+    for e in engines:
+        info = discovery.find(e)
+        out[e] = {"found": info is not None, "version": info.version if info else None,
+                  "executable": info.executable if info else None,
+                  "how_to_install": None if info else discovery.HOW_TO_INSTALL[e]}
+    return out
+
+
+def _series(contact, source: str) -> dict | None:
+    """The contact's force–overlap–time samples for the plots (at most SERIES_POINTS)."""
+    if contact is None or contact.empty:
+        return None
+    c = contact[(contact["delta"] > 0) | (contact["fn"] != 0)]
+    if c.empty:
+        return None
+    step = max(1, len(c) // SERIES_POINTS)
+    c = c.iloc[::step]
+    t0 = float(c["t"].iloc[0])
+    return {"source": source, "t": (c["t"] - t0).tolist(), "delta": c["delta"].tolist(), "fn": c["fn"].tolist()}
+
+
+def restate(result, case):
+    """A verlet result's contact table read off its states, as an engine's is (engines/states.py)."""
+    from ..engines import states
+
+    c = result.contact
+    parts = result.particles.copy()
+    f0 = -c["fn"].to_numpy()[:, None] * c[["nx", "ny", "nz"]].to_numpy() + c[["ftx", "fty", "ftz"]].to_numpy()
+    p0 = parts["id"] == 0
+    for k, col in enumerate(("fx", "fy", "fz")):
+        parts[col] = float("nan")
+        parts.loc[p0, col] = f0[:, k]
+    result.contact = states.trim(states.from_particles(parts, case))
+    return result
+
+
+def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
+    from ..engines.collide import collide as run_engine, twin_states
+    from ..inputs import common
+    from ..reference import collision3d
+
+    tol = opts.tolerances
+    entry = {"case": case.name, "file": str(file), "case_hash": case.hash, "kind": case.kind,
+             "sources": {}, "comparisons": [], "curves": {}, "series": []}
     if case.kind != "collision":
-        entry["status"] = "skipped"
-        entry["message"] = "packing cases are not run by this version"
+        entry.update(status="skipped", message="packing cases are run by `demcheck pack` (not in this version)")
         return entry
+    model = resolve(case)
+    entry["model"] = model.describe()
+    entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
+    p0 = case.particles[0]
+    v_in = model.pair.impact_speed
+    entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution,
+                       **{k: case.raw.get("impact", {}).get(k) for k in ("angle", "spin")}}
+    scales = {"impact_energy": 0.5 * model.pair.m_eff * v_in * v_in, "spin": v_in / p0.radius}
+    entry["scales"] = scales
+    comps: list[V.Comparison] = []
+
     adaptive = collide(case, "adaptive")
+    ref = adaptive.metrics()
+    entry["sources"]["reference"] = _source(adaptive)
+    entry["series"].append(_series(adaptive.contact, "reference"))
+    if not adaptive.ok:
+        comps.append(V.status_comparison("reference", V.FAILED, f"{adaptive.status}: {adaptive.message}"))
+    for metric, exact in closed_form_metrics(model).items():
+        comps.append(V.judge_closed_form(metric, ref[metric], exact, scales, tol))
+
     verlet = collide(case, "verlet")
-    entry["model"] = adaptive.model
-    entry["params"] = adaptive.params
-    entry["results"] = {"adaptive": adaptive.summary(), "verlet": verlet.summary()}
-    failed = not adaptive.ok or verlet.status not in ("ok",)
-    ma, mv = adaptive.metrics(), verlet.metrics()
-    for metric, value in closed_form_metrics(resolve(case)).items():
-        diff = _rel(ma[metric], value)
-        if metric == "energy_dissipated":  # relative to the impact energy: a small loss is not a large error
-            ke = 0.5 * adaptive.params["m_eff"] * adaptive.params["impact_speed"] ** 2
-            diff = abs(ma[metric] - value) / ke
-        ok = diff <= CLOSED_FORM_RTOL
-        failed |= not ok
-        entry["checks"].append({"check": "adaptive vs closed form", "metric": metric, "value": ma[metric],
-                                "expected": value, "rel_diff": diff, "tolerance": CLOSED_FORM_RTOL,
-                                "verdict": "agree" if ok else "differs"})
-    for metric in ma:
-        entry["checks"].append({"check": f"verlet (dt={verlet.dt:.3g}) vs adaptive", "metric": metric,
-                                "value": mv[metric], "expected": ma[metric], "rel_diff": _rel(mv[metric], ma[metric]),
-                                "tolerance": None, "verdict": "reported"})
-    entry["status"] = "failed" if failed else "ok"
-    entry["message"] = "; ".join(m for m in (adaptive.message, verlet.message) if m and not (adaptive.ok and verlet.ok))
+    mv = verlet.metrics()
+    entry["sources"]["reference-verlet"] = _source(verlet)
+    entry["series"].append(_series(verlet.contact, "reference-verlet"))
+    entry["curves"]["reference-verlet"] = curves.distances(verlet.contact, adaptive.contact, adaptive.events)
+    spc = case.run.steps_per_contact
+    if verlet.status != "ok":
+        comps.append(V.status_comparison("reference-verlet", V.EXPECTED, f"{verlet.status}: {verlet.message}"))
+    else:
+        for metric in ref:
+            comps.append(V.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol))
+
+    seed_cache: dict = {}
+    for engine in opts.engines:
+        mp = common.contact_mapping(case, engine)
+        if mp.native is None:
+            entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
+            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
+            continue
+        if not found[engine]["found"]:
+            why = f"{engine} is not installed: {found[engine]['how_to_install']}"
+            entry["sources"][engine] = {"status": "engine missing", "message": why}
+            comps.append(V.status_comparison(engine, V.MISSING, why))
+            continue
+        try:
+            res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout)
+        except DemcheckError as exc:
+            entry["sources"][engine] = {"status": "failed", "message": str(exc)}
+            comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
+            continue
+        me = res.metrics()
+        twin = twin_states(case, engine, res.dt).metrics()
+        if res.dt not in seed_cache:
+            seed_cache[res.dt] = restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
+        seed_v = seed_cache[res.dt]
+        entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                                    "twin_metrics": twin, "seed_verlet_metrics": seed_v}
+        entry["series"].append(_series(res.contact, engine))
+        entry["curves"][engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
+        for metric in ref:
+            comps.append(V.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
+                                        twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons), scales, tol,
+                                        opts.expected))
+    entry["series"] = [s for s in entry["series"] if s]
+    entry["comparisons"] = [c.as_dict() for c in comps]
+    worst = V.worst(c.verdict for c in comps)
+    entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    entry["verdict"] = worst
     return entry
 
 
-def run_suite(files: list[Path], report_root: Path, quiet: bool = False) -> dict:
+def _source(result) -> dict:
+    return {"status": result.status, "message": result.message, "method": result.method, "dt": result.dt,
+            "rtol": result.rtol, "engine_version": result.engine_version, "wall_time": result.wall_time,
+            "metrics": result.metrics(), "cached": result.meta.get("cached"),
+            "warnings": result.meta.get("warnings", [])}
+
+
+def collect(paths) -> list[tuple[Path, Case]]:
+    cases = []
+    for path in paths:
+        for case in expand(path):
+            cases.append((Path(path), case))
+    return cases
+
+
+def run_suite(files: list[Path], report_root: Path, opts: Options | None = None, quiet: bool = False,
+              junit: Path | None = None, argv: list[str] | None = None) -> dict:
+    from . import report
+
+    opts = opts or Options()
     console = Console(stderr=True, quiet=quiet)
     run_id = _dt.datetime.now().strftime("%Y%m%d-%H%M%S") + f"-{os.getpid()}"
     out_dir = report_root / run_id
+    found = discover(opts.engines)
     summary = {"demcheck": __version__, "run_id": run_id, "report": str(out_dir), "partial": True,
-               "engines": {}, "cases": [], "failed": 0}
+               "started": _dt.datetime.now().isoformat(timespec="seconds"),
+               "command": argv if argv is not None else sys.argv, "engines": found,
+               "tolerances": opts.tolerances.__dict__, "cases": [], "failed": 0}
+    cases = collect(files)
+    summary["planned"] = len(cases)
     started = time.perf_counter()
+    entries: dict[int, dict] = {}
+    interrupted = False
     try:
-        with Progress(console=console, transient=True) as progress:
-            task = progress.add_task("verify", total=len(files))
-            for path in files:
-                progress.update(task, description=path.stem)
+        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                      console=console, transient=True) as progress:
+            task = progress.add_task("verify", total=len(cases))
+            with cf.ThreadPoolExecutor(max_workers=max(1, opts.jobs)) as pool:
+                futures = {pool.submit(_safe_case, case, path, opts, found): i for i, (path, case) in enumerate(cases)}
                 try:
-                    entry = run_case(path)
-                except DemcheckError as exc:
-                    entry = {"case": path.stem, "file": str(path), "status": "failed", "message": str(exc),
-                             "checks": []}
-                summary["cases"].append(entry)
-                summary["failed"] += entry["status"] == "failed"
-                progress.advance(task)
-        summary["partial"] = False
+                    for fut in cf.as_completed(futures):
+                        i = futures[fut]
+                        entries[i] = fut.result()
+                        progress.update(task, advance=1, description=cases[i][1].name[:50])
+                except KeyboardInterrupt:
+                    interrupted = True
+                    for f in futures:
+                        f.cancel()
+                    from ..engines import run as runner
+
+                    runner.kill_all()
+                    pool.shutdown(wait=True, cancel_futures=True)
+                    for f, i in futures.items():
+                        if f.done() and not f.cancelled() and i not in entries and f.exception() is None:
+                            entries[i] = f.result()
+        summary["partial"] = interrupted
+    except KeyboardInterrupt:
+        interrupted = True
     finally:
+        summary["cases"] = [entries[i] for i in sorted(entries)]
+        summary["failed"] = sum(e["status"] in ("failed", "unexpected") for e in summary["cases"])
         summary["wall_time"] = time.perf_counter() - started
-        _write_reports(summary, out_dir, report_root)
+        summary["partial"] = interrupted or len(summary["cases"]) < len(cases)
+        if opts.cache is not None:
+            summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
+        report.write_all(summary, out_dir, report_root, junit=junit)
     _print(console, summary)
+    if interrupted:
+        raise KeyboardInterrupt
     return summary
 
 
-def _clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_clean(v) for v in obj]
-    return obj
+def _safe_case(case, path, opts, found) -> dict:
+    try:
+        return run_case(case, path, opts, found)
+    except DemcheckError as exc:
+        return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
+                "verdict": V.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
+                "comparisons": [V.status_comparison("reference", V.FAILED, str(exc)).as_dict()]}
 
 
-def _write_reports(summary: dict, out_dir: Path, root: Path) -> None:
-    write_json(out_dir / "results.json", _clean(summary))
-    write_text(out_dir / "report.md", render_markdown(summary))
-    latest = root / "latest"
-    tmp = root / f".latest.{os.getpid()}"
-    if tmp.is_symlink() or tmp.exists():
-        tmp.unlink()
-    tmp.symlink_to(out_dir.name)
-    os.replace(tmp, latest)
+def _print(console: Console, summary: dict) -> None:
+    from rich.table import Table
 
-
-def render_markdown(summary: dict) -> str:
-    lines = [f"# demcheck verification {summary['run_id']}", ""]
-    if summary["partial"]:
-        lines += ["**PARTIAL REPORT: the run was interrupted; the cases below finished.**", ""]
-    lines += [f"demcheck {summary['demcheck']}; engines: reference only in this version.", "",
-              "| case | model | status | checks | worst closed-form rel. diff |", "|---|---|---|---|---|"]
+    counts: dict[str, int] = {}
     for c in summary["cases"]:
-        model = c.get("model", {})
-        cf = [k["rel_diff"] for k in c.get("checks", []) if k["check"] == "adaptive vs closed form"]
-        worst = f"{max(cf):.2e}" if cf else "no closed form"
-        lines.append(f"| {c['case']} | {model.get('normal', '—')}/{model.get('tangential', '—')} | {c['status']} "
-                     f"| {len(c.get('checks', []))} | {worst} |")
-    for c in summary["cases"]:
-        lines += ["", f"## {c['case']}", ""]
-        if c.get("message"):
-            lines += [c["message"], ""]
-        if c.get("checks"):
-            lines += ["| check | metric | value | expected | rel. diff | verdict |", "|---|---|---|---|---|---|"]
-            for k in c["checks"]:
-                lines.append(f"| {k['check']} | {k['metric']} | {_f(k['value'])} | {_f(k['expected'])} "
-                             f"| {_f(k['rel_diff'], '.2e')} | {k['verdict']} |")
-    return "\n".join(lines) + "\n"
+        for k in c.get("comparisons", []):
+            counts[k["verdict"]] = counts.get(k["verdict"], 0) + 1
+    bad = [c for c in summary["cases"] if c["status"] in ("failed", "unexpected")]
+    for c in bad:
+        for k in c.get("comparisons", []):
+            if k["verdict"] in V.FAILING:
+                console.print(f"[red]{k['verdict']}[/] {c['case']} {k['source']} {k['metric']}: {k['reason']}")
+    t = Table(title=f"demcheck verify: {len(summary['cases'])} of {summary['planned']} cases"
+              + (" (PARTIAL)" if summary["partial"] else ""))
+    t.add_column("verdict")
+    t.add_column("comparisons", justify="right")
+    for v in V.VERDICTS:
+        if counts.get(v):
+            t.add_row(v, str(counts[v]))
+    console.print(t)
+    engines = ", ".join(f"{k} {v['version']}" if v["found"] else f"{k} missing" for k, v in summary["engines"].items())
+    console.print(f"engines: {engines or 'none (reference only)'}")
+    console.print(f"{summary['failed']} case(s) failing; wall time {summary['wall_time']:.1f} s; "
+                  f"report: {summary['report']}/report.md (and report.html, results.json, junit.xml)")
 
 
 def _f(v, spec=".10g"):
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
     return format(v, spec)
-
-
-def _print(console: Console, summary: dict) -> None:
-    for c in summary["cases"]:
-        colour = {"ok": "green", "failed": "red"}.get(c["status"], "yellow")
-        console.print(f"[{colour}]{c['status']:>7}[/] {c['case']}" + (f"  {c['message']}" if c.get("message") else ""))
-    console.print(f"{len(summary['cases'])} cases, {summary['failed']} failed; report: {summary['report']}/report.md")

@@ -12,6 +12,7 @@ import re
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,6 +42,21 @@ class RunOutput:
     warnings: list[str] = field(default_factory=list)
 
 
+_RUNNING: set = set()
+_LOCK = threading.Lock()
+
+
+def kill_all() -> None:
+    """Stop every engine this process has running (an interrupted suite)."""
+    with _LOCK:
+        procs = list(_RUNNING)
+    for proc in procs:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
 def log_tail(text: str, lines: int = 15) -> str:
     return "\n".join(text.rstrip().splitlines()[-lines:])
 
@@ -67,6 +83,8 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     started = time.perf_counter()
     proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
+    with _LOCK:
+        _RUNNING.add(proc)
     try:
         out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -75,6 +93,9 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         log = _read_log(wd, out)
         raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
                             f"kept: {wd}\n{log_tail(log)}", pid=proc.pid) from None
+    finally:
+        with _LOCK:
+            _RUNNING.discard(proc)
     wall = time.perf_counter() - started
     log = _read_log(wd, out)
     errors = _ERROR.findall(log)

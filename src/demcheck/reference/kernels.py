@@ -202,7 +202,7 @@ def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
     return hi
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # the suite runs cases in threads
 def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale, t_max, capacity):
     """Integrate the 1-D normal impact to relative tolerance ``rtol``.
 
@@ -342,7 +342,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
 # ----------------------------------------------------------------------------- velocity Verlet
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # the suite runs cases in threads
 def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity):
     """The engines' scheme (fix nve/sphere) on the 1-D normal problem: v += ½dt a; x += dt v; forces from
     full-step positions and half-step velocities; v += ½dt a. History (δ_max) is updated with each force

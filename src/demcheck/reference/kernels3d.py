@@ -235,6 +235,23 @@ def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
 
 
 @njit(cache=True)
+def walton_margin(tl, h, vt, fn_abs, lstar):
+    """x = 1 − (T − T*)/(μ|Fn| − T*): the fraction of the way left to the Coulomb limit (≤ 0: at it)."""
+    vn = _norm(vt)
+    if vn == 0.0:
+        return 1.0
+    t = vt / vn
+    tt, ts = _dot(h, t), _dot(lstar, t)
+    den = tl[T_MU_K] * fn_abs - ts
+    if den <= 0.0:
+        return 0.0
+    return 1.0 - (tt - ts) / den
+
+
+WALTON_NEAR_LIMIT = 1e-6
+
+
+@njit(cache=True)
 def walton_stiffness(tl, h, vt, fn_abs, lstar):
     """Kt = K0 (1 − (T − T*)/(μ|Fn| − T*))^{1/3} with T, T* the load and the load at the last reversal,
     both measured along the current slip direction (docs/models.md: the 3-D definition)."""
@@ -606,7 +623,7 @@ def _record(rec, i, t, y, aux, nl, tl, geo, rules):
     rec[i, C_SLIP] = aux[A_TMODE]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # the suite runs cases in threads
 def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     """Integrate to relative tolerance ``rtol`` with event location (contact start/end, force end, maximum
     overlap, peak force, loading/unloading, stick→slip, slip→stick, slip reversal). ``scales`` (21) are the
@@ -638,6 +655,15 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
         # so only the bodies' state is error-controlled then.
         n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
+        if tl[T_KIND] == WALTON and aux[A_NMODE] != M_PRE:
+            # within 1e-6 of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely stiff as x → 0
+            # with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
+            # integration error, and is left out of the error control (else the steps shrink without end)
+            kin = kinematics(y, geo, rules)
+            fnow = abs(_contact_force(nl, aux[A_NMODE], kin[0], kin[1], aux[A_DMAX]))
+            if walton_margin(tl, _tangent_history(y, kin[2]), kin[4], fnow, aux[A_LSTAR:A_LSTAR + 3]) \
+                    < WALTON_NEAR_LIMIT:
+                n_ctrl = 18
         for i in range(n_ctrl):
             sc = scales[i] * rtol
             if sc > 0.0:
@@ -779,7 +805,7 @@ def _rotate_history(h, n, mode):
     return hp
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # the suite runs cases in threads
 def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     """The engines' scheme (fix nve/sphere, I = 0.4 m R²): half kick, drift, forces from full-step positions
     and half-step velocities with the history updated once per step (not at setup), half kick. History

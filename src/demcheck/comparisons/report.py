@@ -1,0 +1,461 @@
+"""The reports of a verification run: results.json, report.md, junit.xml and report.html.
+
+Every file is written atomically (io.atomic_path); ``<root>/latest`` is switched to the new run only after
+its files exist. report.html carries its plots inline (PNG, base64) and a small script that marks the page
+``data-plots-ok`` once every plot has decoded, which the browser test reads back.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections import defaultdict
+from pathlib import Path
+
+from ..io import write_json, write_text
+from . import verdicts as V
+
+ENGINE_SOURCES = ("lammps", "liggghts")
+METRIC_ORDER = ("restitution", "contact_time", "force_contact_time", "max_overlap", "peak_force",
+                "energy_dissipated", "tangential_restitution", "rebound_angle", "rebound_angular_velocity")
+
+
+def clean(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {str(k): clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [clean(v) for v in obj]
+    if hasattr(obj, "item"):
+        return clean(obj.item())
+    return obj
+
+
+def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None) -> None:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]).parent / "plots" if "cache" in summary else None
+    data = {k: v for k, v in summary.items()}
+    data["cases"] = [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]
+    write_json(out_dir / "results.json", clean(data))
+    write_text(out_dir / "report.md", render_markdown(summary))
+    junit_text = render_junit(summary)
+    write_text(out_dir / "junit.xml", junit_text)
+    if junit is not None:
+        write_text(junit, junit_text)
+    write_text(out_dir / "report.html", render_html(summary))
+    latest = root / "latest"
+    tmp = root / f".latest.{os.getpid()}"
+    if tmp.is_symlink() or tmp.exists():
+        tmp.unlink()
+    tmp.symlink_to(out_dir.name)
+    os.replace(tmp, latest)
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _f(v, spec=".6g"):
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return format(v, spec) if isinstance(v, (int, float)) else str(v)
+
+
+def _model(c: dict) -> str:
+    m = c.get("model") or {}
+    if not m:
+        return "—"
+    text = f"{m['normal']} / {m['tangential']}"
+    return text + (" (limit_force)" if m.get("limit_force") else "")
+
+
+def _engine_text(summary: dict) -> str:
+    parts = []
+    for name, e in summary["engines"].items():
+        parts.append(f"{name} {e['version']}" if e["found"] else f"{name}: missing ({e['how_to_install']})")
+    return "; ".join(parts) if parts else "none selected (reference only)"
+
+
+def matrix(summary: dict) -> dict:
+    """(model, source, metric) → worst verdict over the cases."""
+    out: dict = defaultdict(list)
+    for c in summary["cases"]:
+        for k in c.get("comparisons", []):
+            out[(_model(c), k["source"], k["metric"])].append(k["verdict"])
+    return {key: V.worst(vs) for key, vs in out.items()}
+
+
+_SHORT = {V.AGREE: "✓", V.EXPECTED: "≈", V.UNEXPECTED: "✗", V.NOT_EXPRESSIBLE: "n/e", V.MISSING: "missing",
+          V.FAILED: "FAIL"}
+
+
+# ----------------------------------------------------------------------------- markdown
+
+
+def render_markdown(summary: dict) -> str:
+    lines = [f"# demcheck verification {summary['run_id']}", ""]
+    if summary["partial"]:
+        lines += [f"**PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of {summary['planned']} "
+                  "cases finished and are reported below.**", ""]
+    lines += [f"demcheck {summary['demcheck']} · started {summary['started']} · wall time "
+              f"{summary.get('wall_time', 0):.1f} s", "", f"Engines: {_engine_text(summary)}", ""]
+    if "cache" in summary:
+        lines += [f"Engine-run cache: {summary['cache']['hits']} hits, {summary['cache']['misses']} misses "
+                  f"({summary['cache']['dir']})", ""]
+    counts: dict = defaultdict(int)
+    for c in summary["cases"]:
+        for k in c.get("comparisons", []):
+            counts[k["verdict"]] += 1
+    lines += ["| verdict | comparisons |", "|---|---|"]
+    lines += [f"| {v} | {counts[v]} |" for v in V.VERDICTS if counts[v]]
+    lines += ["", f"**{summary['failed']} case(s) with an unexpected difference or a failure.**", ""]
+
+    # the agreement matrix: models × sources × metrics
+    mat = matrix(summary)
+    sources = ["closed-form", "reference-verlet", *[s for s in ENGINE_SOURCES if s in summary["engines"]]]
+    models = sorted({m for m, _, _ in mat})
+    lines += ["## Agreement matrix", "",
+              "Worst verdict over the cases of each model: ✓ agree, ≈ differs as expected, ✗ differs unexpectedly, "
+              "n/e not expressible, missing (engine not installed), FAIL (a run failed). Columns: "
+              "restitution, contact time, max overlap, peak force, energy, tangential restitution, rebound spin.",
+              ""]
+    keys = ("restitution", "contact_time", "max_overlap", "peak_force", "energy_dissipated",
+            "tangential_restitution", "rebound_angular_velocity")
+    head = "| model | " + " | ".join(f"{s}: e · t · δ · F · E · et · ω" for s in sources) + " |"
+    lines += [head, "|---|" + "---|" * len(sources)]
+    for m in models:
+        cells = []
+        for s in sources:
+            if (m, s, "*") in mat:
+                cells.append(_SHORT[mat[(m, s, "*")]])
+                continue
+            marks = [_SHORT.get(mat.get((m, s, k)), "·") if (m, s, k) in mat else "·" for k in keys]
+            cells.append(" ".join(marks))
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+
+    # every disagreement, explained
+    lines += ["", "## Disagreements and their reasons", ""]
+    reasons: dict = defaultdict(list)
+    for c in summary["cases"]:
+        for k in c.get("comparisons", []):
+            if k["verdict"] in (V.EXPECTED, V.UNEXPECTED, V.FAILED, V.NOT_EXPRESSIBLE, V.MISSING):
+                reasons[(k["verdict"], k["source"], k["reason"])].append((c["case"], k["metric"], k["rel_diff"]))
+    if not reasons:
+        lines.append("None: every source agrees with the seed model on every metric.")
+    for (verdict, source, reason), hits in sorted(reasons.items(), key=lambda x: (-len(x[1]), x[0])):
+        worst = max((h[2] for h in hits if h[2] is not None and math.isfinite(h[2])), default=None)
+        cases = sorted({h[0] for h in hits})
+        metrics = sorted({h[1] for h in hits})
+        lines += [f"* **{verdict}** — {source}: {reason}",
+                  f"  {len(hits)} comparison(s) in {len(cases)} case(s); metrics {', '.join(metrics)}"
+                  + (f"; largest scaled difference {worst:.3g}" if worst is not None else "")
+                  + f". Cases: {', '.join(cases[:6])}{' …' if len(cases) > 6 else ''}"]
+
+    # per case
+    lines += ["", "## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
+              "|---|---|---|---|---|"]
+    for c in summary["cases"]:
+        srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
+        worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
+        lines.append(f"| {c['case']} | {_model(c)} | {c['status']} | {srcs} | {_f(worst_curve, '.3g')} |")
+    return "\n".join(lines) + "\n"
+
+
+# ----------------------------------------------------------------------------- junit
+
+
+def render_junit(summary: dict) -> str:
+    """One testcase per case × source (the reference's checks, each engine): failure for an unexpected
+    difference or a failed run, skipped for not expressible or a missing engine."""
+    suite = ET.Element("testsuite", name="demcheck-verify", timestamp=summary["started"],
+                       time=f"{summary.get('wall_time', 0):.3f}")
+    n = fails = errors = skips = 0
+    for c in summary["cases"]:
+        by_source: dict = defaultdict(list)
+        for k in c.get("comparisons", []):
+            src = "reference" if k["source"] in ("closed-form", "reference-verlet") else k["source"]
+            by_source[src].append(k)
+        for src, comps in by_source.items():
+            n += 1
+            tc = ET.SubElement(suite, "testcase", classname=f"{c['case']}", name=f"{_model(c)} · {src}")
+            bad = [k for k in comps if k["verdict"] == V.UNEXPECTED]
+            failed = [k for k in comps if k["verdict"] == V.FAILED]
+            skipped = [k for k in comps if k["verdict"] in (V.NOT_EXPRESSIBLE, V.MISSING)]
+            if failed:
+                errors += 1
+                ET.SubElement(tc, "error", message=failed[0]["reason"][:500]).text = "\n".join(
+                    f"{k['source']} {k['metric']}: {k['reason']}" for k in failed)
+            elif bad:
+                fails += 1
+                ET.SubElement(tc, "failure", message=f"{len(bad)} unexpected difference(s)").text = "\n".join(
+                    f"{k['metric']}: {_f(k['value'])} vs {_f(k['reference'])} (scaled {_f(k['rel_diff'], '.3g')} > "
+                    f"{_f(k['tolerance'], '.3g')}): {k['reason']}" for k in bad)
+            elif skipped:
+                skips += 1
+                ET.SubElement(tc, "skipped", message=skipped[0]["reason"][:500])
+            expected = [k for k in comps if k["verdict"] == V.EXPECTED]
+            if expected:
+                ET.SubElement(tc, "system-out").text = "\n".join(
+                    f"differs as expected: {k['metric']} ({_f(k['rel_diff'], '.3g')}): {k['reason']}" for k in expected)
+    suite.set("tests", str(n))
+    suite.set("failures", str(fails))
+    suite.set("errors", str(errors))
+    suite.set("skipped", str(skips))
+    root = ET.Element("testsuites")
+    root.append(suite)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+# ----------------------------------------------------------------------------- html
+
+_STYLE = """
+body{font-family:system-ui,sans-serif;margin:2em;max-width:1400px;color:#222}
+table{border-collapse:collapse;margin:1em 0;font-size:13px}td,th{border:1px solid #ccc;padding:3px 6px}
+th{background:#f3f3f3}.agree{color:#1a7f37}.expected{color:#9a6700}.unexpected,.failed{color:#cf222e;font-weight:bold}
+.partial{background:#fff3cd;padding:.5em;border:1px solid #e0c060}img{max-width:100%;border:1px solid #ddd;margin:4px 0}
+details{margin:.4em 0}summary{cursor:pointer}
+"""
+_SCRIPT = """
+<script>
+window.addEventListener('load', function () {
+  var imgs = Array.prototype.slice.call(document.querySelectorAll('img.plot'));
+  var ok = imgs.filter(function (i) { return i.complete && i.naturalWidth > 0; }).length;
+  document.body.setAttribute('data-plots', String(imgs.length));
+  document.body.setAttribute('data-plots-ok', String(ok));
+});
+</script>
+"""
+
+
+def _png(fig) -> str:
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
+PLOT_CACHE: dict = {"dir": None}  # set by write_all when the run uses the cache
+
+
+def _cached(key_obj, render):
+    """A plot's PNG (base64), from the plot cache when the same data was drawn before (warm runs)."""
+    import hashlib
+    import json
+
+    d = PLOT_CACHE["dir"]
+    if d is None:
+        return render()
+    k = hashlib.sha256(json.dumps(clean(key_obj), sort_keys=True, default=str).encode()).hexdigest()
+    path = Path(d) / f"{k}.b64"
+    if path.exists():
+        return path.read_text()
+    b64 = render()
+    if b64:
+        write_text(path, b64)
+    return b64
+
+
+def _img(b64: str, alt: str) -> str:
+    return f'<img class="plot" alt="{html.escape(alt)}" src="data:image/png;base64,{b64}">'
+
+
+STYLE = {"reference": ("-", 2.0), "reference-verlet": (":", 1.2), "lammps": ("--", 1.2), "liggghts": ("-.", 1.2)}
+
+
+def case_panels(entry: dict) -> str | None:
+    """Force–overlap loop and force–time curve of one case, one line per source."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    series = entry.get("series") or []
+    if not series:
+        return None
+    return _cached({"case": entry["case"], "series": series}, lambda: _draw_case(entry["case"], series))
+
+
+def _draw_case(name, series) -> str:
+    import matplotlib.pyplot as plt
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.2))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.16, top=0.85, wspace=0.25)
+    for s in series:
+        ls, lw = STYLE.get(s["source"], ("-", 1))
+        a1.plot([d * 1e6 for d in s["delta"]], s["fn"], ls, lw=lw, label=s["source"])
+        a2.plot([t * 1e6 for t in s["t"]], s["fn"], ls, lw=lw, label=s["source"])
+    a1.set(xlabel="overlap δ (µm)", ylabel="Fn (N)", title="force–overlap")
+    a2.set(xlabel="time since contact start (µs)", ylabel="Fn (N)", title="force–time")
+    for a in (a1, a2):
+        a.grid(alpha=0.3)
+        a.axhline(0, color="0.6", lw=0.5)
+    a1.legend(fontsize=7)
+    fig.suptitle(name, fontsize=9)
+    return _png(fig)
+
+
+def _metric_of(entry, source, metric):
+    s = entry.get("sources", {}).get(source, {})
+    return (s.get("metrics") or {}).get(metric)
+
+
+def suite_plots(summary: dict) -> list[tuple[str, str]]:
+    """Restitution in vs out; restitution against impact speed; tangential restitution and rebound spin
+    against incidence angle — each per model and source."""
+    import json
+
+    key = [(c["case"], c.get("impact"), {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()})
+           for c in summary["cases"]]
+    text = _cached({"suite": key}, lambda: json.dumps(_suite_plots(summary)))
+    return [tuple(x) for x in json.loads(text)]
+
+
+def _suite_plots(summary: dict) -> list[tuple[str, str]]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = []
+    sources = ["reference", *ENGINE_SOURCES]
+    normal = [c for c in summary["cases"] if c.get("model") and c["model"]["tangential"] == "none"]
+    if normal:
+        fig, ax = plt.subplots(figsize=(4.5, 4))
+        for src, marker in zip(sources, "o^s"):
+            xs = [c["impact"]["restitution_input"] for c in normal if c["impact"].get("restitution_input") is not None]
+            ys = [_metric_of(c, src, "restitution") for c in normal if c["impact"].get("restitution_input") is not None]
+            pts = [(x, y) for x, y in zip(xs, ys) if y is not None and math.isfinite(y)]
+            if pts:
+                ax.plot(*zip(*pts), marker, ms=4, alpha=0.6, label=src)
+        ax.plot([0, 1], [0, 1], color="0.5", lw=0.8)
+        ax.set(xlabel="input restitution", ylabel="measured restitution", title="restitution: in vs out")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        out.append(("restitution in vs out", _png(fig)))
+        groups = defaultdict(list)
+        for c in normal:
+            groups[_model(c) + (" wall" if "wall" in c["case"] else " pair")].append(c)
+        groups = {k: v for k, v in groups.items() if len({c["impact"]["speed"] for c in v}) > 1}
+        if groups:
+            n = len(groups)
+            cols = 4
+            rows = (n + cols - 1) // cols
+            fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
+            for ax, (name, cs) in zip(axes.ravel(), sorted(groups.items())):
+                cs = sorted(cs, key=lambda c: c["impact"]["speed"])
+                for src, marker in zip(sources, "o^s"):
+                    pts = [(c["impact"]["speed"], _metric_of(c, src, "restitution")) for c in cs]
+                    pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
+                    if pts:
+                        ax.semilogx(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
+                ax.set_title(name, fontsize=8)
+                ax.grid(alpha=0.3)
+                ax.tick_params(labelsize=7)
+            for ax in axes.ravel()[n:]:
+                ax.axis("off")
+            axes[0][0].legend(fontsize=6)
+            fig.supxlabel("impact speed (m/s)", fontsize=8)
+            fig.supylabel("restitution", fontsize=8)
+            fig.tight_layout()
+            out.append(("restitution against impact speed", _png(fig)))
+    oblique = [c for c in summary["cases"] if c.get("model") and c["model"]["tangential"] != "none"
+               and c["impact"].get("angle") is not None]
+    groups = defaultdict(list)
+    for c in oblique:
+        groups[(c["file"], c["impact"].get("spin") or 0.0)].append(c)
+    groups = {k: v for k, v in groups.items() if len(v) > 1}
+    for metric, label in (("tangential_restitution", "tangential restitution"),
+                          ("rebound_angular_velocity", "rebound spin (rad/s)")):
+        if not groups:
+            break
+        n = len(groups)
+        cols = 4
+        rows = (n + cols - 1) // cols
+        fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
+        for ax, ((file, spin), cs) in zip(axes.ravel(), sorted(groups.items())):
+            cs = sorted(cs, key=lambda c: c["impact"]["angle"])
+            for src, marker in zip(sources, "o^s"):
+                pts = [(c["impact"]["angle"], _metric_of(c, src, metric)) for c in cs]
+                pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
+                if pts:
+                    ax.plot(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
+            ax.set_title(f"{_model(cs[0])}, spin {spin:g}", fontsize=8)
+            ax.grid(alpha=0.3)
+            ax.tick_params(labelsize=7)
+        for ax in axes.ravel()[n:]:
+            ax.axis("off")
+        axes[0][0].legend(fontsize=6)
+        fig.supxlabel("incidence angle (°)", fontsize=8)
+        fig.supylabel(label, fontsize=8)
+        fig.tight_layout()
+        out.append((f"{label} against incidence angle", _png(fig)))
+    return out
+
+
+def render_html(summary: dict) -> str:
+    esc = html.escape
+    parts = ["<!doctype html><html><head><meta charset='utf-8'>",
+             f"<title>demcheck verify {esc(summary['run_id'])}</title><style>{_STYLE}</style>{_SCRIPT}</head><body>",
+             f"<h1>demcheck verification {esc(summary['run_id'])}</h1>"]
+    if summary["partial"]:
+        parts.append(f"<p class='partial'>PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of "
+                     f"{summary['planned']} cases finished.</p>")
+    parts.append(f"<p>demcheck {esc(summary['demcheck'])} · engines: {esc(_engine_text(summary))} · "
+                 f"{summary['failed']} case(s) failing</p>")
+    # matrix
+    md = render_markdown(summary)
+    mat_start = md.index("## Agreement matrix")
+    mat_end = md.index("## Disagreements")
+    parts.append("<h2>Agreement matrix</h2>" + _md_table_to_html(md[mat_start:mat_end]))
+    parts.append("<h2>Suite plots</h2>")
+    for title, b64 in suite_plots(summary):
+        parts.append(f"<h3>{esc(title)}</h3>{_img(b64, title)}")
+    parts.append("<h2>Disagreements</h2>" + "".join(
+        f"<p>{esc(line.strip('* '))}</p>" for line in md[mat_end:md.index('## Cases')].splitlines()[2:] if line.strip()))
+    parts.append("<h2>Cases</h2>")
+    # one plot per case file (its first variant), every case's numbers in a table
+    shown = set()
+    for c in summary["cases"]:
+        cls = {"ok": "agree", "unexpected": "unexpected", "failed": "failed"}.get(c["status"], "expected")
+        parts.append(f"<details><summary><span class='{cls}'>{esc(c['status'])}</span> {esc(c['case'])} — "
+                     f"{esc(_model(c))}</summary>")
+        if c["file"] not in shown:
+            b64 = case_panels(c)
+            if b64:
+                parts.append(_img(b64, f"force curves of {c['case']}"))
+                shown.add(c["file"])
+        rows = [k for k in c.get("comparisons", [])]
+        parts.append("<table><tr><th>source</th><th>metric</th><th>value</th><th>reference</th><th>scaled diff"
+                     "</th><th>tolerance</th><th>verdict</th><th>reason</th></tr>")
+        for k in rows:
+            vcls = {V.AGREE: "agree", V.EXPECTED: "expected", V.UNEXPECTED: "unexpected", V.FAILED: "failed"}.get(
+                k["verdict"], "")
+            parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{_f(k['value'])}</td>"
+                         f"<td>{_f(k['reference'])}</td><td>{_f(k['rel_diff'], '.3g')}</td>"
+                         f"<td>{_f(k['tolerance'], '.3g')}</td><td class='{vcls}'>{esc(k['verdict'])}</td>"
+                         f"<td>{esc(k['reason'])}</td></tr>")
+        parts.append("</table></details>")
+    parts.append("</body></html>")
+    return "\n".join(parts) + "\n"
+
+
+def _md_table_to_html(text: str) -> str:
+    rows = [line for line in text.splitlines() if line.startswith("|")]
+    if not rows:
+        return ""
+    out = ["<table>"]
+    for i, row in enumerate(rows):
+        if set(row.replace("|", "").strip()) <= {"-"}:
+            continue
+        cells = [html.escape(c.strip()) for c in row.strip("|").split("|")]
+        tag = "th" if i == 0 else "td"
+        out.append("<tr>" + "".join(f"<{tag}>{c}</{tag}>" for c in cells) + "</tr>")
+    out.append("</table>")
+    return "".join(out)

@@ -1,0 +1,214 @@
+"""Verdicts: does a source agree with the seed model, metric by metric, and if not, why?
+
+The reference's adaptive method is the seed model's converged answer. A time-stepped source at step dt is
+compared with it in units of each metric's scale (:func:`scale`), against a tolerance that includes the
+time step's own error, measured in the same run (the reference's verlet method, seed law, same dt). For
+an engine the difference is split in two, as DESIGN.md asks:
+
+* implementation: the engine against its twin at equal dt (what the engine should compute) — must be
+  within ``tolerances.engine.implementation``;
+* formula: what is left is the engine's formula (an approximate mapping, documented) or a known engine
+  behaviour (``data/expected_differences.toml``, matched by engine version).
+
+Verdicts: agree, differs as expected, differs unexpectedly, not expressible, engine missing, failed.
+Only "differs unexpectedly" and "failed" fail a run.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+AGREE = "agree"
+EXPECTED = "differs as expected"
+UNEXPECTED = "differs unexpectedly"
+NOT_EXPRESSIBLE = "not expressible"
+MISSING = "engine missing"
+FAILED = "failed"
+VERDICTS = (AGREE, EXPECTED, UNEXPECTED, NOT_EXPRESSIBLE, MISSING, FAILED)
+FAILING = (UNEXPECTED, FAILED)
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    engine_rtol: float = 1e-6
+    implementation: float = 1e-9
+    verlet_rtol: float = 1e-2
+    closed_form: float = 1e-8
+
+    @classmethod
+    def load(cls, path: str | Path | None = None) -> "Tolerances":
+        d = tomllib.loads(Path(path or DATA / "tolerances.toml").read_text())
+        return cls(engine_rtol=d["engine"]["rtol"], implementation=d["engine"]["implementation"],
+                   verlet_rtol=d["verlet"]["rtol"], closed_form=d["closed_form"]["rtol"])
+
+
+@dataclass(frozen=True)
+class ExpectedDifference:
+    engine: str
+    versions: tuple[str, ...]
+    reason: str
+    normal: str = "*"
+    tangential: str = "*"
+    metrics: tuple[str, ...] = ("*",)
+    source: str = ""
+
+    def matches(self, engine: str, version: str | None, model: dict, metric: str) -> bool:
+        return (fnmatch.fnmatchcase(engine, self.engine)
+                and version is not None and any(fnmatch.fnmatchcase(version, v) for v in self.versions)
+                and fnmatch.fnmatchcase(model.get("normal", ""), self.normal)
+                and fnmatch.fnmatchcase(model.get("tangential", ""), self.tangential)
+                and any(fnmatch.fnmatchcase(metric, m) for m in self.metrics))
+
+
+def load_expected(path: str | Path | None = None) -> list[ExpectedDifference]:
+    from ..errors import ConfigError
+
+    path = Path(path or DATA / "expected_differences.toml")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
+    out = []
+    for i, d in enumerate(raw.get("difference", [])):
+        where = f"{path.name}: difference.{i}"
+        for key in ("engine", "versions", "reason"):
+            if key not in d:
+                raise ConfigError(f"{where}.{key}", None, "missing")
+        if not isinstance(d["versions"], list) or not d["versions"]:
+            raise ConfigError(f"{where}.versions", d["versions"], "must be a non-empty list of version patterns")
+        unknown = set(d) - {"engine", "versions", "reason", "normal", "tangential", "metrics", "source"}
+        if unknown:
+            raise ConfigError(f"{where}.{sorted(unknown)[0]}", d[sorted(unknown)[0]], "unknown key")
+        out.append(ExpectedDifference(engine=d["engine"], versions=tuple(d["versions"]), reason=d["reason"],
+                                      normal=d.get("normal", "*"), tangential=d.get("tangential", "*"),
+                                      metrics=tuple(d.get("metrics", ["*"])), source=d.get("source", "")))
+    return out
+
+
+def scale(metric: str, ref: float, case_scales: dict) -> float:
+    """The unit a metric's difference is measured in."""
+    if metric in ("restitution", "tangential_restitution"):
+        return 1.0
+    if metric == "energy_dissipated":
+        return case_scales["impact_energy"]
+    if metric == "rebound_angle":
+        return 90.0
+    if metric == "rebound_angular_velocity":
+        return case_scales["spin"]
+    return abs(ref) if ref else 1.0
+
+
+def scaled(a: float, b: float, metric: str, case_scales: dict) -> float:
+    """|a − b| in units of the metric's scale; 0 when neither exists (a metric that does not apply), NaN
+    when only one does."""
+    fa, fb = _finite(a), _finite(b)
+    if not (fa or fb):
+        return 0.0 if _nan(a) and _nan(b) else math.nan
+    if fa != fb:
+        return math.nan
+    return abs(a - b) / scale(metric, b, case_scales)
+
+
+def _finite(x) -> bool:
+    return x is not None and isinstance(x, (int, float)) and math.isfinite(x)
+
+
+def _nan(x) -> bool:
+    return x is None or (isinstance(x, float) and math.isnan(x))
+
+
+@dataclass
+class Comparison:
+    source: str
+    metric: str
+    value: float
+    reference: float
+    abs_diff: float
+    rel_diff: float  # in units of the metric's scale
+    tolerance: float
+    verdict: str
+    reason: str = ""
+    parts: dict = field(default_factory=dict)  # implementation / time step / formula, scaled
+
+    def as_dict(self) -> dict:
+        return {"source": self.source, "metric": self.metric, "value": self.value, "reference": self.reference,
+                "abs_diff": self.abs_diff, "rel_diff": self.rel_diff, "tolerance": self.tolerance,
+                "verdict": self.verdict, "reason": self.reason, "parts": self.parts}
+
+
+def judge_engine(engine: str, version: str | None, model: dict, metric: str, value: float, reference: float,
+                 twin: float, seed_verlet: float, fidelity: str, reasons: list[str], case_scales: dict,
+                 tol: Tolerances, expected: list[ExpectedDifference]) -> Comparison:
+    """One metric of an engine run against the seed model."""
+    diff = scaled(value, reference, metric, case_scales)
+    impl = scaled(value, twin, metric, case_scales)
+    step = scaled(seed_verlet, reference, metric, case_scales)
+    formula = scaled(twin, seed_verlet, metric, case_scales)
+    tolerance = tol.engine_rtol + 1.01 * (step if _finite(step) else 0.0)
+    parts = {"implementation": impl, "time_step": step, "formula": formula}
+    absd = abs(value - reference) if _finite(value) and _finite(reference) else math.nan
+    c = Comparison(engine, metric, value, reference, absd, diff, tolerance, AGREE, "", parts)
+    if _nan(value) and _nan(reference):
+        return c  # a metric that does not apply (a head-on impact's tangential restitution)
+    match = next((e for e in expected if e.matches(engine, version, model, metric)), None)
+    if not _finite(impl) or impl > tol.implementation:
+        if match is not None:
+            c.verdict, c.reason = EXPECTED, f"{match.reason} ({match.source})" if match.source else match.reason
+        else:
+            c.verdict = UNEXPECTED
+            c.reason = (f"the engine does not compute its own documented formula: {impl:.3g} from its twin at "
+                        f"equal dt (bar {tol.implementation:g})")
+        return c
+    if _finite(diff) and diff <= tolerance:
+        return c
+    if fidelity == "approximate":
+        c.verdict, c.reason = EXPECTED, "approximate mapping: " + "; ".join(reasons)
+    elif match is not None:
+        c.verdict, c.reason = EXPECTED, f"{match.reason} ({match.source})" if match.source else match.reason
+    else:
+        c.verdict = UNEXPECTED
+        c.reason = (f"{diff:.3g} from the seed model beyond the time step's own {step:.3g}; the engine meets its "
+                    f"twin ({impl:.2g}), so the twin's formula differs ({formula:.3g}) and no documented "
+                    "difference explains it")
+    return c
+
+
+def judge_verlet(metric: str, value: float, reference: float, steps_per_contact: float, case_scales: dict,
+                 tol: Tolerances) -> Comparison:
+    """The reference's verlet method at the case's dt against its converged answer: the time step's error."""
+    diff = scaled(value, reference, metric, case_scales)
+    absd = abs(value - reference) if _finite(value) and _finite(reference) else math.nan
+    c = Comparison("reference-verlet", metric, value, reference, absd, diff, tol.verlet_rtol, AGREE)
+    if _nan(value) and _nan(reference):
+        return c
+    if not (_finite(diff) and diff <= tol.verlet_rtol):
+        c.verdict = EXPECTED
+        c.reason = (f"time-step error of the velocity-Verlet scheme at {steps_per_contact:.0f} steps per contact "
+                    "(docs/models.md, convergence orders)")
+    return c
+
+
+def judge_closed_form(metric: str, value: float, exact: float, case_scales: dict, tol: Tolerances) -> Comparison:
+    diff = scaled(value, exact, metric, case_scales)
+    c = Comparison("closed-form", metric, value, exact, abs(value - exact), diff, tol.closed_form, AGREE)
+    if not (_finite(diff) and diff <= tol.closed_form):
+        c.verdict, c.reason = UNEXPECTED, "the adaptive method misses the model's closed form"
+    return c
+
+
+def status_comparison(source: str, verdict: str, reason: str) -> Comparison:
+    """A source that produced no numbers (not expressible, engine missing, failed)."""
+    nan = math.nan
+    return Comparison(source, "*", nan, nan, nan, nan, nan, verdict, reason)
+
+
+def worst(verdicts) -> str:
+    order = {AGREE: 0, NOT_EXPRESSIBLE: 1, MISSING: 2, EXPECTED: 3, UNEXPECTED: 4, FAILED: 5}
+    vs = list(verdicts)
+    return max(vs, key=order.__getitem__) if vs else AGREE
