@@ -6,7 +6,7 @@ VENV    ?= .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.demcheck-installed
 
-.PHONY: setup engines run test bench clean
+.PHONY: setup engines browser run test bench clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -20,14 +20,20 @@ setup: $(STAMP)
 engines: $(STAMP)
 	bash scripts/install-engines.sh $(VENV)
 
+# a headless browser for the report-rendering test
+browser:
+	bash scripts/install-browser.sh
+
 run: engines
 	$(BIN)/demcheck verify
 
-test: engines
+test: engines browser
 	bash scripts/run-tests.sh $(VENV)
 
-bench: $(STAMP)
+bench: engines
 	$(BIN)/python benchmarks/bench_adaptive.py
+	$(BIN)/python benchmarks/engine_twin_agreement.py
+	$(BIN)/python benchmarks/bench_verify.py
 
 clean:
 	rm -rf $(VENV) reports .pytest_cache .hypothesis

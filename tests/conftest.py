@@ -18,8 +18,13 @@ def pytest_collection_modifyitems(config, items):
     engine is a failure, never a skip."""
     from demcheck.engines import discovery
 
+    import shutil
+
     require = os.environ.get("DEMCHECK_REQUIRE_ENGINES") == "1"
+    browser = any(shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome"))
     for item in items:
+        if item.get_closest_marker("browser") is not None and not browser and not require:
+            item.add_marker(pytest.mark.skip(reason="no chromium (scripts/install-browser.sh)"))
         marker = item.get_closest_marker("engine")
         if marker is None:
             continue

@@ -369,7 +369,7 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
                and c["impact"].get("angle") is not None]
     groups = defaultdict(list)
     for c in oblique:
-        groups[(c["file"], c["impact"].get("spin") or 0.0)].append(c)
+        groups[(c["file"], round(c["impact"].get("spin") or 0.0, 6))].append(c)
     groups = {k: v for k, v in groups.items() if len(v) > 1}
     for metric, label in (("tangential_restitution", "tangential restitution"),
                           ("rebound_angular_velocity", "rebound spin (rad/s)")):

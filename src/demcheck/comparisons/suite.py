@@ -105,13 +105,14 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     p0 = case.particles[0]
     v_in = model.pair.impact_speed
-    entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution,
-                       **{k: case.raw.get("impact", {}).get(k) for k in ("angle", "spin")}}
-    scales = {"impact_energy": 0.5 * model.pair.m_eff * v_in * v_in, "spin": v_in / p0.radius}
+    entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution, **_incidence(case)}
+    adaptive = collide(case, "adaptive")
+    # energy in units of the bodies' kinetic energy at impact (translation, spin, and the tangential motion
+    # a grazing impact carries: the normal part alone vanishes at 90°)
+    scales = {"impact_energy": _impact_energy(case, model), "spin": v_in / p0.radius}
     entry["scales"] = scales
     comps: list[V.Comparison] = []
 
-    adaptive = collide(case, "adaptive")
     ref = adaptive.metrics()
     entry["sources"]["reference"] = _source(adaptive)
     entry["series"].append(_series(adaptive.contact, "reference"))
@@ -169,6 +170,40 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
     entry["verdict"] = worst
     return entry
+
+
+def _impact_energy(case: Case, model) -> float:
+    """Kinetic energy of the relative motion, m̄|v_rel|²/2, plus the bodies' spin energy."""
+    import numpy as np
+
+    v = np.asarray(case.particles[0].velocity, float)
+    if not case.walls:
+        v = v - np.asarray(case.particles[1].velocity, float)
+    e = 0.5 * model.pair.m_eff * float(v @ v)
+    for i, p in enumerate(case.particles):
+        w = np.asarray(p.angular_velocity, float)
+        e += 0.5 * 0.4 * case.mass(i) * p.radius**2 * float(w @ w)
+    return max(e, 0.5 * model.pair.m_eff * model.pair.impact_speed**2)
+
+
+def _incidence(case: Case) -> dict:
+    """Incidence angle from the normal (degrees) of the initial relative velocity, and the spin |ω| of
+    particle 0 (rad/s) — the axes of the suite's tangential plots."""
+    import numpy as np
+
+    p0 = case.particles[0]
+    v = np.asarray(p0.velocity, float)
+    if case.walls:
+        n = -np.asarray(case.walls[0].normal, float)
+    else:
+        p1 = case.particles[1]
+        v = v - np.asarray(p1.velocity, float)
+        d = np.asarray(p1.position, float) - np.asarray(p0.position, float)
+        n = d / np.linalg.norm(d)
+    vn = float(v @ n)
+    vt = float(np.linalg.norm(v - vn * n))
+    return {"angle": float(np.degrees(np.arctan2(vt, abs(vn)))) if vn else None,
+            "spin": float(np.linalg.norm(p0.angular_velocity))}
 
 
 def _source(result) -> dict:
