@@ -350,6 +350,151 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
     sys.exit(0 if summary["failed"] == 0 else 1)
 
 
+def _engine_list(engines: str) -> list[str]:
+    names = [] if engines.strip().lower() == "none" else [e.strip() for e in engines.split(",") if e.strip()]
+    for e in names:
+        if e not in ("lammps", "liggghts"):
+            raise ConfigError("--engines", e, "must be lammps, liggghts (comma-separated) or none")
+    return names
+
+
+def _engine_text(names) -> str:
+    from .engines import discovery
+
+    out = []
+    for e in names:
+        info = discovery.find(e)
+        out.append(f"{e} {info.version}" if info else f"{e}: missing ({discovery.HOW_TO_INSTALL[e]})")
+    return "; ".join(out) or "none (reference only)"
+
+
+@cli.command()
+@click.argument("paths", nargs=-1, required=True, metavar="CASE|DIR...")
+@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST",
+              help="comma-separated engines (lammps, liggghts), or 'none'")
+@click.option("--steps", "steps", default=None, metavar="LIST",
+              help="steps per elastic contact time to sweep (default 5,10,20,50,100,200,500,1000,2000,5000)")
+@click.option("--batch", type=int, default=16, show_default=True, help="copies per engine batch run")
+@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@_set_option
+def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
+    """Run time against error: sweep the time step of the reference's verlet method and of each engine (one
+    collision per process, and a batch of copies per process), and the adaptive method's tolerance; fit the
+    order of convergence and find the cheapest step for each target error."""
+    from rich.progress import Progress
+
+    from .case import load
+    from .comparisons import bench as B
+    from .comparisons.perf_report import new_run_dir, write_bench
+
+    names = _engine_list(engines)
+    grid = B.STEPS_PER_CONTACT
+    if steps:
+        try:
+            grid = tuple(float(x) for x in steps.split(","))
+        except ValueError:
+            raise ConfigError("--steps", steps, "must be comma-separated numbers of steps per contact") from None
+        if not grid or any(not (x >= 1) for x in grid):
+            raise ConfigError("--steps", steps, "must be numbers >= 1")
+    if batch < 1:
+        raise ConfigError("--batch", batch, "must be >= 1")
+    files = _case_files(paths)
+    root = Path(report_dir)
+    out_dir = new_run_dir(root, "bench")
+    results = []
+    per_case = len(B.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
+    with Progress(transient=True, disable=as_json) as progress:
+        task = progress.add_task("bench", total=per_case * len(files))
+        for f in files:
+            case = load(f, list(overrides))
+            results.append(B.bench_case(case, names, grid, batch=batch,
+                                        progress=lambda: progress.advance(task)).summary())
+    data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names), "batch": batch,
+            "command": ["demcheck", "bench", *sys.argv[2:]], "cases": results,
+            "speed_goal": B.speed_goal_text(results)}
+    write_bench(data, root)
+    if as_json:
+        from .comparisons.report import clean
+
+        emit_json(clean(data))
+    else:
+        click.echo(Path(out_dir / "report.md").read_text())
+        click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)
+
+
+@cli.command()
+@click.argument("paths", nargs=-1, required=True, metavar="CASE|DIR...")
+@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST")
+@click.option("--only", "only", multiple=True, metavar="NAME",
+              help="stress only parameters whose name contains NAME (stiffness, restitution, radius, speed, "
+                   "angle, mass); repeatable")
+@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True)
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def stress(paths, engines, only, report_dir, as_json):
+    """Numerical stability: the largest stable time step of each source against stiffness, mass ratio,
+    impact speed, restitution, radius and incidence, with the failures and where the engines and the
+    reference disagree."""
+    from rich.progress import Progress
+
+    from .comparisons.perf_report import new_run_dir, write_stress
+    from .comparisons.stress import stress_file
+
+    names = _engine_list(engines)
+    files = _case_files(paths)
+    root = Path(report_dir)
+    out_dir = new_run_dir(root, "stress")
+    results = []
+    with Progress(transient=True, disable=as_json) as progress:
+        task = progress.add_task("stress", total=None)
+        for f in files:
+            results.append(stress_file(f, names, list(only) or None,
+                                       progress=lambda: progress.advance(task)).summary())
+    data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names),
+            "command": ["demcheck", "stress", *sys.argv[2:]], "cases": results}
+    write_stress(data, root)
+    if as_json:
+        from .comparisons.report import clean
+
+        emit_json(clean(data))
+    else:
+        click.echo(Path(out_dir / "report.md").read_text())
+        click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)
+    if any(c["disagreements"] for c in results):
+        sys.exit(1)
+
+
+@cli.command()
+@click.argument("case_path", metavar="CASE")
+@click.option("--target", type=float, default=1e-3, show_default=True,
+              help="the worst relative error to allow (restitution, contact time, max overlap, peak force)")
+@_set_option
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def dt(case_path, target, overrides, as_json):
+    """A recommended time step for the case's model, from the Rayleigh and Hertz times and the measured
+    work–precision of the engines' scheme, with the error to expect."""
+    from .comparisons.bench import recommend
+
+    if not (0 < target < 1):
+        raise ConfigError("--target", target, "must be between 0 and 1 (a relative error)")
+    case = _load(case_path, overrides)
+    rec = recommend(case, target)
+    if as_json:
+        emit_json(rec)
+        return
+    click.echo(f"{rec['case']}: normal={rec['model']['normal']} tangential={rec['model']['tangential']}")
+    click.echo(f"  elastic contact time t_c = {rec['t_contact']:.4g} s; Hertz time {rec['hertz_time']:.4g} s; "
+               f"Rayleigh time {rec['rayleigh_time']:.4g} s")
+    click.echo(f"  rules of thumb: 0.2 t_Rayleigh = {rec['rules_of_thumb']['0.2 t_Rayleigh']:.4g} s, "
+               f"t_Hertz/50 = {rec['rules_of_thumb']['t_Hertz / 50']:.4g} s")
+    if rec["dt"] is None:
+        click.echo(f"  {rec['message']}")
+        sys.exit(1)
+    click.echo(f"  recommended dt = {rec['dt']:.4g} s ({rec['steps_per_contact']:g} steps per contact, "
+               f"{rec['dt_over_rayleigh']:.3g} t_Rayleigh): expected error {rec['expected_error']:.2g} "
+               f"(target {target:g}; measured order {rec['order']:.2f})")
+
+
 def _case_files(paths) -> list[Path]:
     if not paths:
         paths = [str(CASES_DIR)]

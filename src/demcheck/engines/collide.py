@@ -60,6 +60,11 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             if cache is not None:
                 cache.put(k, table, {"version": out.version, "workdir": str(out.workdir),
                                      "wall_time": out.wall_time, "warnings": out.warnings})
+        n = len(case.particles)
+        copies = int(options.get("copies", 1))
+        if copies > 1:
+            spread = _copies_spread(table, n, copies)
+            table = table[table["id"] <= n]
         particles = _particles(table, case, _dt_of(text))
         contact = states.trim(states.from_particles(particles, case))
         d = contact["delta"].to_numpy()
@@ -84,8 +89,18 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         engine_version=out.version, status="ok",
         message="; ".join(mp.reasons),
         meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": text, "fidelity": mp.fidelity,
-              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons)},
+              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons),
+              "copies": int(options.get("copies", 1)),
+              "copies_spread": spread if int(options.get("copies", 1)) > 1 else 0.0},
     )
+
+
+def _copies_spread(table: pd.DataFrame, n: int, copies: int) -> float:
+    """Largest difference between any copy's final velocities and copy 0's (they are the same collision;
+    far apart, they must agree to round-off)."""
+    last = table[table["step"] == table["step"].max()].sort_values("id")
+    v = last[["vx", "vy", "vz", "omegax", "omegay", "omegaz"]].to_numpy().reshape(copies, n, 6)
+    return float(np.max(np.abs(v - v[0])))
 
 
 def _dt_of(text: str) -> float:

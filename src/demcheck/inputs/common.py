@@ -149,17 +149,49 @@ class Deck:
         return written
 
 
-def data_file(case: Case, ntypes: int, box, title: str) -> str:
+def data_file(case: Case, ntypes: int, box, title: str, copies: int = 1, axis: int = 0,
+              spacing: float = 0.0) -> str:
     """A LAMMPS data file (atom_style sphere / granular: id type diameter density x y z; velocities with
     angular velocities), which both engines read."""
     lo, hi = box
-    lines = [f"# {title}", "", f"{len(case.particles)} atoms", f"{ntypes} atom types", "",
+    n = len(case.particles)
+    lines = [f"# {title}", "", f"{n * copies} atoms", f"{ntypes} atom types", "",
              f"{fmt(lo[0])} {fmt(hi[0])} xlo xhi", f"{fmt(lo[1])} {fmt(hi[1])} ylo yhi",
              f"{fmt(lo[2])} {fmt(hi[2])} zlo zhi", "", "Atoms", ""]
-    for k, p in enumerate(case.particles, start=1):
-        rho = case.materials[p.material].density
-        lines.append(f"{k} {k} {fmt(2 * p.radius)} {fmt(rho)} {' '.join(fmt(x) for x in p.position)}")
+    for c in range(copies):
+        for i, p in enumerate(case.particles):
+            k = c * n + i + 1
+            rho = case.materials[p.material].density
+            pos = offset(p.position, axis, spacing, c)
+            lines.append(f"{k} {k} {fmt(2 * p.radius)} {fmt(rho)} {' '.join(fmt(x) for x in pos)}")
     lines += ["", "Velocities", ""]
-    for k, p in enumerate(case.particles, start=1):
-        lines.append(f"{k} {' '.join(fmt(x) for x in p.velocity)} {' '.join(fmt(x) for x in p.angular_velocity)}")
+    for c in range(copies):
+        for i, p in enumerate(case.particles):
+            k = c * n + i + 1
+            lines.append(f"{k} {' '.join(fmt(x) for x in p.velocity)} "
+                         f"{' '.join(fmt(x) for x in p.angular_velocity)}")
     return "\n".join(lines) + "\n"
+
+
+def batch_layout(sc: "Scene", copies: int) -> tuple[int, float, tuple]:
+    """Copies of a two-body scene, far apart, side by side along an axis the motion (and a wall's normal)
+    does not use: (axis, spacing, enlarged box). Each copy's bodies get their own atom types."""
+    case = sc.case
+    lo, hi = (np.array(b, float) for b in sc.box)
+    motion = np.zeros(3)
+    for p in case.particles:
+        motion += np.abs(np.asarray(p.velocity, float))
+    if sc.wall_axis is not None:
+        motion[sc.wall_axis] = np.inf
+    axis = int(np.argmin(motion))
+    rmax = max(p.radius for p in case.particles)
+    spacing = (hi[axis] - lo[axis]) + 4.0 * rmax
+    hi = hi.copy()
+    hi[axis] += spacing * (copies - 1)
+    return axis, spacing, (lo, hi)
+
+
+def offset(position, axis: int, spacing: float, copy: int) -> list:
+    x = list(position)
+    x[axis] += spacing * copy
+    return x

@@ -35,15 +35,20 @@ def coeff_args(nat: Native) -> str:
 
 
 def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Native | None = None,
-         explicit_pairs: bool = True) -> common.Deck:
+         explicit_pairs: bool = True, copies: int = 1) -> common.Deck:
     """The deck of a collision case. ``native``: one configuration for every type pair instead of the
     case's mapped model; ``explicit_pairs=False`` writes only the I I coefficients and lets LAMMPS mix the
-    rest (to show its mixing trap — never what demcheck writes otherwise)."""
+    rest (to show its mixing trap — never what demcheck writes otherwise); ``copies``: that many
+    independent copies of the collision in one run, far apart, each body with its own type (atom ids
+    k·n + 1 … k·n + n for copy k), so that engine start-up is paid once."""
     sc = common.scene(case, dt, length)
     mp = common.contact_mapping(case, "lammps", native)
     mp.require()
     n = len(case.particles)
     lo, hi = sc.box
+    batch_axis, spacing = 0, 0.0
+    if copies > 1:
+        batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
     lines = common.header("lammps", sc, mp, VERSION_NOTE)
     for c in mp.native.comments:
         lines.append(f"#   {c}")
@@ -51,24 +56,33 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
               "comm_modify vel yes",
               f"region box block {fmt(lo[0])} {fmt(hi[0])} {fmt(lo[1])} {fmt(hi[1])} {fmt(lo[2])} {fmt(hi[2])} "
               "units box",
-              f"create_box {n} box"]
-    for k, p in enumerate(case.particles, start=1):
-        i = k - 1
-        lines += [f"create_atoms {k} single {' '.join(fmt(x) for x in p.position)} units box",
-                  f"set atom {k} diameter {fmt(2 * p.radius)}",
-                  f"set atom {k} mass {fmt(case.mass(i))}",
-                  f"set atom {k} vx {fmt(p.velocity[0])} vy {fmt(p.velocity[1])} vz {fmt(p.velocity[2])}",
-                  f"set atom {k} omega {' '.join(fmt(x) for x in p.angular_velocity)}"]
+              f"create_box {n * copies} box"]
+    for c in range(copies):
+        for i, p in enumerate(case.particles):
+            k = c * n + i + 1
+            pos = common.offset(p.position, batch_axis, spacing, c)
+            lines += [f"create_atoms {k} single {' '.join(fmt(x) for x in pos)} units box",
+                      f"set atom {k} diameter {fmt(2 * p.radius)}",
+                      f"set atom {k} mass {fmt(case.mass(i))}",
+                      f"set atom {k} vx {fmt(p.velocity[0])} vy {fmt(p.velocity[1])} vz {fmt(p.velocity[2])}",
+                      f"set atom {k} omega {' '.join(fmt(x) for x in p.angular_velocity)}"]
     rmax = max(p.radius for p in case.particles)
     lines += ["", f"neighbor {fmt(rmax)} bin", "neigh_modify delay 0 every 1 check yes",
               "pair_style granular"]
+    coeffs = {}
     for i, j in common.type_pairs(case):
-        if j is None or (i != j and not explicit_pairs):
+        if j is None:
             continue
         pm = common.pair_mapping(case, "lammps", i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"type pair {i + 1} {j + 1}: {'; '.join(pm.reasons)}")
-        lines.append(f"pair_coeff {i + 1} {j + 1} {coeff_args(pm.native)}")
+        coeffs[(i, j)] = coeffs[(j, i)] = coeff_args(pm.native)
+    ntypes = n * copies
+    for a in range(ntypes):
+        for b in range(a, ntypes):
+            if a != b and not explicit_pairs:
+                continue
+            lines.append(f"pair_coeff {a + 1} {b + 1} {coeffs[(a % n, b % n)]}")
     if case.walls:
         pm = common.pair_mapping(case, "lammps", 0, None, native)
         axis = "xyz"[sc.wall_axis]

@@ -26,15 +26,18 @@ def _matrix(name: str, values: np.ndarray) -> str:
 
 
 def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
-         data_name: str = "data.lmp") -> common.Deck:
+         data_name: str = "data.lmp", copies: int = 1) -> common.Deck:
     """The deck of a collision case (``native``: one configuration for every type pair instead of the case's
-    mapped model)."""
+    mapped model; ``copies``: independent copies of the collision in one run, as in lammps.deck)."""
     sc = common.scene(case, dt, length)
     mp = common.contact_mapping(case, "liggghts", native)
     nat = mp.require()
     n = len(case.particles)
-    ntypes = n + (1 if case.walls else 0)
+    ntypes = n * copies + (1 if case.walls else 0)
     lo, hi = sc.box
+    batch_axis, spacing = 0, 0.0
+    if copies > 1:
+        batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
     lines = common.header("liggghts", sc, mp, VERSION_NOTE)
     for c in nat.comments:
         lines.append(f"#   {c}")
@@ -58,8 +61,13 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         # pairs that never meet (the wall type with itself) take the contact's own value: LIGGGHTS checks
         # every entry against its sanity limits
         mat = np.full((ntypes, ntypes), nat.props.get(key, 0.0))
-        for (i, j), v in natives.items():
-            mat[i, j] = mat[j, i] = v.props.get(key, 0.0)
+        for a in range(ntypes):
+            for b in range(ntypes):
+                ia = n if (case.walls and a == ntypes - 1) else a % n
+                ib = n if (case.walls and b == ntypes - 1) else b % n
+                v = natives.get((min(ia, ib), max(ia, ib)))
+                if v is not None:
+                    mat[a, b] = v.props.get(key, 0.0)
         matrices[names[key]] = mat
     if nat.tangential != "off" and "coefficientFriction" not in matrices:
         matrices["coefficientFriction"] = np.zeros((ntypes, ntypes))
@@ -73,11 +81,11 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
             if not case.walls[0].rigid:
                 raise UnsupportedByEngine("edinburgh (HLS) decks are written for rigid walls")
             e_part = (1.0 - nu * nu) * nat.props["kl"] / (2.0 * r_eff)
-            moduli, ratios = [e_part] * n + [RIGID_WALL_MODULUS], [nu] * (n + 1)
+            moduli, ratios = [e_part] * (n * copies) + [RIGID_WALL_MODULUS], [nu] * (n * copies + 1)
         else:
-            moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * n, [nu] * n
+            moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * (n * copies), [nu] * (n * copies)
     if nat.normal in ("hertz", "hooke"):
-        mats = [case.materials[p.material] for p in case.particles]
+        mats = [case.materials[p.material] for p in case.particles] * copies
         moduli = [m.youngs_modulus for m in mats]
         ratios = [m.poisson_ratio for m in mats]
         if case.walls:
@@ -93,8 +101,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
               "communicate single vel yes",
               f"read_data {data_name}"]
     # read_data sets the angular velocities (3.8.0's set has no omega); masses are then set exactly
-    for k in range(1, n + 1):
-        lines.append(f"set atom {k} mass {fmt(case.mass(k - 1))}")
+    for k in range(1, n * copies + 1):
+        lines.append(f"set atom {k} mass {fmt(case.mass((k - 1) % n))}")
     rmax = max(p.radius for p in case.particles)
     lines += ["", f"neighbor {fmt(rmax)} bin", "neigh_modify delay 0", ""]
     if moduli:
@@ -134,5 +142,6 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
               f'dump_modify state format "{fmt_line}" sort id',
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]
-    data = common.data_file(case, ntypes, sc.box, f"demcheck: case {case.name} (hash {case.hash})")
+    data = common.data_file(case, ntypes, (lo, hi), f"demcheck: case {case.name} (hash {case.hash})", copies=copies,
+                            axis=batch_axis, spacing=spacing)
     return common.Deck("liggghts", "\n".join(lines), {data_name: data})

@@ -145,7 +145,7 @@ def collide(case: Case, method: str | None = None, dt: float | None = None,
     result.particles = _particles_1d(case, geo, contact)
     _add_frame_columns(result, case, geo)
     if method == "verlet" and status_name == "ok":
-        _flag_unresolved(result, t_c)
+        _flag_unresolved(result, t_c, min(p.radius for p in case.particles))
     return result
 
 
@@ -200,11 +200,37 @@ def _frame(t, pid, pos, vel, omega):
                          "wx": omega[0], "wy": omega[1], "wz": omega[2]})
 
 
-def _flag_unresolved(result: Result, t_c: float) -> None:
-    """A verlet run with too few steps in the contact is not trusted silently."""
+MAX_OVERLAP_FRACTION = 0.5  # an overlap beyond half the smaller radius is a numerical failure
+ENERGY_GAIN_TOLERANCE = 0.01  # of the impact kinetic energy, for laws that cannot create energy
+
+
+def health(result: Result, t_c: float, radius: float | None = None, min_steps: int = 5) -> tuple[str, str]:
+    """("ok" | "unresolved" | "unstable", why) of a time-stepped result (the reference's verlet method or an
+    engine): fewer than ``min_steps`` steps inside the contact, an overlap beyond half the radius, or energy
+    created by a law that only stores or dissipates it."""
     c = result.contact
     inside = int((c["delta"] > 0).sum())
-    if inside < 5:
-        result.status = "unresolved"
-        result.message = (f"only {inside} steps inside the contact (dt = {result.dt:.3g} s, elastic contact "
-                          f"time {t_c:.3g} s): the time step does not resolve the collision")
+    if inside < min_steps:
+        return "unresolved", (f"only {inside} steps inside the contact (dt = {result.dt:.3g} s, elastic contact "
+                              f"time {t_c:.3g} s): the time step does not resolve the collision")
+    radius = radius or result.meta.get("radius0")
+    d_max = float(c["delta"].max())
+    if radius and d_max > MAX_OVERLAP_FRACTION * radius:
+        return "unstable", (f"the overlap reached {d_max / radius:.3g} of the radius (dt = {result.dt:.3g} s, "
+                            f"{t_c / result.dt:.3g} steps per elastic contact time)")
+    m = result.metrics()
+    e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
+    gained = -m["energy_dissipated"]
+    if e_in > 0 and math.isfinite(gained) and gained > ENERGY_GAIN_TOLERANCE * e_in:
+        return "unstable", (f"the collision created {gained / e_in:.3g} of the impact energy (dt = {result.dt:.3g} "
+                            f"s, {t_c / result.dt:.3g} steps per elastic contact time): the scheme is unstable there")
+    if not np.all(np.isfinite(c[["delta", "fn"]].to_numpy())):
+        return "unstable", "the state became NaN or infinite"
+    return "ok", ""
+
+
+def _flag_unresolved(result: Result, t_c: float, radius: float | None = None) -> None:
+    """A verlet run is not trusted silently (see :func:`health`)."""
+    status, why = health(result, t_c, radius)
+    if status != "ok":
+        result.status, result.message = status, why

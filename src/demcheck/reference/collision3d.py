@@ -121,7 +121,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
     if method == "verlet" and status_name == "ok":
         from .collision import _flag_unresolved
 
-        _flag_unresolved(result, t_c)
+        _flag_unresolved(result, t_c, min(p.radius for p in case.particles))
     return result
 
 

@@ -1,0 +1,251 @@
+"""Run time against error (``demcheck bench``) and the recommended time step (``demcheck dt``).
+
+For a collision case and each source — the reference's verlet method (the engines' scheme with the seed
+law), each engine that can express the model, and the reference's adaptive method over its tolerance —
+the errors of restitution, contact time, maximum overlap and peak force against the converged adaptive
+answer (rtol 1e-13), with the wall time that bought them:
+
+* time-stepped sources over a grid of steps per elastic contact time (a few to thousands); the order of
+  convergence fitted on the asymptotic part; the cheapest time step meeting each target error;
+* engines timed two ways: one collision per process (start-up included), and per collision in a batch of
+  independent copies run in one process (start-up paid once), so that start-up does not dominate.
+
+Errors are relative (|x − x_ref| / |x_ref|); a source's error is the worst of the four metrics.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..case import Case
+from ..errors import DemcheckError
+from ..reference.collision import characteristic_time, collide
+from ..reference.model import resolve
+
+METRICS = ("restitution", "contact_time", "max_overlap", "peak_force")
+STEPS_PER_CONTACT = (5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
+ADAPTIVE_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+TARGETS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+BATCH = 16
+
+
+@dataclass
+class Point:
+    source: str
+    steps_per_contact: float | None
+    dt: float | None
+    rtol: float | None
+    wall_time: float  # s per collision (engines: per process)
+    batch_time: float | None  # s per collision in a batch (engines)
+    errors: dict
+    status: str = "ok"
+    message: str = ""
+
+    @property
+    def error(self) -> float:
+        vals = [v for v in self.errors.values() if v is not None and math.isfinite(v)]
+        return max(vals) if len(vals) == len(self.errors) else math.nan
+
+    def as_dict(self) -> dict:
+        return {"source": self.source, "steps_per_contact": self.steps_per_contact, "dt": self.dt,
+                "rtol": self.rtol, "wall_time": self.wall_time, "batch_time": self.batch_time,
+                "errors": self.errors, "error": self.error, "status": self.status, "message": self.message}
+
+
+def _errors(m: dict, ref: dict) -> dict:
+    out = {}
+    for k in METRICS:
+        a, b = m.get(k), ref.get(k)
+        out[k] = abs(a - b) / abs(b) if (a is not None and b and math.isfinite(a) and math.isfinite(b)) else math.nan
+    return out
+
+
+def _timed(fn, repeat: int = 3):
+    """(best wall time, result) of ``repeat`` calls: the machine is shared and noisy."""
+    best, out = math.inf, None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def fit_order(points: list[Point], metric: str | None = None) -> float:
+    """Slope of log(error) against log(dt) on the asymptotic range (error between 1e-12 and 1e-2, at least
+    20 steps per contact): the order of convergence."""
+    xs, ys = [], []
+    for p in points:
+        e = p.error if metric is None else p.errors.get(metric)
+        if p.status == "ok" and p.dt and e and math.isfinite(e) and 1e-12 < e < 1e-2 and p.steps_per_contact >= 20:
+            xs.append(math.log10(p.dt))
+            ys.append(math.log10(e))
+    if len(xs) < 3:
+        return math.nan
+    return float(np.polyfit(xs, ys, 1)[0])
+
+
+def cheapest(points: list[Point], target: float) -> Point | None:
+    """The largest dt of the grid that meets ``target`` — and whose finer steps all do too (so a lucky
+    cancellation at one coarse step is not taken for convergence)."""
+    pts = sorted((p for p in points if p.dt), key=lambda p: p.dt)
+    best = None
+    for p in pts:
+        if p.status == "ok" and math.isfinite(p.error) and p.error <= target:
+            best = p
+        else:
+            break
+    return best
+
+
+@dataclass
+class BenchResult:
+    case: str
+    model: dict
+    t_contact: float
+    reference: dict
+    points: list[Point] = field(default_factory=list)
+    skipped: dict = field(default_factory=dict)
+
+    def sources(self) -> list[str]:
+        return list(dict.fromkeys(p.source for p in self.points))
+
+    def summary(self) -> dict:
+        out = {"case": self.case, "model": self.model, "t_contact": self.t_contact, "reference": self.reference,
+               "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {}}
+        for src in self.sources():
+            pts = [p for p in self.points if p.source == src]
+            s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in METRICS},
+                 "cheapest": {}}
+            for tgt in TARGETS:
+                if src == "reference-adaptive":
+                    ok = [p for p in pts if math.isfinite(p.error) and p.error <= tgt]
+                    c = min(ok, key=lambda p: p.wall_time) if ok else None
+                else:
+                    c = cheapest(pts, tgt)
+                s["cheapest"][f"{tgt:g}"] = None if c is None else {
+                    "dt": c.dt, "steps_per_contact": c.steps_per_contact, "rtol": c.rtol, "error": c.error,
+                    "wall_time": c.wall_time, "batch_time": c.batch_time}
+            out["sources"][src] = s
+        return out
+
+
+def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
+               batch: int = BATCH, cache=None, progress=None) -> BenchResult:
+    from ..engines import discovery
+    from ..engines.collide import collide as run_engine
+    from ..inputs import common
+
+    model = resolve(case)
+    t_c = characteristic_time(model)
+    ref = collide(case, "adaptive").metrics()
+    res = BenchResult(case.name, model.describe(), t_c, ref)
+    tick = progress or (lambda: None)
+    for rtol in rtols:
+        wall, r = _timed(lambda: collide(case, "adaptive", rtol=rtol))
+        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, _errors(r.metrics(), ref),
+                                r.status, r.message))
+        tick()
+    for spc in steps:
+        dt = t_c / spc
+        wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
+        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, _errors(r.metrics(), ref),
+                                r.status, r.message))
+        tick()
+    for engine in engines:
+        mp = common.contact_mapping(case, engine)
+        if mp.native is None:
+            res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
+            continue
+        if discovery.find(engine) is None:
+            res.skipped[engine] = f"not installed: {discovery.HOW_TO_INSTALL[engine]}"
+            continue
+        for spc in steps:
+            dt = t_c / spc
+            try:
+                one = run_engine(case, engine, dt=dt, cache=None)
+                many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
+            except DemcheckError as exc:
+                res.points.append(Point(engine, spc, dt, None, math.nan, math.nan, {k: math.nan for k in METRICS},
+                                        "failed", str(exc).splitlines()[0]))
+                tick()
+                continue
+            status, why = _stable_engine(one, t_c, case)
+            res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
+                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref), status, why))
+            tick()
+    return res
+
+
+def _stable_engine(result, t_c, case) -> tuple[str, str]:
+    """An engine result through the reference's own checks (resolved, bounded overlap, no energy created)."""
+    from ..reference.collision import health
+
+    return health(result, t_c, min(p.radius for p in case.particles))
+
+
+# ----------------------------------------------------------------------------- demcheck dt
+
+
+def rayleigh_time(case: Case) -> float:
+    """Rayleigh wave time πR√(ρ/G)/(0.1631ν + 0.8766) of the smallest particle (ENGINES.md pitfall 11)."""
+    out = math.inf
+    for p in case.particles:
+        m = case.materials[p.material]
+        out = min(out, math.pi * p.radius * math.sqrt(m.density / m.shear_modulus) / (0.1631 * m.poisson_ratio + 0.8766))
+    return out
+
+
+def hertz_time(case: Case) -> float:
+    """The exact elastic Hertz contact time at the case's impact speed (2.868266 (m̄²/(R̄Ē²v))^{1/5})."""
+    from ..reference.analytic import HERTZ_DURATION_CONSTANT
+
+    model = resolve(case)
+    p = model.pair
+    return HERTZ_DURATION_CONSTANT * (p.m_eff**2 / (p.r_eff * p.e_eff**2 * p.impact_speed)) ** 0.2
+
+
+def recommend(case: Case, target: float = 1e-3) -> dict:
+    """A time step for the case's model meeting ``target`` (worst relative error of restitution, contact
+    time, maximum overlap and peak force), from the measured work-precision data of the reference's verlet
+    method (the engines' scheme, which exact engine mappings reproduce to round-off)."""
+    b = bench_case(case, engines=(), rtols=(), steps=(10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000))
+    pts = [p for p in b.points if p.source == "reference-verlet"]
+    c = cheapest(pts, target)
+    t_r, t_h = rayleigh_time(case), hertz_time(case)
+    out = {"case": case.name, "model": b.model, "target": target, "t_contact": b.t_contact,
+           "rayleigh_time": t_r, "hertz_time": t_h, "order": fit_order(pts),
+           "rules_of_thumb": {"0.2 t_Rayleigh": 0.2 * t_r, "t_Hertz / 50": t_h / 50},
+           "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
+                      "status": p.status} for p in pts]}
+    if c is None:
+        out.update(dt=None, message=f"no time step of the grid (down to t_c/10000) meets {target:g}")
+    else:
+        out.update(dt=c.dt, steps_per_contact=c.steps_per_contact, expected_error=c.error,
+                   dt_over_rayleigh=c.dt / t_r, dt_over_hertz=c.dt / t_h)
+    return out
+
+
+def speed_goal_text(results: list[dict]) -> str:
+    """The issue's speed goal, per case: the adaptive method's time to an error of 1e-8 against the time
+    each engine needs for 1e-3 (per process and per batched collision), measured in this run."""
+    lines = []
+    for b in results:
+        src = b["sources"]
+        a = (src.get("reference-adaptive") or {}).get("cheapest", {}).get("1e-08")
+        if a is None:
+            continue
+        for e in ("lammps", "liggghts"):
+            c = (src.get(e) or {}).get("cheapest", {}).get("0.001")
+            if c is None:
+                continue
+            ratio_p = c["wall_time"] / a["wall_time"]
+            ratio_b = (c["batch_time"] / a["wall_time"]) if c.get("batch_time") else math.nan
+            lines.append(f"{b['case']}: adaptive to 1e-8 in {a['wall_time'] * 1e3:.3g} ms; {e} to 1e-3 in "
+                         f"{c['wall_time'] * 1e3:.3g} ms per process ({ratio_p:.3g}×), "
+                         f"{c['batch_time'] * 1e3:.3g} ms per batched collision ({ratio_b:.3g}×) — goal "
+                         f"{'met' if min(ratio_p, ratio_b) > 1 else 'MISSED'}")
+    return "\n".join(lines)

@@ -1,0 +1,224 @@
+"""Numerical stability (``demcheck stress``): how large a time step each source survives, and where.
+
+For a collision case file, each stress parameter is pushed over its range (stiffness, mass ratio up to a
+rigid wall, impact speed, restitution near 0 and near 1, very small and very large radii, grazing
+incidence); at each value, and for each source (the reference's verlet method and every engine that can
+express the model), the largest stable time step is found by bisection over a grid of steps per elastic
+contact time. A run fails when it is unresolved, produces NaN, overlaps beyond half the radius, creates
+energy (a law that only stores or dissipates it; reference/collision.py ``health``), does not separate, or
+the engine errors (lost atoms, …). The stability map is dt_max / t_c against each parameter; where an
+engine and the reference disagree about the limit by more than one grid step, the point is flagged.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..case import Case, from_dict
+from ..errors import ConfigError, DemcheckError
+from ..reference.collision import characteristic_time, collide, health
+from ..reference.model import resolve
+
+# steps per elastic contact time, coarse to fine: the search grid
+GRID = (1, 1.5, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 100)
+
+
+def _scaled(key, factor):
+    def apply(raw):
+        for m in raw.get("materials", {}).values():
+            if key in m:
+                m[key] = m[key] * factor
+        return raw
+    return apply
+
+
+def _set_materials(key, value):
+    def apply(raw):
+        for m in raw.get("materials", {}).values():
+            m[key] = value
+        return raw
+    return apply
+
+
+def _radius(factor):
+    def apply(raw):
+        for p in raw.get("particles", []):
+            p["radius"] = p["radius"] * factor
+            if "position" in p and "impact" not in raw:
+                p["position"] = [x * factor for x in p["position"]]
+        return raw
+    return apply
+
+
+def _impact(key, value):
+    def apply(raw):
+        if "impact" not in raw:
+            raise ConfigError("impact", None, f"stress parameter {key} needs an [impact] table in the case")
+        raw["impact"][key] = value
+        return raw
+    return apply
+
+
+def _mass_ratio(ratio):
+    def apply(raw):
+        parts = raw.get("particles", [])
+        if len(parts) != 2:
+            raise ConfigError("particles", len(parts), "the mass-ratio sweep needs a particle pair")
+        mats = raw["materials"]
+        base = mats[parts[1]["material"]]
+        mats["heavy"] = {**base, "density": base["density"] * ratio}
+        parts[1]["material"] = "heavy"
+        return raw
+    return apply
+
+
+def parameters(raw: dict) -> dict[str, list[tuple[float, object]]]:
+    """The stress parameters that apply to a case: name → [(value, raw transform)]."""
+    out = {
+        "stiffness (E × factor)": [(f, _scaled("youngs_modulus", f)) for f in (1e-2, 1.0, 1e2)],
+        "restitution": [(e, _set_materials("restitution", e)) for e in (0.05, 0.5, 0.99, 1.0)],
+        "radius (× factor)": [(f, _radius(f)) for f in (1e-2, 1.0, 1e2)],
+    }
+    if "impact" in raw:
+        out["impact speed (m/s)"] = [(v, _impact("speed", v)) for v in (0.01, 1.0, 100.0)]
+        out["incidence angle (°)"] = [(a, _impact("angle", a)) for a in (0.0, 45.0, 85.0, 89.0)]
+    if len(raw.get("particles", [])) == 2:
+        out["mass ratio"] = [(r, _mass_ratio(r)) for r in (1.0, 10.0, 100.0, 1000.0)]
+    return out
+
+
+@dataclass
+class Limit:
+    parameter: str
+    value: float
+    source: str
+    steps_per_contact: float | None  # the finest grid point that failed, or None when all were stable
+    dt_max_over_tc: float | None
+    failure: str = ""
+
+
+@dataclass
+class StressResult:
+    case: str
+    model: dict
+    limits: list[Limit] = field(default_factory=list)
+    skipped: dict = field(default_factory=dict)
+
+    def flags(self) -> list[dict]:
+        """Where an engine and the reference disagree about stability by more than one grid step."""
+        out = []
+        ref = {(l.parameter, l.value): l for l in self.limits if l.source == "reference-verlet"}
+        for l in self.limits:
+            r = ref.get((l.parameter, l.value))
+            if l.source == "reference-verlet" or r is None:
+                continue
+            a, b = _grid_index(r.dt_max_over_tc), _grid_index(l.dt_max_over_tc)
+            if abs(a - b) > 1:
+                out.append({"parameter": l.parameter, "value": l.value, "source": l.source,
+                            "reference_dt_max_over_tc": r.dt_max_over_tc, "engine_dt_max_over_tc": l.dt_max_over_tc,
+                            "engine_failure": l.failure, "reference_failure": r.failure})
+        return out
+
+    def summary(self) -> dict:
+        return {"case": self.case, "model": self.model, "skipped": self.skipped,
+                "limits": [l.__dict__ for l in self.limits], "disagreements": self.flags()}
+
+
+def _grid_index(x):
+    if x is None:
+        return -1
+    spc = 1.0 / x
+    return min(range(len(GRID)), key=lambda i: abs(math.log(GRID[i] / spc)))
+
+
+def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
+    """Stability, not resolution: a run with few steps inside the contact is inaccurate (``bench`` measures
+    that) but stable as long as it stays finite, bounded and does not create energy."""
+    try:
+        r = collide(case, "verlet", dt=dt)
+    except DemcheckError as exc:
+        return False, str(exc).splitlines()[0]
+    if r.status not in ("ok", "unresolved", "unstable"):
+        return False, f"{r.status}: {r.message}"
+    status, why = health(r, t_c, min(p.radius for p in case.particles), min_steps=1)
+    return status == "ok", why
+
+
+def _stable_engine(case: Case, engine: str, dt: float, t_c: float) -> tuple[bool, str]:
+    from ..engines.collide import collide as run_engine
+
+    try:
+        r = run_engine(case, engine, dt=dt, timeout=120.0)
+    except DemcheckError as exc:
+        return False, str(exc).splitlines()[0]
+    status, why = health(r, t_c, min(p.radius for p in case.particles), min_steps=1)
+    return status == "ok", why
+
+
+def largest_stable(check) -> tuple[float | None, str]:
+    """Bisection over GRID (coarse → fine), assuming stability is monotone in dt: the coarsest grid point
+    from which every finer one is stable. Returns (steps per contact of the limit, failure of the next
+    coarser point) or (None, why) when even the finest point fails."""
+    lo, hi = 0, len(GRID) - 1  # GRID[hi] must be stable; find the smallest stable index
+    ok, why = check(GRID[hi])
+    if not ok:
+        return None, why
+    failure = ""
+    ok0, why0 = check(GRID[0])
+    if ok0:
+        return GRID[0], ""
+    failure = why0
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        ok, why = check(GRID[mid])
+        if ok:
+            hi = mid
+        else:
+            lo, failure = mid, why
+    return GRID[hi], failure
+
+
+def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | None = None,
+                progress=None) -> StressResult:
+    from ..engines import discovery
+    from ..inputs import common
+
+    raw0 = tomllib.loads(Path(path).read_text())
+    raw0.setdefault("name", Path(path).stem)
+    raw0.pop("variants", None)
+    base = from_dict(copy.deepcopy(raw0))
+    res = StressResult(base.name, resolve(base).describe())
+    params = parameters(raw0)
+    if only:
+        params = {k: v for k, v in params.items() if any(o in k for o in only)}
+    tick = progress or (lambda: None)
+    for name, values in params.items():
+        for value, transform in values:
+            try:
+                case = from_dict(transform(copy.deepcopy(raw0)))
+                t_c = characteristic_time(resolve(case))
+            except DemcheckError as exc:
+                res.limits.append(Limit(name, value, "reference-verlet", None, None, f"invalid: {exc}"))
+                continue
+            sources = ["reference-verlet"]
+            for e in engines:
+                mp = common.contact_mapping(case, e)
+                if mp.native is None:
+                    res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
+                elif discovery.find(e) is None:
+                    res.skipped[e] = f"not installed: {discovery.HOW_TO_INSTALL[e]}"
+                else:
+                    sources.append(e)
+            for src in sources:
+                if src == "reference-verlet":
+                    check = lambda spc, c=case, t=t_c: _stable_reference(c, t / spc, t)  # noqa: E731
+                else:
+                    check = lambda spc, c=case, t=t_c, e=src: _stable_engine(c, e, t / spc, t)  # noqa: E731
+                spc, why = largest_stable(check)
+                res.limits.append(Limit(name, value, src, spc, (1.0 / spc) if spc else None, why))
+                tick()
+    return res

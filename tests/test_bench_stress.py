@@ -1,0 +1,152 @@
+"""Run time against error, stability, the recommended time step, and results that are never garbage."""
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from demcheck.comparisons import bench as B, stress as S
+from demcheck.reference.collision import auto_dt, collide
+
+from .conftest import CASES
+from .helpers import glass_case
+
+
+def _pts(order, c=1.0, steps=(10, 20, 50, 100, 200, 500)):
+    t_c = 1e-5
+    return [B.Point("x", s, t_c / s, None, 1.0 / s, None, {m: c * (t_c / s / t_c) ** order for m in B.METRICS})
+            for s in steps]
+
+
+def test_fit_order_recovers_a_known_slope():
+    assert B.fit_order(_pts(2.0, c=1e-1)) == pytest.approx(2.0, abs=1e-12)
+    assert B.fit_order(_pts(1.0, c=1e-1)) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_cheapest_takes_the_largest_dt_whose_finer_steps_all_meet_the_target():
+    pts = _pts(2.0, c=1.0)  # error = (1/steps)²: 1e-2 at 10 steps, 1e-4 at 100
+    assert B.cheapest(pts, 1.01e-2).steps_per_contact == 10
+    assert B.cheapest(pts, 1.01e-4).steps_per_contact == 100
+    assert B.cheapest(pts, 1e-9) is None
+    # a lucky coarse point followed by a miss is not taken for convergence
+    pts[0].errors = {m: 1e-12 for m in B.METRICS}
+    assert B.cheapest(pts, 1e-3).steps_per_contact == 50
+
+
+def test_reference_bench_measures_the_orders_of_the_scheme():
+    """Elastic Hertz converges at second order in the engines' scheme, a damped law at first
+    (docs/models.md, convergence); the adaptive method's error follows its tolerance."""
+    hertz = B.bench_case(glass_case("hertz", {}, wall=True), engines=(), steps=(20, 50, 100, 200, 500),
+                         rtols=(1e-6, 1e-9, 1e-12)).summary()
+    assert hertz["sources"]["reference-verlet"]["order"] == pytest.approx(2.0, abs=0.15)
+    lsd = B.bench_case(glass_case("lsd", {"stiffness_method": "energy"}, wall=True, restitution=0.5), engines=(),
+                       steps=(100, 200, 500, 1000, 2000), rtols=()).summary()
+    # contact time (the restitution's O(dt) term depends on where the steps fall: see test_convergence.py)
+    assert lsd["sources"]["reference-verlet"]["order_per_metric"]["contact_time"] == pytest.approx(1.0, abs=0.05)
+    errs = [p["error"] for p in hertz["points"] if p["source"] == "reference-adaptive"]
+    assert errs[0] > errs[1] > errs[2] and errs[2] < 1e-10
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("liggghts")
+def test_engine_bench_matches_the_reference_scheme_and_batching_pays():
+    """An exact mapping: each engine's error at each step is the reference verlet's (the twin is the seed
+    law), and a batch of copies costs less per collision than a process per collision."""
+    b = B.bench_case(glass_case("kk", {"eta_n": 20.0}, wall=True), steps=(20, 200), rtols=(), batch=8).summary()
+    ref = {p["steps_per_contact"]: p["error"] for p in b["points"] if p["source"] == "reference-verlet"}
+    for engine in ("lammps", "liggghts"):
+        pts = [p for p in b["points"] if p["source"] == engine]
+        assert len(pts) == 2
+        for p in pts:
+            assert p["error"] == pytest.approx(ref[p["steps_per_contact"]], rel=1e-6)
+            assert p["batch_time"] < p["wall_time"]
+
+
+def test_largest_stable_bisects_a_monotone_limit():
+    calls = []
+
+    def check(spc):
+        calls.append(spc)
+        return spc >= 7, "too coarse"
+
+    assert S.largest_stable(check) == (8, "too coarse")
+    assert len(calls) <= 6
+    assert S.largest_stable(lambda spc: (False, "never"))[0] is None
+    assert S.largest_stable(lambda spc: (True, ""))[0] == S.GRID[0]
+
+
+def test_verlet_stability_limit_of_an_undamped_linear_spring():
+    """Velocity Verlet is stable for a linear spring while dt < 2/ω = (2/π) t_c: the finest grid point
+    below that bound, 2 steps per contact time (1.5 gives ω dt = 2.09 > 2), is the limit."""
+    case = glass_case("lsd", {"kn": 2e6, "eta_n": 0.0}, wall=True, restitution=1.0)
+    model_tc = auto_dt(case) * case.run.steps_per_contact
+    spc, why = S.largest_stable(lambda s: S._stable_reference(case, model_tc / s, model_tc))
+    assert spc == 2
+    assert "energy" in why or "overlap" in why or "NaN" in why
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("liggghts")
+def test_engines_and_reference_agree_about_stability(tmp_path):
+    s = S.stress_file(CASES / "suite" / "normal-lsd-wall.toml", only=["restitution"]).summary()
+    assert {l["source"] for l in s["limits"]} == {"reference-verlet", "lammps", "liggghts"}
+    assert s["disagreements"] == []
+    assert all(l["dt_max_over_tc"] for l in s["limits"])
+
+
+def test_the_reference_never_returns_garbage_silently():
+    case = glass_case("hertz", {}, wall=True)
+    t_c = auto_dt(case) * case.run.steps_per_contact
+    assert collide(case, "verlet", dt=t_c / 3).status == "unresolved"
+    r = collide(case, "verlet", dt=t_c / 5)
+    assert r.status == "unstable" and "created" in r.message
+    assert collide(case, "verlet", dt=t_c / 50).status == "ok"
+    bad = collide(glass_case("lsd", {"kn": 2e6, "eta_n": 0.0}, wall=True, restitution=1.0), "verlet", dt=t_c / 1.2)
+    assert bad.status in ("unstable", "unresolved")
+
+
+def test_recommended_time_step_meets_its_target():
+    rec = B.recommend(glass_case("tti", {}, wall=True, restitution=0.7), target=1e-3)
+    assert rec["dt"] is not None and rec["expected_error"] <= 1e-3
+    assert rec["dt"] == pytest.approx(rec["t_contact"] / rec["steps_per_contact"])
+    # the Hertz time of the rules of thumb is the exact elastic contact time
+    assert rec["hertz_time"] == pytest.approx(rec["t_contact"], rel=1e-12)
+    coarser = [row for row in rec["table"] if row["steps_per_contact"] < rec["steps_per_contact"]]
+    assert all(row["error"] > 1e-3 or row["status"] != "ok" for row in coarser[-1:])
+
+
+def test_cli_dt_and_bad_target():
+    ok = subprocess.run([sys.executable, "-m", "demcheck", "dt", str(CASES / "kk-wall.toml"), "--json"],
+                        capture_output=True, text=True, timeout=300)
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["expected_error"] <= 1e-3
+    bad = subprocess.run([sys.executable, "-m", "demcheck", "dt", str(CASES / "kk-wall.toml"), "--target", "2"],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "--target = 2.0: must be between 0 and 1" in bad.stderr
+
+
+def test_cli_bench_reference_only_writes_reports(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "demcheck", "bench", str(CASES / "hertz-wall.toml"), "--engines", "none",
+                        "--steps", "10,50,200", "--report", str(tmp_path), "--json"], capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["cases"][0]["sources"]["reference-verlet"]["cheapest"]["0.01"]["steps_per_contact"] in (10, 50, 200)
+    latest = tmp_path / "latest"
+    assert "## Work–precision" in (latest / "report.md").read_text()
+    assert '<img class="plot"' in (latest / "report.html").read_text()
+    bad = subprocess.run([sys.executable, "-m", "demcheck", "bench", str(CASES / "hertz-wall.toml"), "--steps", "0,5"],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "--steps" in bad.stderr
+
+
+def test_cli_stress_reference_only_writes_reports(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "demcheck", "stress", str(CASES / "suite" / "normal-hertz-wall.toml"),
+                        "--engines", "none", "--only", "restitution", "--report", str(tmp_path), "--json"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert len(out["cases"][0]["limits"]) == 4
+    assert "## Stability" in (tmp_path / "latest" / "report.md").read_text()
