@@ -34,6 +34,9 @@ bench: engines
 	$(BIN)/python benchmarks/bench_adaptive.py
 	$(BIN)/python benchmarks/engine_twin_agreement.py
 	$(BIN)/python benchmarks/bench_verify.py
+	$(BIN)/python benchmarks/bench_skips.py
+	$(BIN)/demcheck bench cases/hertz-wall.toml cases/tti-pair.toml cases/suite/normal-kk-wall.toml \
+		cases/oblique-viscous-sliding-pair.toml
 
 clean:
 	rm -rf $(VENV) reports .pytest_cache .hypothesis

@@ -100,8 +100,8 @@ class Case:
 # ----------------------------------------------------------------------------- loading
 
 
-def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
-    """Read a TOML case file, apply ``key=value`` overrides, validate, and build a :class:`Case`."""
+def _read(path: str | Path) -> dict:
+    """A case file's raw table (its name defaults to the file's)."""
     path = Path(path)
     if not path.is_file():
         raise ConfigError("CASE", str(path), "no such case file")
@@ -110,22 +110,19 @@ def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
     raw.setdefault("name", path.stem)
-    return from_dict(apply_overrides(raw, overrides))
+    return raw
+
+
+def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
+    """Read a TOML case file, apply ``key=value`` overrides, validate, and build a :class:`Case`."""
+    return from_dict(apply_overrides(_read(path), overrides))
 
 
 def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> list[Case]:
     """The cases of a file: one, or with a ``[variants]`` table one per combination of its values
     (``"impact.speed" = [0.1, 1.0, 10.0]``: dotted keys as in ``--set``, each a non-empty list). Each
     variant is named ``name[key=value,…]`` after the last part of its keys."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError("CASE", str(path), "no such case file")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
-    raw.setdefault("name", path.stem)
-    raw = apply_overrides(raw, overrides)
+    raw = apply_overrides(_read(path), overrides)
     variants = raw.pop("variants", None) or {}
     if not isinstance(variants, dict):
         raise ConfigError("variants", variants, "must be a table of dotted keys to lists of values")

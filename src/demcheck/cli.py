@@ -325,10 +325,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
     from .comparisons.suite import Options, run_suite
     from .engines.cache import Cache
 
-    names = [] if engines.strip().lower() == "none" else [e.strip() for e in engines.split(",") if e.strip()]
-    for e in names:
-        if e not in ("lammps", "liggghts"):
-            raise ConfigError("--engines", e, "must be lammps, liggghts (comma-separated) or none")
+    names = _engine_list(engines)
     if jobs < 1:
         raise ConfigError("--jobs", jobs, "must be >= 1")
     if timeout <= 0:
@@ -348,6 +345,16 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
         emit_json(clean({k: v for k, v in summary.items() if k != "cases"}
                         | {"cases": [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]}))
     sys.exit(0 if summary["failed"] == 0 else 1)
+
+
+def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
+    if as_json:
+        from .comparisons.report import clean
+
+        emit_json(clean(data))
+    else:
+        click.echo(Path(out_dir / "report.md").read_text())
+        click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)
 
 
 def _engine_list(engines: str) -> list[str]:
@@ -414,13 +421,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
             "command": ["demcheck", "bench", *sys.argv[2:]], "cases": results,
             "speed_goal": B.speed_goal_text(results)}
     write_bench(data, root)
-    if as_json:
-        from .comparisons.report import clean
-
-        emit_json(clean(data))
-    else:
-        click.echo(Path(out_dir / "report.md").read_text())
-        click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)
+    _show_report(data, out_dir, as_json)
 
 
 @cli.command()
@@ -453,13 +454,7 @@ def stress(paths, engines, only, report_dir, as_json):
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names),
             "command": ["demcheck", "stress", *sys.argv[2:]], "cases": results}
     write_stress(data, root)
-    if as_json:
-        from .comparisons.report import clean
-
-        emit_json(clean(data))
-    else:
-        click.echo(Path(out_dir / "report.md").read_text())
-        click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)
+    _show_report(data, out_dir, as_json)
     if any(c["disagreements"] for c in results):
         sys.exit(1)
 

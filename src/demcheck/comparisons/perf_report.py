@@ -50,11 +50,13 @@ def bench_markdown(data: dict) -> str:
                   f"Elastic contact time t_c = {b['t_contact']:.4g} s.", ""]
         for src, why in b["skipped"].items():
             lines.append(f"* {src}: {why}")
-        lines += ["", "| source | order | " + " | ".join(f"cheapest for {t}" for t in b["sources"].get(
-            "reference-verlet", {}).get("cheapest", {})) + " |", "|---|---|" + "---|" * 5]
+        targets = ("0.01", "0.001", "0.0001", "1e-05", "1e-06")
+        lines += ["", "| source | order | " + " | ".join(f"cheapest for {t}" for t in targets) + " |",
+                  "|---|---|" + "---|" * len(targets)]
         for src, s in b["sources"].items():
             cells = []
-            for tgt, c in s["cheapest"].items():
+            for tgt in targets:
+                c = s["cheapest"].get(tgt)
                 if c is None:
                     cells.append("not reached")
                 elif src == "reference-adaptive":
@@ -106,17 +108,21 @@ def bench_plots(b: dict) -> str:
     return _png(fig)
 
 
-def write_bench(data: dict, root: Path) -> Path:
+def _write(data: dict, root: Path, kind: str, section: str, md: str, plot) -> Path:
+    """report.html: one plot per case under ``section``, then the markdown report verbatim."""
     out = Path(data["report"])
-    md = bench_markdown(data)
-    parts = ["<!doctype html><html><head><meta charset='utf-8'><title>demcheck bench</title>"
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>demcheck {kind}</title>"
              "<style>body{font-family:system-ui,sans-serif;margin:2em}img{max-width:100%}</style></head><body>",
-             f"<h1>demcheck bench {html.escape(data['run_id'])}</h1><h2>Work–precision</h2>"]
-    for b in data["cases"]:
-        parts.append(f"<h3>{html.escape(b['case'])}</h3>" + _img(bench_plots(b), f"work-precision {b['case']}"))
+             f"<h1>demcheck {kind} {html.escape(data['run_id'])}</h1><h2>{section}</h2>"]
+    for c in data["cases"]:
+        parts.append(f"<h3>{html.escape(c['case'])}</h3>" + _img(plot(c), f"{section} {c['case']}"))
     parts.append("<pre>" + html.escape(md) + "</pre></body></html>")
     _publish(out, root, data, md, "\n".join(parts))
     return out
+
+
+def write_bench(data: dict, root: Path) -> Path:
+    return _write(data, root, "bench", "Work–precision", bench_markdown(data), bench_plots)
 
 
 # ----------------------------------------------------------------------------- stability
@@ -177,13 +183,4 @@ def stress_plots(s: dict) -> str:
 
 
 def write_stress(data: dict, root: Path) -> Path:
-    out = Path(data["report"])
-    md = stress_markdown(data)
-    parts = ["<!doctype html><html><head><meta charset='utf-8'><title>demcheck stress</title>"
-             "<style>body{font-family:system-ui,sans-serif;margin:2em}img{max-width:100%}</style></head><body>",
-             f"<h1>demcheck stress {html.escape(data['run_id'])}</h1><h2>Stability</h2>"]
-    for s in data["cases"]:
-        parts.append(f"<h3>{html.escape(s['case'])}</h3>" + _img(stress_plots(s), f"stability map {s['case']}"))
-    parts.append("<pre>" + html.escape(md) + "</pre></body></html>")
-    _publish(out, root, data, md, "\n".join(parts))
-    return out
+    return _write(data, root, "stress", "Stability", stress_markdown(data), stress_plots)

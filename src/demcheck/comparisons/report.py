@@ -344,59 +344,53 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
             groups[_model(c) + (" wall" if "wall" in c["case"] else " pair")].append(c)
         groups = {k: v for k, v in groups.items() if len({c["impact"]["speed"] for c in v}) > 1}
         if groups:
-            n = len(groups)
-            cols = 4
-            rows = (n + cols - 1) // cols
-            fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
-            for ax, (name, cs) in zip(axes.ravel(), sorted(groups.items())):
-                cs = sorted(cs, key=lambda c: c["impact"]["speed"])
-                for src, marker in zip(sources, "o^s"):
-                    pts = [(c["impact"]["speed"], _metric_of(c, src, "restitution")) for c in cs]
-                    pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
-                    if pts:
-                        ax.semilogx(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
-                ax.set_title(name, fontsize=8)
-                ax.grid(alpha=0.3)
-                ax.tick_params(labelsize=7)
-            for ax in axes.ravel()[n:]:
-                ax.axis("off")
-            axes[0][0].legend(fontsize=6)
-            fig.supxlabel("impact speed (m/s)", fontsize=8)
-            fig.supylabel("restitution", fontsize=8)
-            fig.tight_layout()
-            out.append(("restitution against impact speed", _png(fig)))
+            panels = {name: cs for name, cs in groups.items()}
+            out.append(("restitution against impact speed",
+                        _panel_grid(panels, sources, "speed", "restitution", "impact speed (m/s)", "restitution",
+                                    log_x=True)))
     oblique = [c for c in summary["cases"] if c.get("model") and c["model"]["tangential"] != "none"
                and c["impact"].get("angle") is not None]
     groups = defaultdict(list)
     for c in oblique:
         groups[(c["file"], round(c["impact"].get("spin") or 0.0, 6))].append(c)
     groups = {k: v for k, v in groups.items() if len(v) > 1}
+    panels = {f"{_model(cs[0])}, spin {spin:g} ({Path(file).stem})": cs for (file, spin), cs in groups.items()}
     for metric, label in (("tangential_restitution", "tangential restitution"),
                           ("rebound_angular_velocity", "rebound spin (rad/s)")):
-        if not groups:
-            break
-        n = len(groups)
-        cols = 4
-        rows = (n + cols - 1) // cols
-        fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
-        for ax, ((file, spin), cs) in zip(axes.ravel(), sorted(groups.items())):
-            cs = sorted(cs, key=lambda c: c["impact"]["angle"])
-            for src, marker in zip(sources, "o^s"):
-                pts = [(c["impact"]["angle"], _metric_of(c, src, metric)) for c in cs]
-                pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
-                if pts:
-                    ax.plot(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
-            ax.set_title(f"{_model(cs[0])}, spin {spin:g}", fontsize=8)
-            ax.grid(alpha=0.3)
-            ax.tick_params(labelsize=7)
-        for ax in axes.ravel()[n:]:
-            ax.axis("off")
-        axes[0][0].legend(fontsize=6)
-        fig.supxlabel("incidence angle (°)", fontsize=8)
-        fig.supylabel(label, fontsize=8)
-        fig.tight_layout()
-        out.append((f"{label} against incidence angle", _png(fig)))
+        if panels:
+            out.append((f"{label} against incidence angle",
+                        _panel_grid(panels, sources, "angle", metric, "incidence angle (°)", label)))
     return out
+
+
+def _panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_label: str,
+                log_x: bool = False) -> str:
+    """One panel per group of cases: a metric against an impact parameter, a line per source."""
+    import matplotlib.pyplot as plt
+
+    n = len(panels)
+    cols = 4
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
+    for ax, (name, cs) in zip(axes.ravel(), sorted(panels.items())):
+        cs = sorted(cs, key=lambda c: c["impact"][x_key])
+        for src, marker in zip(sources, "o^s"):
+            pts = [(c["impact"][x_key], _metric_of(c, src, metric)) for c in cs]
+            pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
+            if pts:
+                ax.plot(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
+        if log_x:
+            ax.set_xscale("log")
+        ax.set_title(name, fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.tick_params(labelsize=7)
+    for ax in axes.ravel()[n:]:
+        ax.axis("off")
+    axes[0][0].legend(fontsize=6)
+    fig.supxlabel(x_label, fontsize=8)
+    fig.supylabel(y_label, fontsize=8)
+    fig.tight_layout()
+    return _png(fig)
 
 
 def render_html(summary: dict) -> str:

@@ -14,11 +14,10 @@ from __future__ import annotations
 
 import copy
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..case import Case, from_dict
+from ..case import Case, _read, from_dict
 from ..errors import ConfigError, DemcheckError
 from ..reference.collision import characteristic_time, collide, health
 from ..reference.model import resolve
@@ -187,8 +186,7 @@ def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | No
     from ..engines import discovery
     from ..inputs import common
 
-    raw0 = tomllib.loads(Path(path).read_text())
-    raw0.setdefault("name", Path(path).stem)
+    raw0 = _read(path)
     raw0.pop("variants", None)
     base = from_dict(copy.deepcopy(raw0))
     res = StressResult(base.name, resolve(base).describe())

@@ -343,11 +343,12 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
 
 
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
-def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity):
+def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
     """The engines' scheme (fix nve/sphere) on the 1-D normal problem: v += ½dt a; x += dt v; forces from
     full-step positions and half-step velocities; v += ½dt a. History (δ_max) is updated with each force
     evaluation of a step, not at setup; it is forgotten when the overlap ends. Stops at the first step
-    after the contact has ended. Returns (status, n, T, D, R, F); R holds full-step rates."""
+    after the contact has ended (``stop=False``: runs to t_max, as an engine deck does — for measuring what
+    the early stop saves). Returns (status, n, T, D, R, F); R holds full-step rates."""
     T = np.empty(capacity)
     D = np.empty(capacity)
     R = np.empty(capacity)
@@ -387,7 +388,8 @@ def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity):
             touched = True
         elif touched:
             status = ST_OK
-            break
+            if stop:
+                break
     else:
         status = ST_STEPS
     return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()

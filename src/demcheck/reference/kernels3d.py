@@ -254,16 +254,11 @@ WALTON_NEAR_LIMIT = 1e-6
 @njit(cache=True)
 def walton_stiffness(tl, h, vt, fn_abs, lstar):
     """Kt = K0 (1 − (T − T*)/(μ|Fn| − T*))^{1/3} with T, T* the load and the load at the last reversal,
-    both measured along the current slip direction (docs/models.md: the 3-D definition)."""
-    vn = _norm(vt)
-    if vn == 0.0:
+    both measured along the current slip direction (docs/models.md: the 3-D definition); 0 without slip
+    or at the limit."""
+    if _norm(vt) == 0.0:
         return 0.0
-    t = vt / vn
-    tt, ts = _dot(h, t), _dot(lstar, t)
-    den = tl[T_MU_K] * fn_abs - ts
-    if den <= 0.0:
-        return 0.0
-    x = 1.0 - (tt - ts) / den
+    x = walton_margin(tl, h, vt, fn_abs, lstar)
     if x <= 0.0:
         return 0.0
     return tl[T_K0] * x ** (1.0 / 3.0)
