@@ -250,7 +250,10 @@ PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity
 WALL_KEYS = {"point", "normal", "rigid", "material"}
 RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method"}
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
-TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants"}
+TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants",
+            "packing"}
+PACKING_KEYS = {"layout", "count", "material", "radius", "radii", "box", "seed", "duration", "height"}
+LAYOUTS = ("column", "layer", "poured")
 
 
 def _material(name: str, d: dict) -> Material:
@@ -307,6 +310,11 @@ def from_dict(raw: dict) -> Case:
 
     raw = copy.deepcopy(raw)
     impact = raw.get("impact")
+    if kind == "packing":
+        if "particles" not in raw:
+            raw["particles"] = generate_packing(raw.get("packing"), materials)
+    elif "packing" in raw:
+        raise ConfigError("packing", raw["packing"], "a [packing] table needs kind = \"packing\"")
     parts_raw = raw.get("particles")
     if not isinstance(parts_raw, list) or not parts_raw:
         raise ConfigError("particles", parts_raw, "at least one [[particles]] entry is required")
@@ -446,6 +454,96 @@ def _apply_impact(impact: dict, particles: list[dict], walls: list[Wall], materi
         raise ConfigError("impact", impact, "applies to a collision of two particles or of a particle and a wall")
 
 
+def packing_spec(p: dict | None, materials) -> dict:
+    """The validated [packing] table: layout, count, material, radii, periodic box (x, y), seed, duration."""
+    if not isinstance(p, dict):
+        raise ConfigError("packing", p, "a packing case needs a [packing] table (layout, count, material, radius)")
+    _known_keys(p, PACKING_KEYS, "packing")
+    layout = p.get("layout")
+    if layout not in LAYOUTS:
+        raise ConfigError("packing.layout", layout, f"must be one of {', '.join(LAYOUTS)}")
+    count = p.get("count")
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise ConfigError("packing.count", count, "must be an integer >= 1")
+    mat = p.get("material")
+    if mat not in materials:
+        raise ConfigError("packing.material", mat, f"is not a defined material (defined: {', '.join(materials)})")
+    if "radii" in p:
+        radii = p["radii"]
+        if not isinstance(radii, list) or not radii or not all(
+                isinstance(r, (int, float)) and not isinstance(r, bool) and r > 0 for r in radii):
+            raise ConfigError("packing.radii", radii, "must be a non-empty list of radii > 0 (m)")
+        radii = [float(r) for r in radii]
+    else:
+        radii = [_number(p, "radius", "packing", rule="must be > 0 (m)", check=_positive)]
+    rmax = max(radii)
+    box = p.get("box")
+    if layout == "column":
+        box = None
+    elif box is None:
+        side = 2.0 * rmax * math.ceil(math.sqrt(count)) * (1.0 + 1e-3) if layout == "layer" else None
+        if side is None:
+            raise ConfigError("packing.box", None, "missing: a poured packing needs its periodic box [lx, ly] (m)")
+        box = [side, side]
+    if box is not None:
+        if not (isinstance(box, list) and len(box) == 2 and all(isinstance(b, (int, float)) for b in box)):
+            raise ConfigError("packing.box", box, "must be [lx, ly] in m")
+        if min(box) <= 2.0 * rmax:
+            raise ConfigError("packing.box", box, f"must be larger than a particle's diameter ({2 * rmax:g} m) "
+                                                  "in x and y")
+    seed = p.get("seed", 1)
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        raise ConfigError("packing.seed", seed, "must be an integer")
+    duration = _number(p, "duration", "packing", required=False, default=None, rule="must be > 0 (s)",
+                       check=_positive)
+    return {"layout": layout, "count": count, "material": mat, "radii": radii, "box": box, "seed": seed,
+            "duration": duration, "height": p.get("height")}
+
+
+def generate_packing(p: dict | None, materials) -> list[dict]:
+    """The initial positions of a packing (seeded): a vertical column of spheres just apart, a square layer
+    on the floor, or spheres on a loose jittered lattice above the floor to be poured. The floor is z = 0."""
+    spec = packing_spec(p, materials)
+    radii, n, mat = spec["radii"], spec["count"], spec["material"]
+    gap = 1e-3
+    out = []
+    if spec["layout"] == "column":
+        z = 0.0
+        for k in range(n):
+            r = radii[k % len(radii)]
+            z += r * (1.0 + gap)
+            out.append({"material": mat, "radius": r, "position": [0.0, 0.0, z]})
+            z += r * (1.0 + gap)
+        return out
+    lx, ly = spec["box"]
+    if spec["layout"] == "layer":
+        side = int(math.ceil(math.sqrt(n)))
+        a = lx / side
+        for k in range(n):
+            r = radii[k % len(radii)]
+            out.append({"material": mat, "radius": r,
+                        "position": [(k % side + 0.5) * a, (k // side + 0.5) * ly / side, r * (1.0 + gap)]})
+        return out
+    # poured: a loose lattice of cells 2.2 r_max wide, each sphere jittered inside its cell
+    rng = np.random.default_rng(spec["seed"])
+    rmax = max(radii)
+    a = 2.2 * rmax
+    nx, ny = max(1, int(lx / a)), max(1, int(ly / a))
+    ax, ay = lx / nx, ly / ny
+    if ax < 2.0 * rmax * 1.05 or ay < 2.0 * rmax * 1.05:
+        raise ConfigError("packing.box", spec["box"], "is too small for a layer of the particles")
+    slack_x, slack_y, slack_z = ax - 2.0 * rmax, ay - 2.0 * rmax, 0.2 * rmax
+    for k in range(n):
+        layer, cell = divmod(k, nx * ny)
+        i, j = cell % nx, cell // nx
+        r = radii[k % len(radii)]
+        jit = rng.uniform(-0.5, 0.5, 3) * np.array([slack_x, slack_y, slack_z]) * 0.9
+        out.append({"material": mat, "radius": r,
+                    "position": [(i + 0.5) * ax + jit[0], (j + 0.5) * ay + jit[1],
+                                 rmax * 1.2 + layer * a + jit[2]]})
+    return out
+
+
 def _tangent(n: np.ndarray) -> np.ndarray:
     """A fixed unit tangent of a wall normal (x, unless the normal is nearly x; then y)."""
     a = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -454,17 +552,22 @@ def _tangent(n: np.ndarray) -> np.ndarray:
 
 
 def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) -> None:
-    x = [np.asarray(p.position) for p in particles]
-    for i in range(len(particles)):
-        for j in range(i + 1, len(particles)):
-            d = float(np.linalg.norm(x[j] - x[i]))
-            touch = particles[i].radius + particles[j].radius
-            if d < touch * (1 - 1e-12):
-                raise ConfigError(f"particles.{j}.position", list(particles[j].position),
-                                  f"overlaps particle {i} by {touch - d:.3g} m: particles must not start overlapping")
-        for k, w in enumerate(walls):
-            s = float((x[i] - np.asarray(w.point)) @ np.asarray(w.normal))
-            if s < particles[i].radius * (1 - 1e-12):
-                raise ConfigError(f"particles.{i}.position", list(particles[i].position),
-                                  f"is {s:.3g} m in front of wall {k}, less than its radius: "
-                                  "particles must not start overlapping a wall")
+    x = np.array([p.position for p in particles], float)
+    r = np.array([p.radius for p in particles], float)
+    for i in range(len(particles) - 1):
+        d = np.linalg.norm(x[i + 1:] - x[i], axis=1)
+        touch = r[i] + r[i + 1:]
+        bad = np.flatnonzero(d < touch * (1 - 1e-12))
+        if bad.size:
+            j = i + 1 + int(bad[0])
+            raise ConfigError(f"particles.{j}.position", list(particles[j].position),
+                              f"overlaps particle {i} by {touch[bad[0]] - d[bad[0]]:.3g} m: particles must not "
+                              "start overlapping")
+    for k, w in enumerate(walls):
+        s = (x - np.asarray(w.point)) @ np.asarray(w.normal)
+        bad = np.flatnonzero(s < r * (1 - 1e-12))
+        if bad.size:
+            i = int(bad[0])
+            raise ConfigError(f"particles.{i}.position", list(particles[i].position),
+                              f"is {s[i]:.3g} m in front of wall {k}, less than its radius: "
+                              "particles must not start overlapping a wall")

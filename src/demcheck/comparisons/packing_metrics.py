@@ -1,0 +1,77 @@
+"""Packing metrics (DESIGN.md names), computed from positions and radii — independent of the solver that
+produced them, so the reference and the engines' dumps are measured the same way.
+
+* solid_fraction: sphere volume inside a horizontal slab of the bulk (away from the floor and the free
+  surface by ``margin`` diameters) over the slab's volume, spheres cut exactly by the slab planes;
+* coordination_number: contacts (overlap ≥ −tol·d) per particle, over particles of the bulk slab;
+* contact forces (when given): mean and the histogram of f/⟨f⟩; max_overlap_ratio: δ_max/d;
+* bed_height: the highest particle top; kinetic_energy: the last value of the series.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _cap_volume(r, lo, hi):
+    """Volume of a sphere of radius r (centre at 0) between the planes t = lo and t = hi."""
+    a, b = np.maximum(lo, -r), np.minimum(hi, r)
+    v = math.pi * ((r * r * b - b**3 / 3.0) - (r * r * a - a**3 / 3.0))
+    return np.where(b > a, v, 0.0)
+
+
+def contacts(x, rad, box=None, tol=1e-9):
+    """Pairs (i, j) in contact (overlap ≥ −tol·(r_i + r_j)), minimum image in x and y when ``box`` is
+    the periodic (lx, ly). O(N²) in memory chunks of one row: fine for thousands of spheres."""
+    pairs = []
+    for i in range(len(x) - 1):
+        d = x[i + 1:] - x[i]
+        if box is not None:
+            for k in range(2):
+                d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+        dist = np.linalg.norm(d, axis=1)
+        touch = rad[i] + rad[i + 1:]
+        for j in np.flatnonzero(dist <= touch * (1.0 + tol)):
+            pairs.append((i, i + 1 + int(j)))
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+def compute(x, rad, box=None, floor=0.0, margin=2.0, forces=None, overlaps=None, ke=None) -> dict:
+    x = np.asarray(x, float)
+    rad = np.asarray(rad, float)
+    d = 2.0 * float(rad.mean())
+    top = float((x[:, 2] + rad).max())
+    z0, z1 = floor + margin * d, top - margin * d
+    out = {"bed_height": top - floor, "solid_fraction": math.nan, "coordination_number": math.nan,
+           "mean_contact_force": math.nan, "max_overlap_ratio": math.nan, "kinetic_energy": math.nan}
+    pairs = contacts(x, rad, box)
+    if box is not None and z1 > z0:
+        vol = float(_cap_volume(rad, z0 - x[:, 2], z1 - x[:, 2]).sum())
+        out["solid_fraction"] = vol / (box[0] * box[1] * (z1 - z0))
+    bulk = (x[:, 2] >= z0) & (x[:, 2] <= z1) if z1 > z0 else np.ones(len(x), bool)
+    if bulk.any():
+        count = np.zeros(len(x))
+        np.add.at(count, pairs[:, 0], 1)
+        np.add.at(count, pairs[:, 1], 1)
+        out["coordination_number"] = float(count[bulk].mean())
+    if forces is not None and len(forces):
+        f = np.asarray(forces, float)
+        out["mean_contact_force"] = float(f.mean())
+    if overlaps is not None and len(overlaps):
+        out["max_overlap_ratio"] = float(np.max(overlaps) / d)
+    if ke is not None and len(ke):
+        out["kinetic_energy"] = float(ke[-1])
+    return out
+
+
+def force_distribution(forces, bins: int = 20) -> dict:
+    """P(f/⟨f⟩): bin centres and probability densities."""
+    f = np.asarray(forces, float)
+    f = f[f > 0]
+    if not f.size:
+        return {"x": [], "p": []}
+    ratio = f / f.mean()
+    p, edges = np.histogram(ratio, bins=bins, range=(0.0, max(4.0, float(ratio.max()))), density=True)
+    return {"x": (0.5 * (edges[1:] + edges[:-1])).tolist(), "p": p.tolist()}

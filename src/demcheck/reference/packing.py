@@ -1,0 +1,422 @@
+"""The N-body reference solver for packings: spheres, plane walls, periodic x and y, gravity.
+
+The engines' scheme (velocity Verlet of fix nve/sphere, I = 0.4 m R²), a cell-list neighbour search
+rebuilt every step (O(N), memory linear in N), and a contact history per pair and per particle–wall
+contact in fixed slots per particle. The contact laws are the reference's compiled laws (kernels.py's
+normal force, kernels3d.py's tangential laws), one law per pair of particle species, so any normal ×
+tangential model — engine twins included — runs here as in the two-body solvers. Tangential laws with a
+displacement history (spring families) and the history-free ones are supported; LTH, ZZYt and Walton are
+not (yet): ``resolve_laws`` says so.
+
+Conventions as the two-body solver (kernels3d.py): n from i to j, δ = R_i + R_j − |x_j − x_i| > 0 in
+contact, slip velocity at the contact point with the arms R − δ/2, torques r × F_t, history rotated into
+the tangent plane by projection and rescale (the seed's rule), truncated by the law's Coulomb rule.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .kernels import L_KIND, normal_force
+from .kernels3d import return_map, slip_surface, tangential_force
+from .tangential import NONE, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, VISCOUS, VISCOUS_SLIDING
+
+MAXC = 16  # contact slots per particle (pairs with higher-index partners, and walls)
+SUPPORTED_TANGENTIAL = (NONE, SPRING, VISCOUS, VISCOUS_SLIDING)
+
+
+@njit(cache=True, inline="always")
+def _wrap(d, box, periodic):
+    """Minimum image along the periodic axes."""
+    for k in range(2):
+        if periodic[k]:
+            L = box[k]
+            d[k] -= L * math.floor(d[k] / L + 0.5)
+    return d
+
+
+@njit(cache=True)
+def _cells(x, box_lo, box_hi, cell, periodic):
+    """Linked cells: (head, nxt, dims), cells at least the largest contact distance wide. A periodic axis
+    with fewer than three cells is one cell, so that no neighbour cell is visited twice."""
+    dims = np.empty(3, np.int64)
+    for k in range(3):
+        dims[k] = max(1, int((box_hi[k] - box_lo[k]) / cell))
+        if k < 2 and periodic[k] and dims[k] < 3:
+            dims[k] = 1
+    ncell = dims[0] * dims[1] * dims[2]
+    head = -np.ones(ncell, np.int64)
+    nxt = -np.ones(x.shape[0], np.int64)
+    for i in range(x.shape[0]):
+        idx = _cell_index(x[i], box_lo, box_hi, dims, periodic)
+        nxt[i] = head[idx]
+        head[idx] = i
+    return head, nxt, dims
+
+
+@njit(cache=True, inline="always")
+def _cell_of(xk, lo, hi, dim, per):
+    s = (xk - lo) / (hi - lo)
+    if per:
+        s -= math.floor(s)
+    return min(dim - 1, max(0, int(s * dim)))
+
+
+@njit(cache=True)
+def _cell_index(xi, box_lo, box_hi, dims, periodic):
+    c0 = _cell_of(xi[0], box_lo[0], box_hi[0], dims[0], periodic[0])
+    c1 = _cell_of(xi[1], box_lo[1], box_hi[1], dims[1], periodic[1])
+    c2 = _cell_of(xi[2], box_lo[2], box_hi[2], dims[2], False)
+    return (c0 * dims[1] + c1) * dims[2] + c2
+
+
+@njit(cache=True)
+def _slot(partner, i, j):
+    """The slot of i holding partner j, or a free one (-1 if full)."""
+    free = -1
+    for s in range(partner.shape[1]):
+        if partner[i, s] == j:
+            return s
+        if free < 0 and partner[i, s] == -999999:
+            free = s
+    if free >= 0:
+        partner[i, free] = j
+    return free
+
+
+@njit(cache=True)
+def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update):
+    """Normal force (+ repulsive) and tangential force of one contact, updating its history in place
+    (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update`` False at
+    setup, where the engines compute forces without touching histories."""
+    dmax = max(dmax_in, delta)
+    fn = normal_force(nl, delta, rate, dmax)
+    fabs = abs(fn)
+    kind = tl[T_KIND]
+    ft = np.zeros(3)
+    if kind == SPRING and not update:
+        ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, np.zeros(3))
+        tn = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
+        cap = tl[T_MU_S] * fabs
+        if tn > cap and tn > 0.0:
+            ft = ft * (cap / tn)
+    elif kind == SPRING:
+        old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
+        hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
+        for k in range(3):
+            hist[k] -= hn * n[k]
+        new = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
+        if new > 0.0:
+            for k in range(3):
+                hist[k] *= old / new
+        for k in range(3):
+            hist[k] += vt[k] * dt
+        psi = slip_surface(tl, nl, hist, vt, fabs, delta, tl[T_MU_S])[0]
+        sliding = psi > 0.0
+        if sliding:
+            h2 = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+            for k in range(3):
+                hist[k] = h2[k]
+        ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, np.zeros(3))
+    elif kind != NONE:
+        ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, np.zeros(3))
+    return fn, ft, dmax
+
+
+@njit(cache=True)
+def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
+            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update):
+    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``."""
+    n_p = x.shape[0]
+    f[:, :] = 0.0
+    tq[:, :] = 0.0
+    touched[:, :] = False
+    box = box_hi - box_lo
+    head, nxt, dims = _cells(x, box_lo, box_hi, cell, periodic)
+    nc = 0
+    for i in range(n_p):
+        c0 = _cell_of(x[i, 0], box_lo[0], box_hi[0], dims[0], periodic[0])
+        c1 = _cell_of(x[i, 1], box_lo[1], box_hi[1], dims[1], periodic[1])
+        c2 = _cell_of(x[i, 2], box_lo[2], box_hi[2], dims[2], False)
+        rx = 1 if dims[0] >= 3 or not periodic[0] else 0
+        ry = 1 if dims[1] >= 3 or not periodic[1] else 0
+        for dx in range(-rx, rx + 1):
+            for dy in range(-ry, ry + 1):
+                for dz in range(-1, 2):
+                    cx, cy, cz = c0 + dx, c1 + dy, c2 + dz
+                    if cx < 0 or cx >= dims[0]:
+                        if not periodic[0]:
+                            continue
+                        cx %= dims[0]
+                    if cy < 0 or cy >= dims[1]:
+                        if not periodic[1]:
+                            continue
+                        cy %= dims[1]
+                    if cz < 0 or cz >= dims[2]:
+                        continue
+                    j = head[(cx * dims[1] + cy) * dims[2] + cz]
+                    while j >= 0:
+                        if j > i:
+                            d = x[j] - x[i]
+                            d = _wrap(d, box, periodic)
+                            dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                            delta = rad[i] + rad[j] - dist
+                            if delta > 0.0:
+                                nvec = d / dist
+                                ai, aj = rad[i] - 0.5 * delta, rad[j] - 0.5 * delta
+                                vr = v[i] - v[j]
+                                rate = vr[0] * nvec[0] + vr[1] * nvec[1] + vr[2] * nvec[2]
+                                vc = vr + np.cross(w[i], ai * nvec) + np.cross(w[j], aj * nvec)
+                                vn = vc[0] * nvec[0] + vc[1] * nvec[1] + vc[2] * nvec[2]
+                                vt = vc - vn * nvec
+                                s = _slot(partner, i, j)
+                                if s < 0:
+                                    nc_out[1] = 1  # slots exhausted
+                                    j = nxt[j]
+                                    continue
+                                si, sj = species[i], species[j]
+                                fn, ft, dm = _contact_force(laws_n[si, sj], laws_t[si, sj], delta, rate, nvec, vt,
+                                                            hist[i, s], dmax[i, s], dt, update)
+                                dmax[i, s] = dm
+                                touched[i, s] = True
+                                fi = -fn * nvec + ft
+                                f[i] += fi
+                                f[j] -= fi
+                                tq[i] += np.cross(ai * nvec, ft)
+                                tq[j] += np.cross(aj * nvec, ft)
+                                if nc < contacts.shape[0]:
+                                    contacts[nc, 0], contacts[nc, 1] = i, j
+                                    contacts[nc, 2], contacts[nc, 3] = delta, fn
+                                    contacts[nc, 4] = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
+                                nc += 1
+                        j = nxt[j]
+        # walls: plane through p with normal nw into the domain
+        for k in range(walls.shape[0]):
+            nw = walls[k, 3:6]
+            dist = (x[i, 0] - walls[k, 0]) * nw[0] + (x[i, 1] - walls[k, 1]) * nw[1] + (x[i, 2] - walls[k, 2]) * nw[2]
+            delta = rad[i] - dist
+            if delta > 0.0:
+                nvec = -nw
+                ai = rad[i] - 0.5 * delta
+                rate = v[i, 0] * nvec[0] + v[i, 1] * nvec[1] + v[i, 2] * nvec[2]
+                vc = v[i] + np.cross(w[i], ai * nvec)
+                vn = vc[0] * nvec[0] + vc[1] * nvec[1] + vc[2] * nvec[2]
+                vt = vc - vn * nvec
+                s = _slot(partner, i, -1 - k)
+                if s < 0:
+                    nc_out[1] = 1
+                    continue
+                si = species[i]
+                fn, ft, dm = _contact_force(wall_n[si], wall_t[si], delta, rate, nvec, vt, hist[i, s], dmax[i, s],
+                                            dt, update)
+                dmax[i, s] = dm
+                touched[i, s] = True
+                fi = -fn * nvec + ft
+                f[i] += fi
+                tq[i] += np.cross(ai * nvec, ft)
+    # forget contacts that ended
+    for i in range(n_p):
+        for s in range(partner.shape[1]):
+            if partner[i, s] != -999999 and not touched[i, s]:
+                partner[i, s] = -999999
+                hist[i, s, :] = 0.0
+                dmax[i, s] = 0.0
+    nc_out[0] = nc
+
+
+@njit(cache=True)
+def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
+        dt, steps, ke_every, partner, hist, dmax, contacts):
+    """Velocity Verlet for ``steps`` steps from the given state (modified in place). Returns (kinetic
+    energy every ke_every steps, number of pair contacts at the end, flags: [slots exhausted, non-finite])."""
+    n_p = x.shape[0]
+    inertia = 0.4 * mass * rad * rad
+    f = np.zeros((n_p, 3))
+    tq = np.zeros((n_p, 3))
+    touched = np.zeros(partner.shape, np.bool_)
+    nc_out = np.zeros(2, np.int64)
+    cell = 2.0 * rad.max() * 1.0001
+    ke = np.zeros(steps // ke_every + 1)
+    flags = np.zeros(2, np.int64)
+    # setup: forces of the initial state without touching histories (as the engines do)
+    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
+            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, False)
+    for step in range(1, steps + 1):
+        for i in range(n_p):
+            for k in range(3):
+                v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
+                x[i, k] += dt * v[i, k]
+                w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
+        for i in range(n_p):  # periodic wrap of positions
+            for k in range(2):
+                if periodic[k]:
+                    L = box_hi[k] - box_lo[k]
+                    if x[i, k] < box_lo[k]:
+                        x[i, k] += L
+                    elif x[i, k] >= box_hi[k]:
+                        x[i, k] -= L
+        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
+                partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, True)
+        e = 0.0
+        for i in range(n_p):
+            for k in range(3):
+                v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
+                w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
+            e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2) \
+                + 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
+        if step % ke_every == 0:
+            ke[step // ke_every] = e
+        if not math.isfinite(e):
+            flags[1] = 1
+            break
+    flags[0] = nc_out[1]
+    return ke, nc_out[0], flags
+
+
+# ----------------------------------------------------------------------------- Python side
+
+
+def species_of(case) -> tuple[np.ndarray, list[int]]:
+    """Species (material, radius) of each particle, and one representative particle per species."""
+    keys, rep, sp = {}, [], np.empty(len(case.particles), np.int64)
+    for i, p in enumerate(case.particles):
+        k = (p.material, p.radius)
+        if k not in keys:
+            keys[k] = len(rep)
+            rep.append(i)
+        sp[i] = keys[k]
+    return sp, rep
+
+
+def resolve_laws(case):
+    """Per species pair (and per species against the walls) the normal and tangential law arrays."""
+    from ..errors import ConfigError
+    from .contact import pair_of
+    from .model import models_of
+    from .normal import NormalLaw
+
+    normal, tangential = models_of(case)
+    sp, rep = species_of(case)
+    ns = len(rep)
+    params = case.contact.params
+    laws_n = np.zeros((ns, ns, len(NormalLaw(0).array())))
+    laws_t = np.zeros((ns, ns, T_SIZE))
+    wall_n = np.zeros((ns, len(NormalLaw(0).array())))
+    wall_t = np.zeros((ns, T_SIZE))
+
+    def law(pair):
+        nl, _ = normal.resolve(pair, params, case.contact.limit_force)
+        tl, _ = tangential.resolve(pair, params, nl)
+        if tl.kind not in SUPPORTED_TANGENTIAL:
+            raise ConfigError("contact.tangential", tangential.id,
+                              "is not supported by the packing solver yet (spring, viscous and history-free laws are)")
+        return nl.array(), tl.array()
+
+    for a in range(ns):
+        for b in range(a, ns):
+            laws_n[a, b], laws_t[a, b] = law(pair_of(case, rep[a], rep[b]))
+            laws_n[b, a], laws_t[b, a] = laws_n[a, b], laws_t[a, b]
+        if case.walls:
+            wall_n[a], wall_t[a] = law(pair_of(case, rep[a], None))
+    return sp, laws_n, laws_t, wall_n, wall_t
+
+
+def packing_dt(case) -> float:
+    """dt: the case's, or the elastic contact time of the smallest species' pair law at the speed of a
+    one-diameter drop, over steps_per_contact."""
+    if case.run.dt:
+        return case.run.dt
+    from .contact import pair_of
+
+    sp, rep = species_of(case)
+    sp_laws = resolve_laws(case)
+    g = float(np.linalg.norm(case.run.gravity)) or 9.81
+    best = math.inf
+    for a, i in enumerate(rep):
+        pair = pair_of(case, i, i)
+        v = math.sqrt(2.0 * g * 2.0 * case.particles[i].radius)
+        from .normal import NormalLaw
+
+        nl = sp_laws[1][a, a]
+        law = NormalLaw(int(nl[0]), k=nl[1], a=nl[2], eta=nl[3], b=nl[4], kl=nl[5], ku=nl[6], s=nl[7])
+        best = min(best, law.characteristic_time(pair.m_eff, v))
+    return best / case.run.steps_per_contact
+
+
+class PackState:
+    """The state of a packing run (arrays the compiled kernel updates in place)."""
+
+    def __init__(self, case):
+        n = len(case.particles)
+        self.case = case
+        self.x = np.array([p.position for p in case.particles], float)
+        self.v = np.array([p.velocity for p in case.particles], float)
+        self.w = np.array([p.angular_velocity for p in case.particles], float)
+        self.rad = np.array([p.radius for p in case.particles], float)
+        self.mass = np.array([case.mass(i) for i in range(n)], float)
+        self.partner = np.full((n, MAXC), -999999, np.int64)
+        self.hist = np.zeros((n, MAXC, 3))
+        self.dmax = np.zeros((n, MAXC))
+        self.contacts = np.zeros((8 * n + 16, 5))
+        self.n_contacts = 0
+        self.time = 0.0
+        self.ke = []  # (t, kinetic energy)
+
+
+def box_of(case, x, rad):
+    """(lo, hi, periodic): the packing's periodic box in x and y, and a z range that holds the particles."""
+    from ..case import packing_spec
+
+    spec = packing_spec(case.raw.get("packing"), case.materials) if case.raw.get("packing") else None
+    rmax = float(rad.max())
+    zlo = min(0.0, float((x[:, 2] - rad).min())) - rmax
+    zhi = float((x[:, 2] + rad).max()) + 4 * rmax
+    if spec and spec["box"] is not None:
+        lx, ly = spec["box"]
+        return np.array([0.0, 0.0, zlo]), np.array([lx, ly, zhi]), np.array([True, True])
+    lo = (x - rad[:, None]).min(axis=0) - 4 * rmax
+    hi = (x + rad[:, None]).max(axis=0) + 4 * rmax
+    lo[2], hi[2] = zlo, zhi
+    return lo, hi, np.array([False, False])
+
+
+def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 1e-14,
+             chunk: int = 2000, state: PackState | None = None) -> PackState:
+    """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
+    energy falls below ``rest`` × N m g R (settled)."""
+    from ..errors import ConfigError
+
+    sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
+    dt = dt or packing_dt(case)
+    st = state or PackState(case)
+    spec_duration = (case.raw.get("packing") or {}).get("duration")
+    duration = duration or spec_duration
+    if not duration:
+        raise ConfigError("packing.duration", None, "missing: how long to let the packing settle (s)")
+    walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+    g = np.asarray(case.run.gravity, float)
+    scale = len(case.particles) * float(st.mass.mean()) * max(float(np.linalg.norm(g)), 1e-300) * float(st.rad.mean())
+    total = int(math.ceil(duration / dt))
+    done = 0
+    while done < total:
+        n_steps = min(chunk, total - done)
+        lo, hi, periodic = box_of(case, st.x, st.rad)
+        ke, nc, flags = run(st.x, st.v, st.w, st.rad, st.mass, sp, laws_n, laws_t, wall_n, wall_t, walls, lo, hi,
+                            periodic, g, dt, n_steps, max(1, n_steps // 20), st.partner, st.hist, st.dmax,
+                            st.contacts)
+        if flags[0]:
+            raise ConfigError("packing", case.name, f"more than {MAXC} contacts on one particle: overlaps are too "
+                                                    "large for this time step or stiffness")
+        if flags[1]:
+            raise ConfigError("run.dt", dt, "the packing became non-finite: the time step is too large")
+        for k, e in enumerate(ke[1:], start=1):
+            st.ke.append((st.time + k * max(1, n_steps // 20) * dt, float(e)))
+        done += n_steps
+        st.time += n_steps * dt
+        st.n_contacts = int(nc)
+        if st.ke and st.ke[-1][1] < rest * scale:
+            break
+    return st

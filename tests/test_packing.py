@@ -1,0 +1,126 @@
+"""Packings: the case layouts, the N-body reference solver against the column's closed form, and the
+packing metrics on lattices whose values are known exactly."""
+
+import math
+
+import numpy as np
+import pytest
+
+from demcheck import case as C
+from demcheck.comparisons import packing_metrics as PM
+from demcheck.errors import ConfigError
+from demcheck.reference import packing as P
+
+COLUMN = """
+name = "column"
+kind = "packing"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 1e8
+poisson_ratio = 0.3
+restitution = 0.05
+[packing]
+layout = "column"
+count = 5
+material = "glass"
+radius = 1e-3
+duration = 0.05
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[contact]
+normal = "lsd"
+kn = 2000.0
+[run]
+gravity = [0.0, 0.0, -9.81]
+"""
+
+
+def test_column_of_spheres_settles_to_the_static_closed_form():
+    """Each contact carries the weight above it: δ = F/Kn (the pair's Kn, and the wall's), to 1e-6."""
+    case = C.loads(COLUMN)
+    sp, laws_n, _, wall_n, _ = P.resolve_laws(case)
+    st = P.simulate(case, rest=0.0)
+    z, r, m, g, n = st.x[:, 2], st.rad[0], st.mass[0], 9.81, 5
+    for k in range(n):
+        weight = (n - k) * m * g
+        if k == 0:
+            delta, kn = r - z[0], wall_n[0][1]
+        else:
+            delta, kn = 2 * r - (z[k] - z[k - 1]), laws_n[0, 0][1]
+        assert delta == pytest.approx(weight / kn, rel=1e-6), k
+    assert np.allclose(st.x[:, :2], 0.0)  # it stays a column
+    assert st.n_contacts == n - 1
+
+
+def test_column_hertz_overlaps():
+    """Hertz: δ = (F/K_HZ)^{2/3}, K_HZ = (4/3)Ē√R̄ with R̄ = R/2 between spheres and R at the rigid floor."""
+    case = C.loads(COLUMN.replace('normal = "lsd"\nkn = 2000.0', 'normal = "kk"\neta_n = 200.0')
+                   .replace("duration = 0.05", "duration = 0.2"))
+    st = P.simulate(case, rest=0.0)
+    e, nu, r, m, g, n = 1e8, 0.3, 1e-3, st.mass[0], 9.81, 5
+    for k in range(n):
+        weight = (n - k) * m * g
+        if k == 0:
+            k_hz, delta = 4 / 3 * e / (1 - nu**2) * math.sqrt(r), r - st.x[0, 2]
+        else:
+            k_hz, delta = 4 / 3 * e / (2 * (1 - nu**2)) * math.sqrt(r / 2), 2 * r - (st.x[k, 2] - st.x[k - 1, 2])
+        assert delta == pytest.approx((weight / k_hz) ** (2 / 3), rel=1e-6), k
+
+
+def test_metrics_of_a_simple_cubic_lattice_are_exact():
+    """Spheres touching on a simple cubic lattice: solid fraction π/6, coordination 6 in the bulk."""
+    r, n = 1e-3, 6
+    a = 2 * r
+    g = np.arange(n) * a + r
+    x = np.array([(i, j, k) for i in g for j in g for k in g])
+    rad = np.full(len(x), r)
+    m = PM.compute(x, rad, box=(n * a, n * a), floor=0.0, margin=1.0)
+    assert m["solid_fraction"] == pytest.approx(math.pi / 6, rel=1e-12)
+    assert m["coordination_number"] == 6.0
+    assert m["bed_height"] == pytest.approx(n * a)
+
+
+def test_metrics_of_a_face_centred_cubic_lattice():
+    """FCC touching spheres: solid fraction π/(3√2), coordination 12."""
+    r = 1e-3
+    a = 2 * math.sqrt(2) * r
+    base = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) * a
+    cells = 5
+    x = np.array([b + a * np.array([i, j, k]) for i in range(cells) for j in range(cells) for k in range(cells)
+                  for b in base]) + r
+    m = PM.compute(x, np.full(len(x), r), box=(cells * a, cells * a), floor=0.0, margin=1.5)
+    # the slab cuts an integer number of periods only approximately: its planes cut layers anywhere
+    assert m["solid_fraction"] == pytest.approx(math.pi / (3 * math.sqrt(2)), rel=0.02)
+    assert m["coordination_number"] == 12.0
+
+
+def test_force_distribution_is_a_density():
+    f = np.random.default_rng(1).exponential(size=5000)
+    d = PM.force_distribution(f)
+    width = d["x"][1] - d["x"][0]
+    assert sum(p * width for p in d["p"]) == pytest.approx(1.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("change,message", [
+    (("layout = \"column\"", "layout = \"heap\""), "packing.layout = 'heap': must be one of column, layer, poured"),
+    (("count = 5", "count = 0"), "packing.count = 0: must be an integer >= 1"),
+    (("radius = 1e-3", "radius = -1e-3"), "packing.radius = -0.001: must be > 0 (m)"),
+    (("layout = \"column\"", "layout = \"poured\"\nbox = [1e-3, 1e-2]"),
+     "packing.box = [0.001, 0.01]: must be larger than a particle's diameter (0.002 m) in x and y"),
+    (("layout = \"column\"", "layout = \"poured\""), "packing.box = (missing): missing: a poured packing needs"),
+    (("material = \"glass\"", "material = \"steel\""), "packing.material = 'steel': is not a defined material"),
+])
+def test_bad_packing_input_is_one_clear_line(change, message):
+    with pytest.raises(ConfigError) as info:
+        C.loads(COLUMN.replace(*change))
+    assert str(info.value).startswith(message)
+
+
+def test_poured_layout_is_seeded_and_does_not_overlap():
+    text = COLUMN.replace('layout = "column"', 'layout = "poured"\nbox = [0.012, 0.012]\nseed = 7').replace(
+        "count = 5", "count = 200").replace("radius = 1e-3", "radii = [0.8e-3, 1.0e-3, 1.2e-3]")
+    a, b = C.loads(text), C.loads(text)
+    assert [p.position for p in a.particles] == [p.position for p in b.particles]
+    assert sorted({p.radius for p in a.particles}) == [0.8e-3, 1.0e-3, 1.2e-3]
+    assert len(a.particles) == 200  # the loader rejects any overlap, so none
