@@ -124,3 +124,47 @@ def test_poured_layout_is_seeded_and_does_not_overlap():
     assert [p.position for p in a.particles] == [p.position for p in b.particles]
     assert sorted({p.radius for p in a.particles}) == [0.8e-3, 1.0e-3, 1.2e-3]
     assert len(a.particles) == 200  # the loader rejects any overlap, so none
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
+@pytest.mark.parametrize("normal", ["lsd", "kk"])
+def test_engines_settle_the_column_to_the_closed_form(engine, normal):
+    """The same data file, coefficients from the mapping, the engine's final dump (float64): every overlap
+    within 1e-6 of the closed form, as the reference."""
+    from demcheck.inputs.packing_decks import run_engine
+
+    text = COLUMN if normal == "lsd" else COLUMN.replace('normal = "lsd"\nkn = 2000.0', 'normal = "kk"\neta_n = 200.0') \
+        .replace("duration = 0.05", "duration = 0.2")
+    case = C.loads(text)
+    table, ke, version = run_engine(case, engine)
+    assert ke and ke[-1][1] < 1e-20 and version
+    z, r, m, g, n = table["z"].to_numpy(), 1e-3, case.mass(0), 9.81, 5
+    e, nu = 1e8, 0.3
+    _, laws_n, _, wall_n, _ = P.resolve_laws(case)
+    for k in range(n):
+        weight = (n - k) * m * g
+        delta = r - z[0] if k == 0 else 2 * r - (z[k] - z[k - 1])
+        if normal == "lsd":
+            expected = weight / (wall_n[0][1] if k == 0 else laws_n[0, 0][1])
+        else:
+            k_hz = 4 / 3 * e / (1 - nu**2) * math.sqrt(r) if k == 0 else 4 / 3 * e / (2 * (1 - nu**2)) * math.sqrt(r / 2)
+            expected = (weight / k_hz) ** (2 / 3)
+        assert delta == pytest.approx(expected, rel=1e-6), k
+
+
+def test_cli_pack_reference(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    p = subprocess.run([sys.executable, "-m", "demcheck", "pack", str(CASES / "packing" / "column-lsd.toml"), "--json"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["particles"] == 5 and out["contacts"] == 4
+    assert out["metrics"]["coordination_number"] == 2.0
+    bad = subprocess.run([sys.executable, "-m", "demcheck", "pack", str(CASES / "glass-pair.toml")],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and "kind = 'collision': demcheck pack runs packing cases" in bad.stderr

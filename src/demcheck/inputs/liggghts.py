@@ -19,6 +19,62 @@ VERSION_NOTE = "written for LIGGGHTS-PUBLIC 3.8.0 (pair_style gran)"
 RIGID_WALL_MODULUS = 1e30
 
 
+NAMES = {"kn": "kn", "kt": "kt", "gamman": "gamman", "gammat": "gammat", "friction": "coefficientFriction",
+         "restitution": "coefficientRestitution", "unloading": "UnloadingStiffness",
+         "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy"}
+
+
+def property_matrices(nat, ntypes: int, native_of_types) -> dict:
+    """The peratomtypepair matrices of every per-pair property, from each type pair's configuration
+    (``native_of_types(a, b)``, None for pairs that never meet: they take ``nat``'s value, since LIGGGHTS
+    checks every entry against its sanity limits)."""
+    keys = set()
+    for a in range(ntypes):
+        for b in range(ntypes):
+            v = native_of_types(a, b)
+            if v is not None:
+                keys |= set(v.props)
+    keys -= {"youngs_eff", "shear_eff", "kl", "characteristic_velocity"}
+    matrices = {}
+    for key in sorted(keys):
+        mat = np.full((ntypes, ntypes), nat.props.get(key, 0.0))
+        for a in range(ntypes):
+            for b in range(ntypes):
+                v = native_of_types(a, b)
+                if v is not None:
+                    mat[a, b] = v.props.get(key, 0.0)
+        matrices[NAMES[key]] = mat
+    if nat.tangential != "off" and "coefficientFriction" not in matrices:
+        matrices["coefficientFriction"] = np.zeros((ntypes, ntypes))
+    return matrices
+
+
+def model_setup(nat, matrices: dict, moduli: list, ratios: list) -> tuple[list[str], str, list[str]]:
+    """The property fixes and sanity switches, the gran style and its flags (pair_style and wall/gran)."""
+    lines = []
+    if moduli:
+        lines.append(f"fix m_E all property/global youngsModulus peratomtype {' '.join(fmt(x) for x in moduli)}")
+        lines.append(f"fix m_nu all property/global poissonsRatio peratomtype {' '.join(fmt(x) for x in ratios)}")
+    for name, mat in matrices.items():
+        lines.append(_matrix(name, mat))
+    if nat.normal == "hooke":
+        lines.append(f"fix m_vc all property/global characteristicVelocity scalar "
+                     f"{fmt(nat.props['characteristic_velocity'])}")
+    if nat.normal == "edinburgh":
+        lines += ["fix m_cex all property/global adhesionExponent scalar 1",
+                  "fix m_dex all property/global overlapExponent scalar 1"]
+    style = f"model {nat.normal} tangential {'off' if nat.tangential == 'off' else nat.tangential}"
+    flags = ["fixKc on"] if nat.normal == "edinburgh" else []
+    if nat.tangential == "history" and not nat.tangential_damping:
+        flags.append("tangential_damping off")
+    flags.append(f"limitForce {'on' if nat.limit else 'off'}")
+    if moduli and max(moduli) > 1e9:
+        lines.append("hard_particles yes  # a Young's modulus above LIGGGHTS's 1e9 Pa sanity limit")
+    if moduli and min(moduli) < 5e6:
+        lines.append("soft_particles yes  # a Young's modulus below LIGGGHTS's 5e6 Pa sanity limit")
+    return lines, style, flags
+
+
 def _matrix(name: str, values: np.ndarray) -> str:
     n = values.shape[0]
     return (f"fix m_{name} all property/global {name} peratomtypepair {n} "
@@ -51,26 +107,12 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         if pm.native.normal != nat.normal or pm.native.tangential != nat.tangential:
             raise UnsupportedByEngine("LIGGGHTS has one gran model per pair style: type pairs map differently")
         natives[(i, n if j is None else j)] = pm.native
-    props = sorted({k for v in natives.values() for k in v.props
-                    if k not in ("youngs_eff", "shear_eff", "kl", "characteristic_velocity")})
-    names = {"kn": "kn", "kt": "kt", "gamman": "gamman", "gammat": "gammat", "friction": "coefficientFriction",
-             "restitution": "coefficientRestitution", "unloading": "UnloadingStiffness",
-             "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy"}
-    matrices = {}
-    for key in props:
-        # pairs that never meet (the wall type with itself) take the contact's own value: LIGGGHTS checks
-        # every entry against its sanity limits
-        mat = np.full((ntypes, ntypes), nat.props.get(key, 0.0))
-        for a in range(ntypes):
-            for b in range(ntypes):
-                ia = n if (case.walls and a == ntypes - 1) else a % n
-                ib = n if (case.walls and b == ntypes - 1) else b % n
-                v = natives.get((min(ia, ib), max(ia, ib)))
-                if v is not None:
-                    mat[a, b] = v.props.get(key, 0.0)
-        matrices[names[key]] = mat
-    if nat.tangential != "off" and "coefficientFriction" not in matrices:
-        matrices["coefficientFriction"] = np.zeros((ntypes, ntypes))
+    def native_of_types(a, b):
+        ia = n if (case.walls and a == ntypes - 1) else a % n
+        ib = n if (case.walls and b == ntypes - 1) else b % n
+        return natives.get((min(ia, ib), max(ia, ib)))
+
+    matrices = property_matrices(nat, ntypes, native_of_types)
     moduli = []
     if nat.normal == "edinburgh":
         # K_L = 2E*R̄ of the contact: equal moduli E for the particles give E* = E/(2(1−ν²)); a rigid wall
@@ -105,27 +147,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         lines.append(f"set atom {k} mass {fmt(case.mass((k - 1) % n))}")
     rmax = max(p.radius for p in case.particles)
     lines += ["", f"neighbor {fmt(rmax)} bin", "neigh_modify delay 0", ""]
-    if moduli:
-        lines.append(f"fix m_E all property/global youngsModulus peratomtype {' '.join(fmt(x) for x in moduli)}")
-        lines.append(f"fix m_nu all property/global poissonsRatio peratomtype {' '.join(fmt(x) for x in ratios)}")
-    for name, mat in matrices.items():
-        lines.append(_matrix(name, mat))
-    if nat.normal == "hooke":
-        lines.append(f"fix m_vc all property/global characteristicVelocity scalar "
-                     f"{fmt(nat.props['characteristic_velocity'])}")
-    if nat.normal == "edinburgh":
-        lines += ["fix m_cex all property/global adhesionExponent scalar 1",
-                  "fix m_dex all property/global overlapExponent scalar 1"]
-    style = f"model {nat.normal}"
-    style += f" tangential {'off' if nat.tangential == 'off' else nat.tangential}"
-    flags = ["fixKc on"] if nat.normal == "edinburgh" else []
-    if nat.tangential == "history" and not nat.tangential_damping:
-        flags.append("tangential_damping off")
-    flags.append(f"limitForce {'on' if nat.limit else 'off'}")
-    if moduli and max(moduli) > 1e9:
-        lines.append("hard_particles yes  # a Young's modulus above LIGGGHTS's 1e9 Pa sanity limit")
-    if moduli and min(moduli) < 5e6:
-        lines.append("soft_particles yes  # a Young's modulus below LIGGGHTS's 5e6 Pa sanity limit")
+    model_lines, style, flags = model_setup(nat, matrices, moduli, ratios if moduli else [])
+    lines += model_lines
     lines += [f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
     if case.walls:
         axis = "xyz"[sc.wall_axis]

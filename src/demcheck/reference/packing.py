@@ -28,16 +28,6 @@ MAXC = 16  # contact slots per particle (pairs with higher-index partners, and w
 SUPPORTED_TANGENTIAL = (NONE, SPRING, VISCOUS, VISCOUS_SLIDING)
 
 
-@njit(cache=True, inline="always")
-def _wrap(d, box, periodic):
-    """Minimum image along the periodic axes."""
-    for k in range(2):
-        if periodic[k]:
-            L = box[k]
-            d[k] -= L * math.floor(d[k] / L + 0.5)
-    return d
-
-
 @njit(cache=True)
 def _cells(x, box_lo, box_hi, cell, periodic):
     """Linked cells: (head, nxt, dims), cells at least the largest contact distance wide. A periodic axis
@@ -160,12 +150,20 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     j = head[(cx * dims[1] + cy) * dims[2] + cz]
                     while j >= 0:
                         if j > i:
-                            d = x[j] - x[i]
-                            d = _wrap(d, box, periodic)
-                            dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                            delta = rad[i] + rad[j] - dist
-                            if delta > 0.0:
-                                nvec = d / dist
+                            # candidate pairs by scalars: no allocation on the hot path
+                            d0 = x[j, 0] - x[i, 0]
+                            d1 = x[j, 1] - x[i, 1]
+                            d2 = x[j, 2] - x[i, 2]
+                            if periodic[0]:
+                                d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
+                            if periodic[1]:
+                                d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
+                            touch = rad[i] + rad[j]
+                            dist2 = d0 * d0 + d1 * d1 + d2 * d2
+                            if dist2 < touch * touch:
+                                dist = math.sqrt(dist2)
+                                delta = touch - dist
+                                nvec = np.array([d0 / dist, d1 / dist, d2 / dist])
                                 ai, aj = rad[i] - 0.5 * delta, rad[j] - 0.5 * delta
                                 vr = v[i] - v[j]
                                 rate = vr[0] * nvec[0] + vr[1] * nvec[1] + vr[2] * nvec[2]

@@ -1,0 +1,170 @@
+"""Decks for packing cases: the same initial state as the reference (a LAMMPS data file, one atom type per
+particle species), the species pairs' coefficients from the mapping, plane walls, gravity, periodic x and
+y where the packing has a box, and a final dump of every particle in full precision."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..case import Case
+from ..errors import UnsupportedByEngine
+from ..reference import packing as P
+from . import common, lammps as L
+from .common import fmt
+
+FINAL_DUMP = "final.txt"
+FINAL_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
+                 "fx", "fy", "fz")
+
+
+def _data_file(case: Case, species, lo, hi, n_types: int | None = None) -> str:
+    n_types = n_types or int(species.max()) + 1
+    lines = [f"# demcheck packing: case {case.name} (hash {case.hash})", "", f"{len(case.particles)} atoms",
+             f"{n_types} atom types", "", f"{fmt(lo[0])} {fmt(hi[0])} xlo xhi", f"{fmt(lo[1])} {fmt(hi[1])} ylo yhi",
+             f"{fmt(lo[2])} {fmt(hi[2])} zlo zhi", "", "Atoms", ""]
+    for k, p in enumerate(case.particles):
+        rho = case.materials[p.material].density
+        lines.append(f"{k + 1} {species[k] + 1} {fmt(2 * p.radius)} {fmt(rho)} {' '.join(fmt(x) for x in p.position)}")
+    lines += ["", "Velocities", ""]
+    for k, p in enumerate(case.particles):
+        lines.append(f"{k + 1} {' '.join(fmt(x) for x in p.velocity)} {' '.join(fmt(x) for x in p.angular_velocity)}")
+    return "\n".join(lines) + "\n"
+
+
+def lammps_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+    if case.kind != "packing":
+        raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
+    species, rep = P.species_of(case)
+    x = np.array([p.position for p in case.particles], float)
+    rad = np.array([p.radius for p in case.particles], float)
+    lo, hi, periodic = P.box_of(case, x, rad)
+    dt = dt or P.packing_dt(case)
+    duration = duration or (case.raw.get("packing") or {}).get("duration")
+    steps = int(np.ceil(duration / dt))
+    g = np.asarray(case.run.gravity, float)
+    gn = float(np.linalg.norm(g))
+    bounds = " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
+    lines = [f"# demcheck packing deck for lammps ({L.VERSION_NOTE})", f"# case: {case.name} (hash {case.hash})",
+             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
+             f"# {len(case.particles)} particles of {len(rep)} species, dt = {fmt(dt)} s, {steps} steps; "
+             f"final state: {FINAL_DUMP}", "",
+             "units si", "atom_style sphere", "atom_modify map array", f"boundary {bounds}", "newton off",
+             "comm_modify vel yes", "read_data data.lmp"]
+    for k in range(len(case.particles)):
+        lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
+    rmax = float(rad.max())
+    lines += ["", f"neighbor {fmt(0.5 * rmax)} bin", "neigh_modify delay 0 every 1 check yes", "pair_style granular"]
+    for a in range(len(rep)):
+        for b in range(a, len(rep)):
+            mp = common.pair_mapping(case, "lammps", rep[a], rep[b])
+            if mp.native is None:
+                raise UnsupportedByEngine(f"lammps cannot express this model: {'; '.join(mp.reasons)}")
+            lines.append(f"pair_coeff {a + 1} {b + 1} {L.coeff_args(mp.native)}")
+    for k, w in enumerate(case.walls):
+        nvec = np.asarray(w.normal, float)
+        axes = np.flatnonzero(np.abs(nvec) > 1e-15)
+        if len(axes) != 1:
+            raise UnsupportedByEngine(f"walls.{k}.normal = {list(w.normal)}: the engines' flat walls are axis-aligned")
+        ax = int(axes[0])
+        where = f"{fmt(w.point[ax])} NULL" if nvec[ax] > 0 else f"NULL {fmt(w.point[ax])}"
+        for s_ in range(len(rep)):
+            mp = common.pair_mapping(case, "lammps", rep[s_], None)
+            if s_ > 0 and mp.native != common.pair_mapping(case, "lammps", rep[0], None).native:
+                raise UnsupportedByEngine("fix wall/gran takes one set of coefficients for every species: species "
+                                          "whose wall contacts differ are not expressible")
+        lines.append(f"fix wall{k} all wall/gran granular {L.coeff_args(mp.require())} {'xyz'[ax]}plane {where}")
+    if gn > 0:
+        lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
+    every = max(1, steps // 50)
+    lines += ["fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
+              "thermo_modify norm no", f"thermo {every}", f"run {steps}",
+              f"write_dump all custom {FINAL_DUMP} {' '.join(FINAL_COLUMNS)} modify format float %.17g sort id", ""]
+    return common.Deck("lammps", "\n".join(lines), {"data.lmp": _data_file(case, species, lo, hi)})
+
+
+def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+    from . import liggghts as G
+
+    if case.kind != "packing":
+        raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
+    species, rep = P.species_of(case)
+    ns = len(rep)
+    x = np.array([p.position for p in case.particles], float)
+    rad = np.array([p.radius for p in case.particles], float)
+    lo, hi, periodic = P.box_of(case, x, rad)
+    dt = dt or P.packing_dt(case)
+    duration = duration or (case.raw.get("packing") or {}).get("duration")
+    steps = int(np.ceil(duration / dt))
+    natives = {}
+    for a in range(ns):
+        for b in range(a, ns):
+            natives[(a, b)] = common.pair_mapping(case, "liggghts", rep[a], rep[b])
+        if case.walls:
+            natives[(a, ns)] = common.pair_mapping(case, "liggghts", rep[a], None)
+    for mp in natives.values():
+        if mp.native is None:
+            raise UnsupportedByEngine(f"liggghts cannot express this model: {'; '.join(mp.reasons)}")
+    nat = natives[(0, 0)].native
+    if nat.normal == "edinburgh" or any(mp.native.normal != nat.normal for mp in natives.values()):
+        raise UnsupportedByEngine("this packing's species map to different LIGGGHTS models (or to edinburgh, whose "
+                                  "moduli are set per contact): not expressible in one pair style")
+    ntypes = ns + (1 if case.walls else 0)
+
+    def native_of_types(a, b):
+        mp = natives.get((min(a, b), max(a, b)))
+        return mp.native if mp else None
+
+    matrices = G.property_matrices(nat, ntypes, native_of_types)
+    moduli, ratios = [], []
+    if nat.normal in ("hertz", "hooke"):
+        for i in rep:
+            m = case.materials[case.particles[i].material]
+            moduli.append(m.youngs_modulus)
+            ratios.append(m.poisson_ratio)
+        if case.walls:
+            moduli.append(G.RIGID_WALL_MODULUS)
+            ratios.append(ratios[0])
+    model_lines, style, flags = G.model_setup(nat, matrices, moduli, ratios)
+    bounds = " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
+    lines = [f"# demcheck packing deck for liggghts ({G.VERSION_NOTE})", f"# case: {case.name} (hash {case.hash})",
+             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
+             f"# {len(case.particles)} particles of {ns} species, dt = {fmt(dt)} s, {steps} steps; "
+             f"final state: {FINAL_DUMP}", "",
+             "units si", "atom_style granular", "atom_modify map array", f"boundary {bounds}", "newton off",
+             "communicate single vel yes", "read_data data.lmp"]
+    for k in range(len(case.particles)):
+        lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
+    lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
+              f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
+    for k, w in enumerate(case.walls):
+        nvec = np.asarray(w.normal, float)
+        axes = np.flatnonzero(np.abs(nvec) > 1e-15)
+        if len(axes) != 1:
+            raise UnsupportedByEngine(f"walls.{k}.normal = {list(w.normal)}: the engines' flat walls are axis-aligned")
+        lines.append(f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[int(axes[0])]}plane "
+                     f"{fmt(w.point[int(axes[0])])} {' '.join(flags)}")
+    g = np.asarray(case.run.gravity, float)
+    gn = float(np.linalg.norm(g))
+    if gn > 0:
+        lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
+    every = max(1, steps // 50)
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(FINAL_COLUMNS) - 2))
+    lines += ["fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
+              "thermo_modify norm no", f"thermo {every}", f"run {steps}",
+              f"dump final all custom 1 {FINAL_DUMP} {' '.join(FINAL_COLUMNS)}",
+              f'dump_modify final format "{fmt_line}" sort id', "run 0", ""]
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": _data_file(case, species, lo, hi, ntypes)})
+
+
+def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0):
+    """Run the packing in an engine: (final table, kinetic energy series [(step, ke)], engine version)."""
+    import re
+
+    from ..engines import dumps, run as runner
+
+    dk = (lammps_deck if engine == "lammps" else liggghts_deck)(case, duration, dt)
+    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout)
+    table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
+    table = table[table["step"] == table["step"].max()]
+    ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
+    return table.sort_values("id").reset_index(drop=True), ke, out.version
