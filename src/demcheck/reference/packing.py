@@ -21,8 +21,9 @@ import numpy as np
 from numba import njit
 
 from .kernels import L_KIND, normal_force
-from .kernels3d import return_map, slip_surface, tangential_force
-from .tangential import NONE, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, VISCOUS, VISCOUS_SLIDING
+from .kernels3d import eta_of, kt_of, tangential_force
+from .tangential import (NONE, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, T_TRUNC, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
+                         VISCOUS_SLIDING)
 
 MAXC = 16  # contact slots per particle (pairs with higher-index partners, and walls)
 SUPPORTED_TANGENTIAL = (NONE, SPRING, VISCOUS, VISCOUS_SLIDING)
@@ -63,76 +64,24 @@ def _cell_index(xi, box_lo, box_hi, dims, periodic):
     return (c0 * dims[1] + c1) * dims[2] + c2
 
 
-@njit(cache=True)
-def _slot(partner, i, j):
-    """The slot of i holding partner j, or a free one (-1 if full)."""
-    free = -1
-    for s in range(partner.shape[1]):
-        if partner[i, s] == j:
-            return s
-        if free < 0 and partner[i, s] == -999999:
-            free = s
-    if free >= 0:
-        partner[i, free] = j
-    return free
+MAXNB = 48  # neighbours within contact distance plus the skin, per particle (pairs j > i)
 
 
 @njit(cache=True)
-def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update):
-    """Normal force (+ repulsive) and tangential force of one contact, updating its history in place
-    (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update`` False at
-    setup, where the engines compute forces without touching histories."""
-    dmax = max(dmax_in, delta)
-    fn = normal_force(nl, delta, rate, dmax)
-    fabs = abs(fn)
-    kind = tl[T_KIND]
-    ft = np.zeros(3)
-    if kind == SPRING and not update:
-        ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, np.zeros(3))
-        tn = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
-        cap = tl[T_MU_S] * fabs
-        if tn > cap and tn > 0.0:
-            ft = ft * (cap / tn)
-    elif kind == SPRING:
-        old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-        hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-        for k in range(3):
-            hist[k] -= hn * n[k]
-        new = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-        if new > 0.0:
-            for k in range(3):
-                hist[k] *= old / new
-        for k in range(3):
-            hist[k] += vt[k] * dt
-        psi = slip_surface(tl, nl, hist, vt, fabs, delta, tl[T_MU_S])[0]
-        sliding = psi > 0.0
-        if sliding:
-            h2 = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
-            for k in range(3):
-                hist[k] = h2[k]
-        ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, np.zeros(3))
-    elif kind != NONE:
-        ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, np.zeros(3))
-    return fn, ft, dmax
-
-
-@njit(cache=True)
-def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
-            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update):
-    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``."""
-    n_p = x.shape[0]
-    f[:, :] = 0.0
-    tq[:, :] = 0.0
-    touched[:, :] = False
-    box = box_hi - box_lo
+def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
+    """Verlet list: for each i, the j > i within r_i + r_j + skin (linked cells of that width). Returns
+    False when a list overflows."""
+    cell = 2.0 * rad.max() + skin
     head, nxt, dims = _cells(x, box_lo, box_hi, cell, periodic)
-    nc = 0
-    for i in range(n_p):
+    box = box_hi - box_lo
+    rx = 1 if dims[0] >= 3 or not periodic[0] else 0
+    ry = 1 if dims[1] >= 3 or not periodic[1] else 0
+    ok = True
+    for i in range(x.shape[0]):
+        nnb[i] = 0
         c0 = _cell_of(x[i, 0], box_lo[0], box_hi[0], dims[0], periodic[0])
         c1 = _cell_of(x[i, 1], box_lo[1], box_hi[1], dims[1], periodic[1])
         c2 = _cell_of(x[i, 2], box_lo[2], box_hi[2], dims[2], False)
-        rx = 1 if dims[0] >= 3 or not periodic[0] else 0
-        ry = 1 if dims[1] >= 3 or not periodic[1] else 0
         for dx in range(-rx, rx + 1):
             for dy in range(-ry, ry + 1):
                 for dz in range(-1, 2):
@@ -150,7 +99,6 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     j = head[(cx * dims[1] + cy) * dims[2] + cz]
                     while j >= 0:
                         if j > i:
-                            # candidate pairs by scalars: no allocation on the hot path
                             d0 = x[j, 0] - x[i, 0]
                             d1 = x[j, 1] - x[i, 1]
                             d2 = x[j, 2] - x[i, 2]
@@ -158,39 +106,178 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                                 d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
                             if periodic[1]:
                                 d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
-                            touch = rad[i] + rad[j]
-                            dist2 = d0 * d0 + d1 * d1 + d2 * d2
-                            if dist2 < touch * touch:
-                                dist = math.sqrt(dist2)
-                                delta = touch - dist
-                                nvec = np.array([d0 / dist, d1 / dist, d2 / dist])
-                                ai, aj = rad[i] - 0.5 * delta, rad[j] - 0.5 * delta
-                                vr = v[i] - v[j]
-                                rate = vr[0] * nvec[0] + vr[1] * nvec[1] + vr[2] * nvec[2]
-                                vc = vr + np.cross(w[i], ai * nvec) + np.cross(w[j], aj * nvec)
-                                vn = vc[0] * nvec[0] + vc[1] * nvec[1] + vc[2] * nvec[2]
-                                vt = vc - vn * nvec
-                                s = _slot(partner, i, j)
-                                if s < 0:
-                                    nc_out[1] = 1  # slots exhausted
-                                    j = nxt[j]
-                                    continue
-                                si, sj = species[i], species[j]
-                                fn, ft, dm = _contact_force(laws_n[si, sj], laws_t[si, sj], delta, rate, nvec, vt,
-                                                            hist[i, s], dmax[i, s], dt, update)
-                                dmax[i, s] = dm
-                                touched[i, s] = True
-                                fi = -fn * nvec + ft
-                                f[i] += fi
-                                f[j] -= fi
-                                tq[i] += np.cross(ai * nvec, ft)
-                                tq[j] += np.cross(aj * nvec, ft)
-                                if nc < contacts.shape[0]:
-                                    contacts[nc, 0], contacts[nc, 1] = i, j
-                                    contacts[nc, 2], contacts[nc, 3] = delta, fn
-                                    contacts[nc, 4] = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
-                                nc += 1
+                            reach = rad[i] + rad[j] + skin
+                            if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                                if nnb[i] < nb.shape[1]:
+                                    nb[i, nnb[i]] = j
+                                    nnb[i] += 1
+                                else:
+                                    ok = False
                         j = nxt[j]
+    return ok
+
+
+@njit(cache=True)
+def _slot(partner, i, j):
+    """The slot of i holding partner j, or a free one (-1 if full)."""
+    free = -1
+    for s in range(partner.shape[1]):
+        if partner[i, s] == j:
+            return s
+        if free < 0 and partner[i, s] == -999999:
+            free = s
+    if free >= 0:
+        partner[i, free] = j
+    return free
+
+
+@njit(cache=True)
+def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft):
+    """Normal force (+ repulsive) of one contact, and its tangential force into ``ft``, updating its history
+    in place (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update``
+    False at setup, where the engines compute forces without touching histories. Returns (Fn, δ_max)."""
+    dmax = max(dmax_in, delta)
+    fn = normal_force(nl, delta, rate, dmax)
+    fabs = abs(fn)
+    kind = tl[T_KIND]
+    ft[0] = ft[1] = ft[2] = 0.0
+    if kind == NONE:
+        return fn, dmax
+    if kind == SPRING and update:
+        return _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax)
+    out = tangential_force(tl, nl, hist, vt, fabs, delta, False, ZERO3)
+    if kind == SPRING:  # setup: the trial force within the static limit, history untouched
+        tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
+        cap = tl[T_MU_S] * fabs
+        if tn > cap and tn > 0.0:
+            out = out * (cap / tn)
+    ft[0], ft[1], ft[2] = out[0], out[1], out[2]
+    return fn, dmax
+
+
+ZERO3 = np.zeros(3)
+
+
+@njit(cache=True)
+def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax):
+    """The spring family (kernels3d's SPRING: slip_surface, return_map, tangential_force) with scalars only,
+    for the packing solver's inner loop: rotate and rescale the history, increment it, test the slip
+    surface with μs, truncate with μk by the law's rule (force cap, Maw overlap limit, spring cap)."""
+    h0, h1, h2 = hist[0], hist[1], hist[2]
+    old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+    h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
+    new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    if new > 0.0:
+        r = old / new
+        h0, h1, h2 = h0 * r, h1 * r, h2 * r
+    h0, h1, h2 = h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt
+    kt = kt_of(tl, delta)
+    eta = eta_of(tl, nl, delta)
+    trunc = tl[T_TRUNC]
+    s0, s1, s2 = -kt * h0 - eta * vt[0], -kt * h1 - eta * vt[1], -kt * h2 - eta * vt[2]  # the trial force
+    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    hm = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    cap_s = tl[T_MU_S] * fabs
+    psi = kt * hm - cap_s if trunc == TRUNC_SPRING else sn - cap_s
+    if psi <= 0.0:
+        ft[0], ft[1], ft[2] = s0, s1, s2
+    else:
+        cap = tl[T_MU_K] * fabs
+        if kt <= 0.0:  # as kernels3d.return_map: no spring, no history
+            h0 = h1 = h2 = 0.0
+            hm = 0.0
+        if trunc == TRUNC_SPRING:
+            if hm > 0.0:  # the spring limited to the cap (its length cap/Kt), the dashpot dropped
+                r = cap / (kt * hm)
+                h0, h1, h2 = h0 * r, h1 * r, h2 * r
+                ft[0], ft[1], ft[2] = -kt * h0, -kt * h1, -kt * h2
+            else:
+                ft[0] = ft[1] = ft[2] = 0.0
+        else:
+            r = cap / sn if sn > 0.0 else 0.0
+            f0, f1, f2 = s0 * r, s1 * r, s2 * r
+            if trunc == TRUNC_MAW and kt > 0.0:
+                h0, h1, h2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
+            ft[0], ft[1], ft[2] = f0, f1, f2
+    hist[0], hist[1], hist[2] = h0, h1, h2
+    return fn, dmax
+
+
+@njit(cache=True)
+def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
+            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update):
+    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``."""
+    n_p = x.shape[0]
+    f[:, :] = 0.0
+    tq[:, :] = 0.0
+    touched[:, :] = False
+    nbuf = np.empty(3)
+    vtbuf = np.empty(3)
+    ft = np.empty(3)
+    box = box_hi - box_lo
+    nc = 0
+    for i in range(n_p):
+        for q in range(nnb[i]):
+            j = nb[i, q]
+            # candidate pairs by scalars: no allocation on the hot path
+            d0 = x[j, 0] - x[i, 0]
+            d1 = x[j, 1] - x[i, 1]
+            d2 = x[j, 2] - x[i, 2]
+            if periodic[0]:
+                d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
+            if periodic[1]:
+                d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
+            touch = rad[i] + rad[j]
+            dist2 = d0 * d0 + d1 * d1 + d2 * d2
+            if dist2 < touch * touch:
+                dist = math.sqrt(dist2)
+                delta = touch - dist
+                n0, n1, n2 = d0 / dist, d1 / dist, d2 / dist
+                ai, aj = rad[i] - 0.5 * delta, rad[j] - 0.5 * delta
+                vr0, vr1, vr2 = v[i, 0] - v[j, 0], v[i, 1] - v[j, 1], v[i, 2] - v[j, 2]
+                rate = vr0 * n0 + vr1 * n1 + vr2 * n2
+                # ω_i × (a_i n) + ω_j × (a_j n)
+                o0 = ai * w[i, 0] + aj * w[j, 0]
+                o1 = ai * w[i, 1] + aj * w[j, 1]
+                o2 = ai * w[i, 2] + aj * w[j, 2]
+                u0 = vr0 + o1 * n2 - o2 * n1
+                u1 = vr1 + o2 * n0 - o0 * n2
+                u2 = vr2 + o0 * n1 - o1 * n0
+                vn = u0 * n0 + u1 * n1 + u2 * n2
+                nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
+                vtbuf[0], vtbuf[1], vtbuf[2] = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+                s = _slot(partner, i, j)
+                if s < 0:
+                    nc_out[1] = 1  # slots exhausted
+                    continue
+                si, sj = species[i], species[j]
+                fn, dm = _contact_force(laws_n[si, sj], laws_t[si, sj], delta, rate, nbuf, vtbuf,
+                                        hist[i, s], dmax[i, s], dt, update, ft)
+                dmax[i, s] = dm
+                touched[i, s] = True
+                f0, f1, f2 = -fn * n0 + ft[0], -fn * n1 + ft[1], -fn * n2 + ft[2]
+                f[i, 0] += f0
+                f[i, 1] += f1
+                f[i, 2] += f2
+                f[j, 0] -= f0
+                f[j, 1] -= f1
+                f[j, 2] -= f2
+                # torques (a n) × F_t
+                t0 = n1 * ft[2] - n2 * ft[1]
+                t1 = n2 * ft[0] - n0 * ft[2]
+                t2 = n0 * ft[1] - n1 * ft[0]
+                tq[i, 0] += ai * t0
+                tq[i, 1] += ai * t1
+                tq[i, 2] += ai * t2
+                tq[j, 0] += aj * t0
+                tq[j, 1] += aj * t1
+                tq[j, 2] += aj * t2
+                if nc < contacts.shape[0]:
+                    contacts[nc, 0], contacts[nc, 1] = i, j
+                    contacts[nc, 2], contacts[nc, 3] = delta, fn
+                    contacts[nc, 4] = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
+                nc += 1
         # walls: plane through p with normal nw into the domain
         for k in range(walls.shape[0]):
             nw = walls[k, 3:6]
@@ -208,8 +295,8 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     nc_out[1] = 1
                     continue
                 si = species[i]
-                fn, ft, dm = _contact_force(wall_n[si], wall_t[si], delta, rate, nvec, vt, hist[i, s], dmax[i, s],
-                                            dt, update)
+                fn, dm = _contact_force(wall_n[si], wall_t[si], delta, rate, nvec, vt, hist[i, s], dmax[i, s],
+                                        dt, update, ft)
                 dmax[i, s] = dm
                 touched[i, s] = True
                 fi = -fn * nvec + ft
@@ -236,11 +323,16 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
     tq = np.zeros((n_p, 3))
     touched = np.zeros(partner.shape, np.bool_)
     nc_out = np.zeros(2, np.int64)
-    cell = 2.0 * rad.max() * 1.0001
+    skin = 0.3 * rad.max()
+    nb = np.empty((n_p, MAXNB), np.int64)
+    nnb = np.zeros(n_p, np.int64)
+    x_ref = x.copy()
     ke = np.zeros(steps // ke_every + 1)
     flags = np.zeros(2, np.int64)
+    if not _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
+        flags[0] = 1
     # setup: forces of the initial state without touching histories (as the engines do)
-    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
+    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
             partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, False)
     for step in range(1, steps + 1):
         for i in range(n_p):
@@ -256,7 +348,17 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
                         x[i, k] += L
                     elif x[i, k] >= box_hi[k]:
                         x[i, k] -= L
-        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, cell,
+        # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
+        moved = 0.0
+        for i in range(n_p):
+            dd = (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
+            if dd > moved:
+                moved = dd
+        if moved > (0.5 * skin) ** 2:
+            if not _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
+                flags[0] = 1
+            x_ref[:, :] = x
+        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
                 partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, True)
         e = 0.0
         for i in range(n_p):
@@ -270,7 +372,7 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
         if not math.isfinite(e):
             flags[1] = 1
             break
-    flags[0] = nc_out[1]
+    flags[0] = max(flags[0], nc_out[1])
     return ke, nc_out[0], flags
 
 
