@@ -19,7 +19,7 @@ if command -v liggghts >/dev/null 2>&1; then
     echo "engines: LIGGGHTS ok ($(command -v liggghts))"
 elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq >/dev/null && apt-get install -y -qq liggghts >/dev/null \
+    apt-get update -qq >/dev/null && apt-get install -y -qq liggghts openmpi-bin >/dev/null \
         && echo "engines: LIGGGHTS installed" \
         || { echo "engines: LIGGGHTS install failed: run 'apt-get install liggghts'"; status=1; }
 else

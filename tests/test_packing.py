@@ -198,3 +198,61 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
     for i in (0, 1):
         np.testing.assert_allclose(st.v[i], last.loc[i, ["vx", "vy", "vz"]].to_numpy(), rtol=0, atol=1e-12)
         np.testing.assert_allclose(st.w[i], last.loc[i, ["wx", "wy", "wz"]].to_numpy(), rtol=0, atol=1e-9)
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("liggghts")
+def test_verify_runs_the_small_packings_in_every_source(tmp_path):
+    from pathlib import Path
+
+    from demcheck.comparisons import suite
+
+    from .conftest import CASES
+
+    files = sorted((CASES / "packing").glob("*.toml"))
+    s = suite.run_suite(files, tmp_path / "r", suite.Options(jobs=2, cache=None), quiet=True)
+    assert s["failed"] == 0 and {c["case"] for c in s["cases"]} == {"column-lsd", "layer-kk"}
+    for c in s["cases"]:
+        static = {k["source"]: k for k in c["comparisons"] if k["metric"] == "static_overlap"}
+        assert set(static) == {"reference", "lammps", "liggghts"}
+        assert all(k["verdict"] == "agree" and k["value"] < 1e-6 for k in static.values())
+    md = (Path(s["report"]) / "report.md").read_text()
+    assert "## Packings" in md and "| column-lsd | lammps |" in md
+    assert "packing column-lsd" in (Path(s["report"]) / "report.html").read_text()
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
+def test_engines_run_packings_under_mpi(engine):
+    """Two MPI ranks (each engine's own launcher and domain decomposition): the same settled column."""
+    from demcheck.inputs.packing_decks import run_engine
+
+    case = C.loads(COLUMN)
+    table, ke, _ = run_engine(case, engine, mpi=2)
+    z, r = table["z"].to_numpy(), 1e-3
+    _, laws_n, _, wall_n, _ = P.resolve_laws(case)
+    assert r - z[0] == pytest.approx(5 * case.mass(0) * 9.81 / wall_n[0][1], rel=1e-6)
+
+
+@pytest.mark.engine("lammps")
+def test_polydisperse_species_pairs_run_in_the_reference_and_lammps():
+    from demcheck.inputs.packing_decks import lammps_deck, run_engine
+
+    from .conftest import CASES
+
+    case = C.load(CASES / "optin" / "poured-small-poly.toml", ["packing.duration=0.01"])
+    sp, rep = P.species_of(case)
+    assert len(rep) == 3
+    assert lammps_deck(case).text.count("pair_coeff") == 6  # every species pair, explicitly
+    st = P.simulate(case, rest=0.0)
+    assert np.all(np.isfinite(st.x)) and st.x[:, 2].min() > 0
+    table, _, _ = run_engine(case, "lammps")
+    assert len(table) == 150 and np.all(np.isfinite(table["z"]))
+
+
+def test_default_suite_leaves_the_optin_cases_out():
+    from demcheck.cli import CASES_DIR, _case_files
+
+    files = _case_files([])
+    assert any(f.parent.name == "packing" for f in files)
+    assert not any("optin" in f.parts for f in files)
+    assert _case_files([str(CASES_DIR / "optin")])  # named explicitly, they run

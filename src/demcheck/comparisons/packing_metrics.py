@@ -75,3 +75,16 @@ def force_distribution(forces, bins: int = 20) -> dict:
     ratio = f / f.mean()
     p, edges = np.histogram(ratio, bins=bins, range=(0.0, max(4.0, float(ratio.max()))), density=True)
     return {"x": (0.5 * (edges[1:] + edges[:-1])).tolist(), "p": p.tolist()}
+
+
+def profile(x, rad, box, bins: int = 30) -> dict:
+    """Solid fraction against height: the sphere volume in horizontal slices of the periodic box."""
+    x = np.asarray(x, float)
+    rad = np.asarray(rad, float)
+    top = float((x[:, 2] + rad).max())
+    edges = np.linspace(0.0, top, bins + 1)
+    frac = []
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        vol = float(_cap_volume(rad, lo - x[:, 2], hi - x[:, 2]).sum())
+        frac.append(vol / (box[0] * box[1] * (hi - lo)))
+    return {"z": (0.5 * (edges[1:] + edges[:-1])).tolist(), "solid_fraction": frac}

@@ -155,6 +155,20 @@ def render_markdown(summary: dict) -> str:
                   + (f"; largest scaled difference {worst:.3g}" if worst is not None else "")
                   + f". Cases: {', '.join(cases[:6])}{' …' if len(cases) > 6 else ''}"]
 
+    packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
+    if packings:
+        lines += ["", "## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
+                  "within statistical tolerances; column and layer against their static closed form).", "",
+                  "| case | source | solid fraction | coordination | bed height (m) | max overlap / d | static closed form |",
+                  "|---|---|---|---|---|---|---|"]
+        for c in packings:
+            for src, v in c["sources"].items():
+                m = v.get("metrics") or {}
+                cf = next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == "static_overlap"), None)
+                lines.append(f"| {c['case']} | {src} | {_f(m.get('solid_fraction'), '.4f')} | "
+                             f"{_f(m.get('coordination_number'), '.3f')} | {_f(m.get('bed_height'), '.5g')} | "
+                             f"{_f(m.get('max_overlap_ratio'), '.3g')} | "
+                             f"{_f(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
     # per case
     lines += ["", "## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
               "|---|---|---|---|---|"]
@@ -324,7 +338,8 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
 
     out = []
     sources = ["reference", *ENGINE_SOURCES]
-    normal = [c for c in summary["cases"] if c.get("model") and c["model"]["tangential"] == "none"]
+    collisions = [c for c in summary["cases"] if c.get("kind") != "packing"]
+    normal = [c for c in collisions if c.get("model") and c["model"]["tangential"] == "none"]
     if normal:
         fig, ax = plt.subplots(figsize=(4.5, 4))
         for src, marker in zip(sources, "o^s"):
@@ -348,7 +363,7 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
             out.append(("restitution against impact speed",
                         _panel_grid(panels, sources, "speed", "restitution", "impact speed (m/s)", "restitution",
                                     log_x=True)))
-    oblique = [c for c in summary["cases"] if c.get("model") and c["model"]["tangential"] != "none"
+    oblique = [c for c in collisions if c.get("model") and c["model"]["tangential"] != "none"
                and c["impact"].get("angle") is not None]
     groups = defaultdict(list)
     for c in oblique:
@@ -411,6 +426,9 @@ def render_html(summary: dict) -> str:
     parts.append("<h2>Suite plots</h2>")
     for title, b64 in suite_plots(summary):
         parts.append(f"<h3>{esc(title)}</h3>{_img(b64, title)}")
+    for c in summary["cases"]:
+        if c.get("kind") == "packing" and c.get("packing"):
+            parts.append(f"<h3>packing {esc(c['case'])}</h3>" + _img(packing_plots(c), f"packing {c['case']}"))
     parts.append("<h2>Disagreements</h2>" + "".join(
         f"<p>{esc(line.strip('* '))}</p>" for line in md[mat_end:md.index('## Cases')].splitlines()[2:] if line.strip()))
     parts.append("<h2>Cases</h2>")
@@ -420,7 +438,7 @@ def render_html(summary: dict) -> str:
         cls = {"ok": "agree", "unexpected": "unexpected", "failed": "failed"}.get(c["status"], "expected")
         parts.append(f"<details><summary><span class='{cls}'>{esc(c['status'])}</span> {esc(c['case'])} — "
                      f"{esc(_model(c))}</summary>")
-        if c["file"] not in shown:
+        if c.get("kind") != "packing" and c["file"] not in shown:
             b64 = case_panels(c)
             if b64:
                 parts.append(_img(b64, f"force curves of {c['case']}"))
@@ -438,6 +456,36 @@ def render_html(summary: dict) -> str:
         parts.append("</table></details>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
+
+
+def packing_plots(entry: dict) -> str:
+    """Solid fraction against height per source, the reference's P(f/⟨f⟩), kinetic energy against time."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = entry["packing"]
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(12, 3.2))
+    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.16, top=0.86, wspace=0.3)
+    for src, d in data.items():
+        if d.get("profile"):
+            a1.plot(d["profile"]["solid_fraction"], [z * 1e3 for z in d["profile"]["z"]], label=src)
+        if d.get("ke"):
+            ts = [k[0] for k in d["ke"]]
+            a3.semilogy(range(len(ts)), [max(k[1], 1e-300) for k in d["ke"]], label=src)
+    forces = (data.get("reference") or {}).get("forces") or {}
+    if forces.get("x"):
+        a2.plot(forces["x"], forces["p"], "o-", ms=3, label="reference")
+    a1.set(xlabel="solid fraction", ylabel="height (mm)", title="solid fraction against height")
+    a2.set(xlabel="f/⟨f⟩", ylabel="P", title="contact force distribution")
+    a3.set(xlabel="sample", ylabel="kinetic energy (J)", title="kinetic energy")
+    for a in (a1, a2, a3):
+        a.grid(alpha=0.3)
+        if a.get_legend_handles_labels()[0]:
+            a.legend(fontsize=7)
+    fig.suptitle(entry["case"], fontsize=9)
+    return _png(fig)
 
 
 def _md_table_to_html(text: str) -> str:

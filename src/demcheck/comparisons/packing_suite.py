@@ -1,0 +1,132 @@
+"""Packing cases in ``demcheck verify``: the reference's N-body solver and each engine from the same
+initial state; static closed forms where the layout has one (a column, a layer on the floor), bulk values
+compared with statistical tolerances otherwise (the trajectories are chaotic), and the physical ranges.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import packing_metrics as PM, verdicts as V
+
+# statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
+TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02}
+RANGES = {"solid_fraction": (0.55, 0.64), "coordination_number": (4.0, 6.0)}
+CLOSED_FORM_RTOL = 1e-6
+
+
+def static_overlaps(case, x) -> list[tuple[float, float]] | None:
+    """(overlap, closed form) of every load-bearing contact of a settled column or floor layer: each contact
+    carries the weight above it, δ = (F/k)^{1/a} on the law's loading branch. None for other layouts."""
+    from ..reference.packing import resolve_laws
+
+    layout = (case.raw.get("packing") or {}).get("layout")
+    if layout not in ("column", "layer") or not case.walls:
+        return None
+    sp, laws_n, _, wall_n, _ = resolve_laws(case)
+    g = float(np.linalg.norm(case.run.gravity))
+
+    def solve(law, force):
+        if law[0] == 1.0:  # HLS loading branch
+            return force / law[5]
+        return (force / law[1]) ** (1.0 / law[2])
+
+    out = []
+    n = len(case.particles)
+    if layout == "layer":
+        for i, p in enumerate(case.particles):
+            out.append((p.radius - x[i, 2], solve(wall_n[sp[i]], case.mass(i) * g)))
+        return out
+    order = np.argsort(x[:, 2])
+    for rank, i in enumerate(order):
+        above = sum(case.mass(int(k)) for k in order[rank:]) * g
+        p = case.particles[i]
+        if rank == 0:
+            out.append((p.radius - x[i, 2], solve(wall_n[sp[i]], above)))
+        else:
+            j = order[rank - 1]
+            gap = float(np.linalg.norm(x[i] - x[j]))
+            out.append((p.radius + case.particles[j].radius - gap, solve(laws_n[sp[i], sp[j]], above)))
+    return out
+
+
+def run_packing(case, opts, found, file=None) -> dict:
+    from ..inputs.common import pair_mapping
+    from ..inputs.packing_decks import run_engine
+    from ..reference import packing as P
+
+    entry = {"case": case.name, "file": str(file), "kind": "packing", "case_hash": case.hash, "sources": {},
+             "comparisons": [],
+             "curves": {}, "series": [], "packing": {}}
+    from ..reference.model import models_of
+
+    normal, tangential = models_of(case)
+    entry["model"] = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
+    box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
+    comps = []
+    st = P.simulate(case, rest=0.0)
+    nc = min(st.n_contacts, len(st.contacts))
+    states = {"reference": (st.x.copy(), st.rad.copy())}
+    ref_m = PM.compute(st.x, st.rad, box=box, margin=1.0, forces=st.contacts[:nc, 3],
+                       overlaps=st.contacts[:nc, 2], ke=[e for _, e in st.ke])
+    entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": st.time}
+    entry["packing"]["reference"] = {"ke": st.ke, "forces": PM.force_distribution(st.contacts[:nc, 3]),
+                                     "profile": PM.profile(st.x, st.rad, box) if box else None}
+    for engine in opts.engines:
+        mp = pair_mapping(case, engine, 0, 0)
+        if mp.native is None:
+            entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
+            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
+            continue
+        if not found[engine]["found"]:
+            why = f"{engine} is not installed: {found[engine]['how_to_install']}"
+            entry["sources"][engine] = {"status": "engine missing", "message": why}
+            comps.append(V.status_comparison(engine, V.MISSING, why))
+            continue
+        try:
+            table, ke, version = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
+        except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
+            entry["sources"][engine] = {"status": "failed", "message": str(exc)}
+            comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
+            continue
+        x = table[["x", "y", "z"]].to_numpy()
+        rad = table["radius"].to_numpy()
+        states[engine] = (x, rad)
+        m = PM.compute(x, rad, box=box, margin=1.0, ke=[e for _, e in ke])
+        entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": version}
+        entry["packing"][engine] = {"ke": ke, "profile": PM.profile(x, rad, box) if box else None}
+        for metric, tol in TOLERANCES.items():
+            a, b = m[metric], ref_m[metric]
+            if not (math.isfinite(a) and math.isfinite(b)):
+                continue
+            diff = abs(a - b) / (abs(b) if metric == "bed_height" else 1.0)
+            verdict = V.AGREE if diff <= tol else V.UNEXPECTED
+            comps.append(V.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
+                                      "" if verdict == V.AGREE else
+                                      f"beyond the statistical tolerance {tol:g} between chaotic packings"))
+    for src, (x, rad) in states.items():
+        pairs = static_overlaps(case, x)
+        if pairs is not None:
+            worst = max(abs(d / e - 1.0) for d, e in pairs)
+            comps.append(V.Comparison(src, "static_overlap", worst, 0.0, worst, worst, CLOSED_FORM_RTOL,
+                                      V.AGREE if worst <= CLOSED_FORM_RTOL else V.UNEXPECTED,
+                                      "" if worst <= CLOSED_FORM_RTOL else
+                                      "the settled overlaps miss the static closed form (not settled?)"))
+        elif (case.raw.get("packing") or {}).get("layout") == "poured":
+            m = PM.compute(x, rad, box=box, margin=1.0)
+            for metric, (lo, hi) in RANGES.items():
+                val = m[metric]
+                ok = math.isfinite(val) and lo <= val <= hi
+                comps.append(V.Comparison(src, f"{metric} (range)", val, lo, 0.0, 0.0, hi - lo,
+                                          V.AGREE if ok else V.EXPECTED,
+                                          "" if ok else f"outside the physical range {lo:g}–{hi:g} of a "
+                                                        "settled poured packing (not settled, or too small a bulk)"))
+    entry["comparisons"] = [c.as_dict() for c in comps]
+    worst = V.worst(c.verdict for c in comps)
+    entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    entry["verdict"] = worst
+    entry["impact"] = {}
+    entry["scales"] = {}
+    return entry
