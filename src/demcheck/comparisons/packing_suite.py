@@ -74,16 +74,10 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": st.time}
     entry["packing"]["reference"] = {"ke": st.ke, "forces": PM.force_distribution(st.contacts[:nc, 3]),
                                      "profile": PM.profile(st.x, st.rad, box) if box else None}
+    from .suite import unavailable
+
     for engine in opts.engines:
-        mp = pair_mapping(case, engine, 0, 0)
-        if mp.native is None:
-            entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
-            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
-            continue
-        if not found[engine]["found"]:
-            why = f"{engine} is not installed: {found[engine]['how_to_install']}"
-            entry["sources"][engine] = {"status": "engine missing", "message": why}
-            comps.append(V.status_comparison(engine, V.MISSING, why))
+        if unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
             continue
         try:
             table, ke, version = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)

@@ -137,14 +137,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     seed_cache: dict = {}
     for engine in opts.engines:
         mp = common.contact_mapping(case, engine)
-        if mp.native is None:
-            entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
-            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
-            continue
-        if not found[engine]["found"]:
-            why = f"{engine} is not installed: {found[engine]['how_to_install']}"
-            entry["sources"][engine] = {"status": "engine missing", "message": why}
-            comps.append(V.status_comparison(engine, V.MISSING, why))
+        if unavailable(entry, comps, engine, mp, found):
             continue
         try:
             res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout)
@@ -205,6 +198,20 @@ def _incidence(case: Case) -> dict:
     vt = float(np.linalg.norm(v - vn * n))
     return {"angle": float(np.degrees(np.arctan2(vt, abs(vn)))) if vn else None,
             "spin": float(np.linalg.norm(p0.angular_velocity))}
+
+
+def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
+    """Record an engine that cannot run this case (the model is not expressible, or it is not installed)."""
+    if mp.native is None:
+        entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
+        comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
+        return True
+    if not found[engine]["found"]:
+        why = f"{engine} is not installed: {found[engine]['how_to_install']}"
+        entry["sources"][engine] = {"status": "engine missing", "message": why}
+        comps.append(V.status_comparison(engine, V.MISSING, why))
+        return True
+    return False
 
 
 def _source(result) -> dict:

@@ -31,6 +31,20 @@ def _data_file(case: Case, species, lo, hi, n_types: int | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _head(case: Case, engine: str, note: str, n_species: int, dt: float, steps: int, periodic, setup: list[str]):
+    """Header comments, units, the engine's atom setup (BOUNDS: the boundary line), the data file and the
+    exact masses."""
+    bounds = "boundary " + " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
+    lines = [f"# demcheck packing deck for {engine} ({note})", f"# case: {case.name} (hash {case.hash})",
+             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
+             f"# {len(case.particles)} particles of {n_species} species, dt = {fmt(dt)} s, {steps} steps; "
+             f"final state: {FINAL_DUMP}", "", "units si", *[bounds if x == "BOUNDS" else x for x in setup],
+             "read_data data.lmp"]
+    for k in range(len(case.particles)):
+        lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
+    return lines
+
+
 def lammps_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
     if case.kind != "packing":
         raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
@@ -43,15 +57,8 @@ def lammps_deck(case: Case, duration: float | None = None, dt: float | None = No
     steps = int(np.ceil(duration / dt))
     g = np.asarray(case.run.gravity, float)
     gn = float(np.linalg.norm(g))
-    bounds = " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
-    lines = [f"# demcheck packing deck for lammps ({L.VERSION_NOTE})", f"# case: {case.name} (hash {case.hash})",
-             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
-             f"# {len(case.particles)} particles of {len(rep)} species, dt = {fmt(dt)} s, {steps} steps; "
-             f"final state: {FINAL_DUMP}", "",
-             "units si", "atom_style sphere", "atom_modify map array", f"boundary {bounds}", "newton off",
-             "comm_modify vel yes", "read_data data.lmp"]
-    for k in range(len(case.particles)):
-        lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
+    lines = _head(case, "lammps", L.VERSION_NOTE, len(rep), dt, steps, periodic,
+                  ["atom_style sphere", "atom_modify map array", "BOUNDS", "newton off", "comm_modify vel yes"])
     rmax = float(rad.max())
     lines += ["", f"neighbor {fmt(0.5 * rmax)} bin", "neigh_modify delay 0 every 1 check yes", "pair_style granular"]
     for a in range(len(rep)):
@@ -125,15 +132,9 @@ def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = 
             moduli.append(G.RIGID_WALL_MODULUS)
             ratios.append(ratios[0])
     model_lines, style, flags = G.model_setup(nat, matrices, moduli, ratios)
-    bounds = " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
-    lines = [f"# demcheck packing deck for liggghts ({G.VERSION_NOTE})", f"# case: {case.name} (hash {case.hash})",
-             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
-             f"# {len(case.particles)} particles of {ns} species, dt = {fmt(dt)} s, {steps} steps; "
-             f"final state: {FINAL_DUMP}", "",
-             "units si", "atom_style granular", "atom_modify map array", f"boundary {bounds}", "newton off",
-             "communicate single vel yes", "read_data data.lmp"]
-    for k in range(len(case.particles)):
-        lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
+    lines = _head(case, "liggghts", G.VERSION_NOTE, ns, dt, steps, periodic,
+                  ["atom_style granular", "atom_modify map array", "BOUNDS", "newton off",
+                   "communicate single vel yes"])
     lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
               f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
     for k, w in enumerate(case.walls):
