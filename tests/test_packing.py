@@ -174,7 +174,9 @@ def test_cli_pack_reference(tmp_path):
                                                ("lsd_sliding", {"truncation": "overlap", "tangential_restitution": 0.5}),
                                                ("lsd_sliding", {"truncation": "spring", "tangential_restitution": 0.5}),
                                                ("lsd_sliding", {"truncation": "force", "tangential_restitution": 0.5}),
-                                               ("viscous_sliding", {"eta_t": 2.0}), ("none", {})])
+                                               ("viscous_sliding", {"eta_t": 2.0}), ("none", {}),
+                                               ("lth", {"eta_t": 0.5}), ("zzy", {"eta_1": 1e-4}), ("sliding", {}),
+                                               ("viscous", {"eta_t": 2.0})])
 def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangential, params):
     """An oblique spinning pair through the N-body solver (cell lists, slots, its scalar spring law) and
     through the two-body verlet method (kernels3d, seed rules): the same collision to round-off."""
@@ -184,16 +186,29 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
 
     from .helpers import oblique_case
 
+    from demcheck.inputs.mapping import RULES
+
     case = oblique_case(tangential, params, wall=False, angle=30.0, spin=500.0,
                         overrides=["contact.reference_velocity=1.0"])  # one species pair: calibrate explicitly
     dt = auto_dt(case)
-    two = collision3d.collide(case, resolve(case), "verlet", dt=dt)
+    # the seed's rules, and each engine twin's for the laws the engines express (LTH, ZZYt and the slider's
+    # stick have no engine twin)
+    engine_laws = tangential not in ("lth", "zzy")
+    for rules in (None, RULES["lammps"], RULES["liggghts"]) if engine_laws else (None,):
+        _same_as_two_body(case, dt, rules)
+
+
+def _same_as_two_body(case, dt, rules):
+    from demcheck.reference import collision3d
+    from demcheck.reference.model import resolve
+
+    two = collision3d.collide(case, resolve(case), "verlet", dt=dt, rules=rules)
     steps = int(round(two.contact["t"].iloc[-1] / dt))
     st = P.PackState(case)
     sp, ln, lt, wn, wt = P.resolve_laws(case)
     lo, hi, periodic = P.box_of(case, st.x, st.rad)
     P.run(st.x, st.v, st.w, st.rad, st.mass, sp, ln, lt, wn, wt, np.zeros((0, 6)), lo, hi, periodic, np.zeros(3), dt,
-          steps, steps, st.partner, st.hist, st.dmax, st.contacts)
+          steps, steps, st.partner, st.hist, st.dmax, st.contacts, collision3d.rules_array(rules))
     last = two.particles.groupby("id").last()
     for i in (0, 1):
         np.testing.assert_allclose(st.v[i], last.loc[i, ["vx", "vy", "vz"]].to_numpy(), rtol=0, atol=1e-12)

@@ -21,12 +21,13 @@ import numpy as np
 from numba import njit
 
 from .kernels import L_KIND, normal_force
-from .kernels3d import eta_of, kt_of, tangential_force
-from .tangential import (NONE, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, T_TRUNC, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
-                         VISCOUS_SLIDING)
+from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_LAMMPS,
+                        ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force)
+from .tangential import (LTH, NONE, SLIDING, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, T_TRUNC, TRUNC_MAW,
+                         TRUNC_SPRING, VISCOUS, VISCOUS_SLIDING, ZZY)
 
 MAXC = 16  # contact slots per particle (pairs with higher-index partners, and walls)
-SUPPORTED_TANGENTIAL = (NONE, SPRING, VISCOUS, VISCOUS_SLIDING)
+SUPPORTED_TANGENTIAL = (NONE, SLIDING, SPRING, VISCOUS, VISCOUS_SLIDING, LTH, ZZY)
 
 
 @njit(cache=True)
@@ -132,7 +133,7 @@ def _slot(partner, i, j):
 
 
 @njit(cache=True)
-def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft):
+def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft, rot):
     """Normal force (+ repulsive) of one contact, and its tangential force into ``ft``, updating its history
     in place (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update``
     False at setup, where the engines compute forces without touching histories. Returns (Fn, δ_max)."""
@@ -144,7 +145,31 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft):
     if kind == NONE:
         return fn, dmax
     if kind == SPRING and update:
-        return _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax)
+        return _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot)
+    if (kind == LTH or kind == ZZY) and update:
+        # Langston's and Zheng's laws on their overlap history, by kernels3d's functions (as verlet_3d)
+        hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
+        if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs):
+            old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
+            for k in range(3):
+                hist[k] -= hn * n[k]
+            new = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
+            if new > 0.0:
+                for k in range(3):
+                    hist[k] *= old / new
+        for k in range(3):
+            hist[k] += vt[k] * dt
+        if rot == ROT_PROJECT:
+            hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
+            for k in range(3):
+                hist[k] -= hn * n[k]
+        sliding = slip_surface(tl, nl, hist, vt, fabs, delta, tl[T_MU_S])[0] > 0.0
+        if sliding:
+            mapped = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+            hist[0], hist[1], hist[2] = mapped[0], mapped[1], mapped[2]
+        out = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, ZERO3)
+        ft[0], ft[1], ft[2] = out[0], out[1], out[2]
+        return fn, dmax
     out = tangential_force(tl, nl, hist, vt, fabs, delta, False, ZERO3)
     if kind == SPRING:  # setup: the trial force within the static limit, history untouched
         tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
@@ -159,20 +184,24 @@ ZERO3 = np.zeros(3)
 
 
 @njit(cache=True)
-def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax):
+def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot):
     """The spring family (kernels3d's SPRING: slip_surface, return_map, tangential_force) with scalars only,
     for the packing solver's inner loop: rotate and rescale the history, increment it, test the slip
     surface with μs, truncate with μk by the law's rule (force cap, Maw overlap limit, spring cap)."""
     h0, h1, h2 = hist[0], hist[1], hist[2]
-    old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-    h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
-    new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    if new > 0.0:
-        r = old / new
-        h0, h1, h2 = h0 * r, h1 * r, h2 * r
-    h0, h1, h2 = h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt
     kt = kt_of(tl, delta)
+    hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+    if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt > 1e-10 * tl[T_MU_K] * fabs):
+        old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
+        new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+        if new > 0.0:
+            r = old / new
+            h0, h1, h2 = h0 * r, h1 * r, h2 * r
+    h0, h1, h2 = h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt
+    if rot == ROT_PROJECT:  # LIGGGHTS: project after the increment, no rescale
+        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
     eta = eta_of(tl, nl, delta)
     trunc = tl[T_TRUNC]
     s0, s1, s2 = -kt * h0 - eta * vt[0], -kt * h1 - eta * vt[1], -kt * h2 - eta * vt[2]  # the trial force
@@ -206,7 +235,7 @@ def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax):
 
 @njit(cache=True)
 def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update):
+            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update, rules):
     """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``."""
     n_p = x.shape[0]
     f[:, :] = 0.0
@@ -215,6 +244,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
     nbuf = np.empty(3)
     vtbuf = np.empty(3)
     ft = np.empty(3)
+    rot = rules[R_ROTATION]
     box = box_hi - box_lo
     nc = 0
     for i in range(n_p):
@@ -234,7 +264,11 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 dist = math.sqrt(dist2)
                 delta = touch - dist
                 n0, n1, n2 = d0 / dist, d1 / dist, d2 / dist
-                ai, aj = rad[i] - 0.5 * delta, rad[j] - 0.5 * delta
+                # lever arms by rule (kernels3d): the contact point R − δ/2, or the full radius
+                ai = rad[i] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
+                aj = rad[j] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[j] - 0.5 * delta
+                bi = rad[i] if rules[R_TORQUE_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
+                bj = rad[j] if rules[R_TORQUE_ARM] == ARM_RADIUS else rad[j] - 0.5 * delta
                 vr0, vr1, vr2 = v[i, 0] - v[j, 0], v[i, 1] - v[j, 1], v[i, 2] - v[j, 2]
                 rate = vr0 * n0 + vr1 * n1 + vr2 * n2
                 # ω_i × (a_i n) + ω_j × (a_j n)
@@ -253,7 +287,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     continue
                 si, sj = species[i], species[j]
                 fn, dm = _contact_force(laws_n[si, sj], laws_t[si, sj], delta, rate, nbuf, vtbuf,
-                                        hist[i, s], dmax[i, s], dt, update, ft)
+                                        hist[i, s], dmax[i, s], dt, update, ft, rot)
                 dmax[i, s] = dm
                 touched[i, s] = True
                 f0, f1, f2 = -fn * n0 + ft[0], -fn * n1 + ft[1], -fn * n2 + ft[2]
@@ -267,12 +301,12 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 t0 = n1 * ft[2] - n2 * ft[1]
                 t1 = n2 * ft[0] - n0 * ft[2]
                 t2 = n0 * ft[1] - n1 * ft[0]
-                tq[i, 0] += ai * t0
-                tq[i, 1] += ai * t1
-                tq[i, 2] += ai * t2
-                tq[j, 0] += aj * t0
-                tq[j, 1] += aj * t1
-                tq[j, 2] += aj * t2
+                tq[i, 0] += bi * t0
+                tq[i, 1] += bi * t1
+                tq[i, 2] += bi * t2
+                tq[j, 0] += bj * t0
+                tq[j, 1] += bj * t1
+                tq[j, 2] += bj * t2
                 if nc < contacts.shape[0]:
                     contacts[nc, 0], contacts[nc, 1] = i, j
                     contacts[nc, 2], contacts[nc, 3] = delta, fn
@@ -285,7 +319,8 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
             delta = rad[i] - dist
             if delta > 0.0:
                 nvec = -nw
-                ai = rad[i] - 0.5 * delta
+                ai = rad[i] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
+                bi = rad[i] if rules[R_WALL_TORQUE_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
                 rate = v[i, 0] * nvec[0] + v[i, 1] * nvec[1] + v[i, 2] * nvec[2]
                 vc = v[i] + np.cross(w[i], ai * nvec)
                 vn = vc[0] * nvec[0] + vc[1] * nvec[1] + vc[2] * nvec[2]
@@ -296,12 +331,12 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     continue
                 si = species[i]
                 fn, dm = _contact_force(wall_n[si], wall_t[si], delta, rate, nvec, vt, hist[i, s], dmax[i, s],
-                                        dt, update, ft)
+                                        dt, update, ft, rot)
                 dmax[i, s] = dm
                 touched[i, s] = True
                 fi = -fn * nvec + ft
                 f[i] += fi
-                tq[i] += np.cross(ai * nvec, ft)
+                tq[i] += np.cross(bi * nvec, ft)
     # forget contacts that ended
     for i in range(n_p):
         for s in range(partner.shape[1]):
@@ -314,7 +349,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
 
 @njit(cache=True)
 def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
-        dt, steps, ke_every, partner, hist, dmax, contacts):
+        dt, steps, ke_every, partner, hist, dmax, contacts, rules):
     """Velocity Verlet for ``steps`` steps from the given state (modified in place). Returns (kinetic
     energy every ke_every steps, number of pair contacts at the end, flags: [slots exhausted, non-finite])."""
     n_p = x.shape[0]
@@ -333,7 +368,7 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
         flags[0] = 1
     # setup: forces of the initial state without touching histories (as the engines do)
     _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, False)
+            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, False, rules)
     for step in range(1, steps + 1):
         for i in range(n_p):
             for k in range(3):
@@ -359,7 +394,7 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
                 flags[0] = 1
             x_ref[:, :] = x
         _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-                partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, True)
+                partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, True, rules)
         e = 0.0
         for i in range(n_p):
             for k in range(3):
@@ -412,7 +447,8 @@ def resolve_laws(case):
         tl, _ = tangential.resolve(pair, params, nl)
         if tl.kind not in SUPPORTED_TANGENTIAL:
             raise ConfigError("contact.tangential", tangential.id,
-                              "is not supported by the packing solver yet (spring, viscous and history-free laws are)")
+                              "is not supported by the packing solver yet (Walton's needs a reversal state per "
+                              "contact; every other tangential law runs)")
         return nl.array(), tl.array()
 
     for a in range(ns):
@@ -484,10 +520,12 @@ def box_of(case, x, rad):
 
 
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 1e-14,
-             chunk: int = 2000, state: PackState | None = None) -> PackState:
+             chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
     """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
-    energy falls below ``rest`` × N m g R (settled)."""
+    energy falls below ``rest`` × N m g R (settled). ``rules``: the kinematic rules (collision3d's names;
+    default the seed's), e.g. inputs.mapping.RULES[engine] for an engine twin."""
     from ..errors import ConfigError
+    from .collision3d import rules_array
 
     sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
     dt = dt or packing_dt(case)
@@ -506,7 +544,7 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
         lo, hi, periodic = box_of(case, st.x, st.rad)
         ke, nc, flags = run(st.x, st.v, st.w, st.rad, st.mass, sp, laws_n, laws_t, wall_n, wall_t, walls, lo, hi,
                             periodic, g, dt, n_steps, max(1, n_steps // 20), st.partner, st.hist, st.dmax,
-                            st.contacts)
+                            st.contacts, rules_array(rules))
         if flags[0]:
             raise ConfigError("packing", case.name, f"more than {MAXC} contacts on one particle: overlaps are too "
                                                     "large for this time step or stiffness")
