@@ -1,7 +1,6 @@
 """Run time against error, stability, the recommended time step, and results that are never garbage."""
 
 import json
-import math
 import subprocess
 import sys
 

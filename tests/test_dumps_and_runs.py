@@ -15,7 +15,7 @@ from demcheck.engines import discovery, dumps, run as runner
 from demcheck.engines.collide import collide, deck as make_deck, twin_states
 from demcheck.errors import EngineFailed, EngineNotFound, ParseError
 
-from .conftest import CASES, ROOT
+from .conftest import CASES
 from .helpers import glass_case
 
 DATA = Path(__file__).parent / "data" / "dumps"

@@ -180,9 +180,7 @@ def test_cli_pack_reference(tmp_path):
 def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangential, params):
     """An oblique spinning pair through the N-body solver (cell lists, slots, its scalar spring law) and
     through the two-body verlet method (kernels3d, seed rules): the same collision to round-off."""
-    from demcheck.reference import collision3d
     from demcheck.reference.collision import auto_dt
-    from demcheck.reference.model import resolve
 
     from .helpers import oblique_case
 

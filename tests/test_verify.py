@@ -17,7 +17,7 @@ from demcheck.engines.cache import Cache
 from demcheck.errors import ConfigError
 from demcheck.io import write_text
 
-from .conftest import CASES, ROOT
+from .conftest import CASES
 
 SCALES = {"impact_energy": 1e-5, "spin": 600.0}
 TOL = V.Tolerances()

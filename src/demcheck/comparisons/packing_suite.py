@@ -34,7 +34,6 @@ def static_overlaps(case, x) -> list[tuple[float, float]] | None:
         return (force / law[1]) ** (1.0 / law[2])
 
     out = []
-    n = len(case.particles)
     if layout == "layer":
         for i, p in enumerate(case.particles):
             out.append((p.radius - x[i, 2], solve(wall_n[sp[i]], case.mass(i) * g)))

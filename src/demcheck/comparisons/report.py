@@ -284,11 +284,6 @@ STYLE = {"reference": ("-", 2.0), "reference-verlet": (":", 1.2), "lammps": ("--
 
 def case_panels(entry: dict) -> str | None:
     """Force–overlap loop and force–time curve of one case, one line per source."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     series = entry.get("series") or []
     if not series:
         return None
@@ -296,6 +291,9 @@ def case_panels(entry: dict) -> str | None:
 
 
 def _draw_case(name, series) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.2))

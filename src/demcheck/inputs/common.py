@@ -64,20 +64,26 @@ def scene(case: Case, dt: float | None = None, length: float = 1.0) -> Scene:
         if len(case.walls) > 1:
             raise UnsupportedByEngine("decks are written for one wall")
         w = case.walls[0]
-        nvec = np.asarray(w.normal, float)
-        axes = np.flatnonzero(np.abs(nvec) > 1e-15)
-        if len(axes) != 1:
-            raise UnsupportedByEngine(f"walls.0.normal = {list(w.normal)}: the engines' flat walls (fix wall/gran "
-                                      "xplane|yplane|zplane) are axis-aligned; rotate the case so the wall normal "
-                                      "is a coordinate axis")
-        axis = int(axes[0])
-        side = "lo" if nvec[axis] > 0 else "hi"
+        axis, side = wall_axis(w, 0)
         wpos = float(w.point[axis])
         if side == "lo":
             lo[axis] = min(lo[axis], wpos - 3 * rmax)
         else:
             hi[axis] = max(hi[axis], wpos + 3 * rmax)
     return Scene(case, model, dt, steps, (lo, hi), axis, side, wpos)
+
+
+def wall_axis(w, k: int) -> tuple[int, str]:
+    """(axis, "lo" | "hi") of an axis-aligned plane wall: the engines' flat walls (fix wall/gran
+    xplane|yplane|zplane) are axis-aligned, and a wall that is not gets one clear refusal."""
+    nvec = np.asarray(w.normal, float)
+    axes = np.flatnonzero(np.abs(nvec) > 1e-15)
+    if len(axes) != 1:
+        raise UnsupportedByEngine(f"walls.{k}.normal = {list(w.normal)}: the engines' flat walls (fix wall/gran "
+                                  "xplane|yplane|zplane) are axis-aligned; rotate the case so the wall normal is a "
+                                  "coordinate axis")
+    axis = int(axes[0])
+    return axis, "lo" if nvec[axis] > 0 else "hi"
 
 
 def type_pairs(case: Case) -> list[tuple[int, int | None]]:

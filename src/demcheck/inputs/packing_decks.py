@@ -68,12 +68,8 @@ def lammps_deck(case: Case, duration: float | None = None, dt: float | None = No
                 raise UnsupportedByEngine(f"lammps cannot express this model: {'; '.join(mp.reasons)}")
             lines.append(f"pair_coeff {a + 1} {b + 1} {L.coeff_args(mp.native)}")
     for k, w in enumerate(case.walls):
-        nvec = np.asarray(w.normal, float)
-        axes = np.flatnonzero(np.abs(nvec) > 1e-15)
-        if len(axes) != 1:
-            raise UnsupportedByEngine(f"walls.{k}.normal = {list(w.normal)}: the engines' flat walls are axis-aligned")
-        ax = int(axes[0])
-        where = f"{fmt(w.point[ax])} NULL" if nvec[ax] > 0 else f"NULL {fmt(w.point[ax])}"
+        ax, side = common.wall_axis(w, k)
+        where = f"{fmt(w.point[ax])} NULL" if side == "lo" else f"NULL {fmt(w.point[ax])}"
         for s_ in range(len(rep)):
             mp = common.pair_mapping(case, "lammps", rep[s_], None)
             if s_ > 0 and mp.native != common.pair_mapping(case, "lammps", rep[0], None).native:
@@ -138,12 +134,9 @@ def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = 
     lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
               f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
     for k, w in enumerate(case.walls):
-        nvec = np.asarray(w.normal, float)
-        axes = np.flatnonzero(np.abs(nvec) > 1e-15)
-        if len(axes) != 1:
-            raise UnsupportedByEngine(f"walls.{k}.normal = {list(w.normal)}: the engines' flat walls are axis-aligned")
-        lines.append(f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[int(axes[0])]}plane "
-                     f"{fmt(w.point[int(axes[0])])} {' '.join(flags)}")
+        ax, _ = common.wall_axis(w, k)
+        lines.append(f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[ax]}plane "
+                     f"{fmt(w.point[ax])} {' '.join(flags)}")
     g = np.asarray(case.run.gravity, float)
     gn = float(np.linalg.norm(g))
     if gn > 0:

@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .kernels import L_KIND, normal_force
+from .kernels import normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_LAMMPS,
                         ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force)
 from .tangential import (LTH, NONE, SLIDING, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, T_TRUNC, TRUNC_MAW,
@@ -65,6 +65,19 @@ def _cell_index(xi, box_lo, box_hi, dims, periodic):
     return (c0 * dims[1] + c1) * dims[2] + c2
 
 
+@njit(cache=True, inline="always")
+def _separation(x, i, j, box, periodic):
+    """x_j − x_i, by minimum image along the periodic axes."""
+    d0 = x[j, 0] - x[i, 0]
+    d1 = x[j, 1] - x[i, 1]
+    d2 = x[j, 2] - x[i, 2]
+    if periodic[0]:
+        d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
+    if periodic[1]:
+        d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
+    return d0, d1, d2
+
+
 MAXNB = 48  # neighbours within contact distance plus the skin, per particle (pairs j > i)
 
 
@@ -100,13 +113,7 @@ def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
                     j = head[(cx * dims[1] + cy) * dims[2] + cz]
                     while j >= 0:
                         if j > i:
-                            d0 = x[j, 0] - x[i, 0]
-                            d1 = x[j, 1] - x[i, 1]
-                            d2 = x[j, 2] - x[i, 2]
-                            if periodic[0]:
-                                d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
-                            if periodic[1]:
-                                d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
+                            d0, d1, d2 = _separation(x, i, j, box, periodic)
                             reach = rad[i] + rad[j] + skin
                             if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
                                 if nnb[i] < nb.shape[1]:
@@ -250,14 +257,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
     for i in range(n_p):
         for q in range(nnb[i]):
             j = nb[i, q]
-            # candidate pairs by scalars: no allocation on the hot path
-            d0 = x[j, 0] - x[i, 0]
-            d1 = x[j, 1] - x[i, 1]
-            d2 = x[j, 2] - x[i, 2]
-            if periodic[0]:
-                d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
-            if periodic[1]:
-                d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
+            d0, d1, d2 = _separation(x, i, j, box, periodic)  # scalars: no allocation on the hot path
             touch = rad[i] + rad[j]
             dist2 = d0 * d0 + d1 * d1 + d2 * d2
             if dist2 < touch * touch:
