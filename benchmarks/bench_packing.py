@@ -37,10 +37,11 @@ def main():
                                                    forces=st.contacts[:nc, 3])))
     for engine in ("lammps", "liggghts"):
         t = time.perf_counter()
-        table, ke, version = run_engine(case, engine)
-        rows.append((f"{engine} ({version})", time.perf_counter() - t,
-                     PM.compute(table[["x", "y", "z"]].to_numpy(), table["radius"].to_numpy(),
-                                box=tuple(case.raw["packing"]["box"]), margin=1.0)))
+        run = run_engine(case, engine)
+        rows.append((f"{engine} ({run.version})", time.perf_counter() - t,
+                     PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(),
+                                box=tuple(case.raw["packing"]["box"]), margin=1.0,
+                                forces=run.contacts["fn"].to_numpy())))
     print(f"poured packing: {n} spheres, {steps:.0f} steps of {dt:.3g} s, one core each")
     print(f"{'source':36s} {'wall s':>8s} {'particle-steps/s':>17s} {'vs LAMMPS':>9s} {'solid frac':>10s} {'coord':>6s}")
     lam = rows[1][1]

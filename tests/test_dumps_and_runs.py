@@ -49,6 +49,22 @@ def test_dump_parser_takes_a_changing_number_of_rows():
     assert t["x"].tolist() == [0.25, 0.25, 0.5, 0.75]
 
 
+@pytest.mark.parametrize("engine", ["lammps", "liggghts"])
+def test_engine_contact_dumps_parse(engine):
+    """Each engine's per-contact dump (dump local) of the settled five-sphere column (recorded by the
+    packing decks): the four pairs, each carrying the weight of the spheres above it (closed form), with
+    the overlap δ = F/kn of the case's LSDn (kn = 2000 N/m)."""
+    from demcheck.inputs.packing_decks import CONTACT_COLUMNS, read_contacts
+
+    c = read_contacts(engine, DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3))
+    assert tuple(c.columns) == CONTACT_COLUMNS
+    weight = 2500.0 * 4.0 / 3.0 * np.pi * 1e-9 * 9.81
+    assert [tuple(p) for p in c[["i", "j"]].to_numpy()] == [(0, 1), (1, 2), (2, 3), (3, 4)]
+    np.testing.assert_allclose(c["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-6)
+    np.testing.assert_allclose(c["overlap"], c["fn"] / 2000.0, rtol=1e-6)
+    assert np.all(c["ft"] == 0.0)
+
+
 @pytest.mark.parametrize("name,message", [
     ("short_row.txt", "short_row.txt:11: 6 values for 7 columns"),
     ("truncated.txt", "ended early inside a block; expected 2 atom rows"),

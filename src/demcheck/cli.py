@@ -382,11 +382,12 @@ def pack(case_path, engine, duration, mpi, overrides, as_json):
     else:
         from .inputs.packing_decks import run_engine
 
-        table, ke, version = run_engine(case, engine, duration=duration, mpi=mpi)
-        m = PM.compute(table[["x", "y", "z"]].to_numpy(), table["radius"].to_numpy(), box=box,
-                       ke=[e for _, e in ke])
-        out = {"case": case.name, "source": engine, "engine_version": version, "particles": len(table),
-               "dt": P.packing_dt(case), "metrics": m}
+        run = run_engine(case, engine, duration=duration, mpi=mpi)
+        m = PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
+                       forces=run.contacts["fn"].to_numpy(), overlaps=run.contacts["overlap"].to_numpy(),
+                       ke=[e for _, e in run.ke])
+        out = {"case": case.name, "source": engine, "engine_version": run.version, "particles": len(run.table),
+               "dt": P.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
     if as_json:
         emit_json(out)
         return

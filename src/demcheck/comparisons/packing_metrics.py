@@ -5,7 +5,10 @@ produced them, so the reference and the engines' dumps are measured the same way
   surface by ``margin`` diameters) over the slab's volume, spheres cut exactly by the slab planes;
 * coordination_number: contacts (overlap ≥ −tol·d) per particle, over particles of the bulk slab;
 * contact forces (when given): mean and the histogram of f/⟨f⟩; max_overlap_ratio: δ_max/d;
-* bed_height: the highest particle top; kinetic_energy: the last value of the series.
+* bed_height: in a periodic box, the mean free-surface height — the highest particle top in each column of
+  a grid of cells about one mean diameter wide, averaged over the columns (a sphere perched on top moves it
+  by one column's share, not by a diameter); without a box, the highest particle top;
+* kinetic_energy: the last value of the series.
 """
 
 from __future__ import annotations
@@ -38,11 +41,25 @@ def contacts(x, rad, box=None, tol=1e-9):
     return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
+def surface_height(x, rad, box=None) -> float:
+    """The bed's free-surface height (see the module docstring)."""
+    x, rad = np.asarray(x, float), np.asarray(rad, float)
+    tops = x[:, 2] + rad
+    if box is None:
+        return float(tops.max())
+    d = 2.0 * float(rad.mean())
+    n = [max(1, int(box[k] / d * (1.0 + 1e-9))) for k in range(2)]  # a box of exactly k diameters: k cells
+    cell = [np.floor(np.mod(x[:, k], box[k]) / box[k] * n[k]).astype(np.int64).clip(0, n[k] - 1) for k in range(2)]
+    highest = np.full(n[0] * n[1], -np.inf)
+    np.maximum.at(highest, cell[0] * n[1] + cell[1], tops)
+    return float(highest[np.isfinite(highest)].mean())
+
+
 def compute(x, rad, box=None, floor=0.0, margin=2.0, forces=None, overlaps=None, ke=None) -> dict:
     x = np.asarray(x, float)
     rad = np.asarray(rad, float)
     d = 2.0 * float(rad.mean())
-    top = float((x[:, 2] + rad).max())
+    top = surface_height(x, rad, box)
     z0, z1 = floor + margin * d, top - margin * d
     out = {"bed_height": top - floor, "solid_fraction": math.nan, "coordination_number": math.nan,
            "mean_contact_force": math.nan, "max_overlap_ratio": math.nan, "kinetic_energy": math.nan}

@@ -12,7 +12,10 @@ import numpy as np
 from . import packing_metrics as PM, verdicts as V
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
-TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02}
+TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
+# the contact-force distributions P(f/⟨f⟩) of two sources are compared by the two-sample Kolmogorov–Smirnov
+# distance, held to its critical value at this significance for the two sample sizes
+KS_ALPHA = 1e-3
 RANGES = {"solid_fraction": (0.55, 0.64), "coordination_number": (4.0, 6.0)}
 CLOSED_FORM_RTOL = 1e-6
 
@@ -51,6 +54,52 @@ def static_overlaps(case, x) -> list[tuple[float, float]] | None:
     return out
 
 
+def ks_distance(a, b) -> tuple[float, float]:
+    """(KS distance between the distributions of f/⟨f⟩ of two sets of contact forces, its critical value at
+    KS_ALPHA for these sample sizes): c(α)·√((n+m)/(n·m)), c(α) = √(−ln(α/2)/2)."""
+    from scipy.stats import ks_2samp
+
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    a, b = a[a > 0], b[b > 0]
+    if len(a) < 2 or len(b) < 2:
+        return math.nan, math.nan
+    d = float(ks_2samp(a / a.mean(), b / b.mean()).statistic)
+    return d, math.sqrt(-math.log(KS_ALPHA / 2.0) / 2.0) * math.sqrt((len(a) + len(b)) / (len(a) * len(b)))
+
+
+def reference_packing(case, cache=None):
+    """The reference's settled packing: (x, rad, contacts [i, j, δ, Fn, |Ft|], ke [(t, e)], time, seconds).
+    ``cache`` (engines.cache.Cache): keyed by the case, the time step and the solver's source fingerprint, so
+    a warm verify does not settle a large packing again — and a changed solver always does."""
+    import json
+    import time
+
+    import pandas as pd
+
+    from ..engines.cache import key as cache_key
+    from ..reference import packing as P
+
+    k = None
+    if cache is not None:
+        what = json.dumps({"case": case.hash, "dt": P.packing_dt(case), "rest": 0.0})
+        k = cache_key("reference-packing", P.solver_fingerprint(), what, {})
+        hit, hit_c = cache.get(k), cache.get(k + "-contacts")
+        if hit is not None and hit_c is not None:
+            (table, meta), (con, _) = hit, hit_c
+            return (table[["x", "y", "z"]].to_numpy(), table["radius"].to_numpy(), con.to_numpy(),
+                    [tuple(e) for e in meta["ke"]], meta["time"], meta["seconds"])
+    t0 = time.perf_counter()
+    st = P.simulate(case, rest=0.0)
+    seconds = time.perf_counter() - t0
+    nc = min(st.n_contacts, len(st.contacts))
+    contacts = st.contacts[:nc].copy()
+    if k is not None:
+        cache.put(k + "-contacts", pd.DataFrame(contacts, columns=["i", "j", "overlap", "fn", "ft"]), {})
+        table = pd.DataFrame({"x": st.x[:, 0], "y": st.x[:, 1], "z": st.x[:, 2], "radius": st.rad})
+        cache.put(k, table, {"ke": st.ke, "time": st.time, "seconds": seconds})
+    return st.x.copy(), st.rad.copy(), contacts, list(st.ke), st.time, seconds
+
+
 def run_packing(case, opts, found, file=None) -> dict:
     from ..inputs.common import pair_mapping
     from ..inputs.packing_decks import run_engine
@@ -65,36 +114,48 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry["model"] = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
     box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
     comps = []
-    st = P.simulate(case, rest=0.0)
-    nc = min(st.n_contacts, len(st.contacts))
-    states = {"reference": (st.x.copy(), st.rad.copy())}
-    ref_m = PM.compute(st.x, st.rad, box=box, margin=1.0, forces=st.contacts[:nc, 3],
-                       overlaps=st.contacts[:nc, 2], ke=[e for _, e in st.ke])
-    entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": st.time}
-    entry["packing"]["reference"] = {"ke": st.ke, "forces": PM.force_distribution(st.contacts[:nc, 3]),
-                                     "profile": PM.profile(st.x, st.rad, box) if box else None}
+    x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
+    states = {"reference": (x, rad)}
+    ref_forces = contacts[:, 3]
+    ref_m = PM.compute(x, rad, box=box, margin=1.0, forces=ref_forces, overlaps=contacts[:, 2],
+                       ke=[e for _, e in ke])
+    entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": t_end, "wall_time": seconds}
+    entry["packing"]["reference"] = {"ke": ke, "forces": PM.force_distribution(ref_forces),
+                                     "profile": PM.profile(x, rad, box) if box else None}
     from .suite import unavailable
 
     for engine in opts.engines:
         if unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
             continue
         try:
-            table, ke, version = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
+            run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
         except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
             comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
             continue
-        x = table[["x", "y", "z"]].to_numpy()
-        rad = table["radius"].to_numpy()
+        x = run.table[["x", "y", "z"]].to_numpy()
+        rad = run.table["radius"].to_numpy()
         states[engine] = (x, rad)
-        m = PM.compute(x, rad, box=box, margin=1.0, ke=[e for _, e in ke])
-        entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": version}
-        entry["packing"][engine] = {"ke": ke, "profile": PM.profile(x, rad, box) if box else None}
+        fn = run.contacts["fn"].to_numpy()
+        m = PM.compute(x, rad, box=box, margin=1.0, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
+                       ke=[e for _, e in run.ke])
+        entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": run.version}
+        dt = P.packing_dt(case)
+        entry["packing"][engine] = {"ke": [(step * dt, e) for step, e in run.ke],
+                                    "forces": PM.force_distribution(fn),
+                                    "profile": PM.profile(x, rad, box) if box else None}
+        d, crit = ks_distance(fn, ref_forces)
+        if math.isfinite(d):
+            ok = d <= crit
+            comps.append(V.Comparison(engine, "force_distribution_ks", d, 0.0, d, d, crit,
+                                      V.AGREE if ok else V.UNEXPECTED,
+                                      "" if ok else f"the contact-force distributions P(f/⟨f⟩) differ beyond the "
+                                                    f"Kolmogorov–Smirnov critical distance at α = {KS_ALPHA:g}"))
         for metric, tol in TOLERANCES.items():
             a, b = m[metric], ref_m[metric]
             if not (math.isfinite(a) and math.isfinite(b)):
                 continue
-            diff = abs(a - b) / (abs(b) if metric == "bed_height" else 1.0)
+            diff = abs(a - b) / (abs(b) if metric in ("bed_height", "mean_contact_force") else 1.0)
             verdict = V.AGREE if diff <= tol else V.UNEXPECTED
             comps.append(V.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
                                       "" if verdict == V.AGREE else

@@ -159,14 +159,21 @@ def render_markdown(summary: dict) -> str:
     if packings:
         lines += ["", "## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
                   "within statistical tolerances; column and layer against their static closed form).", "",
-                  "| case | source | solid fraction | coordination | bed height (m) | max overlap / d | static closed form |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| case | source | solid fraction | coordination | bed height (m) | mean contact force (N) | "
+                  "force distribution: KS distance to the reference (critical) | max overlap / d | static closed form |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for c in packings:
             for src, v in c["sources"].items():
                 m = v.get("metrics") or {}
-                cf = next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == "static_overlap"), None)
+
+                def comp(metric, src=src, c=c):
+                    return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
+
+                cf, ks = comp("static_overlap"), comp("force_distribution_ks")
                 lines.append(f"| {c['case']} | {src} | {_f(m.get('solid_fraction'), '.4f')} | "
                              f"{_f(m.get('coordination_number'), '.3f')} | {_f(m.get('bed_height'), '.5g')} | "
+                             f"{_f(m.get('mean_contact_force'), '.4g')} | "
+                             f"{_f(ks['value'], '.3f') + ' (' + _f(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
                              f"{_f(m.get('max_overlap_ratio'), '.3g')} | "
                              f"{_f(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
     # per case
@@ -457,7 +464,7 @@ def render_html(summary: dict) -> str:
 
 
 def packing_plots(entry: dict) -> str:
-    """Solid fraction against height per source, the reference's P(f/⟨f⟩), kinetic energy against time."""
+    """Solid fraction against height, P(f/⟨f⟩) and kinetic energy against time, per source."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -470,14 +477,15 @@ def packing_plots(entry: dict) -> str:
         if d.get("profile"):
             a1.plot(d["profile"]["solid_fraction"], [z * 1e3 for z in d["profile"]["z"]], label=src)
         if d.get("ke"):
-            ts = [k[0] for k in d["ke"]]
-            a3.semilogy(range(len(ts)), [max(k[1], 1e-300) for k in d["ke"]], label=src)
-    forces = (data.get("reference") or {}).get("forces") or {}
-    if forces.get("x"):
-        a2.plot(forces["x"], forces["p"], "o-", ms=3, label="reference")
+            pts = [k for k in d["ke"] if k[1] > 0]  # log axis: the start at rest left out
+            a3.semilogy([k[0] for k in pts], [k[1] for k in pts], label=src)
+        forces = d.get("forces") or {}
+        if forces.get("x"):
+            pts = [(x, p) for x, p in zip(forces["x"], forces["p"]) if p > 0]  # log axis: the empty bins left out
+            a2.semilogy([q[0] for q in pts], [q[1] for q in pts], "o-", ms=3, label=src)
     a1.set(xlabel="solid fraction", ylabel="height (mm)", title="solid fraction against height")
-    a2.set(xlabel="f/⟨f⟩", ylabel="P", title="contact force distribution")
-    a3.set(xlabel="sample", ylabel="kinetic energy (J)", title="kinetic energy")
+    a2.set(xlabel=r"$f/\langle f\rangle$", ylabel=r"$P(f/\langle f\rangle)$", title="contact force distribution")
+    a3.set(xlabel="time (s)", ylabel="kinetic energy (J)", title="kinetic energy")
     for a in (a1, a2, a3):
         a.grid(alpha=0.3)
         if a.get_legend_handles_labels()[0]:

@@ -252,7 +252,9 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                       console=console, transient=True) as progress:
             task = progress.add_task("verify", total=len(cases))
             with cf.ThreadPoolExecutor(max_workers=max(1, opts.jobs)) as pool:
-                futures = {pool.submit(_safe_case, case, path, opts, found): i for i, (path, case) in enumerate(cases)}
+                # the packings first: the longest jobs, so that the collisions fill the other workers meanwhile
+                order = sorted(range(len(cases)), key=lambda i: cases[i][1].kind != "packing")
+                futures = {pool.submit(_safe_case, cases[i][1], cases[i][0], opts, found): i for i in order}
                 try:
                     for fut in cf.as_completed(futures):
                         i = futures[fut]

@@ -1,7 +1,8 @@
 """Reading the engines' text dumps.
 
 Both engines write LAMMPS's ``dump custom`` format: blocks of ``ITEM: TIMESTEP``, ``ITEM: NUMBER OF
-ATOMS``, ``ITEM: BOX BOUNDS``, ``ITEM: ATOMS <columns>``, then one row per atom. The column names come
+ATOMS``, ``ITEM: BOX BOUNDS``, ``ITEM: ATOMS <columns>``, then one row per atom — or ``dump local``'s, the
+same with ``ENTRIES`` for ``ATOMS`` and one row per entry (a contact). The column names come
 from the block's own header, so decks may order or extend them freely, and the number of rows may change
 from block to block.
 
@@ -73,8 +74,12 @@ def read_dump(path, columns: tuple[str, ...] | None = None) -> pd.DataFrame:
                 step = int(line.split()[0])
             except (ValueError, IndexError):
                 raise ParseError(f"{path}:{no}: timestep is not an integer: {line.strip()[:60]!r}") from None
-            expect("ITEM: NUMBER OF ATOMS")
-            no, line = value_line("a number of atoms")
+            no, line = value_line("'ITEM: NUMBER OF ATOMS'")
+            if not line.startswith(("ITEM: NUMBER OF ATOMS", "ITEM: NUMBER OF ENTRIES")):
+                raise ParseError(f"{path}:{no}: expected 'ITEM: NUMBER OF ATOMS' (or ENTRIES, a dump local), "
+                                 f"found {line.strip()[:60]!r}")
+            item = "ENTRIES" if "ENTRIES" in line else "ATOMS"  # dump local: one row per entry (contact)
+            no, line = value_line("a number of rows")
             try:
                 natoms = int(line.split()[0])
             except (ValueError, IndexError):
@@ -82,7 +87,7 @@ def read_dump(path, columns: tuple[str, ...] | None = None) -> pd.DataFrame:
             no, line = expect("ITEM: BOX BOUNDS")
             for _ in range(3):
                 value_line("box bounds")
-            no, line = expect("ITEM: ATOMS")
+            no, line = expect(f"ITEM: {item}")
             cols = tuple(line.split()[2:])
             if names is None:
                 names = cols
@@ -90,7 +95,7 @@ def read_dump(path, columns: tuple[str, ...] | None = None) -> pd.DataFrame:
                 raise ParseError(f"{path}:{no}: columns changed from {' '.join(names)} to {' '.join(cols)}")
             rows = []
             for _ in range(natoms):
-                no, line = value_line(f"{natoms} atom rows")
+                no, line = value_line(f"{natoms} {'atom' if item == 'ATOMS' else 'entry'} rows")
                 parts = line.split()
                 if len(parts) != len(cols):
                     raise ParseError(f"{path}:{no}: {len(parts)} values for {len(cols)} columns")

@@ -1,10 +1,15 @@
 """Decks for packing cases: the same initial state as the reference (a LAMMPS data file, one atom type per
 particle species), the species pairs' coefficients from the mapping, plane walls, gravity, periodic x and
-y where the packing has a box, and a final dump of every particle in full precision."""
+y where the packing has a box, a final dump of every particle in full precision, and a final dump of every
+particle-particle contact (the engine's own per-contact output: LAMMPS ``compute pair/local`` with
+``property/local``, LIGGGHTS ``compute pair/gran/local``) for the contact-force distribution."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import pandas as pd
 
 from ..case import Case
 from ..errors import UnsupportedByEngine
@@ -13,6 +18,9 @@ from . import common, lammps as L
 from .common import fmt
 
 FINAL_DUMP = "final.txt"
+CONTACT_DUMP = "contacts.txt"
+# the contact table every source yields: particle indices (0-based), overlap, normal force, |tangential force|
+CONTACT_COLUMNS = ("i", "j", "overlap", "fn", "ft")
 FINAL_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
                  "fx", "fy", "fz")
 
@@ -81,6 +89,11 @@ def lammps_deck(case: Case, duration: float | None = None, dt: float | None = No
     every = max(1, steps // 50)
     lines += ["fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
               "thermo_modify norm no", f"thermo {every}", f"run {steps}",
+              "# every pair within the cutoff: the two ids, centre distance, normal force (repulsive > 0) and the",
+              "# tangential force's magnitude (pair granular's 4th single() quantity), re-evaluated at the final state",
+              "compute pairs all pair/local dist force p4", "compute ids all property/local patom1 patom2",
+              f"dump contacts all local 1 {CONTACT_DUMP} c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3]",
+              "dump_modify contacts format float %.17g", "run 0", "undump contacts",
               f"write_dump all custom {FINAL_DUMP} {' '.join(FINAL_COLUMNS)} modify format float %.17g sort id", ""]
     return common.Deck("lammps", "\n".join(lines), {"data.lmp": _data_file(case, species, lo, hi)})
 
@@ -143,17 +156,55 @@ def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = 
         lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
     every = max(1, steps // 50)
     fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(FINAL_COLUMNS) - 2))
-    lines += ["fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
+    local_fmt = " ".join(["%.17g"] * 10)  # compute values are doubles, the ids too
+    lines += ["# per contact: the two ids, a periodic flag, the force on the first and its normal part, the overlap",
+              "# (defined before the first run, as LIGGGHTS requires; dumped at the final state only)",
+              "compute pairs all pair/gran/local id force force_normal delta",
+              "fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
               "thermo_modify norm no", f"thermo {every}", f"run {steps}",
               f"dump final all custom 1 {FINAL_DUMP} {' '.join(FINAL_COLUMNS)}",
-              f'dump_modify final format "{fmt_line}" sort id', "run 0", ""]
+              f'dump_modify final format "{fmt_line}" sort id',
+              f"dump contacts all local 1 {CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
+              f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
     return common.Deck("liggghts", "\n".join(lines), {"data.lmp": _data_file(case, species, lo, hi, ntypes)})
 
 
+@dataclass
+class PackingRun:
+    """An engine's settled packing: the final per-particle table (FINAL_COLUMNS), its particle-particle
+    contacts (CONTACT_COLUMNS), the kinetic energy series [(step, ke)] and the engine's version."""
+
+    table: pd.DataFrame
+    contacts: pd.DataFrame
+    ke: list
+    version: str
+
+
+def read_contacts(engine: str, path, radius: np.ndarray) -> pd.DataFrame:
+    """The engine's per-contact dump as CONTACT_COLUMNS: touching pairs only (overlap > 0), each once
+    (with newton off a pair across a periodic or processor boundary may be listed from both sides).
+    ``radius``: per particle, indexed by id − 1 (LAMMPS lists centre distances, not overlaps)."""
+    from ..engines import dumps
+
+    raw = dumps.read_dump(path)
+    raw = raw[raw["step"] == raw["step"].max()] if len(raw) else raw
+    v = raw.drop(columns="step").to_numpy(float)
+    i, j = v[:, 0].astype(np.int64) - 1, v[:, 1].astype(np.int64) - 1
+    if engine == "lammps":
+        overlap, fn, ft = radius[i] + radius[j] - v[:, 2], v[:, 3], v[:, 4]
+    else:  # id1 id2 periodic-flag, force (3), its normal part (3), delta
+        overlap = v[:, 9]
+        fn = np.linalg.norm(v[:, 6:9], axis=1)
+        ft = np.linalg.norm(v[:, 3:6] - v[:, 6:9], axis=1)
+    out = pd.DataFrame({"i": np.minimum(i, j), "j": np.maximum(i, j), "overlap": overlap, "fn": fn, "ft": ft})
+    out = out[out["overlap"] > 0].drop_duplicates(subset=["i", "j"]).sort_values(["i", "j"])
+    return out.reset_index(drop=True)
+
+
 def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
-               cache=None):
-    """Run the packing in an engine (``mpi`` ranks): (final table, kinetic energy series [(step, ke)],
-    engine version). ``cache`` (engines.cache.Cache) skips decks already run (keyed with the ranks too)."""
+               cache=None) -> PackingRun:
+    """Run the packing in an engine (``mpi`` ranks). ``cache`` (engines.cache.Cache) skips decks already
+    run (keyed with the ranks too)."""
     import re
 
     from ..engines import discovery, dumps, run as runner
@@ -163,15 +214,20 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     k = None
     if cache is not None and discovery.find(engine) is not None:
         k = cache_key(engine, discovery.find(engine).version, dk.text + f"\n# mpi {mpi}", dk.files)
-        hit = cache.get(k)
-        if hit is not None:
+        hit, hit_contacts = cache.get(k), cache.get(k + "-contacts")
+        if hit is not None and hit_contacts is not None:
             table, meta = hit
-            return table, [tuple(x) for x in meta["ke"]], meta["version"]
+            contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
+            return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
     out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi)
     table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
     table = table[table["step"] == table["step"].max()]
     ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
     table = table.sort_values("id").reset_index(drop=True)
+    radius = np.zeros(int(table["id"].max()))
+    radius[table["id"].to_numpy() - 1] = table["radius"].to_numpy()
+    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, radius)
     if k is not None:
+        cache.put(k + "-contacts", contacts, {})  # first: the table's entry is what marks the run cached
         cache.put(k, table, {"version": out.version, "ke": ke})
-    return table, ke, out.version
+    return PackingRun(table, contacts, ke, out.version)

@@ -5,8 +5,9 @@ rebuilt every step (O(N), memory linear in N), and a contact history per pair an
 contact in fixed slots per particle. The contact laws are the reference's compiled laws (kernels.py's
 normal force, kernels3d.py's tangential laws), one law per pair of particle species, so any normal ×
 tangential model — engine twins included — runs here as in the two-body solvers. Tangential laws with a
-displacement history (spring families) and the history-free ones are supported; LTH, ZZYt and Walton are
-not (yet): ``resolve_laws`` says so.
+displacement history (spring families, LTH, ZZYt), Walton's incrementally slipping friction (with its
+reversal state per contact) and the history-free ones run; the LAMMPS twins' force-history variants
+(mindlin/force, mindlin_rescale) do not (no deck uses them in a packing): ``resolve_laws`` says so.
 
 Conventions as the two-body solver (kernels3d.py): n from i to j, δ = R_i + R_j − |x_j − x_i| > 0 in
 contact, slip velocity at the contact point with the arms R − δ/2, torques r × F_t, history rotated into
@@ -22,12 +23,16 @@ from numba import njit
 
 from .kernels import normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_LAMMPS,
-                        ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force)
-from .tangential import (LTH, NONE, SLIDING, SPRING, T_KIND, T_MU_K, T_MU_S, T_SIZE, T_TRUNC, TRUNC_MAW,
-                         TRUNC_SPRING, VISCOUS, VISCOUS_SLIDING, ZZY)
+                        ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force,
+                        walton_stiffness)
+from .tangential import (LTH, NONE, SLIDING, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC,
+                         TRUNC_MAW, TRUNC_SPRING, VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
 
 MAXC = 16  # contact slots per particle (pairs with higher-index partners, and walls)
-SUPPORTED_TANGENTIAL = (NONE, SLIDING, SPRING, VISCOUS, VISCOUS_SLIDING, LTH, ZZY)
+SUPPORTED_TANGENTIAL = (NONE, SLIDING, SPRING, VISCOUS, VISCOUS_SLIDING, LTH, ZZY, WALTON)
+# per contact slot: the tangential history (3); Walton's also the load at the last reversal (3) and the last
+# nonzero v_t·L (1), so its slots are wider (only when a Walton law is in the packing: memory and bandwidth)
+HIST_WIDTH, WALTON_HIST_WIDTH = 3, 7
 
 
 @njit(cache=True)
@@ -153,8 +158,10 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft, ro
         return fn, dmax
     if kind == SPRING and update:
         return _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot)
-    if (kind == LTH or kind == ZZY) and update:
-        # Langston's and Zheng's laws on their overlap history, by kernels3d's functions (as verlet_3d)
+    if (kind == LTH or kind == ZZY or kind == WALTON) and update:
+        # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
+        # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
+        # in verlet_3d's order
         hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
         if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs):
             old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
@@ -164,8 +171,18 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft, ro
             if new > 0.0:
                 for k in range(3):
                     hist[k] *= old / new
-        for k in range(3):
-            hist[k] += vt[k] * dt
+        if kind == WALTON:
+            vl = vt[0] * hist[0] + vt[1] * hist[1] + vt[2] * hist[2]
+            if (vl < 0.0 and hist[6] > 0.0) or (vl > 0.0 and hist[6] < 0.0):  # a reversal: L* = L
+                hist[3], hist[4], hist[5] = hist[0], hist[1], hist[2]
+            if vl != 0.0:
+                hist[6] = vl
+            kw = walton_stiffness(tl, hist[0:3], vt, fabs, hist[3:6])
+            for k in range(3):
+                hist[k] += kw * vt[k] * dt
+        else:
+            for k in range(3):
+                hist[k] += vt[k] * dt
         if rot == ROT_PROJECT:
             hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
             for k in range(3):
@@ -347,7 +364,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
     nc_out[0] = nc
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
         dt, steps, ke_every, partner, hist, dmax, contacts, rules):
     """Velocity Verlet for ``steps`` steps from the given state (modified in place). Returns (kinetic
@@ -414,6 +431,21 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
 # ----------------------------------------------------------------------------- Python side
 
 
+def solver_fingerprint() -> str:
+    """A hash of the reference solver's source (every module of demcheck.reference) and of numba's and
+    numpy's versions: part of the key under which verify caches a reference packing, so that a change to the
+    solver never serves a stale result."""
+    import hashlib
+    from pathlib import Path
+
+    import numba
+
+    h = hashlib.sha256(f"numba {numba.__version__} numpy {np.__version__}".encode())
+    for f in sorted(Path(__file__).parent.glob("*.py")):
+        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def species_of(case) -> tuple[np.ndarray, list[int]]:
     """Species (material, radius) of each particle, and one representative particle per species."""
     keys, rep, sp = {}, [], np.empty(len(case.particles), np.int64)
@@ -445,11 +477,12 @@ def resolve_laws(case):
     def law(pair):
         nl, _ = normal.resolve(pair, params, case.contact.limit_force)
         tl, _ = tangential.resolve(pair, params, nl)
-        if tl.kind not in SUPPORTED_TANGENTIAL:
+        arr = tl.array()
+        if tl.kind not in SUPPORTED_TANGENTIAL or arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:
             raise ConfigError("contact.tangential", tangential.id,
-                              "is not supported by the packing solver yet (Walton's needs a reversal state per "
-                              "contact; every other tangential law runs)")
-        return nl.array(), tl.array()
+                              "is not supported by the packing solver (a force history or a contact-radius "
+                              "rescale: LAMMPS's mindlin/force and mindlin_rescale twins)")
+        return nl.array(), arr
 
     for a in range(ns):
         for b in range(a, ns):
@@ -494,7 +527,9 @@ class PackState:
         self.rad = np.array([p.radius for p in case.particles], float)
         self.mass = np.array([case.mass(i) for i in range(n)], float)
         self.partner = np.full((n, MAXC), -999999, np.int64)
-        self.hist = np.zeros((n, MAXC, 3))
+        _, _, laws_t, _, wall_t = resolve_laws(case)
+        walton = bool(np.any(laws_t[..., T_KIND] == WALTON) or (case.walls and np.any(wall_t[..., T_KIND] == WALTON)))
+        self.hist = np.zeros((n, MAXC, WALTON_HIST_WIDTH if walton else HIST_WIDTH))
         self.dmax = np.zeros((n, MAXC))
         self.contacts = np.zeros((8 * n + 16, 5))
         self.n_contacts = 0
