@@ -208,6 +208,21 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
         _same_as_two_body(case, dt, rules)
 
 
+@pytest.mark.parametrize("tangential,params", [("spring_sliding", None), ("walton", {}),
+                                               ("lsd_sliding", {"truncation": "overlap", "tangential_restitution": 0.5})])
+def test_the_packing_solver_is_the_two_body_verlet_method_against_a_wall(tangential, params):
+    """The same against a rigid plane wall (the solver's wall path), with the seed's and the engines' rules."""
+    from demcheck.inputs.mapping import RULES
+    from demcheck.reference.collision import auto_dt
+
+    from .helpers import oblique_case
+
+    case = oblique_case(tangential, params, wall=True, angle=30.0, spin=500.0,
+                        overrides=["contact.reference_velocity=1.0"])
+    for rules in (None, RULES["lammps"], RULES["liggghts"]) if tangential != "walton" else (None,):
+        _same_as_two_body(case, auto_dt(case), rules)
+
+
 def _same_as_two_body(case, dt, rules):
     from demcheck.reference import collision3d
     from demcheck.reference.model import resolve
@@ -215,12 +230,9 @@ def _same_as_two_body(case, dt, rules):
     two = collision3d.collide(case, resolve(case), "verlet", dt=dt, rules=rules)
     steps = int(round(two.contact["t"].iloc[-1] / dt))
     st = P.PackState(case)
-    sp, ln, lt, wn, wt = P.resolve_laws(case)
-    lo, hi, periodic = P.box_of(case, st.x, st.rad)
-    P.run(st.x, st.v, st.w, st.rad, st.mass, sp, ln, lt, wn, wt, np.zeros((0, 6)), lo, hi, periodic, np.zeros(3), dt,
-          steps, steps, st.partner, st.hist, st.dmax, st.contacts, collision3d.rules_array(rules))
+    P.advance(case, st, dt, steps, rules, gravity=np.zeros(3), ke_every=steps)
     last = two.particles.groupby("id").last()
-    for i in (0, 1):
+    for i in range(len(case.particles)):
         np.testing.assert_allclose(st.v[i], last.loc[i, ["vx", "vy", "vz"]].to_numpy(), rtol=0, atol=1e-12)
         np.testing.assert_allclose(st.w[i], last.loc[i, ["wx", "wy", "wz"]].to_numpy(), rtol=0, atol=1e-9)
 
@@ -346,3 +358,19 @@ def test_reference_packings_are_cached_by_case_and_solver_source(tmp_path, monke
     monkeypatch.setattr(P, "solver_fingerprint", lambda: "changed")
     reference_packing(case, cache)
     assert cache.hits == 2 and cache.misses == 4
+
+
+def test_contact_search_is_the_brute_force_one():
+    """The k-d tree contact search (periodic in x and y) against every pair by minimum image."""
+    rng = np.random.default_rng(5)
+    box = (0.01, 0.008)
+    x = rng.uniform(0, 1, (300, 3)) * [box[0], box[1], 0.01]
+    rad = rng.choice([0.4e-3, 0.5e-3, 0.7e-3], 300)
+    d = x[None, :, :] - x[:, None, :]
+    for k in range(2):
+        d[..., k] -= box[k] * np.floor(d[..., k] / box[k] + 0.5)
+    touch = np.linalg.norm(d, axis=2) <= (rad[:, None] + rad[None, :]) * (1 + 1e-9)
+    expected = np.argwhere(np.triu(touch, 1))
+    got = PM.contacts(x, rad, box=box)
+    assert len(expected) > 100
+    np.testing.assert_array_equal(got, expected)

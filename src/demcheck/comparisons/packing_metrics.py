@@ -26,19 +26,34 @@ def _cap_volume(r, lo, hi):
 
 
 def contacts(x, rad, box=None, tol=1e-9):
-    """Pairs (i, j) in contact (overlap ≥ −tol·(r_i + r_j)), minimum image in x and y when ``box`` is
-    the periodic (lx, ly). O(N²) in memory chunks of one row: fine for thousands of spheres."""
-    pairs = []
-    for i in range(len(x) - 1):
-        d = x[i + 1:] - x[i]
-        if box is not None:
-            for k in range(2):
-                d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
-        dist = np.linalg.norm(d, axis=1)
-        touch = rad[i] + rad[i + 1:]
-        for j in np.flatnonzero(dist <= touch * (1.0 + tol)):
-            pairs.append((i, i + 1 + int(j)))
-    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+    """Pairs (i, j), i < j, in contact (overlap ≥ −tol·(r_i + r_j)), sorted; minimum image in x and y when
+    ``box`` is the periodic (lx, ly). A k-d tree (scipy's, periodic in x and y): O(N log N)."""
+    from scipy.spatial import cKDTree
+
+    x = np.array(x, float)
+    rad = np.asarray(rad, float)
+    if len(x) < 2:
+        return np.empty((0, 2), np.int64)
+    reach = 2.0 * float(rad.max()) * (1.0 + tol)
+    x[:, 2] -= x[:, 2].min()
+    if box is not None:
+        for k in range(2):
+            x[:, k] = np.mod(x[:, k], box[k])
+            x[x[:, k] >= box[k], k] = 0.0  # mod can round up to the box length
+        size = [box[0], box[1], float(x[:, 2].max()) + 2.0 * reach]  # no image within reach along z
+        tree = cKDTree(x, boxsize=size)
+    else:
+        tree = cKDTree(x)
+    pairs = tree.query_pairs(reach, output_type="ndarray").astype(np.int64)
+    if not len(pairs):
+        return np.empty((0, 2), np.int64)
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    if box is not None:
+        for k in range(2):
+            d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+    keep = np.linalg.norm(d, axis=1) <= (rad[pairs[:, 0]] + rad[pairs[:, 1]]) * (1.0 + tol)
+    pairs = np.sort(pairs[keep], axis=1)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
 
 
 def surface_height(x, rad, box=None) -> float:

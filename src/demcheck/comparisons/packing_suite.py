@@ -169,7 +169,7 @@ def run_packing(case, opts, found, file=None) -> dict:
                                       "" if worst <= CLOSED_FORM_RTOL else
                                       "the settled overlaps miss the static closed form (not settled?)"))
         elif (case.raw.get("packing") or {}).get("layout") == "poured":
-            m = PM.compute(x, rad, box=box, margin=1.0)
+            m = entry["sources"][src]["metrics"]
             for metric, (lo, hi) in RANGES.items():
                 val = m[metric]
                 ok = math.isfinite(val) and lo <= val <= hi

@@ -1,10 +1,12 @@
 """The N-body reference solver for packings: spheres, plane walls, periodic x and y, gravity.
 
-The engines' scheme (velocity Verlet of fix nve/sphere, I = 0.4 m R²), a cell-list neighbour search
-rebuilt every step (O(N), memory linear in N), and a contact history per pair and per particle–wall
-contact in fixed slots per particle. The contact laws are the reference's compiled laws (kernels.py's
-normal force, kernels3d.py's tangential laws), one law per pair of particle species, so any normal ×
-tangential model — engine twins included — runs here as in the two-body solvers. Tangential laws with a
+The engines' scheme (velocity Verlet of fix nve/sphere, I = 0.4 m R²), Verlet neighbour lists in
+compressed rows built from linked cells with a skin (rebuilt once a particle has moved half of it; O(N),
+memory linear in N), each listed pair's contact state (history, largest overlap) stored beside it in the
+list and carried over at a rebuild (as LAMMPS's fix neigh/history), and one state per particle–wall
+contact. The contact laws are the reference's compiled laws (kernels.py's normal force, kernels3d.py's
+tangential laws), one law per pair of particle species, so any normal × tangential model — engine twins
+included — runs here as in the two-body solvers. Tangential laws with a
 displacement history (spring families, LTH, ZZYt), Walton's incrementally slipping friction (with its
 reversal state per contact) and the history-free ones run; the LAMMPS twins' force-history variants
 (mindlin/force, mindlin_rescale) do not (no deck uses them in a packing): ``resolve_laws`` says so.
@@ -28,7 +30,6 @@ from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL
 from .tangential import (LTH, NONE, SLIDING, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC,
                          TRUNC_MAW, TRUNC_SPRING, VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
 
-MAXC = 16  # contact slots per particle (pairs with higher-index partners, and walls)
 SUPPORTED_TANGENTIAL = (NONE, SLIDING, SPRING, VISCOUS, VISCOUS_SLIDING, LTH, ZZY, WALTON)
 # per contact slot: the tangential history (3); Walton's also the load at the last reversal (3) and the last
 # nonzero v_t·L (1), so its slots are wider (only when a Walton law is in the packing: memory and bandwidth)
@@ -83,21 +84,22 @@ def _separation(x, i, j, box, periodic):
     return d0, d1, d2
 
 
-MAXNB = 48  # neighbours within contact distance plus the skin, per particle (pairs j > i)
+NB_PER_PARTICLE = 8  # the neighbour list's first capacity per particle (pairs j > i); grown when short
 
 
 @njit(cache=True)
-def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
-    """Verlet list: for each i, the j > i within r_i + r_j + skin (linked cells of that width). Returns
-    False when a list overflows."""
+def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, start, nbj):
+    """Verlet list in compressed rows: for each i, the j > i within r_i + r_j + skin (linked cells of that
+    width) in nbj[start[i]:start[i+1]]. Returns the number of entries needed; when it exceeds len(nbj) the
+    list is incomplete and the caller grows nbj and builds again."""
     cell = 2.0 * rad.max() + skin
     head, nxt, dims = _cells(x, box_lo, box_hi, cell, periodic)
     box = box_hi - box_lo
     rx = 1 if dims[0] >= 3 or not periodic[0] else 0
     ry = 1 if dims[1] >= 3 or not periodic[1] else 0
-    ok = True
+    count = 0
     for i in range(x.shape[0]):
-        nnb[i] = 0
+        start[i] = count
         c0 = _cell_of(x[i, 0], box_lo[0], box_hi[0], dims[0], periodic[0])
         c1 = _cell_of(x[i, 1], box_lo[1], box_hi[1], dims[1], periodic[1])
         c2 = _cell_of(x[i, 2], box_lo[2], box_hi[2], dims[2], False)
@@ -121,34 +123,46 @@ def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
                             d0, d1, d2 = _separation(x, i, j, box, periodic)
                             reach = rad[i] + rad[j] + skin
                             if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                                if nnb[i] < nb.shape[1]:
-                                    nb[i, nnb[i]] = j
-                                    nnb[i] += 1
-                                else:
-                                    ok = False
+                                if count < nbj.shape[0]:
+                                    nbj[count] = j
+                                count += 1
                         j = nxt[j]
-    return ok
+    start[x.shape[0]] = count
+    return count
 
 
 @njit(cache=True)
-def _slot(partner, i, j):
-    """The slot of i holding partner j, or a free one (-1 if full)."""
-    free = -1
-    for s in range(partner.shape[1]):
-        if partner[i, s] == j:
-            return s
-        if free < 0 and partner[i, s] == -999999:
-            free = s
-    if free >= 0:
-        partner[i, free] = j
-    return free
+def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax):
+    """A new Verlet list, each pair's contact state (history, largest overlap) carried over from the old
+    list where the pair was already listed (as LAMMPS's fix neigh/history). Returns the new arrays."""
+    n = x.shape[0]
+    new_start = np.empty(n + 1, np.int64)
+    new_j = np.empty(max(nbj.shape[0], NB_PER_PARTICLE * n), np.int64)
+    need = _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, new_start, new_j)
+    if need > new_j.shape[0]:
+        new_j = np.empty(need + need // 4, np.int64)
+        _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, new_start, new_j)
+    new_hist = np.zeros((new_j.shape[0], hist.shape[1]))
+    new_dmax = np.zeros(new_j.shape[0])
+    for i in range(n):
+        for q in range(new_start[i], new_start[i + 1]):
+            j = new_j[q]
+            for p in range(start[i], start[i + 1]):
+                if nbj[p] == j:
+                    if dmax[p] != 0.0:
+                        new_hist[q, :] = hist[p, :]
+                        new_dmax[q] = dmax[p]
+                    break
+    return new_start, new_j, new_hist, new_dmax
 
 
 @njit(cache=True)
-def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft, rot):
+def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, ft, rot):
     """Normal force (+ repulsive) of one contact, and its tangential force into ``ft``, updating its history
     in place (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update``
-    False at setup, where the engines compute forces without touching histories. Returns (Fn, δ_max)."""
+    False at setup, where the engines compute forces without touching histories. Returns (Fn, δ_max).
+    The history is row ``row`` of ``hist2``, indexed in place on the spring path (no array view per contact
+    in the hottest loop)."""
     dmax = max(dmax_in, delta)
     fn = normal_force(nl, delta, rate, dmax)
     fabs = abs(fn)
@@ -157,7 +171,8 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist, dmax_in, dt, update, ft, ro
     if kind == NONE:
         return fn, dmax
     if kind == SPRING and update:
-        return _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot)
+        return _spring(nl, tl, delta, n, vt, hist2, row, fabs, dt, ft, fn, dmax, rot)
+    hist = hist2[row]
     if (kind == LTH or kind == ZZY or kind == WALTON) and update:
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
         # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
@@ -208,11 +223,11 @@ ZERO3 = np.zeros(3)
 
 
 @njit(cache=True)
-def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot):
+def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
     """The spring family (kernels3d's SPRING: slip_surface, return_map, tangential_force) with scalars only,
     for the packing solver's inner loop: rotate and rescale the history, increment it, test the slip
     surface with μs, truncate with μk by the law's rule (force cap, Maw overlap limit, spring cap)."""
-    h0, h1, h2 = hist[0], hist[1], hist[2]
+    h0, h1, h2 = hist[row, 0], hist[row, 1], hist[row, 2]
     kt = kt_of(tl, delta)
     hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
     if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt > 1e-10 * tl[T_MU_K] * fabs):
@@ -253,27 +268,32 @@ def _spring(nl, tl, delta, n, vt, hist, fabs, dt, ft, fn, dmax, rot):
             if trunc == TRUNC_MAW and kt > 0.0:
                 h0, h1, h2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
             ft[0], ft[1], ft[2] = f0, f1, f2
-    hist[0], hist[1], hist[2] = h0, h1, h2
+    hist[row, 0], hist[row, 1], hist[row, 2] = h0, h1, h2
     return fn, dmax
 
 
 @njit(cache=True)
-def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, update, rules):
-    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``."""
+def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
+            hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, update, rules):
+    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``. A pair's
+    contact state (history, largest overlap) lives beside it in the Verlet list (``hist``, ``dmax``), a
+    particle–wall contact's in row i·n_walls + k of ``w_hist``, ``w_dmax``; a contact that has ended is
+    forgotten (its state zeroed) when next seen apart."""
     n_p = x.shape[0]
+    n_w = walls.shape[0]
     f[:, :] = 0.0
     tq[:, :] = 0.0
-    touched[:, :] = False
     nbuf = np.empty(3)
     vtbuf = np.empty(3)
     ft = np.empty(3)
     rot = rules[R_ROTATION]
     box = box_hi - box_lo
     nc = 0
+    nl, tl, law_i, law_j = laws_n[0, 0], laws_t[0, 0], 0, 0
+    wnl, wtl, wall_i = wall_n[0], wall_t[0], 0
     for i in range(n_p):
-        for q in range(nnb[i]):
-            j = nb[i, q]
+        for q in range(start[i], start[i + 1]):
+            j = nbj[q]
             d0, d1, d2 = _separation(x, i, j, box, periodic)  # scalars: no allocation on the hot path
             touch = rad[i] + rad[j]
             dist2 = d0 * d0 + d1 * d1 + d2 * d2
@@ -298,15 +318,19 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 vn = u0 * n0 + u1 * n1 + u2 * n2
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
                 vtbuf[0], vtbuf[1], vtbuf[2] = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-                s = _slot(partner, i, j)
-                if s < 0:
-                    nc_out[1] = 1  # slots exhausted
-                    continue
                 si, sj = species[i], species[j]
-                fn, dm = _contact_force(laws_n[si, sj], laws_t[si, sj], delta, rate, nbuf, vtbuf,
-                                        hist[i, s], dmax[i, s], dt, update, ft, rot)
-                dmax[i, s] = dm
-                touched[i, s] = True
+                if si != law_i or sj != law_j:  # a new species pair: its law views (once, not per contact)
+                    nl, tl = laws_n[si, sj], laws_t[si, sj]
+                    law_i, law_j = si, sj
+                # the spring family straight to its scalar law: calling _contact_force (whose other branches build
+                # arrays) costs a third of the loop (measured)
+                if update and tl[T_KIND] == SPRING:
+                    dm = max(dmax[q], delta)
+                    fn = normal_force(nl, delta, rate, dm)
+                    _spring(nl, tl, delta, nbuf, vtbuf, hist, q, abs(fn), dt, ft, fn, dm, rot)
+                else:
+                    fn, dm = _contact_force(nl, tl, delta, rate, nbuf, vtbuf, hist, q, dmax[q], dt, update, ft, rot)
+                dmax[q] = dm
                 f0, f1, f2 = -fn * n0 + ft[0], -fn * n1 + ft[1], -fn * n2 + ft[2]
                 f[i, 0] += f0
                 f[i, 1] += f1
@@ -329,63 +353,71 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                     contacts[nc, 2], contacts[nc, 3] = delta, fn
                     contacts[nc, 4] = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
                 nc += 1
+            elif dmax[q] != 0.0:  # the contact has ended: forget it
+                dmax[q] = 0.0
+                hist[q, :] = 0.0
         # walls: plane through p with normal nw into the domain
         for k in range(walls.shape[0]):
-            nw = walls[k, 3:6]
-            dist = (x[i, 0] - walls[k, 0]) * nw[0] + (x[i, 1] - walls[k, 1]) * nw[1] + (x[i, 2] - walls[k, 2]) * nw[2]
+            dist = (x[i, 0] - walls[k, 0]) * walls[k, 3] + (x[i, 1] - walls[k, 1]) * walls[k, 4] \
+                + (x[i, 2] - walls[k, 2]) * walls[k, 5]
             delta = rad[i] - dist
             if delta > 0.0:
-                nvec = -nw
+                n0, n1, n2 = -walls[k, 3], -walls[k, 4], -walls[k, 5]  # from the particle into the wall
                 ai = rad[i] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
                 bi = rad[i] if rules[R_WALL_TORQUE_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
-                rate = v[i, 0] * nvec[0] + v[i, 1] * nvec[1] + v[i, 2] * nvec[2]
-                vc = v[i] + np.cross(w[i], ai * nvec)
-                vn = vc[0] * nvec[0] + vc[1] * nvec[1] + vc[2] * nvec[2]
-                vt = vc - vn * nvec
-                s = _slot(partner, i, -1 - k)
-                if s < 0:
-                    nc_out[1] = 1
-                    continue
-                si = species[i]
-                fn, dm = _contact_force(wall_n[si], wall_t[si], delta, rate, nvec, vt, hist[i, s], dmax[i, s],
-                                        dt, update, ft, rot)
-                dmax[i, s] = dm
-                touched[i, s] = True
-                fi = -fn * nvec + ft
-                f[i] += fi
-                tq[i] += np.cross(bi * nvec, ft)
-    # forget contacts that ended
-    for i in range(n_p):
-        for s in range(partner.shape[1]):
-            if partner[i, s] != -999999 and not touched[i, s]:
-                partner[i, s] = -999999
-                hist[i, s, :] = 0.0
-                dmax[i, s] = 0.0
+                rate = v[i, 0] * n0 + v[i, 1] * n1 + v[i, 2] * n2
+                # the contact point's velocity v + ω × (a n), scalars: no allocation on the hot path
+                u0 = v[i, 0] + ai * (w[i, 1] * n2 - w[i, 2] * n1)
+                u1 = v[i, 1] + ai * (w[i, 2] * n0 - w[i, 0] * n2)
+                u2 = v[i, 2] + ai * (w[i, 0] * n1 - w[i, 1] * n0)
+                vn = u0 * n0 + u1 * n1 + u2 * n2
+                nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
+                vtbuf[0], vtbuf[1], vtbuf[2] = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+                row = i * n_w + k
+                if species[i] != wall_i:
+                    wnl, wtl = wall_n[species[i]], wall_t[species[i]]
+                    wall_i = species[i]
+                if update and wtl[T_KIND] == SPRING:
+                    dm = max(w_dmax[row], delta)
+                    fn = normal_force(wnl, delta, rate, dm)
+                    _spring(wnl, wtl, delta, nbuf, vtbuf, w_hist, row, abs(fn), dt, ft, fn, dm, rot)
+                else:
+                    fn, dm = _contact_force(wnl, wtl, delta, rate, nbuf, vtbuf, w_hist, row, w_dmax[row], dt, update,
+                                            ft, rot)
+                w_dmax[row] = dm
+                f[i, 0] += -fn * n0 + ft[0]
+                f[i, 1] += -fn * n1 + ft[1]
+                f[i, 2] += -fn * n2 + ft[2]
+                # torque (b n) × F_t
+                tq[i, 0] += bi * (n1 * ft[2] - n2 * ft[1])
+                tq[i, 1] += bi * (n2 * ft[0] - n0 * ft[2])
+                tq[i, 2] += bi * (n0 * ft[1] - n1 * ft[0])
+            elif w_dmax[i * n_w + k] != 0.0:
+                w_dmax[i * n_w + k] = 0.0
+                w_hist[i * n_w + k, :] = 0.0
     nc_out[0] = nc
 
 
 @njit(cache=True, nogil=True)
 def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
-        dt, steps, ke_every, partner, hist, dmax, contacts, rules):
-    """Velocity Verlet for ``steps`` steps from the given state (modified in place). Returns (kinetic
-    energy every ke_every steps, number of pair contacts at the end, flags: [slots exhausted, non-finite])."""
+        dt, steps, ke_every, start, nbj, hist, dmax, w_hist, w_dmax, contacts, rules):
+    """Velocity Verlet for ``steps`` steps from the given state (x, v, w, the wall contact states modified in
+    place; the pair contact states travel with the Verlet list, rebuilt here). Returns (kinetic energy every
+    ke_every steps, number of pair contacts at the end, flags: [unused, non-finite], and the Verlet list with
+    its pair states: start, nbj, hist, dmax)."""
     n_p = x.shape[0]
     inertia = 0.4 * mass * rad * rad
     f = np.zeros((n_p, 3))
     tq = np.zeros((n_p, 3))
-    touched = np.zeros(partner.shape, np.bool_)
     nc_out = np.zeros(2, np.int64)
     skin = 0.3 * rad.max()
-    nb = np.empty((n_p, MAXNB), np.int64)
-    nnb = np.zeros(n_p, np.int64)
     x_ref = x.copy()
     ke = np.zeros(steps // ke_every + 1)
     flags = np.zeros(2, np.int64)
-    if not _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
-        flags[0] = 1
+    start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax)
     # setup: forces of the initial state without touching histories (as the engines do)
-    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-            partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, False, rules)
+    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
+            hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, False, rules)
     for step in range(1, steps + 1):
         for i in range(n_p):
             for k in range(3):
@@ -407,11 +439,10 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
             if dd > moved:
                 moved = dd
         if moved > (0.5 * skin) ** 2:
-            if not _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, nb, nnb):
-                flags[0] = 1
+            start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax)
             x_ref[:, :] = x
-        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, nb, nnb,
-                partner, hist, dmax, touched, f, tq, contacts, nc_out, dt, True, rules)
+        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
+                hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, True, rules)
         e = 0.0
         for i in range(n_p):
             for k in range(3):
@@ -424,8 +455,7 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
         if not math.isfinite(e):
             flags[1] = 1
             break
-    flags[0] = max(flags[0], nc_out[1])
-    return ke, nc_out[0], flags
+    return ke, nc_out[0], flags, start, nbj, hist, dmax
 
 
 # ----------------------------------------------------------------------------- Python side
@@ -526,11 +556,17 @@ class PackState:
         self.w = np.array([p.angular_velocity for p in case.particles], float)
         self.rad = np.array([p.radius for p in case.particles], float)
         self.mass = np.array([case.mass(i) for i in range(n)], float)
-        self.partner = np.full((n, MAXC), -999999, np.int64)
         _, _, laws_t, _, wall_t = resolve_laws(case)
         walton = bool(np.any(laws_t[..., T_KIND] == WALTON) or (case.walls and np.any(wall_t[..., T_KIND] == WALTON)))
-        self.hist = np.zeros((n, MAXC, WALTON_HIST_WIDTH if walton else HIST_WIDTH))
-        self.dmax = np.zeros((n, MAXC))
+        width = WALTON_HIST_WIDTH if walton else HIST_WIDTH
+        # the Verlet list (compressed rows) and, beside each listed pair, its contact state; built by run()
+        self.start = np.zeros(n + 1, np.int64)
+        self.nbj = np.zeros(0, np.int64)
+        self.hist = np.zeros((0, width))
+        self.dmax = np.zeros(0)
+        # particle–wall contact states: row i·n_walls + k
+        self.w_hist = np.zeros((n * len(case.walls), width))
+        self.w_dmax = np.zeros(n * len(case.walls))
         self.contacts = np.zeros((8 * n + 16, 5))
         self.n_contacts = 0
         self.time = 0.0
@@ -554,13 +590,30 @@ def box_of(case, x, rad):
     return lo, hi, np.array([False, False])
 
 
+def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = None, laws=None, walls=None,
+            gravity=None, ke_every: int | None = None):
+    """``steps`` velocity-Verlet steps of the packing state ``st`` (updated): (kinetic energy every ke_every
+    steps, number of pair contacts, flags [unused, non-finite])."""
+    from .collision3d import rules_array
+
+    sp, laws_n, laws_t, wall_n, wall_t = laws or resolve_laws(case)
+    if walls is None:
+        walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+    g = np.asarray(case.run.gravity if gravity is None else gravity, float)
+    lo, hi, periodic = box_of(case, st.x, st.rad)
+    ke, nc, flags, st.start, st.nbj, st.hist, st.dmax = run(
+        st.x, st.v, st.w, st.rad, st.mass, sp, laws_n, laws_t, wall_n, wall_t, walls, lo, hi, periodic, g, dt, steps,
+        ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax, st.w_hist, st.w_dmax, st.contacts,
+        rules_array(rules))
+    return ke, nc, flags
+
+
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 1e-14,
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
     """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
     energy falls below ``rest`` × N m g R (settled). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. inputs.mapping.RULES[engine] for an engine twin."""
     from ..errors import ConfigError
-    from .collision3d import rules_array
 
     sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
     dt = dt or packing_dt(case)
@@ -576,13 +629,8 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
     done = 0
     while done < total:
         n_steps = min(chunk, total - done)
-        lo, hi, periodic = box_of(case, st.x, st.rad)
-        ke, nc, flags = run(st.x, st.v, st.w, st.rad, st.mass, sp, laws_n, laws_t, wall_n, wall_t, walls, lo, hi,
-                            periodic, g, dt, n_steps, max(1, n_steps // 20), st.partner, st.hist, st.dmax,
-                            st.contacts, rules_array(rules))
-        if flags[0]:
-            raise ConfigError("packing", case.name, f"more than {MAXC} contacts on one particle: overlaps are too "
-                                                    "large for this time step or stiffness")
+        ke, nc, flags = advance(case, st, dt, n_steps, rules, laws=(sp, laws_n, laws_t, wall_n, wall_t),
+                                walls=walls, gravity=g)
         if flags[1]:
             raise ConfigError("run.dt", dt, "the packing became non-finite: the time step is too large")
         for k, e in enumerate(ke[1:], start=1):
