@@ -374,3 +374,28 @@ def test_contact_search_is_the_brute_force_one():
     got = PM.contacts(x, rad, box=box)
     assert len(expected) > 100
     np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
+def test_packing_decks_run_by_hand(engine, tmp_path):
+    """`demcheck deck` writes a packing's deck and its data file; a person runs it with the engine's own
+    command line and reads the settled column from its dumps: every contact carries the weight above it."""
+    import subprocess
+    import sys
+
+    from demcheck.engines import discovery, dumps
+    from demcheck.inputs.packing_decks import CONTACT_DUMP, FINAL_COLUMNS, FINAL_DUMP, read_contacts
+
+    from .conftest import CASES
+
+    p = subprocess.run([sys.executable, "-m", "demcheck", "deck", str(CASES / "packing" / "column-lsd.toml"),
+                        "--engine", engine, "-o", str(tmp_path / "in.column")], capture_output=True, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "data.lmp").exists()
+    subprocess.run([discovery.find(engine).executable, "-in", "in.column"], cwd=tmp_path, check=True,
+                   capture_output=True, timeout=300)
+    table = dumps.read_dump(tmp_path / FINAL_DUMP, columns=FINAL_COLUMNS)
+    c = read_contacts(engine, tmp_path / CONTACT_DUMP, table["radius"].to_numpy())
+    weight = C.load(CASES / "packing" / "column-lsd.toml").mass(0) * 9.81
+    np.testing.assert_allclose(c["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-6)

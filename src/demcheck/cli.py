@@ -205,13 +205,19 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
 @click.option("--dt", type=float, default=None, help="time step (s); default: the case's")
 @_set_option
 def deck(case_path, engine, output, dt, overrides):
-    """Write the engine's input deck of a collision case (runnable by hand: lmp -in / liggghts -in)."""
+    """Write the engine's input deck of a collision or packing case (runnable by hand: lmp -in / liggghts
+    -in; a packing's deck reads data.lmp, its initial state, written beside it)."""
     from .engines.collide import deck as make_deck
 
     case = _load(case_path, overrides)
     if dt is not None and not dt > 0:
         raise ConfigError("--dt", dt, "must be > 0 (s)")
-    dk = make_deck(case, engine, dt)
+    if case.kind == "packing":
+        from .inputs import packing_decks
+
+        dk = (packing_decks.lammps_deck if engine == "lammps" else packing_decks.liggghts_deck)(case, dt=dt)
+    else:
+        dk = make_deck(case, engine, dt)
     if output:
         for path in dk.write(output):
             click.echo(f"wrote {path}", err=True)
