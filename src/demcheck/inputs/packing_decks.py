@@ -53,7 +53,9 @@ def _head(case: Case, engine: str, note: str, n_species: int, dt: float, steps: 
     return lines
 
 
-def lammps_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+def _layout(case: Case, duration, dt):
+    """What both decks take from the case: species and their representatives, radii, the box (lo, hi,
+    periodic), dt and the number of steps."""
     if case.kind != "packing":
         raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
     species, rep = P.species_of(case)
@@ -62,7 +64,11 @@ def lammps_deck(case: Case, duration: float | None = None, dt: float | None = No
     lo, hi, periodic = P.box_of(case, x, rad)
     dt = dt or P.packing_dt(case)
     duration = duration or (case.raw.get("packing") or {}).get("duration")
-    steps = int(np.ceil(duration / dt))
+    return species, rep, rad, lo, hi, periodic, dt, int(np.ceil(duration / dt))
+
+
+def lammps_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+    species, rep, rad, lo, hi, periodic, dt, steps = _layout(case, duration, dt)
     g = np.asarray(case.run.gravity, float)
     gn = float(np.linalg.norm(g))
     lines = _head(case, "lammps", L.VERSION_NOTE, len(rep), dt, steps, periodic,
@@ -101,16 +107,8 @@ def lammps_deck(case: Case, duration: float | None = None, dt: float | None = No
 def liggghts_deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
     from . import liggghts as G
 
-    if case.kind != "packing":
-        raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
-    species, rep = P.species_of(case)
+    species, rep, rad, lo, hi, periodic, dt, steps = _layout(case, duration, dt)
     ns = len(rep)
-    x = np.array([p.position for p in case.particles], float)
-    rad = np.array([p.radius for p in case.particles], float)
-    lo, hi, periodic = P.box_of(case, x, rad)
-    dt = dt or P.packing_dt(case)
-    duration = duration or (case.raw.get("packing") or {}).get("duration")
-    steps = int(np.ceil(duration / dt))
     natives = {}
     for a in range(ns):
         for b in range(a, ns):

@@ -185,6 +185,35 @@ def _slot_direction(law, mode, slot):
     return 0
 
 
+@njit(cache=True, inline="always")
+def illinois_trial(lo, hi, glo, ghi):
+    """The regula falsi point of the bracket [lo, hi] (event values glo, ghi), or its midpoint where the
+    secant is undefined or leaves the bracket. Shared by the 1-D and the 3-D event location."""
+    theta = lo - glo * (hi - lo) / (ghi - glo) if (math.isfinite(glo) and math.isfinite(ghi)
+                                                    and ghi != glo) else 0.5 * (lo + hi)
+    if not (lo < theta < hi) or not math.isfinite(theta):
+        theta = 0.5 * (lo + hi)
+    return theta
+
+
+@njit(cache=True, inline="always")
+def illinois_update(lo, hi, glo, ghi, side, theta, g, crossed):
+    """Shrink the bracket to the side of θ that holds the root (``crossed``: between lo and θ), halving the
+    value kept on the other side when the same side moves twice (Illinois). Returns (lo, hi, glo, ghi,
+    side)."""
+    if crossed:
+        hi, ghi = theta, g
+        if side == -1:
+            glo *= 0.5
+        side = -1
+    else:
+        lo, glo = theta, g
+        if side == 1:
+            ghi *= 0.5
+        side = 1
+    return lo, hi, glo, ghi, side
+
+
 @njit(cache=True)
 def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta):
     """Root of event ``slot`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
@@ -194,22 +223,11 @@ def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
     for _ in range(200):
         if hi - lo <= tol_theta:
             break
-        theta = lo - glo * (hi - lo) / (ghi - glo) if (math.isfinite(glo) and math.isfinite(ghi)
-                                                        and ghi != glo) else 0.5 * (lo + hi)
-        if not (lo < theta < hi) or not math.isfinite(theta):
-            theta = 0.5 * (lo + hi)
+        theta = illinois_trial(lo, hi, glo, ghi)
         dt_, rt_, _, _ = _dp5(law, mode, d, r, theta * h, dmax, m, an)
         g = _event_value(law, mode, slot, dt_, rt_, dmax, m, an)
-        if _crossed(glo, g, direction) or g == 0.0:
-            hi, ghi = theta, g
-            if side == -1:
-                glo *= 0.5
-            side = -1
-        else:
-            lo, glo = theta, g
-            if side == 1:
-                ghi *= 0.5
-            side = 1
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, theta, g,
+                                                 _crossed(glo, g, direction) or g == 0.0)
     return hi
 
 

@@ -23,7 +23,7 @@ from numba import njit
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
                       L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
-                      normal_force, spow, viscoelastic_force)
+                      illinois_trial, illinois_update, normal_force, spow, viscoelastic_force)
 from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_KIND, T_KT,
                          T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
@@ -572,21 +572,11 @@ def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
     for _ in range(200):
         if hi - lo <= 1e-15:
             break
-        theta = lo - glo * (hi - lo) / (ghi - glo) if ghi != glo else 0.5 * (lo + hi)
-        if not (lo < theta < hi) or not math.isfinite(theta):
-            theta = 0.5 * (lo + hi)
+        theta = illinois_trial(lo, hi, glo, ghi)
         yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
         g = _event_value(yt, aux, nl, tl, geo, rules, slot)
-        if _crossed(glo, g, direction) or g == 0.0:
-            hi, ghi = theta, g
-            if side == -1:
-                glo *= 0.5
-            side = -1
-        else:
-            lo, glo = theta, g
-            if side == 1:
-                ghi *= 0.5
-            side = 1
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, theta, g,
+                                                 _crossed(glo, g, direction) or g == 0.0)
     return hi
 
 
@@ -637,6 +627,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     hstep = 1e-3 * ts
     status = ST_NO_SEPARATION
     force_ended = False
+    graze_t = -1.0  # the time of the last stick→slip graze
     for _ in range(10_000_000):
         if t >= t_max:
             break
@@ -746,10 +737,14 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             else:
                 y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
                 if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
-                    # slip only where sticking would push past the surface (λ > 0); else it is a graze
+                    # slip only where sticking would push past the surface (λ > 0); else it is a graze —
+                    # unless a graze was taken at this very instant already: then the first-order test
+                    # contradicts the step it predicts (near contact end |Fn| ∝ δ^{1/4} has an unbounded
+                    # rate), sticking would re-cross at θ = 0 for ever, and the contact slips
                     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-                    if lam < 0.0:
+                    if lam < 0.0 and t != graze_t:
                         aux[A_TMODE] = STICK
+                        graze_t = t
         elif best_slot == 6:
             code = EV_SLIP_STICK
             if kind != SLIDING:  # stick from exactly on the surface
