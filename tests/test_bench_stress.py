@@ -116,6 +116,24 @@ def test_recommended_time_step_meets_its_target():
     assert all(row["error"] > 1e-3 or row["status"] != "ok" for row in coarser[-1:])
 
 
+def test_oblique_time_steps_answer_for_the_friction_law_too():
+    """An oblique impact's error includes tangential restitution and rebound spin: for Walton's law at the
+    Coulomb limit (its verlet plateau is false: docs/models.md) the rebound spin sets the step for 1e-3, and
+    no step of the grid meets 1e-4 — where the normal metrics alone would have asked for 100 steps."""
+    from demcheck import case as C
+
+    case = C.load(CASES / "oblique-walton-spin-wall.toml")
+    rec = B.recommend(case, target=1e-3)
+    assert rec["metrics"][-2:] == ["tangential_restitution", "rebound_angular_velocity"]
+    assert rec["dt"] is not None and rec["limited_by"] in B.OBLIQUE_METRICS
+    tight = B.recommend(case, target=1e-4)
+    assert tight["dt"] is None and "rebound_angular_velocity" in tight["message"]
+    normal_only = [row for row in tight["table"] if row["status"] == "ok"]
+    assert normal_only  # the grid ran; the normal metrics alone meet 1e-4 at 100 steps per contact:
+    b = B.bench_case(case, engines=(), rtols=(), steps=(100,))
+    assert max(b.points[0].errors[k] for k in B.METRICS) < 1e-4 < b.points[0].error
+
+
 def test_cli_dt_and_bad_target():
     ok = subprocess.run([sys.executable, "-m", "demcheck", "dt", str(CASES / "kk-wall.toml"), "--json"],
                         capture_output=True, text=True, timeout=300)

@@ -542,7 +542,8 @@ def dt(case_path, target, overrides, as_json):
         sys.exit(1)
     click.echo(f"  recommended dt = {rec['dt']:.4g} s ({rec['steps_per_contact']:g} steps per contact, "
                f"{rec['dt_over_rayleigh']:.3g} t_Rayleigh): expected error {rec['expected_error']:.2g} "
-               f"(target {target:g}; measured order {rec['order']:.2f})")
+               f"in {rec['limited_by']} (target {target:g}; measured order {rec['order']:.2f}; errors of "
+               f"{', '.join(rec['metrics'])})")
 
 
 def _case_files(paths) -> list[Path]:

@@ -10,7 +10,11 @@ answer (rtol 1e-13), with the wall time that bought them:
 * engines timed two ways: one collision per process (start-up included), and per collision in a batch of
   independent copies run in one process (start-up paid once), so that start-up does not dominate.
 
-Errors are relative (|x − x_ref| / |x_ref|); a source's error is the worst of the four metrics.
+Errors are relative (|x − x_ref| / |x_ref|); a source's error is the worst of the four metrics — and, for an
+oblique impact with friction, also of tangential restitution and rebound spin, in the suite's units (1 for
+a restitution, v_in/R for a spin: a near-zero tangential restitution is not divided by itself). Without
+them an oblique case's time step would be chosen on its normal motion alone, blind to the friction law's
+own error (Walton's at the Coulomb limit: docs/models.md, "A false plateau").
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from ..reference.collision import characteristic_time, collide
 from ..reference.model import resolve
 
 METRICS = ("restitution", "contact_time", "max_overlap", "peak_force")
+OBLIQUE_METRICS = ("tangential_restitution", "rebound_angular_velocity")  # in the suite's units
 STEPS_PER_CONTACT = (5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
 ADAPTIVE_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 TARGETS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
@@ -56,11 +61,33 @@ class Point:
                 "errors": self.errors, "error": self.error, "status": self.status, "message": self.message}
 
 
-def _errors(m: dict, ref: dict) -> dict:
+def metrics_of(case: Case, model) -> tuple[str, ...]:
+    """The metrics a case's error is the worst of: the normal four, and the tangential two for an oblique
+    (3-D) impact with a friction law."""
+    from ..reference.collision import is_one_dimensional
+
+    if is_one_dimensional(case, model) or case.contact.tangential in (None, "none"):
+        return METRICS
+    return METRICS + OBLIQUE_METRICS
+
+
+def impact_scales(case: Case, model) -> dict:
+    """The units of the oblique metrics (as the suite's: the impact speed over the radius for a spin)."""
+    return {"spin": model.pair.impact_speed / case.particles[0].radius, "impact_energy": 1.0}
+
+
+def _errors(m: dict, ref: dict, metrics=METRICS, scales=None) -> dict:
+    from .verdicts import scale
+
     out = {}
-    for k in METRICS:
+    for k in metrics:
         a, b = m.get(k), ref.get(k)
-        out[k] = abs(a - b) / abs(b) if (a is not None and b and math.isfinite(a) and math.isfinite(b)) else math.nan
+        if not (a is not None and b is not None and math.isfinite(a) and math.isfinite(b)):
+            out[k] = math.nan
+        elif k in OBLIQUE_METRICS:
+            out[k] = abs(a - b) / scale(k, b, scales)
+        else:
+            out[k] = abs(a - b) / abs(b) if b else math.nan
     return out
 
 
@@ -118,7 +145,8 @@ class BenchResult:
                "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {}}
         for src in self.sources():
             pts = [p for p in self.points if p.source == src]
-            s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in METRICS},
+            names = list(pts[0].errors) if pts else list(METRICS)
+            s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in names},
                  "cheapest": {}}
             for tgt in TARGETS + ((1e-7, 1e-8) if src == "reference-adaptive" else ()):
                 if src == "reference-adaptive":
@@ -142,17 +170,18 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
+    metrics, scales = metrics_of(case, model), impact_scales(case, model)
     res = BenchResult(case.name, model.describe(), t_c, ref)
     tick = progress or (lambda: None)
     for rtol in rtols:
         wall, r = _timed(lambda: collide(case, "adaptive", rtol=rtol))
-        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, _errors(r.metrics(), ref),
+        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, _errors(r.metrics(), ref, metrics, scales),
                                 r.status, r.message))
         tick()
     for spc in steps:
         dt = t_c / spc
         wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
-        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, _errors(r.metrics(), ref),
+        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, _errors(r.metrics(), ref, metrics, scales),
                                 r.status, r.message))
         tick()
     for engine in engines:
@@ -169,13 +198,13 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
                 one = run_engine(case, engine, dt=dt, cache=None)
                 many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
             except DemcheckError as exc:
-                res.points.append(Point(engine, spc, dt, None, math.nan, math.nan, {k: math.nan for k in METRICS},
+                res.points.append(Point(engine, spc, dt, None, math.nan, math.nan, {k: math.nan for k in metrics},
                                         "failed", str(exc).splitlines()[0]))
                 tick()
                 continue
             status, why = _stable_engine(one, t_c, case)
             res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
-                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref), status, why))
+                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref, metrics, scales), status, why))
             tick()
     return res
 
@@ -210,7 +239,8 @@ def hertz_time(case: Case) -> float:
 
 def recommend(case: Case, target: float = 1e-3) -> dict:
     """A time step for the case's model meeting ``target`` (worst relative error of restitution, contact
-    time, maximum overlap and peak force), from the measured work-precision data of the reference's verlet
+    time, maximum overlap and peak force; for an oblique impact with friction also of tangential restitution
+    and rebound spin in the suite's units), from the measured work-precision data of the reference's verlet
     method (the engines' scheme, which exact engine mappings reproduce to round-off)."""
     b = bench_case(case, engines=(), rtols=(), steps=(10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000))
     pts = [p for p in b.points if p.source == "reference-verlet"]
@@ -218,13 +248,21 @@ def recommend(case: Case, target: float = 1e-3) -> dict:
     t_r, t_h = rayleigh_time(case), hertz_time(case)
     out = {"case": case.name, "model": b.model, "target": target, "t_contact": b.t_contact,
            "rayleigh_time": t_r, "hertz_time": t_h, "order": fit_order(pts),
+           "metrics": list(pts[0].errors) if pts else list(METRICS),
            "rules_of_thumb": {"0.2 t_Rayleigh": 0.2 * t_r, "t_Hertz / 50": t_h / 50},
            "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
                       "status": p.status} for p in pts]}
     if c is None:
-        out.update(dt=None, message=f"no time step of the grid (down to t_c/10000) meets {target:g}")
+        finest = min((p for p in pts if p.status == "ok"), key=lambda p: p.dt, default=None)
+        why = ""
+        if finest is not None:
+            worst = sorted(((v, k) for k, v in finest.errors.items() if math.isfinite(v)), reverse=True)
+            why = ": at t_c/{:g} the error is still {}".format(
+                finest.steps_per_contact, ", ".join(f"{v:.2g} in {k}" for v, k in worst if v > target) or "—")
+        out.update(dt=None, message=f"no time step of the grid (down to t_c/10000) meets {target:g}{why}")
     else:
         out.update(dt=c.dt, steps_per_contact=c.steps_per_contact, expected_error=c.error,
+                   limited_by=max(c.errors, key=lambda k: c.errors[k]),
                    dt_over_rayleigh=c.dt / t_r, dt_over_hertz=c.dt / t_h)
     return out
 

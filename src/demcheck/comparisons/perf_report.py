@@ -41,8 +41,9 @@ def _publish(out_dir: Path, root: Path, data: dict, md: str, page: str) -> None:
 def bench_markdown(data: dict) -> str:
     lines = [f"# demcheck bench {data['run_id']}", "", f"Engines: {data['engines']}", "",
              "## Work–precision", "",
-             "Error: the worst relative error of restitution, contact time, maximum overlap and peak force against "
-             "the converged adaptive answer (rtol 1e-13). Time: wall seconds per collision — engines per process "
+             "Error: the worst relative error of restitution, contact time, maximum overlap and peak force (and, "
+             "for an oblique impact with friction, of tangential restitution and rebound spin in the suite's units) "
+             "against the converged adaptive answer (rtol 1e-13). Time: wall seconds per collision — engines per process "
              f"(start-up included) and per collision in a batch of {data['batch']} independent copies in one process.",
              ""]
     for b in data["cases"]:
