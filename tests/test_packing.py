@@ -399,3 +399,20 @@ def test_packing_decks_run_by_hand(engine, tmp_path):
     c = read_contacts(engine, tmp_path / CONTACT_DUMP, table["radius"].to_numpy())
     weight = C.load(CASES / "packing" / "column-lsd.toml").mass(0) * 9.81
     np.testing.assert_allclose(c["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-6)
+
+
+def test_a_poured_packing_that_has_not_settled_is_flagged():
+    """verify checks that a poured packing has come to rest (kinetic energy below 1e-4 of N m g d) before
+    its bulk values count; 0.02 s is mid-fall."""
+    from types import SimpleNamespace
+
+    from demcheck.comparisons import verdicts as V
+    from demcheck.comparisons.packing_suite import SETTLED, run_packing
+
+    from .conftest import CASES
+
+    case = C.load(CASES / "optin" / "poured-small.toml", ["packing.duration=0.02"])
+    entry = run_packing(case, SimpleNamespace(engines=[], cache=None, timeout=60.0), {})
+    settled = next(c for c in entry["comparisons"] if c["metric"].startswith("settled"))
+    assert settled["value"] > 100 * SETTLED and settled["verdict"] == V.UNEXPECTED
+    assert "lengthen the duration" in settled["reason"] and entry["status"] == "unexpected"
