@@ -63,6 +63,10 @@ def test_engine_contact_dumps_parse(engine):
     np.testing.assert_allclose(c["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-6)
     np.testing.assert_allclose(c["overlap"], c["fn"] / 2000.0, rtol=1e-6)
     assert np.all(c["ft"] == 0.0)
+    # with the positions (a vertical column), Fn is signed: repulsive > 0 in both engines' readings
+    column = np.array([[0.0, 0.0, (2 * k + 1) * 1e-3] for k in range(5)])
+    signed = read_contacts(engine, DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3), column)
+    np.testing.assert_allclose(signed["fn"], c["fn"], rtol=1e-15)
 
 
 @pytest.mark.parametrize("name,message", [

@@ -21,6 +21,7 @@ FINAL_DUMP = "final.txt"
 CONTACT_DUMP = "contacts.txt"
 # the contact table every source yields: particle indices (0-based), overlap, normal force, |tangential force|
 CONTACT_COLUMNS = ("i", "j", "overlap", "fn", "ft")
+CONTACT_READER = 2  # in the engine-run cache key: cached contact tables are parsed ones (2: LIGGGHTS Fn signed)
 FINAL_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
                  "fx", "fy", "fz")
 
@@ -178,10 +179,13 @@ class PackingRun:
     version: str
 
 
-def read_contacts(engine: str, path, radius: np.ndarray) -> pd.DataFrame:
+def read_contacts(engine: str, path, radius: np.ndarray, x: np.ndarray | None = None, box=None) -> pd.DataFrame:
     """The engine's per-contact dump as CONTACT_COLUMNS: touching pairs only (overlap > 0), each once
     (with newton off a pair across a periodic or processor boundary may be listed from both sides).
-    ``radius``: per particle, indexed by id − 1 (LAMMPS lists centre distances, not overlaps)."""
+    ``radius`` (and ``x``): per particle, indexed by id − 1 (LAMMPS lists centre distances, not overlaps).
+    Fn is signed, repulsive > 0: LAMMPS's as it writes it; LIGGGHTS's normal force vector projected on the
+    contact normal from the positions ``x`` (minimum image in the periodic ``box`` [lx, ly]), its magnitude
+    when no positions are given."""
     from ..engines import dumps
 
     raw = dumps.read_dump(path)
@@ -193,6 +197,12 @@ def read_contacts(engine: str, path, radius: np.ndarray) -> pd.DataFrame:
     else:  # id1 id2 periodic-flag, force (3), its normal part (3), delta
         overlap = v[:, 9]
         fn = np.linalg.norm(v[:, 6:9], axis=1)
+        if x is not None and len(v):
+            d = x[j] - x[i]
+            for k in range(2 if box is not None else 0):
+                d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+            # the force on i pushes it away from j when repulsive: −F_n·n̂(i→j) > 0
+            fn = -np.einsum("ij,ij->i", v[:, 6:9], d) / np.linalg.norm(d, axis=1)
         ft = np.linalg.norm(v[:, 3:6] - v[:, 6:9], axis=1)
     out = pd.DataFrame({"i": np.minimum(i, j), "j": np.maximum(i, j), "overlap": overlap, "fn": fn, "ft": ft})
     out = out[out["overlap"] > 0].drop_duplicates(subset=["i", "j"]).sort_values(["i", "j"])
@@ -211,7 +221,8 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     dk = (lammps_deck if engine == "lammps" else liggghts_deck)(case, duration, dt)
     k = None
     if cache is not None and discovery.find(engine) is not None:
-        k = cache_key(engine, discovery.find(engine).version, dk.text + f"\n# mpi {mpi}", dk.files)
+        k = cache_key(engine, discovery.find(engine).version,
+                      dk.text + f"\n# mpi {mpi}\n# contact reader {CONTACT_READER}", dk.files)
         hit, hit_contacts = cache.get(k), cache.get(k + "-contacts")
         if hit is not None and hit_contacts is not None:
             table, meta = hit
@@ -224,7 +235,10 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     table = table.sort_values("id").reset_index(drop=True)
     radius = np.zeros(int(table["id"].max()))
     radius[table["id"].to_numpy() - 1] = table["radius"].to_numpy()
-    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, radius)
+    pos = np.zeros((len(radius), 3))
+    pos[table["id"].to_numpy() - 1] = table[["x", "y", "z"]].to_numpy()
+    box = (case.raw.get("packing") or {}).get("box")
+    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, radius, pos, box)
     if k is not None:
         cache.put(k + "-contacts", contacts, {})  # first: the table's entry is what marks the run cached
         cache.put(k, table, {"version": out.version, "ke": ke})
