@@ -177,6 +177,18 @@ def test_cli_pack_reference(tmp_path):
     out = json.loads(p.stdout)
     assert out["particles"] == 5 and out["contacts"] == 4
     assert out["metrics"]["coordination_number"] == 2.0
+    csv = subprocess.run([sys.executable, "-m", "demcheck", "pack", str(CASES / "packing" / "column-lsd.toml"),
+                          "--csv", str(tmp_path / "state")], capture_output=True, text=True, timeout=300)
+    assert csv.returncode == 0, csv.stderr
+    import pandas as pd
+
+    parts, contacts = pd.read_csv(tmp_path / "state" / "particles.csv"), pd.read_csv(tmp_path / "state" / "contacts.csv")
+    assert list(parts.columns) == ["id", "x", "y", "z", "radius"] and len(parts) == 5
+    assert list(contacts.columns) == ["i", "j", "overlap", "fn", "ft"]
+    assert [tuple(r) for r in contacts[["i", "j"]].to_numpy()] == [(0, 1), (1, 2), (2, 3), (3, 4)]
+    # settled to the pack command's rest criterion: each contact near the weight above it
+    weight = C.load(CASES / "packing" / "column-lsd.toml").mass(0) * 9.81
+    np.testing.assert_allclose(contacts["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-4)
     bad = subprocess.run([sys.executable, "-m", "demcheck", "pack", str(CASES / "glass-pair.toml")],
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and "kind = 'collision': demcheck pack runs packing cases" in bad.stderr

@@ -360,9 +360,12 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
 @click.option("--duration", type=float, default=None, help="simulated time (s); default: the case's packing.duration")
 @click.option("--mpi", "mpi", type=int, default=1, show_default=True,
               help="run the engine on this many MPI ranks (its own domain decomposition)")
+@click.option("--csv", "csv_dir", type=click.Path(file_okay=False), default=None,
+              help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "
+                   "(i, j, overlap, fn, ft of every particle pair in contact)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def pack(case_path, engine, duration, mpi, overrides, as_json):
+def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics."""
     from .comparisons import packing_metrics as PM
@@ -378,6 +381,8 @@ def pack(case_path, engine, duration, mpi, overrides, as_json):
     if mpi > 1 and engine == "reference":
         raise ConfigError("--mpi", mpi, "applies to an engine (--engine lammps|liggghts); the reference runs on one core")
     box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
+    import pandas as pd
+
     if engine == "reference":
         st = P.simulate(case, duration=duration)
         nc = min(st.n_contacts, len(st.contacts))
@@ -385,6 +390,8 @@ def pack(case_path, engine, duration, mpi, overrides, as_json):
                        ke=[e for _, e in st.ke])
         out = {"case": case.name, "source": "reference", "particles": len(case.particles), "time": st.time,
                "dt": P.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
+        x, rad = st.x, st.rad
+        contacts = pd.DataFrame(st.contacts[:nc], columns=["i", "j", "overlap", "fn", "ft"]).astype({"i": int, "j": int})
     else:
         from .inputs.packing_decks import run_engine
 
@@ -394,6 +401,14 @@ def pack(case_path, engine, duration, mpi, overrides, as_json):
                        ke=[e for _, e in run.ke])
         out = {"case": case.name, "source": engine, "engine_version": run.version, "particles": len(run.table),
                "dt": P.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
+        x, rad, contacts = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), run.contacts
+    if csv_dir:
+        from .io import write_text
+
+        parts = pd.DataFrame({"id": range(len(x)), "x": x[:, 0], "y": x[:, 1], "z": x[:, 2], "radius": rad})
+        for name, table in (("particles.csv", parts), ("contacts.csv", contacts)):
+            write_text(Path(csv_dir) / name, table.to_csv(index=False, float_format="%.17g"))
+            click.echo(f"wrote {Path(csv_dir) / name}", err=True)
     if as_json:
         emit_json(out)
         return
