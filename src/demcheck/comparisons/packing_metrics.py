@@ -8,7 +8,9 @@ produced them, so the reference and the engines' dumps are measured the same way
 * bed_height: in a periodic box, the mean free-surface height — the highest particle top in each column of
   a grid of cells about one mean diameter wide, averaged over the columns (a sphere perched on top moves it
   by one column's share, not by a diameter); without a box, the highest particle top;
-* kinetic_energy: the last value of the series.
+* kinetic_energy: the last value of the series — translational, in every source (the engines' thermo `ke`;
+  without rolling or twisting resistance a sphere rolling or spinning about its contact normal keeps its
+  rotational energy indefinitely, so rotation says nothing about whether a packing has settled).
 """
 
 from __future__ import annotations

@@ -17,9 +17,9 @@ TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 
 # distance, held to its critical value at this significance for the two sample sizes
 KS_ALPHA = 1e-3
 RANGES = {"solid_fraction": (0.55, 0.64), "coordination_number": (4.0, 6.0)}
-# a poured packing is settled when its kinetic energy is below this fraction of N m g d (the energy of lifting
-# every sphere by one diameter): a mean speed of about 1.4 % of √(g d); the bulk values of a packing still
-# moving are not compared as settled ones
+# a poured packing is settled when its translational kinetic energy is below this fraction of N m g d (the
+# energy of lifting every sphere by one diameter): a mean speed of about 1.4 % of √(g d); the bulk values of
+# a packing still moving are not compared as settled ones
 SETTLED = 1e-4
 CLOSED_FORM_RTOL = 1e-6
 

@@ -402,8 +402,10 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
 def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
         dt, steps, ke_every, start, nbj, hist, dmax, w_hist, w_dmax, contacts, rules):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w, the wall contact states modified in
-    place; the pair contact states travel with the Verlet list, rebuilt here). Returns (kinetic energy every
-    ke_every steps, number of pair contacts at the end, flags: [unused, non-finite], and the Verlet list with
+    place; the pair contact states travel with the Verlet list, rebuilt here). Returns (translational kinetic
+    energy every ke_every steps — what the engines' thermo `ke` reports; rotation is left out because these
+    contact laws have no rolling or twisting resistance, so a sphere rolling or spinning about its contact
+    normal keeps its rotational energy in every source — number of pair contacts at the end, flags: [unused, non-finite], and the Verlet list with
     its pair states: start, nbj, hist, dmax)."""
     n_p = x.shape[0]
     inertia = 0.4 * mass * rad * rad
@@ -443,16 +445,17 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
             x_ref[:, :] = x
         _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
                 hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, True, rules)
-        e = 0.0
+        e = 0.0  # translational, as the engines' thermo `ke`
+        e_rot = 0.0
         for i in range(n_p):
             for k in range(3):
                 v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
                 w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
-            e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2) \
-                + 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
+            e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+            e_rot += 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
         if step % ke_every == 0:
             ke[step // ke_every] = e
-        if not math.isfinite(e):
+        if not math.isfinite(e + e_rot):
             flags[1] = 1
             break
     return ke, nc_out[0], flags, start, nbj, hist, dmax
