@@ -428,3 +428,16 @@ def test_a_poured_packing_that_has_not_settled_is_flagged():
     settled = next(c for c in entry["comparisons"] if c["metric"].startswith("settled"))
     assert settled["value"] > 100 * SETTLED and settled["verdict"] == V.UNEXPECTED
     assert "lengthen the duration" in settled["reason"] and entry["status"] == "unexpected"
+
+
+def test_packing_kinetic_energy_is_translational_as_the_engines_report_it():
+    """The reference's kinetic energy series is translational, as LAMMPS's and LIGGGHTS's thermo `ke`: a
+    sphere spinning in place (about the vertical; nothing damps that in these laws) adds nothing to it."""
+    case = C.loads(COLUMN.replace("count = 5", "count = 1"))
+    st = P.PackState(case)
+    st.w[0] = [0.0, 0.0, 30.0]
+    ke, _, _ = P.advance(case, st, 1e-6, 100, gravity=np.zeros(3), ke_every=10)
+    assert np.all(ke == 0.0) and st.w[0, 2] == 30.0
+    st.v[0] = [0.01, 0.0, 0.0]
+    ke, _, _ = P.advance(case, st, 1e-6, 100, gravity=np.zeros(3), ke_every=10)
+    assert ke[-1] == pytest.approx(0.5 * case.mass(0) * 0.01**2, rel=1e-12)
