@@ -156,23 +156,32 @@ def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax):
     return new_start, new_j, new_hist, new_dmax
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, ft, rot):
     """Normal force (+ repulsive) of one contact, and its tangential force into ``ft``, updating its history
-    in place (the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment, truncate); ``update``
-    False at setup, where the engines compute forces without touching histories. Returns (Fn, δ_max).
-    The history is row ``row`` of ``hist2``, indexed in place on the spring path (no array view per contact
-    in the hottest loop)."""
+    (row ``row`` of ``hist2``) in place by the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment,
+    truncate; ``update`` False at setup, where the engines compute forces without touching histories.
+    Returns (Fn, δ_max). Inlined into the force loop with the spring family's scalar law (every deck's law):
+    a call per contact, with its dozen array arguments, cost the loop 40 % (0.80 against 0.48 ms per step on
+    the 2000-sphere packing; docs/packing.md). The laws that build arrays (kernels3d's functions) stay in
+    :func:`_other_tangential`, called."""
     dmax = max(dmax_in, delta)
     fn = normal_force(nl, delta, rate, dmax)
-    fabs = abs(fn)
     kind = tl[T_KIND]
     ft[0] = ft[1] = ft[2] = 0.0
     if kind == NONE:
         return fn, dmax
     if kind == SPRING and update:
-        return _spring(nl, tl, delta, n, vt, hist2, row, fabs, dt, ft, fn, dmax, rot)
-    hist = hist2[row]
+        return _spring(nl, tl, delta, n, vt, hist2, row, abs(fn), dt, ft, fn, dmax, rot)
+    _other_tangential(nl, tl, delta, n, vt, hist2[row], abs(fn), dt, update, ft, rot)
+    return fn, dmax
+
+
+@njit(cache=True)
+def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
+    """The tangential force of every law but the updated spring family, into ``ft`` (history ``hist``, one
+    contact's row, updated in place)."""
+    kind = tl[T_KIND]
     if (kind == LTH or kind == ZZY or kind == WALTON) and update:
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
         # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
@@ -208,7 +217,7 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, 
             hist[0], hist[1], hist[2] = mapped[0], mapped[1], mapped[2]
         out = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, ZERO3)
         ft[0], ft[1], ft[2] = out[0], out[1], out[2]
-        return fn, dmax
+        return
     out = tangential_force(tl, nl, hist, vt, fabs, delta, False, ZERO3)
     if kind == SPRING:  # setup: the trial force within the static limit, history untouched
         tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
@@ -216,13 +225,12 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, 
         if tn > cap and tn > 0.0:
             out = out * (cap / tn)
     ft[0], ft[1], ft[2] = out[0], out[1], out[2]
-    return fn, dmax
 
 
 ZERO3 = np.zeros(3)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
     """The spring family (kernels3d's SPRING: slip_surface, return_map, tangential_force) with scalars only,
     for the packing solver's inner loop: rotate and rescale the history, increment it, test the slip
@@ -322,14 +330,7 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 if si != law_i or sj != law_j:  # a new species pair: its law views (once, not per contact)
                     nl, tl = laws_n[si, sj], laws_t[si, sj]
                     law_i, law_j = si, sj
-                # the spring family straight to its scalar law: calling _contact_force (whose other branches build
-                # arrays) costs a third of the loop (measured)
-                if update and tl[T_KIND] == SPRING:
-                    dm = max(dmax[q], delta)
-                    fn = normal_force(nl, delta, rate, dm)
-                    _spring(nl, tl, delta, nbuf, vtbuf, hist, q, abs(fn), dt, ft, fn, dm, rot)
-                else:
-                    fn, dm = _contact_force(nl, tl, delta, rate, nbuf, vtbuf, hist, q, dmax[q], dt, update, ft, rot)
+                fn, dm = _contact_force(nl, tl, delta, rate, nbuf, vtbuf, hist, q, dmax[q], dt, update, ft, rot)
                 dmax[q] = dm
                 f0, f1, f2 = -fn * n0 + ft[0], -fn * n1 + ft[1], -fn * n2 + ft[2]
                 f[i, 0] += f0
@@ -377,13 +378,8 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 if species[i] != wall_i:
                     wnl, wtl = wall_n[species[i]], wall_t[species[i]]
                     wall_i = species[i]
-                if update and wtl[T_KIND] == SPRING:
-                    dm = max(w_dmax[row], delta)
-                    fn = normal_force(wnl, delta, rate, dm)
-                    _spring(wnl, wtl, delta, nbuf, vtbuf, w_hist, row, abs(fn), dt, ft, fn, dm, rot)
-                else:
-                    fn, dm = _contact_force(wnl, wtl, delta, rate, nbuf, vtbuf, w_hist, row, w_dmax[row], dt, update,
-                                            ft, rot)
+                fn, dm = _contact_force(wnl, wtl, delta, rate, nbuf, vtbuf, w_hist, row, w_dmax[row], dt, update, ft,
+                                        rot)
                 w_dmax[row] = dm
                 f[i, 0] += -fn * n0 + ft[0]
                 f[i, 1] += -fn * n1 + ft[1]
