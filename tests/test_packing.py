@@ -441,3 +441,32 @@ def test_packing_kinetic_energy_is_translational_as_the_engines_report_it():
     st.v[0] = [0.01, 0.0, 0.0]
     ke, _, _ = P.advance(case, st, 1e-6, 100, gravity=np.zeros(3), ke_every=10)
     assert ke[-1] == pytest.approx(0.5 * case.mass(0) * 0.01**2, rel=1e-12)
+
+
+@pytest.mark.parametrize("truncation", ["force", "overlap"])
+def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncation):
+    """TTIt under sustained slip: with the seed's min() cap (truncation "force", the default) the force sits
+    at μ|Fn| while the spring keeps every increment — its extension grows as v t without bound (in the
+    Hertz packing it reached 68 μm, 70 overlaps, and kept the bed rattling: docs/packing.md); Maw's limited
+    overlap (LAMMPS) holds it at the cap's extension."""
+    from demcheck.reference.kernels3d import ROT_RESCALE, kt_of
+    from demcheck.reference.model import resolve
+
+    from .helpers import oblique_case
+
+    model = resolve(oblique_case("tti", {"truncation": truncation}, normal="tti", normal_params={}, wall=True,
+                                 angle=30.0, spin=0.0))
+    nl, tl = model.normal_law.array(), model.tangential_law.array()
+    delta, v, dt, steps = 1e-6, 0.01, 1e-7, 1000
+    n, vt = np.array([0.0, 0.0, 1.0]), np.array([v, 0.0, 0.0])
+    hist, ft = np.zeros((1, 3)), np.zeros(3)
+    fn = P.normal_force(nl, delta, 0.0, delta)
+    for _ in range(steps):
+        P._spring(nl, tl, delta, n, vt, hist, 0, fn, dt, ft, fn, delta, ROT_RESCALE)
+    cap = tl[P.T_MU_K] * fn
+    assert np.linalg.norm(ft) == pytest.approx(cap, rel=1e-12)  # sliding at the Coulomb limit in both
+    if truncation == "force":
+        assert hist[0, 0] == pytest.approx(steps * v * dt, rel=1e-12)  # every increment kept
+    else:
+        eta = P.eta_of(tl, nl, delta)
+        assert hist[0, 0] == pytest.approx((cap - eta * v) / kt_of(tl, delta), rel=1e-9)  # Maw's limit
