@@ -447,7 +447,7 @@ def test_packing_kinetic_energy_is_translational_as_the_engines_report_it():
 def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncation):
     """TTIt under sustained slip: with the seed's min() cap (truncation "force", the default) the force sits
     at μ|Fn| while the spring keeps every increment — its extension grows as v t without bound (in the
-    Hertz packing it reached 68 μm, 70 overlaps, and kept the bed rattling: docs/packing.md); Maw's limited
+    Hertz packing it reached 68 μm, 38 largest overlaps, and kept the bed rattling: docs/packing.md); Maw's limited
     overlap (LAMMPS) holds it at the cap's extension."""
     from demcheck.reference.kernels3d import ROT_RESCALE, kt_of
     from demcheck.reference.model import resolve
