@@ -19,8 +19,8 @@ def _numba_cache_dir() -> None:
     """Numba's on-disk cache keys a compiled function by its own file's timestamp only: a kernel that
     inlines a function of another module would be served stale after that module changed (seen here: the
     suite passed on stale 3-D kernels while fresh ones stalled; docs/performance.md). So the kernels cache
-    under a directory named
-    by the fingerprint of the whole reference package: any change to any kernel source starts afresh.
+    under a directory named by the fingerprint of the whole reference package: any change to any kernel
+    source starts afresh.
     Respects a NUMBA_CACHE_DIR set by the user; skipped where the directory cannot be made."""
     if "NUMBA_CACHE_DIR" in _os.environ:
         return

@@ -383,6 +383,8 @@ def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
     box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
     import pandas as pd
 
+    from .inputs.packing_decks import CONTACT_COLUMNS
+
     if engine == "reference":
         st = P.simulate(case, duration=duration)
         nc = min(st.n_contacts, len(st.contacts))
@@ -391,7 +393,7 @@ def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
         out = {"case": case.name, "source": "reference", "particles": len(case.particles), "time": st.time,
                "dt": P.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
         x, rad = st.x, st.rad
-        contacts = pd.DataFrame(st.contacts[:nc], columns=["i", "j", "overlap", "fn", "ft"]).astype({"i": int, "j": int})
+        contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
     else:
         from .inputs.packing_decks import run_engine
 

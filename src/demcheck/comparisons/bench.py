@@ -71,11 +71,6 @@ def metrics_of(case: Case, model) -> tuple[str, ...]:
     return METRICS + OBLIQUE_METRICS
 
 
-def impact_scales(case: Case, model) -> dict:
-    """The units of the oblique metrics (as the suite's: the impact speed over the radius for a spin)."""
-    return {"spin": model.pair.impact_speed / case.particles[0].radius, "impact_energy": 1.0}
-
-
 def _errors(m: dict, ref: dict, metrics=METRICS, scales=None) -> dict:
     from .verdicts import scale
 
@@ -170,19 +165,21 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
+    from .suite import impact_scales
+
     metrics, scales = metrics_of(case, model), impact_scales(case, model)
     res = BenchResult(case.name, model.describe(), t_c, ref)
     tick = progress or (lambda: None)
     for rtol in rtols:
         wall, r = _timed(lambda: collide(case, "adaptive", rtol=rtol))
-        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, _errors(r.metrics(), ref, metrics, scales),
-                                r.status, r.message))
+        errors = _errors(r.metrics(), ref, metrics, scales)
+        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, errors, r.status, r.message))
         tick()
     for spc in steps:
         dt = t_c / spc
         wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
-        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, _errors(r.metrics(), ref, metrics, scales),
-                                r.status, r.message))
+        errors = _errors(r.metrics(), ref, metrics, scales)
+        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, errors, r.status, r.message))
         tick()
     for engine in engines:
         mp = common.contact_mapping(case, engine)
@@ -204,7 +201,8 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
                 continue
             status, why = _stable_engine(one, t_c, case)
             res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
-                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref, metrics, scales), status, why))
+                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref, metrics, scales),
+                                    status, why))
             tick()
     return res
 

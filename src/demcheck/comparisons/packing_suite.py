@@ -81,6 +81,7 @@ def reference_packing(case, cache=None):
     import pandas as pd
 
     from ..engines.cache import key as cache_key
+    from ..inputs.packing_decks import CONTACT_COLUMNS
     from ..reference import packing as P
 
     k = None
@@ -98,7 +99,7 @@ def reference_packing(case, cache=None):
     nc = min(st.n_contacts, len(st.contacts))
     contacts = st.contacts[:nc].copy()
     if k is not None:
-        cache.put(k + "-contacts", pd.DataFrame(contacts, columns=["i", "j", "overlap", "fn", "ft"]), {})
+        cache.put(k + "-contacts", pd.DataFrame(contacts, columns=list(CONTACT_COLUMNS)), {})
         table = pd.DataFrame({"x": st.x[:, 0], "y": st.x[:, 1], "z": st.x[:, 2], "radius": st.rad})
         cache.put(k, table, {"ke": st.ke, "time": st.time, "seconds": seconds})
     return st.x.copy(), st.rad.copy(), contacts, list(st.ke), st.time, seconds

@@ -104,13 +104,12 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     model = resolve(case)
     entry["model"] = model.describe()
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
-    p0 = case.particles[0]
     v_in = model.pair.impact_speed
     entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution, **_incidence(case)}
     adaptive = collide(case, "adaptive")
     # energy in units of the bodies' kinetic energy at impact (translation, spin, and the tangential motion
     # a grazing impact carries: the normal part alone vanishes at 90°)
-    scales = {"impact_energy": _impact_energy(case, model), "spin": v_in / p0.radius}
+    scales = impact_scales(case, model)
     entry["scales"] = scales
     comps: list[V.Comparison] = []
 
@@ -164,6 +163,12 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
     entry["verdict"] = worst
     return entry
+
+
+def impact_scales(case: Case, model) -> dict:
+    """The units the oblique metrics are measured in (verdicts.scale): the impact energy, and v_in/R for a
+    spin. Shared with bench and dt, so that their errors and the suite's verdicts speak the same units."""
+    return {"impact_energy": _impact_energy(case, model), "spin": model.pair.impact_speed / case.particles[0].radius}
 
 
 def _impact_energy(case: Case, model) -> float:

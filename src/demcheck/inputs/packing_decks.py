@@ -233,13 +233,10 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     table = table[table["step"] == table["step"].max()]
     ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
     table = table.sort_values("id").reset_index(drop=True)
-    radius = np.zeros(int(table["id"].max()))
-    radius[table["id"].to_numpy() - 1] = table["radius"].to_numpy()
-    pos = np.zeros((len(radius), 3))
-    pos[table["id"].to_numpy() - 1] = table[["x", "y", "z"]].to_numpy()
-    box = (case.raw.get("packing") or {}).get("box")
-    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, radius, pos, box)
+    # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
+    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
+                             table[["x", "y", "z"]].to_numpy(), (case.raw.get("packing") or {}).get("box"))
     if k is not None:
-        cache.put(k + "-contacts", contacts, {})  # first: the table's entry is what marks the run cached
+        cache.put(k + "-contacts", contacts, {})
         cache.put(k, table, {"version": out.version, "ke": ke})
     return PackingRun(table, contacts, ke, out.version)

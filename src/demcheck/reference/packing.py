@@ -27,10 +27,9 @@ from .kernels import normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_LAMMPS,
                         ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force,
                         walton_stiffness)
-from .tangential import (LTH, NONE, SLIDING, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC,
-                         TRUNC_MAW, TRUNC_SPRING, VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
+from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
+                         TRUNC_SPRING, WALTON, ZZY)
 
-SUPPORTED_TANGENTIAL = (NONE, SLIDING, SPRING, VISCOUS, VISCOUS_SLIDING, LTH, ZZY, WALTON)
 # per contact slot: the tangential history (3); Walton's also the load at the last reversal (3) and the last
 # nonzero v_t·L (1), so its slots are wider (only when a Walton law is in the packing: memory and bandwidth)
 HIST_WIDTH, WALTON_HIST_WIDTH = 3, 7
@@ -399,10 +398,10 @@ def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_
         dt, steps, ke_every, start, nbj, hist, dmax, w_hist, w_dmax, contacts, rules):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w, the wall contact states modified in
     place; the pair contact states travel with the Verlet list, rebuilt here). Returns (translational kinetic
-    energy every ke_every steps — what the engines' thermo `ke` reports; rotation is left out because these
-    contact laws have no rolling or twisting resistance, so a sphere rolling or spinning about its contact
-    normal keeps its rotational energy in every source — number of pair contacts at the end, flags: [unused, non-finite], and the Verlet list with
-    its pair states: start, nbj, hist, dmax)."""
+    energy every ke_every steps, number of pair contacts at the end, flags [unused, non-finite], and the
+    Verlet list with its pair states: start, nbj, hist, dmax). The kinetic energy is translational, as the
+    engines' thermo `ke`: these laws have no rolling or twisting resistance, so a sphere rolling or spinning
+    about its contact normal keeps its rotational energy in every source."""
     n_p = x.shape[0]
     inertia = 0.4 * mass * rad * rad
     f = np.zeros((n_p, 3))
@@ -506,7 +505,7 @@ def resolve_laws(case):
         nl, _ = normal.resolve(pair, params, case.contact.limit_force)
         tl, _ = tangential.resolve(pair, params, nl)
         arr = tl.array()
-        if tl.kind not in SUPPORTED_TANGENTIAL or arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:
+        if arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:  # every tangential kind runs, these two variants not
             raise ConfigError("contact.tangential", tangential.id,
                               "is not supported by the packing solver (a force history or a contact-radius "
                               "rescale: LAMMPS's mindlin/force and mindlin_rescale twins)")
