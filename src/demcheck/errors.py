@@ -33,6 +33,12 @@ class EngineFailed(DemcheckError):
     exit_code = 1
 
 
+class EngineInterrupted(EngineFailed):
+    """An engine run stopped by an interrupt (SIGINT/SIGTERM of demcheck), not by a fault of its own."""
+
+    exit_code = 130
+
+
 class ParseError(DemcheckError):
     exit_code = 1
 
