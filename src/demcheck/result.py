@@ -7,6 +7,21 @@ Tidy pandas tables in SI units plus metadata:
   fn (normal force on the pair, + repulsive); 3-D runs add tangential columns.
 * ``particles``: t, id, x, y, z, vx, vy, vz, wx, wy, wz (and fx.. when the source has them).
 * ``events``: exact event points of the adaptive method (t, event, delta, delta_dot, fn), else empty.
+
+``status`` (with the reason in ``message``; only "ok" is trusted):
+
+* ``ok``;
+* ``failed``: NaN or infinite values in the state or in an engine's output (never cached);
+* ``unresolved``: the time step does not resolve the contact (too few steps inside it); the message names
+  dt and the steps per elastic contact time;
+* ``unstable``: a time-stepped run created energy (the scheme is unstable at its step);
+* ``out-of-range``: the overlap passed half the smaller radius, in any method: the contact law left its
+  range of small overlaps (too fast an impact, too soft a material);
+* ``no-contact``: the bodies never touched; ``no-separation``: the contact did not end within the run;
+* ``tolerance``: the adaptive method could not meet its tolerance; ``too-many-steps``: the solver ran out
+  of room for output points.
+
+The rules are reference/health.py's, the same for the reference's verlet method and every engine.
 """
 
 from __future__ import annotations
@@ -31,7 +46,7 @@ class Result:
     rtol: float | None = None
     wall_time: float = 0.0
     engine_version: str | None = None
-    status: str = "ok"  # ok | failed | unresolved | tolerance | no-contact | no-separation
+    status: str = "ok"  # see the module docstring
     message: str = ""
     meta: dict = field(default_factory=dict)
 

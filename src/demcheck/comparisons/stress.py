@@ -5,7 +5,7 @@ rigid wall, impact speed, restitution near 0 and near 1, very small and very lar
 incidence); at each value, and for each source (the reference's verlet method and every engine that can
 express the model), the largest stable time step is found by bisection over a grid of steps per elastic
 contact time. A run fails when it is unresolved, produces NaN, overlaps beyond half the radius, creates
-energy (a law that only stores or dissipates it; reference/collision.py ``health``), does not separate, or
+energy (a law that only stores or dissipates it; reference/health.py), does not separate, or
 the engine errors (lost atoms, …). The stability map is dt_max / t_c against each parameter; where an
 engine and the reference disagree about the limit by more than one grid step, the point is flagged.
 """
@@ -19,7 +19,8 @@ from pathlib import Path
 
 from ..case import Case, _read, from_dict
 from ..errors import ConfigError, DemcheckError
-from ..reference.collision import characteristic_time, collide, health
+from ..reference.collision import characteristic_time, collide
+from ..reference import health
 from ..reference.model import resolve
 
 # steps per elastic contact time, coarse to fine: the search grid
@@ -143,7 +144,7 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
         return False, str(exc).splitlines()[0]
     if r.status not in ("ok", "unresolved", "unstable"):
         return False, f"{r.status}: {r.message}"
-    status, why = health(r, t_c, min(p.radius for p in case.particles), min_steps=1)
+    status, why = health.check(r, case, min_steps=1)
     return status == "ok", why
 
 
@@ -154,7 +155,7 @@ def _stable_engine(case: Case, engine: str, dt: float, t_c: float) -> tuple[bool
         r = run_engine(case, engine, dt=dt, timeout=120.0)
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
-    status, why = health(r, t_c, min(p.radius for p in case.particles), min_steps=1)
+    status, why = health.check(r, case, min_steps=1)
     return status == "ok", why
 
 

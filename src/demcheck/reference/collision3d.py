@@ -61,7 +61,8 @@ def initial_state(case: Case) -> np.ndarray:
 
 def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = None, rtol: float | None = None,
             rules: dict | None = None) -> Result:
-    from .collision import MESSAGES, STATUS, auto_dt, characteristic_time
+    from .collision import (MESSAGES, ROW_BYTES_3D, STATUS, auto_dt, characteristic_time, judge, time_to_contact,
+                            verlet_capacity)
 
     t_c = characteristic_time(model)
     v = model.pair.impact_speed
@@ -72,11 +73,8 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
     v_rel = np.linalg.norm(y0[3:6] - y0[12:15]) if len(case.particles) == 2 else np.linalg.norm(y0[3:6])
     v_scale = max(v_rel, v)
     r0 = case.particles[0].radius
-    gap = -k3.kinematics(y0, geo, rul)[0]
-    t_max = max(gap, 0.0) / v + 200.0 * t_c
-    g = np.linalg.norm(case.run.gravity)
-    if g > 0 and gap > 0:
-        t_max = max(t_max, math.sqrt(2 * gap / g) + 200.0 * t_c)
+    t_contact = time_to_contact(case)
+    t_max = t_contact + 200.0 * t_c
     started = time.perf_counter()
     if method == "adaptive":
         if model.tangential_law.force_history or model.tangential_law.rescale_history:
@@ -95,10 +93,11 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
                                "delta": rec[idx, k3.C_D], "delta_dot": rec[idx, k3.C_R], "fn": rec[idx, k3.C_FN]})
         used_dt = None
     elif method == "verlet":
+        dt_given = bool(dt or case.run.dt)
         dt = dt or case.run.dt or auto_dt(case, model)
-        if not (dt > 0):
-            raise ConfigError("--dt", dt, "must be > 0 (s)")
-        capacity = int(min(t_max / dt + 4, 20_000_000))
+        if not (dt > 0) or not math.isfinite(dt):
+            raise ConfigError("--dt", dt, "must be > 0 (s) and finite")
+        capacity = verlet_capacity(case, dt, dt_given, t_contact, t_c, t_max, ROW_BYTES_3D)
         status, n, rec = k3.verlet_3d(y0, nl, tl, geo, rul, dt, t_max, capacity)
         events, used_dt, rtol = None, dt, None
     else:
@@ -118,11 +117,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         result.message = ("truncation=overlap with a Kt that vanishes at contact onset: where the dashpot exceeds "
                           "the cap the Maw overlap grows like δ^(-1/4) and the friction can push along the slip "
                           "(docs/models.md, finding 9); truncation=force is the seed's formulation")
-    if method == "verlet" and status_name == "ok":
-        from .collision import _flag_unresolved
-
-        _flag_unresolved(result, t_c, min(p.radius for p in case.particles))
-    return result
+    return judge(result, case, model)
 
 
 def tables(rec: np.ndarray, wall: bool) -> tuple[pd.DataFrame, pd.DataFrame]:

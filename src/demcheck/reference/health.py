@@ -1,0 +1,99 @@
+"""Whether a result can be trusted: one set of rules for every source.
+
+A time-stepped run (the reference's verlet method, LAMMPS, LIGGGHTS) goes through :func:`health`; the
+adaptive method's converged answer through :func:`overlap_rule` alone (the same rule: the model's range
+does not depend on the method). The statuses, first rule that fails wins:
+
+* ``failed``: the state holds NaN or infinite values;
+* ``unresolved``: fewer than ``min_steps`` steps inside the contact (or none, with a time step longer than
+  ``1/min_steps`` of the elastic contact time): the time step is the cause, and the message names it;
+* ``no-contact``: the bodies never touched;
+* ``unstable``: the collision created energy (a law that only stores or dissipates it): the scheme is
+  unstable at this step;
+* ``out-of-range``: the overlap passed half the smaller radius: the contact law has left its range (small
+  overlaps), whatever the method — the impact is too fast or the material too soft for the model;
+* ``no-separation``: the contact had not ended by the end of the run.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+MAX_OVERLAP_FRACTION = 0.5  # of the smaller radius: beyond it a contact law of small overlaps means nothing
+ENERGY_GAIN_TOLERANCE = 0.01  # of the impact kinetic energy, for laws that cannot create energy
+MIN_STEPS = 5  # inside the contact, for a time-stepped answer to count as resolved
+STATE_COLUMNS = ("delta", "delta_dot", "fn")
+
+
+def overlap_rule(d_max: float, radius: float | None) -> tuple[str, str] | None:
+    """("out-of-range", why) when the largest overlap passed half the smaller radius, else None."""
+    if radius and d_max > MAX_OVERLAP_FRACTION * radius:
+        return "out-of-range", (f"the overlap reached {d_max / radius:.3g} of the smaller radius (beyond "
+                                f"{MAX_OVERLAP_FRACTION:g}): the contact law is outside its range of small overlaps; "
+                                "the impact is too fast or the material too soft for this model")
+    return None
+
+
+def _steps(dt: float, t_c: float) -> str:
+    return f"dt = {dt:.3g} s, {t_c / dt:.3g} steps per elastic contact time of {t_c:.3g} s"
+
+
+def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN_STEPS,
+           impact_energy: float | None = None) -> tuple[str, str]:
+    """(status, why) of a time-stepped result (module docstring); ("ok", "") when every rule holds.
+    ``radius``: the smaller radius (default: ``result.meta["radius0"]``); ``impact_energy``: the energy
+    the energy rule is measured in (default ½ m̄ v² of the normal impact)."""
+    c = result.contact
+    dt = result.dt
+    state = c[list(STATE_COLUMNS)].to_numpy(dtype=float)
+    bad = ~np.isfinite(state).all(axis=1)
+    if bad.any():
+        t_bad = float(c["t"].to_numpy()[int(np.argmax(bad))])
+        return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
+    d = c["delta"].to_numpy()
+    inside = int((d > 0).sum())
+    if inside < min_steps and (inside > 0 or t_c / dt < min_steps):
+        return "unresolved", (f"only {inside} steps inside the contact ({_steps(dt, t_c)}): the time step does not "
+                              f"resolve the collision (at least {min_steps} are needed)")
+    if inside == 0:
+        return "no-contact", "the bodies never touched"
+    e_in = impact_energy
+    if e_in is None:
+        e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
+    gained = -result.metrics()["energy_dissipated"]
+    if e_in > 0 and math.isfinite(gained) and gained > ENERGY_GAIN_TOLERANCE * e_in:
+        return "unstable", (f"the collision created {gained / e_in:.3g} of the impact energy ({_steps(dt, t_c)}): "
+                            "the scheme is unstable at this time step")
+    out = overlap_rule(float(d.max()), radius or result.meta.get("radius0"))
+    if out is not None:
+        return out
+    if d[-1] > 0:
+        return "no-separation", f"the contact had not ended by the end of the run (t = {c['t'].iloc[-1]:.3g} s)"
+    return "ok", ""
+
+
+def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, str]:
+    """:func:`health` of a time-stepped result of ``case``: the elastic contact time of its seed model, its
+    smaller radius, and its impact energy (translation, tangential motion and spin: the units of the
+    suite's energy metric, comparisons/suite.py ``impact_scales``)."""
+    from ..comparisons.suite import impact_scales
+    from .collision import characteristic_time
+    from .model import resolve
+
+    model = model or resolve(case)
+    return health(result, characteristic_time(model), smallest_radius(case), min_steps,
+                  impact_scales(case, model)["impact_energy"])
+
+
+def apply(result, case, model=None, min_steps: int = MIN_STEPS):
+    """Set ``result``'s status and message from :func:`check` when a rule fails; returns the result."""
+    status, why = check(result, case, model, min_steps)
+    if status != "ok":
+        result.status, result.message = status, why
+    return result
+
+
+def smallest_radius(case) -> float:
+    return min(p.radius for p in case.particles)
