@@ -231,6 +231,18 @@ def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
     return hi
 
 
+@njit(cache=True)
+def _touch_inside(law, d, r, h, m, an, rn, tol_theta):
+    """A free-flight step [0, h] whose ends both have a gap (δ < 0) but whose approach turned into
+    recession (δ̇: + → −) may hold a touch between them (δ has its maximum inside): the step fraction of the
+    touch (the root of δ before the maximum), or 2 when the maximum has no overlap."""
+    tm = _locate(law, M_PRE, 2, -1, d, r, h, 0.0, m, an, r, rn, tol_theta)
+    dm, _, _, _ = _dp5(law, M_PRE, d, r, tm * h, 0.0, m, an)
+    if not (dm > 0.0):
+        return 2.0
+    return tm * _locate(law, M_PRE, 0, 1, d, r, tm * h, 0.0, m, an, d, dm, tol_theta)
+
+
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
 def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale, t_max, capacity):
     """Integrate the 1-D normal impact to relative tolerance ``rtol``.
@@ -294,6 +306,10 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
                 theta = _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
                 if theta < best_theta:
                     best_theta, best_slot, best_dir = theta, slot, direction
+        if best_slot < 0 and mode == M_PRE and r > 0.0 and rn <= 0.0:
+            best_theta = _touch_inside(law, d, r, h, m, an, rn, tol_theta)
+            if best_theta <= 1.0:
+                best_slot, best_dir = 0, 1
         if best_slot < 0:
             t += h
             d, r = dn, rn
@@ -364,6 +380,8 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
             status = ST_OK
             break
         h = max(h * (1.0 - best_theta), 1e-6 * t_scale) if best_theta < 1.0 else h
+    if status == ST_NO_SEPARATION and mode == M_PRE:
+        status = ST_NO_CONTACT
     return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy(), ne, \
         ET[:ne].copy(), EC[:ne].copy(), ED[:ne].copy(), ER[:ne].copy(), EF[:ne].copy()
 

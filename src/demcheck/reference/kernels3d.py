@@ -671,6 +671,19 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 theta = _locate(y, aux, nl, tl, geo, rules, hstep, slot, direction, g0, g1)
                 if theta < best_theta:
                     best_theta, best_slot, best_dir = theta, slot, direction
+        if best_slot < 0 and aux[A_NMODE] == M_PRE:
+            # a graze: the gap may close and open again inside one free-flight step (δ < 0 at both ends,
+            # its maximum inside, where the approach δ̇ turns into recession)
+            r0 = _event_value(y, aux, nl, tl, geo, rules, 2)
+            r1 = _event_value(yn, aux, nl, tl, geo, rules, 2)
+            if r0 > 0.0 and r1 <= 0.0:
+                tm = _locate(y, aux, nl, tl, geo, rules, hstep, 2, -1, r0, r1)
+                ym, _ = _dp5_3(y, aux, nl, tl, geo, rules, tm * hstep)
+                dm = kinematics(ym, geo, rules)[0]
+                if dm > 0.0:
+                    d0 = kinematics(y, geo, rules)[0]
+                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, 0, 1, d0, dm)
+                    best_slot, best_dir = 0, 1
         if best_slot < 0:
             t += hstep
             y = yn
@@ -776,6 +789,8 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             status = ST_OK
             break
         hstep = max(hstep * (1.0 - best_theta), 1e-6 * ts) if best_theta < 1.0 else hstep
+    if status == ST_NO_SEPARATION and aux[A_NMODE] == M_PRE:
+        status = ST_NO_CONTACT
     return status, n, rec[:n].copy(), ne, ev_t[:ne].copy(), ev_c[:ne].copy()
 
 
