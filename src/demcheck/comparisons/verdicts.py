@@ -144,8 +144,11 @@ class Comparison:
 
 def judge_engine(engine: str, version: str | None, model: dict, metric: str, value: float, reference: float,
                  twin: float, seed_verlet: float, fidelity: str, reasons: list[str], case_scales: dict,
-                 tol: Tolerances, expected: list[ExpectedDifference]) -> Comparison:
-    """One metric of an engine run against the seed model."""
+                 tol: Tolerances, expected: list[ExpectedDifference], status: str = "ok",
+                 message: str = "") -> Comparison:
+    """One metric of an engine run against the seed model. A run whose ``status`` is not "ok" (the
+    reference's rules, reference/health.py) is FAILED whatever its values; so is a value that is not finite
+    where the reference or the twin has one (a broken run is never "agree" or "differs as expected")."""
     diff = scaled(value, reference, metric, case_scales)
     impl = scaled(value, twin, metric, case_scales)
     step = scaled(seed_verlet, reference, metric, case_scales)
@@ -154,8 +157,20 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
     parts = {"implementation": impl, "time_step": step, "formula": formula}
     absd = abs(value - reference) if _finite(value) and _finite(reference) else math.nan
     c = Comparison(engine, metric, value, reference, absd, diff, tolerance, AGREE, "", parts)
-    if _nan(value) and _nan(reference):
+    if status != "ok":
+        c.verdict, c.reason = FAILED, f"{status}: {message}"
+        return c
+    if _nan(value) and _nan(reference) and _nan(twin):
         return c  # a metric that does not apply (a head-on impact's tangential restitution)
+    if not _finite(value):
+        c.verdict, c.reason = FAILED, f"the engine's value is not finite ({value}) where the seed model has one"
+        if not _finite(reference):
+            c.reason = f"the engine's value is not finite ({value}) where its twin has one"
+        return c
+    if not _finite(twin):
+        c.verdict = FAILED
+        c.reason = f"the twin's value is not finite ({twin}): the engine's {value:.6g} cannot be checked"
+        return c
     match = next((e for e in expected if e.matches(engine, version, model, metric)), None)
     if not _finite(impl) or impl > tol.implementation:
         if match is not None:
