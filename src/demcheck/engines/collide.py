@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 
 from ..case import Case
-from ..errors import EngineFailed
 from ..inputs import common, lammps as lammps_deck, liggghts as liggghts_deck
+from ..reference import health
 from ..result import Result
 from . import dumps, run as runner, states
 
@@ -22,11 +22,19 @@ def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, 
     return WRITERS[engine](case, dt, length, native=native, **options)
 
 
+META_KEYS = ("version", "workdir", "wall_time", "warnings")
+
+
 def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
             timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, **options) -> Result:
     """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
     four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
-    ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run."""
+    ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run.
+
+    The Result's status is the reference's own rules for a time-stepped run (reference/health.py): "ok",
+    or "failed" (NaN or infinite output: never cached), "unresolved", "unstable", "out-of-range",
+    "no-contact", "no-separation", with the reason in its message. The work directory of a run that is
+    not "ok" is kept and named."""
     from . import discovery
 
     mp = common.contact_mapping(case, engine, native)
@@ -34,7 +42,10 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     started = time.perf_counter()
     length = 1.0
     cached = False
-    for _ in range(4):
+    non_finite = ""
+    for attempt in range(4):
+        if attempt:
+            length *= 4.0
         dk = deck(case, engine, dt, length, native=native, **options)
         text = dk.text
         hit = None
@@ -47,7 +58,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             from .cache import key as cache_key
 
             k = cache_key(engine, info.version, text, dk.files)
-            hit = cache.get(k)
+            hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS)
         if hit is not None:
             table, meta = hit
             out = runner.RunOutput(engine, meta["version"], Path(meta["workdir"]), "", meta["wall_time"],
@@ -56,7 +67,8 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         else:
             out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
-            if cache is not None:
+            non_finite = _non_finite(table)
+            if cache is not None and not non_finite:
                 cache.put(k, table, {"version": out.version, "workdir": str(out.workdir),
                                      "wall_time": out.wall_time, "warnings": out.warnings})
         n = len(case.particles)
@@ -64,22 +76,17 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         if copies > 1:
             spread = _copies_spread(table, n, copies)
             table = table[table["id"] <= n]
-        particles = _particles(table, case, _dt_of(text))
-        contact = states.trim(states.from_particles(particles, case))
+        with np.errstate(all="ignore"):
+            particles = _particles(table, case, _dt_of(text))
+            contact = states.trim(states.from_particles(particles, case))
+        if non_finite:
+            break
         d = contact["delta"].to_numpy()
         if (d > 0).any() and d[-1] <= 0:
             break
-        length *= 4.0
-    else:
-        raise EngineFailed(f"{engine}: the contact had not ended after {length / 4:g}× the expected duration; "
-                           f"work directory kept: {out.workdir}")
     used_dt = _dt_of(text)
-    if workdir is None and not cached and out.workdir.name.startswith(f"demcheck-{engine}-"):
-        import shutil
-
-        shutil.rmtree(out.workdir, ignore_errors=True)  # a temporary directory of a run that succeeded
     sc = common.scene(case, dt, length)
-    return Result(
+    result = Result(
         source=engine, method="engine", case_name=case.name, case_hash=case.hash,
         model={"normal": case.contact.normal, "tangential": case.contact.tangential,
                "limit_force": case.contact.limit_force},
@@ -92,6 +99,32 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
               "copies": int(options.get("copies", 1)),
               "copies_spread": spread if int(options.get("copies", 1)) > 1 else 0.0},
     )
+    if non_finite:
+        result.status = "failed"
+        result.message = (f"{engine} wrote NaN or infinite values ({non_finite}): the run is not used and not "
+                          f"cached; work directory kept: {out.workdir}")
+        return result
+    health.apply(result, case, sc.model)
+    if not result.ok:
+        if length > 1.0:
+            result.message += f" (after runs up to {length:g}× the expected duration)"
+        if not cached:
+            result.message += f"; work directory kept: {out.workdir}"
+    elif workdir is None and not cached and out.workdir.name.startswith(f"demcheck-{engine}-"):
+        import shutil
+
+        shutil.rmtree(out.workdir, ignore_errors=True)  # a temporary directory of a run that succeeded
+    return result
+
+
+def _non_finite(table: pd.DataFrame) -> str:
+    """Where a dump first holds NaN or infinite values ("step 12, column vx"), or ""."""
+    data = table.to_numpy(dtype=float)
+    bad = ~np.isfinite(data)
+    if not bad.any():
+        return ""
+    row, col = np.argwhere(bad)[0]
+    return f"first at step {int(table['step'].iloc[row])}, column {table.columns[col]}"
 
 
 def _copies_spread(table: pd.DataFrame, n: int, copies: int) -> float:
