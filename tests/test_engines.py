@@ -46,7 +46,11 @@ def _run(case, engine):
     res = collide(case, engine)
     assert res.engine_version == discovery.find(engine).version
     assert res.meta["fidelity"] == mp.fidelity
-    return res, twin_states(case, engine, res.dt)
+    # the health rules (reference/health.py) pass every healthy configuration: they do not misfire
+    assert res.status == "ok", res.message
+    twin = twin_states(case, engine, res.dt)
+    assert twin.status == "ok", twin.message
+    return res, twin
 
 
 def _normal_case(i, wall):
