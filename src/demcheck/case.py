@@ -109,7 +109,9 @@ def _read(path: str | Path) -> dict:
         raw = tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(str(path), "(file)", f"not valid TOML: {exc}") from None
-    raw.setdefault("name", path.stem)
+    if "name" not in raw:
+        check_name("name", path.stem, " (the name defaults to the file's: set name = \"...\" in the case)")
+        raw["name"] = path.stem
     return raw
 
 
@@ -126,11 +128,17 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
     variants = raw.pop("variants", None) or {}
     if not isinstance(variants, dict):
         raise ConfigError("variants", variants, "must be a table of dotted keys to lists of values")
-    for key, values in variants.items():
-        if not isinstance(values, list) or not values:
-            raise ConfigError(f"variants.{key}", values, "must be a non-empty list of values")
     if not variants:
         return [from_dict(raw)]
+    base = check_name("name", raw.get("name"))
+    for key, values in variants.items():
+        where = f"variants.{_key_text(key)}"
+        if not isinstance(values, list) or not values:
+            raise ConfigError(where, values, "must be a non-empty list of values")
+        check_name(where, key.rsplit(".", 1)[-1], " (the key's last part labels each variant)")
+        for v in values:  # a variant's value is part of its name
+            if _name_problem(_label(v)):
+                raise ConfigError(where, v, f"labels its variant, so its text {NAME_RULE}")
     cases = []
     keys = list(variants)
     for combo in itertools.product(*(variants[k] for k in keys)):
@@ -138,7 +146,7 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
         for key, value in zip(keys, combo):
             set_path(r, key, value)
         label = ",".join(f"{k.rsplit('.', 1)[-1]}={_label(v)}" for k, v in zip(keys, combo))
-        r["name"] = f"{raw['name']}[{label}]"
+        r["name"] = f"{base}[{label}]"
         cases.append(from_dict(r))
     return cases
 
@@ -239,7 +247,33 @@ def _known_keys(d: dict, allowed: set[str], where: str) -> None:
         if k not in allowed:
             near = difflib.get_close_matches(k, sorted(allowed), n=1)
             hint = f"; did you mean '{near[0]}'?" if near else f"; known keys: {', '.join(sorted(allowed))}"
-            raise ConfigError(f"{where}.{k}" if where else k, d[k], f"unknown key{hint}")
+            raise ConfigError(f"{where}.{_key_text(k)}" if where else _key_text(k), d[k], f"unknown key{hint}")
+
+
+def _key_text(key: str) -> str:
+    """A user's key as an error names it: as written, or quoted and escaped when it is not one printable line."""
+    return key if key.isprintable() else repr(key)
+
+
+# Names (a case's, its variants' labels, a material's) are written into reports and into the engines' decks (as
+# comments): one line of plain characters, none that a deck, a shell or a report would interpret.
+NAME_MAX = 200
+NAME_PUNCTUATION = frozenset("-_.,:=+[]()/ ")
+NAME_RULE = (f"must be one line of 1 to {NAME_MAX} letters, digits, spaces and - _ . , : = + [ ] ( ) / (no #, $, &, "
+             "quotes, backslashes or control characters)")
+
+
+def _name_problem(value) -> bool:
+    return (not isinstance(value, str) or not value.strip() or len(value) > NAME_MAX
+            or not all(ch.isalnum() or ch in NAME_PUNCTUATION for ch in value))
+
+
+def check_name(key: str, value, hint: str = "") -> str:
+    """``value`` if it is a valid name, else a ConfigError naming ``key`` (``hint``: where the value came from)."""
+    if _name_problem(value):
+        rule = NAME_RULE if isinstance(value, str) else NAME_RULE.replace("must be ", "must be a string, ", 1)
+        raise ConfigError(key, value, rule + hint)
+    return value
 
 
 MATERIAL_KEYS = {
@@ -298,7 +332,9 @@ def from_dict(raw: dict) -> Case:
     if not isinstance(raw, dict):
         raise ConfigError("case", raw, "must be a table")
     _known_keys(raw, TOP_KEYS, "")
-    name = str(raw.get("name", "case"))
+    name = check_name("name", raw.get("name", "case"))
+    if not isinstance(raw.get("description", ""), str):
+        raise ConfigError("description", raw["description"], "must be a string")
     kind = raw.get("kind", "collision")
     if kind not in KINDS:
         raise ConfigError("kind", kind, f"must be one of {', '.join(KINDS)}")
@@ -306,6 +342,8 @@ def from_dict(raw: dict) -> Case:
     mats_raw = raw.get("materials")
     if not isinstance(mats_raw, dict) or not mats_raw:
         raise ConfigError("materials", mats_raw, "at least one [materials.NAME] table is required")
+    for n in mats_raw:
+        check_name(f"materials.{_key_text(n)}", n, " (a material's name)")
     materials = {n: _material(n, d) for n, d in mats_raw.items()}
 
     raw = copy.deepcopy(raw)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..case import Case
-from ..errors import UnsupportedByEngine
+from ..errors import DemcheckError, UnsupportedByEngine
 from ..reference.collision import characteristic_time
 from ..reference.model import ResolvedModel, resolve
 from . import mapping
@@ -121,16 +121,104 @@ def contact_mapping(case: Case, engine: str, native: mapping.Native | None = Non
 
 def header(engine: str, sc: Scene, mp: mapping.Mapping, version_note: str) -> list[str]:
     case = sc.case
-    lines = [f"# demcheck deck for {engine} ({version_note})",
-             f"# case: {case.name} (hash {case.hash})",
-             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}, "
-             f"limit_force = {str(case.contact.limit_force).lower()}",
-             f"# mapping fidelity: {mp.fidelity}"]
-    for r in mp.reasons:
-        lines.append(f"#   {r}")
-    lines.append(f"# dt = {fmt(sc.dt)} s, {sc.steps} steps; dump: {DUMP_FILE} (every step, %.17g)")
-    lines.append(f"# run by hand: {'lmp' if engine == 'lammps' else 'liggghts'} -in <this file>")
+    lines = [comment(f"demcheck deck for {engine} ({version_note})"),
+             comment(f"case: {case.name} (hash {case.hash})"),
+             comment(f"model: normal = {case.contact.normal}, tangential = {case.contact.tangential}, "
+                     f"limit_force = {str(case.contact.limit_force).lower()}"),
+             comment(f"mapping fidelity: {mp.fidelity}")]
+    lines += notes(mp.reasons)
+    lines.append(comment(f"dt = {fmt(sc.dt)} s, {sc.steps} steps; dump: {DUMP_FILE} (every step, %.17g)"))
+    lines.append(comment(f"run by hand: {'lmp' if engine == 'lammps' else 'liggghts'} -in <this file>"))
     return lines
+
+
+# ----------------------------------------------------------------------------- free text and the final guard
+#
+# Both engines read a deck line by line (split at "\n" only): a line that starts with "#" is a comment, but a
+# line whose last printable character is "&" continues onto the next (a comment too), and LAMMPS's triple
+# quotes span lines. Free text (a case's name, a mapping's reasons and comments) reaches a deck only through
+# comment(); check_deck() is run on every deck and data file demcheck writes.
+
+
+def comment(text: str) -> str:
+    """``text`` as one comment line: characters that are not printable (line breaks of any kind, control and
+    format characters) escaped, triple quotes broken, and no "&" at the end."""
+    out = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    out = out.replace('"""', '\\"\\"\\"')
+    if out.rstrip().endswith("&"):
+        out = out.rstrip()[:-1] + "\\x26"
+    return f"# {out}"
+
+
+def notes(texts) -> list[str]:
+    """Indented comment lines (a mapping's reasons, a native configuration's comments)."""
+    return [comment(f"  {t}") for t in texts]
+
+
+# every command demcheck writes, and of those that take a style the word's position and the styles it writes
+COMMANDS = frozenset({
+    "units", "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "region", "create_box",
+    "create_atoms", "set", "read_data", "neighbor", "neigh_modify", "pair_style", "pair_coeff", "fix", "compute",
+    "timestep", "dump", "dump_modify", "undump", "write_dump", "thermo_style", "thermo_modify", "thermo", "run",
+    "hard_particles", "soft_particles"})
+STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/sphere"})),
+          "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local"})),
+          "dump": (3, frozenset({"custom", "local"})), "pair_style": (1, frozenset({"granular", "gran"})),
+          "atom_style": (1, frozenset({"sphere", "granular"})), "region": (2, frozenset({"block"})),
+          "thermo_style": (1, frozenset({"custom"}))}
+DATA_WORDS = frozenset({"atoms", "atom", "types", "xlo", "xhi", "ylo", "yhi", "zlo", "zhi", "Atoms", "Velocities"})
+
+
+def _refuse(what: str, n: int, line: str, why: str):
+    raise DemcheckError(f"refusing to write {what}: line {n} {why}: {line[:80]!r}")
+
+
+def _check_text(text: str, what: str) -> list[str]:
+    lines = text.split("\n")
+    for n, line in enumerate(lines, 1):
+        if not line.isprintable():
+            _refuse(what, n, line, "has a character that is not printable")
+        if line.rstrip().endswith("&"):
+            _refuse(what, n, line, "would continue onto the next line")
+        if '"""' in line:
+            _refuse(what, n, line, "has triple quotes")
+    return lines
+
+
+def check_deck(text: str, files: dict | None = None) -> None:
+    """The final guard on a deck (and its data files): every line is a comment, blank, or one of the commands
+    demcheck writes (``run N`` a plain step count, no variable substitution); anything else raises."""
+    for n, line in enumerate(_check_text(text, "a deck"), 1):
+        words = line.split("#", 1)[0].split()
+        if not words:
+            continue
+        command = words[0]
+        if command not in COMMANDS:
+            _refuse("a deck", n, line, "is not a command demcheck writes")
+        if "$" in line.split("#", 1)[0]:
+            _refuse("a deck", n, line, "substitutes a variable")
+        at, styles = STYLES.get(command, (0, None))
+        if styles is not None and (len(words) <= at or words[at] not in styles):
+            _refuse("a deck", n, line, f"is not a {command} style demcheck writes")
+        if command == "run" and (len(words) != 2 or not words[1].isdigit()):
+            _refuse("a deck", n, line, "is not a plain run N")
+    for name, data in (files or {}).items():
+        check_data(data, name)
+
+
+def check_data(text: str, name: str = "data file") -> None:
+    """A data file: a one-line title (a comment), then header lines, section names and numbers only."""
+    for n, line in enumerate(_check_text(text, name), 1):
+        if n == 1:
+            if not line.startswith("#"):
+                _refuse(name, n, line, "is not a comment title")
+            continue
+        for word in line.split():
+            if word not in DATA_WORDS:
+                try:
+                    float(word)
+                except ValueError:
+                    _refuse(name, n, line, "is not a number, a header or a section name")
 
 
 @dataclass
@@ -141,11 +229,15 @@ class Deck:
     text: str
     files: dict
 
+    def __post_init__(self):
+        check_deck(self.text, self.files)
+
     def write(self, path) -> list:
         from pathlib import Path
 
         from ..io import write_text
 
+        check_deck(self.text, self.files)
         path = Path(path)
         write_text(path, self.text)
         written = [path]
@@ -161,7 +253,7 @@ def data_file(case: Case, ntypes: int, box, title: str, copies: int = 1, axis: i
     angular velocities), which both engines read."""
     lo, hi = box
     n = len(case.particles)
-    lines = [f"# {title}", "", f"{n * copies} atoms", f"{ntypes} atom types", "",
+    lines = [comment(title), "", f"{n * copies} atoms", f"{ntypes} atom types", "",
              f"{fmt(lo[0])} {fmt(hi[0])} xlo xhi", f"{fmt(lo[1])} {fmt(hi[1])} ylo yhi",
              f"{fmt(lo[2])} {fmt(hi[2])} zlo zhi", "", "Atoms", ""]
     for c in range(copies):

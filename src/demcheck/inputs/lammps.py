@@ -49,9 +49,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
     batch_axis, spacing = 0, 0.0
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
-    lines = common.header("lammps", sc, mp, VERSION_NOTE)
-    for c in mp.native.comments:
-        lines.append(f"#   {c}")
+    lines = common.header("lammps", sc, mp, VERSION_NOTE) + common.notes(mp.native.comments)
     lines += ["", "units si", "atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
               "comm_modify vel yes",
               f"region box block {fmt(lo[0])} {fmt(hi[0])} {fmt(lo[1])} {fmt(hi[1])} {fmt(lo[2])} {fmt(hi[2])} "

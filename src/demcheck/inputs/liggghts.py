@@ -94,9 +94,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     batch_axis, spacing = 0, 0.0
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
-    lines = common.header("liggghts", sc, mp, VERSION_NOTE)
-    for c in nat.comments:
-        lines.append(f"#   {c}")
+    lines = common.header("liggghts", sc, mp, VERSION_NOTE) + common.notes(nat.comments)
     # every type pair's configuration (the wall type pairs with each particle)
     natives = {}
     for i, j in common.type_pairs(case):

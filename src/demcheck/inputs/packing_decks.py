@@ -28,9 +28,9 @@ FINAL_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz"
 
 def _data_file(case: Case, species, lo, hi, n_types: int | None = None) -> str:
     n_types = n_types or int(species.max()) + 1
-    lines = [f"# demcheck packing: case {case.name} (hash {case.hash})", "", f"{len(case.particles)} atoms",
-             f"{n_types} atom types", "", f"{fmt(lo[0])} {fmt(hi[0])} xlo xhi", f"{fmt(lo[1])} {fmt(hi[1])} ylo yhi",
-             f"{fmt(lo[2])} {fmt(hi[2])} zlo zhi", "", "Atoms", ""]
+    lines = [common.comment(f"demcheck packing: case {case.name} (hash {case.hash})"), "",
+             f"{len(case.particles)} atoms", f"{n_types} atom types", "", f"{fmt(lo[0])} {fmt(hi[0])} xlo xhi",
+             f"{fmt(lo[1])} {fmt(hi[1])} ylo yhi", f"{fmt(lo[2])} {fmt(hi[2])} zlo zhi", "", "Atoms", ""]
     for k, p in enumerate(case.particles):
         rho = case.materials[p.material].density
         lines.append(f"{k + 1} {species[k] + 1} {fmt(2 * p.radius)} {fmt(rho)} {' '.join(fmt(x) for x in p.position)}")
@@ -44,10 +44,12 @@ def _head(case: Case, engine: str, note: str, n_species: int, dt: float, steps: 
     """Header comments, units, the engine's atom setup (BOUNDS: the boundary line), the data file and the
     exact masses."""
     bounds = "boundary " + " ".join("p" if periodic[k] else "f" for k in range(2)) + " f"
-    lines = [f"# demcheck packing deck for {engine} ({note})", f"# case: {case.name} (hash {case.hash})",
-             f"# model: normal = {case.contact.normal}, tangential = {case.contact.tangential}",
-             f"# {len(case.particles)} particles of {n_species} species, dt = {fmt(dt)} s, {steps} steps; "
-             f"final state: {FINAL_DUMP}", "", "units si", *[bounds if x == "BOUNDS" else x for x in setup],
+    lines = [common.comment(f"demcheck packing deck for {engine} ({note})"),
+             common.comment(f"case: {case.name} (hash {case.hash})"),
+             common.comment(f"model: normal = {case.contact.normal}, tangential = {case.contact.tangential}"),
+             common.comment(f"{len(case.particles)} particles of {n_species} species, dt = {fmt(dt)} s, {steps} "
+                            f"steps; final state: {FINAL_DUMP}"), "", "units si",
+             *[bounds if x == "BOUNDS" else x for x in setup],
              "read_data data.lmp"]
     for k in range(len(case.particles)):
         lines.append(f"set atom {k + 1} mass {fmt(case.mass(k))}")
