@@ -112,3 +112,272 @@ def test_bad_input_names_key_value_and_rule(overrides, key, rule):
 def test_bad_override_syntax():
     with pytest.raises(ConfigError, match="KEY=VALUE"):
         C.loads(BASE, ["contact.normal"])
+
+
+# ----------------------------------------------------------------------------- names and free text
+
+
+@pytest.mark.parametrize("value", [5, 1.5, True, ["a"], {"a": 1}, "", "a\nb", "a#b", "a$b", "a&", "a'b", 'a"b',
+                                   "a\\b", "a\tb", "x" * 1000])
+def test_name_is_a_one_line_string_of_plain_characters(value):
+    raw = C.tomllib.loads(BASE)
+    raw["name"] = value
+    with pytest.raises(ConfigError) as info:
+        C.from_dict(raw)
+    assert info.value.key == "name" and "\n" not in str(info.value) and info.value.exit_code == 2
+
+
+def test_description_is_a_string():
+    with pytest.raises(ConfigError) as info:
+        C.loads('description = 5\n' + BASE)
+    assert info.value.key == "description"
+    assert C.loads('description = """Two spheres.\nHead on."""\n' + BASE).name == "case"
+
+
+# ----------------------------------------------------------------------------- keys accepted and ignored
+
+
+PACKING = """
+name = "p"
+kind = "packing"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 1e8
+poisson_ratio = 0.3
+restitution = 0.3
+[packing]
+layout = "poured"
+count = 20
+material = "glass"
+radius = 1e-3
+box = [0.01, 0.01]
+duration = 0.01
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[contact]
+normal = "lsd"
+kn = 500.0
+[run]
+gravity = [0.0, 0.0, -9.81]
+"""
+
+
+@pytest.mark.parametrize("value", ["0.05", '"tall"', "[1, 2]"])
+def test_packing_height_is_an_unknown_key(value):
+    with pytest.raises(ConfigError) as info:
+        C.loads(PACKING.replace("duration = 0.01", f"duration = 0.01\nheight = {value}"))
+    assert info.value.key == "packing.height" and "unknown key" in info.value.rule
+
+
+def test_a_misspelt_packing_key_gets_a_suggestion():
+    with pytest.raises(ConfigError) as info:
+        C.loads(PACKING.replace("duration = 0.01", "duraton = 0.01"))
+    assert info.value.key == "packing.duraton" and "did you mean 'duration'" in info.value.rule
+
+
+# ----------------------------------------------------------------------------- bad values, one line each
+
+
+def test_a_case_file_that_is_not_utf8_is_one_line(tmp_path):
+    path = tmp_path / "latin1.toml"
+    path.write_bytes(("# Gl\u00e4ser\n" + BASE).encode("latin-1"))
+    with pytest.raises(ConfigError) as info:
+        C.load(path)
+    assert str(path) in str(info.value) and "UTF-8" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("box", ["[nan, 0.01]", "[0.01, inf]", "[-inf, 0.01]", "[true, 0.01]", "[0.01]",
+                                 '["a", 0.01]'])
+def test_packing_box_must_be_two_finite_lengths(box):
+    with pytest.raises(ConfigError) as info:
+        C.loads(PACKING.replace("box = [0.01, 0.01]", f"box = {box}"))
+    assert info.value.key == "packing.box" and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("overrides,key", [
+    (["materials.glass.density=1e-300"], "materials.glass.density"),
+    (["materials.glass.density=1e-200"], "materials.glass.density"),
+    (["materials.glass.density=1e300"], "materials.glass.density"),
+    (["particles.0.radius=1e-120", "particles.0.position=[-1e-3, 0, 0]"], "particles.0.radius"),
+])
+def test_a_mass_outside_the_representable_range_is_refused(overrides, key):
+    """m̄ = m₁m₂/(m₁+m₂) underflows to 0 for masses below ~1e-154 kg (density 1e-300 gave a division by zero
+    in the solver): such a case is refused up front, naming the key that made the mass."""
+    with pytest.raises(ConfigError) as info:
+        C.loads(BASE, overrides)
+    assert info.value.key == key and "\n" not in str(info.value) and "mass" in info.value.rule
+
+
+def test_small_real_particles_are_accepted():
+    """A 1 µm sphere of an aerogel (density 1 kg/m³): 4e-18 kg."""
+    case = C.loads(BASE, ["materials.glass.density=1.0", "particles.0.radius=1e-6", "particles.1.radius=1e-6",
+                          "particles.1.position=[3e-6, 0, 0]"])
+    assert case.mass(0) == pytest.approx(4 / 3 * math.pi * 1e-18, rel=1e-12)
+
+
+def test_a_density_of_1e_300_is_refused_by_the_command_line(tmp_path):
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    for args in (["collide"], ["collide", "--method", "verlet"], ["deck", "--engine", "lammps"]):
+        p = subprocess.run([sys.executable, "-m", "demcheck", args[0], str(CASES / "glass-pair.toml"), *args[1:],
+                            "--set", "materials.glass.density=1e-300"], capture_output=True, text=True, timeout=120)
+        assert p.returncode == 2, p.stderr[-1000:]
+        assert p.stderr.count("\n") == 1 and "materials.glass.density" in p.stderr
+
+
+def test_a_packing_count_the_machine_cannot_hold_is_refused_before_allocating():
+    import time
+    import tracemalloc
+
+    tracemalloc.start()
+    started = time.perf_counter()
+    with pytest.raises(ConfigError) as info:
+        C.loads(PACKING.replace("count = 20", "count = 1_000_000_000_000"))
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert info.value.key == "packing.count" and "memory" in info.value.rule
+    assert peak < 50e6 and time.perf_counter() - started < 5.0
+    assert len(C.loads(PACKING.replace("count = 20", "count = 2000")).particles) == 2000
+
+
+# ----------------------------------------------------------------------------- free flight and run length
+
+
+def _hertz_duration(case):
+    """Hertz's elastic contact duration 2.868 (m̄²/(R̄ Ē² v))^(1/5) of the pair, from the case's own
+    numbers (Ē: the pair's plane-strain modulus)."""
+    p = pair_of(case)
+    return 2.868 * (p.m_eff**2 / (p.r_eff * p.e_eff**2 * p.impact_speed)) ** 0.2
+
+
+def _time_to_contact(case):
+    """First touch of the bodies in free flight without gravity, solved here from the positions."""
+    import numpy as np
+
+    p0 = case.particles[0]
+    x, v = np.asarray(p0.position), np.asarray(p0.velocity)
+    if case.walls:
+        w = case.walls[0]
+        n = np.asarray(w.normal)
+        return ((x - np.asarray(w.point)) @ n - p0.radius) / -(v @ n)
+    p1 = case.particles[1]
+    d, u = np.asarray(p1.position) - x, np.asarray(p1.velocity) - v
+    a, b, c = u @ u, 2 * d @ u, d @ d - (p0.radius + p1.radius) ** 2
+    return (-b - math.sqrt(b * b - 4 * a * c)) / (2 * a)
+
+
+@pytest.mark.parametrize("wall", [False, True])
+@pytest.mark.parametrize("normal", ["hertz", "lsd"])
+def test_a_tiny_impact_speed_starts_the_bodies_near_contact(wall, normal):
+    """At 1e-9 m/s the default gap (1e-3 R) took 1.6e3 s to cross: 265 million steps of free flight in the
+    LAMMPS deck. Without gravity the motion is linear, so the bodies start where they are a few contact
+    times before touching."""
+    from .helpers import glass_case
+
+    case = glass_case(normal, {"stiffness_method": "energy"} if normal == "lsd" else None, wall=wall, speed=1e-9)
+    assert pair_of(case).impact_speed == pytest.approx(1e-9, rel=1e-6)
+    flight = _time_to_contact(case)
+    assert 0 < flight <= 50 * _hertz_duration(case)
+    from demcheck.inputs import lammps, liggghts
+
+    for writer in (lammps.deck, liggghts.deck):
+        steps = int(next(line.split()[1] for line in writer(case).text.splitlines() if line.startswith("run ")))
+        assert steps <= 100 * case.run.steps_per_contact
+
+
+def test_moving_the_bodies_along_their_velocities_changes_nothing():
+    """A pair started 1 m apart at 1 m/s collides as the same pair started 1e-3 R apart."""
+    from demcheck.reference.collision import collide
+
+    from .conftest import CASES
+
+    near = C.load(CASES / "glass-pair.toml")
+    far = C.load(CASES / "glass-pair.toml", ["impact.gap=1.0"])
+    assert _time_to_contact(far) <= 50 * _hertz_duration(far)
+    a, b = collide(near).metrics(), collide(far).metrics()
+    for k in ("restitution", "peak_force", "contact_time", "max_overlap"):
+        assert b[k] == pytest.approx(a[k], rel=1e-9), k
+
+
+def test_with_gravity_the_bodies_start_where_the_impact_puts_them():
+    from .helpers import glass_case
+
+    case = glass_case("hertz", wall=True, speed=1e-3, overrides=["run.gravity=[0, 0, -9.81]"])
+    p, w = case.particles[0], case.walls[0]
+    gap = p.position[2] - w.point[2] - p.radius
+    assert gap == pytest.approx(1e-3 * p.radius, rel=1e-9)
+
+
+@pytest.mark.parametrize("overrides,key", [(["run.dt=1e-16"], "run.dt"),
+                                           (["run.steps_per_contact=100000000"], "run.steps_per_contact"),
+                                           (["impact.gap=10.0", "run.gravity=[0, 0, -9.81]"], "impact.gap")])
+def test_a_run_too_long_to_write_is_refused(overrides, key):
+    from .helpers import glass_case
+
+    with pytest.raises(ConfigError) as info:
+        glass_case("hertz", wall=True, overrides=overrides)
+    assert info.value.key == key and "steps" in info.value.rule and "\n" not in str(info.value)
+
+
+def test_a_deck_dt_too_small_for_the_run_is_refused():
+    from demcheck.inputs import lammps
+
+    from .helpers import glass_case
+
+    with pytest.raises(ConfigError) as info:
+        lammps.deck(glass_case("hertz"), dt=1e-16)
+    assert info.value.key == "--dt" and "steps" in info.value.rule
+
+
+# ----------------------------------------------------------------------------- tilted walls
+
+
+TILTED = """
+name = "tilted"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 71e9
+poisson_ratio = 0.22
+restitution = 0.9
+[[particles]]
+material = "glass"
+radius = 1.59e-3
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.6, 0.8]
+[impact]
+speed = 1.0
+[contact]
+normal = "hertz"
+"""
+
+
+@pytest.mark.parametrize("engine", ["lammps", "liggghts"])
+def test_a_tilted_wall_is_not_expressible_in_an_engine(engine):
+    from demcheck.inputs import common
+
+    mp = common.contact_mapping(C.loads(TILTED), engine)
+    assert mp.native is None and mp.fidelity == "none"
+    assert any("walls.0.normal" in r and "axis" in r for r in mp.reasons)
+
+
+def test_verify_reports_a_tilted_wall_as_not_expressible(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    path = tmp_path / "tilted.toml"
+    path.write_text(TILTED)
+    p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(path), "--engines", "lammps,liggghts",
+                        "--report", str(tmp_path / "reports"), "--json"], capture_output=True, text=True,
+                       cwd=tmp_path, timeout=600)
+    out = json.loads(p.stdout)
+    sources = out["cases"][0]["sources"]
+    for engine in ("lammps", "liggghts"):
+        assert sources[engine]["status"] == "not expressible", sources[engine]
+        assert "walls.0.normal" in sources[engine]["message"]
+    assert p.returncode == 0, p.stderr[-2000:]

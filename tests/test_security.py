@@ -160,7 +160,8 @@ def test_a_hostile_variant_label_is_refused(kind, tmp_path):
     """A variant value is a user string too: it becomes part of the variant's name."""
     f = tmp_path / "PWNED"
     path = tmp_path / "case.toml"
-    path.write_text(_case_text('name = "v"', f'\n[variants]\n"contact.normal" = ["hertz", {_toml_string(hostile(kind, f))}]\n'))
+    values = f'["hertz", {_toml_string(hostile(kind, f))}]'
+    path.write_text(_case_text('name = "v"', f'\n[variants]\n"contact.normal" = {values}\n'))
     with pytest.raises(ConfigError) as info:
         C.expand(path)
     _one_line_config_error(info.value, "variants.contact.normal")
@@ -308,7 +309,8 @@ INJECTED = ["shell touch F", "python f here \"\"\"", "include other.in", "jump S
             "fix p all python/invoke 1 end_of_step f", "compute c all reduce sum x", "dump d all image 1 a.jpg",
             "units si &", "# a comment &", "# \"\"\"", "run 10\rshell touch F", "set atom 1 mass ${m}",
             "run $(1000)", "  shell touch F", "clear", "quit", "partition yes 1 shell touch F", "log /tmp/x",
-            "write_restart r", "write_data d", "next a", "if 1 then \"shell touch F\"", "run 10 every 1 \"shell touch F\"",
+            "write_restart r", "write_data d", "next a", "if 1 then \"shell touch F\"",
+            "run 10 every 1 \"shell touch F\"",
             "timestep 1e-8\u2028shell touch F", "pair_style python 1.0", "fix p all python/move f.py",
             "region r python f", "thermo_style python", "atom_style template t"]
 

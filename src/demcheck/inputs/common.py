@@ -8,7 +8,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..case import Case
-from ..errors import DemcheckError, UnsupportedByEngine
+from ..errors import ConfigError, DemcheckError, UnsupportedByEngine
 from ..reference.collision import characteristic_time
 from ..reference.model import ResolvedModel, resolve
 from . import mapping
@@ -34,24 +34,48 @@ def fmt(x: float) -> str:
     return f"{x:.17g}"
 
 
+# An engine run dumps every step (~1 kB a step for two bodies): a collision's run is refused past this many steps.
+MAX_STEPS = 2_000_000
+
+
+def run_length(case: Case, dt: float | None = None, length: float = 1.0, model: ResolvedModel | None = None,
+               flight: tuple[str, object] | None = None) -> tuple[float, float, int]:
+    """(dt, t_end, steps) of a collision's run in an engine (and in the verlet reference): dt (``dt``, the
+    case's, or auto), free flight to contact plus ``length`` × 6 elastic contact times. More than MAX_STEPS
+    steps is a ConfigError naming what makes the run long: the free flight (``flight``: its key and value,
+    default the first particle's position) or the step (``dt`` given here: --dt; run.dt; the auto dt's
+    run.steps_per_contact)."""
+    from ..reference import kernels3d as k3
+    from ..reference.collision import auto_dt
+    from ..reference.collision3d import geometry, initial_state, rules_array
+
+    model = model or resolve(case)
+    t_c = characteristic_time(model)
+    step = dt or case.run.dt or auto_dt(case, model)
+    gap = max(-k3.kinematics(initial_state(case), geometry(case, t_c), rules_array())[0], 0.0)
+    t_flight, t_contact = gap / model.pair.impact_speed, 6.0 * t_c * length
+    t_end = t_flight + t_contact
+    steps = t_end / step
+    if steps > MAX_STEPS:
+        if t_flight > t_contact:
+            key, value = flight or ("particles.0.position", list(case.particles[0].position))
+            why = f"{t_flight:.3g} s of free flight before the contact"
+        else:
+            key, value = (("--dt", dt) if dt else ("run.dt", case.run.dt) if case.run.dt else
+                          ("run.steps_per_contact", case.run.steps_per_contact))
+            why = f"{t_contact:.3g} s of contact"
+        raise ConfigError(key, value, f"the run would take {steps:.3g} steps ({why} at dt = {step:.3g} s), more "
+                                      f"than the {MAX_STEPS:,} an engine run (dumping every step) is allowed")
+    return step, t_end, int(math.ceil(steps))
+
+
 def scene(case: Case, dt: float | None = None, length: float = 1.0) -> Scene:
     """The two-body scene of a collision case: dt (the case's, or auto), the number of steps (free flight to
     contact plus ``length`` × 6 elastic contact times), a box that holds both bodies for the whole run."""
     if case.kind != "collision":
         raise UnsupportedByEngine(f"case '{case.name}' is a {case.kind}; decks are written for collisions here")
     model = resolve(case)
-    t_c = characteristic_time(model)
-    from ..reference.collision import auto_dt
-
-    dt = dt or case.run.dt or auto_dt(case, model)
-    v = model.pair.impact_speed
-    from ..reference.collision3d import geometry, initial_state, rules_array
-    from ..reference import kernels3d as k3
-
-    y0 = initial_state(case)
-    gap = max(-k3.kinematics(y0, geometry(case, t_c), rules_array())[0], 0.0)
-    t_end = gap / v + 6.0 * t_c * length
-    steps = int(math.ceil(t_end / dt))
+    dt, t_end, steps = run_length(case, dt, length, model)
     pos = [np.asarray(p.position, float) for p in case.particles]
     vel = [np.asarray(p.velocity, float) for p in case.particles]
     g = np.asarray(case.run.gravity, float)
@@ -100,7 +124,14 @@ def pair_mapping(case: Case, engine: str, i: int, j: int | None, native: mapping
     """The mapping of one type pair. Pairs that never touch in this case (a particle with itself) are
     resolved at the contact's own impact speed, where a model calibrates its stiffness at one. A ``native``
     configuration given directly (tests of engine traps, twins of configurations no seed model maps to)
-    is used for every pair as it is."""
+    is used for every pair as it is. A particle–wall pair of a wall the engines' flat walls cannot place
+    (not axis-aligned) is not expressible."""
+    if j is None:
+        for k, w in enumerate(case.walls):
+            try:
+                wall_axis(w, k)
+            except UnsupportedByEngine as exc:
+                return mapping.refused(engine, str(exc))
     if native is not None:
         return mapping.Mapping(engine, mapping.NATIVE, ["a native engine configuration, given directly"], native)
     params = case.contact.params

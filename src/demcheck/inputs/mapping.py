@@ -88,8 +88,8 @@ class Mapping:
         return self.native
 
 
-def _refused(engine: str, reason: str) -> Mapping:
-    """The mapping of a model the engine cannot express, with the one reason why."""
+def refused(engine: str, reason: str) -> Mapping:
+    """The mapping of a model (or a scene) the engine cannot express, with the one reason why."""
     return Mapping(engine, NONE_, [reason], None)
 
 
@@ -216,7 +216,7 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
     comments: list[str] = []
     nid = model.normal.id
     if nl.kind == HYSTERETIC:
-        return _refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
+        return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
     nat = Native("lammps", normal="", limit=model.limit_force)
     fid = EXACT
     if nid == "lsd":
@@ -242,13 +242,13 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
         elif nl.b == 0.25:
             e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
             if not (0.0 < e_prime < 1.0):
-                return _refused("lammps", f"TTIn's ηn = {nl.eta:g} is at or above what coeff_restitution "
+                return refused("lammps", f"TTIn's ηn = {nl.eta:g} is at or above what coeff_restitution "
                                           "can express (e′ would be ≤ 0)")
             nat.damping, nat.damping_coeff = "coeff_restitution", e_prime
             comments.append(f"damping coeff_restitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} "
                             "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of ENGINES.md §3)")
         else:
-            return _refused("lammps", f"no LAMMPS damping style has the δ^{nl.b:g} law")
+            return refused("lammps", f"no LAMMPS damping style has the δ^{nl.b:g} law")
     if model.limit_force:
         comments.append("limit_damping: total normal force ≥ 0 (the collision-time reduction)")
     # tangential: LAMMPS's dashpot is x_t times the normal damping prefactor η(δ)
@@ -258,14 +258,14 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
     if kind == NONE:
         nat.tangential, nat.tangential_args = "linear_nohistory", (0.0, 0.0)
     elif kind in (LTH, ZZY, WALTON):
-        return _refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
+        return refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
                                   "(nearest: mindlin_rescale/force, a different law)")
     else:
         mu, f_mu = _mu(model, reasons)
         fid = _worst(fid, f_mu)
         if kind == SLIDING:
             if nl.eta == 0.0:
-                return _refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
+                return refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
                                           "is x_t × the normal damping, and this normal law has none")
             nat.tangential, nat.tangential_args = "linear_nohistory", (SLIDING_XT, mu)
             fid = _worst(fid, APPROXIMATE)
@@ -273,7 +273,7 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
                            "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
         elif kind in (VISCOUS, VISCOUS_SLIDING):
             if tl.eta_normal or not eta_n_const:
-                return _refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
+                return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
                                           f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}"
                                           + (" and has no damping" if nl.eta == 0 else ""))
             x_t = tl.eta / nl.eta
@@ -288,14 +288,14 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
         elif kind == SPRING:
             if tl.eta_normal:  # TTIt: ηt = ηn
                 if nid != "tti":
-                    return _refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")
+                    return refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")
                 x_t = tl.eta
             elif tl.eta == 0.0:
                 x_t = 0.0
             elif eta_n_const:
                 x_t = tl.eta / nl.eta
             else:
-                return _refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
+                return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
                                           f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}")
             if tl.kt_sqrt:
                 nat.tangential, nat.tangential_args = "mindlin", (tl.kt, x_t, mu)
@@ -309,7 +309,7 @@ def _map_lammps(model: ResolvedModel, cp: dict) -> Mapping:
                 reasons.append(f"LAMMPS limits the history after Maw (truncation = overlap: ξ such that |Kt ξ + "
                                f"ηt v_t| = μ|Fn|); the case asks for truncation = {name}")
         else:
-            return _refused("lammps", f"no LAMMPS equivalent of tangential '{tid}'")
+            return refused("lammps", f"no LAMMPS equivalent of tangential '{tid}'")
     nat.comments = comments
     return Mapping("lammps", fid, reasons, nat)
 
@@ -325,7 +325,7 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
     p = nat.props
     if nl.kind == HYSTERETIC:
         if nl.ku == 0.0:
-            return _refused("liggghts", "HLS with variable unloading (K_U = K_L + S·F_max) maps to luding "
+            return refused("liggghts", "HLS with variable unloading (K_U = K_L + S·F_max) maps to luding "
                                         "only while δ_max < δ_lim; that route is not generated")
         # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
         nat.normal = "edinburgh"
@@ -335,7 +335,7 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
                         f"K_L = 2E*R̄ = {nl.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
                         f"K_U/K_L = {nl.ku / nl.kl:.17g}")
         if tl.kind != NONE:
-            return _refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
+            return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
                                         "no seed tangential law shares it")
         nat.tangential = "off"
         nat.comments = comments
@@ -355,7 +355,7 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
         nat.normal = "hertz"
         e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
         if not (0.05 < e_prime <= 1.0):
-            return _refused("liggghts", f"TTIn's ηn = {nl.eta:g} needs coefficientRestitution e′ = "
+            return refused("liggghts", f"TTIn's ηn = {nl.eta:g} needs coefficientRestitution e′ = "
                                         f"{e_prime:.4g}, outside LIGGGHTS's 0.05 < e ≤ 1")
         # E*, G* as LIGGGHTS mixes the types' moduli (a rigid wall is a type of modulus 1e30 Pa: the same
         # to round-off)
@@ -363,7 +363,7 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
         comments.append(f"hertz coefficientRestitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} through "
                         "√5 β(e′)√(m̄K_HZ) (ENGINES.md §3)")
     else:
-        return _refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
+        return refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
     if model.limit_force:
         comments.append("limitForce on: total normal force ≥ 0")
     kind = tl.kind
@@ -372,14 +372,14 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
     if kind == NONE:
         nat.tangential = "off"
     elif kind in (LTH, ZZY, WALTON):
-        return _refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
+        return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
     else:
         mu, f_mu = _mu(model, reasons)
         fid = _worst(fid, f_mu)
         p["friction"] = mu
         if kind in (SLIDING, VISCOUS, VISCOUS_SLIDING):
             if not stiff:
-                return _refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
+                return refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
                                             f"needs hooke/stiffness, i.e. normal 'lsd' (not '{nid}')")
             nat.tangential = "no_history"
             if kind == SLIDING:
@@ -402,23 +402,23 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
             nat.tangential = "history"
             if tl.eta_normal:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot outside the cap
                 if nid != "tti":
-                    return _refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
+                    return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
                 fid = _worst(fid, APPROXIMATE)
                 ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
                 reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
                                "the dashpot lies outside the Coulomb cap (spring-only truncation)")
             elif tl.kt_sqrt:  # DDt on hertz/stiffness
                 if nat.normal != "hertz/stiffness":
-                    return _refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
+                    return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
                                                 f"Hertz-type; normal '{nid}' is not")
                 if tl.eta > 0.0:
-                    return _refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
+                    return refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
                 p["kt"] = tl.kt
                 nat.tangential_damping = False
                 comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
             else:
                 if not stiff:
-                    return _refused("liggghts", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' "
+                    return refused("liggghts", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' "
                                                 f"(not '{nid}')")
                 p["kt"] = tl.kt
                 p["gammat"] = tl.eta / m
@@ -431,7 +431,7 @@ def _map_liggghts(model: ResolvedModel, cp: dict) -> Mapping:
                                    f"uncapped while sticking and dropped while slipping); the case asks for "
                                    f"truncation = {name}")
         else:
-            return _refused("liggghts", f"no LIGGGHTS equivalent of tangential '{tid}'")
+            return refused("liggghts", f"no LIGGGHTS equivalent of tangential '{tid}'")
     nat.comments = comments
     return Mapping("liggghts", fid, reasons, nat)
 
