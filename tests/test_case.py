@@ -381,3 +381,14 @@ def test_verify_reports_a_tilted_wall_as_not_expressible(tmp_path):
         assert sources[engine]["status"] == "not expressible", sources[engine]
         assert "walls.0.normal" in sources[engine]["message"]
     assert p.returncode == 0, p.stderr[-2000:]
+
+
+def test_a_bad_variant_says_which_one(tmp_path):
+    from .conftest import CASES
+
+    path = tmp_path / "v.toml"
+    path.write_text((CASES / "glass-pair.toml").read_text() + '\n[variants]\n"impact.speed" = [1.0, -2.0]\n'
+                    '"impact.angle" = [0.0, 30.0]\n')
+    with pytest.raises(ConfigError) as info:
+        C.expand(path)
+    assert info.value.key == "impact.speed" and info.value.variant == "speed=-2,angle=0"

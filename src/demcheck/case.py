@@ -127,7 +127,8 @@ def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
 def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> list[Case]:
     """The cases of a file: one, or with a ``[variants]`` table one per combination of its values
     (``"impact.speed" = [0.1, 1.0, 10.0]``: dotted keys as in ``--set``, each a non-empty list). Each
-    variant is named ``name[key=value,…]`` after the last part of its keys."""
+    variant is named ``name[key=value,…]`` after the last part of its keys; a variant that breaks a rule raises
+    the ConfigError with its label as ``variant``."""
     raw = apply_overrides(_read(path), overrides)
     variants = raw.pop("variants", None) or {}
     if not isinstance(variants, dict):
@@ -151,7 +152,11 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
             set_path(r, key, value)
         label = ",".join(f"{k.rsplit('.', 1)[-1]}={_label(v)}" for k, v in zip(keys, combo))
         r["name"] = f"{base}[{label}]"
-        cases.append(from_dict(r))
+        try:
+            cases.append(from_dict(r))
+        except ConfigError as exc:
+            exc.variant = label  # which variant broke the rule (verify names it with the file)
+            raise
     return cases
 
 
