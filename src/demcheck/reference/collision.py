@@ -125,7 +125,9 @@ def time_to_contact(case: Case) -> float:
 def verlet_capacity(case: Case, dt: float, dt_given: bool, t_free: float, t_c: float, t_max: float,
                     row_bytes: int) -> int:
     """Rows to give a verlet run: the whole run's steps, bounded by RECORD_BUDGET. A run that cannot record
-    its free flight and one contact time within the budget is refused before anything is allocated."""
+    its free flight and one contact time within the budget is refused before anything is allocated, naming
+    the speed (a long free flight) or the step: --dt when ``dt_given`` (an argument), else run.dt or, for
+    the auto dt, run.steps_per_contact."""
     limit = RECORD_BUDGET // row_bytes
     free, contact = t_free / dt, t_c / dt
     if free + contact > limit:
@@ -134,9 +136,9 @@ def verlet_capacity(case: Case, dt: float, dt_given: bool, t_free: float, t_c: f
             raise ConfigError("impact.speed", case_speed(case),
                               f"the free flight to contact takes {free:.3g} time steps of {dt:.3g} s; {cap}: "
                               "raise the speed, shorten impact.gap, or use the adaptive method")
-        if dt_given:
-            raise ConfigError("run.dt", dt, f"{contact:.3g} steps per elastic contact time of {t_c:.3g} s; {cap}: "
-                              "use a larger time step, or the adaptive method")
+        if dt_given or case.run.dt:
+            raise ConfigError("--dt" if dt_given else "run.dt", dt, f"{contact:.3g} steps per elastic contact time "
+                              f"of {t_c:.3g} s; {cap}: use a larger time step, or the adaptive method")
         raise ConfigError("run.steps_per_contact", case.run.steps_per_contact, f"{cap}: use fewer steps per "
                           "contact, or the adaptive method")
     return int(min(t_max / dt + 4, limit))
@@ -186,7 +188,7 @@ def collide(case: Case, method: str | None = None, dt: float | None = None,
             "delta": ED, "delta_dot": ER, "fn": EF})
         used_dt = None
     else:
-        dt_given = bool(dt or case.run.dt)
+        dt_given = bool(dt)
         dt = dt or case.run.dt or auto_dt(case, model)
         if not (dt > 0) or not math.isfinite(dt):
             raise ConfigError("--dt", dt, "must be > 0 (s) and finite")
