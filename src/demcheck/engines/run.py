@@ -3,6 +3,11 @@
 LAMMPS and LIGGGHTS export the same C symbols, so they never share a process. A failed run keeps its work
 directory and its error names it and quotes the tail of the log; a run past its timeout is killed and
 reported as such.
+
+Each engine runs in its own session (a process group of its own, with its MPI ranks), so a terminal's
+Ctrl-C does not reach it: an interrupt of demcheck (SIGINT, or SIGTERM once ``handle_sigterm`` is installed)
+kills the group of every running engine (``kill_all``), starts no new one, and each run killed so raises
+EngineInterrupted — "interrupted", never "failed".
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import EngineFailed, EngineNotFound
+from ..errors import EngineFailed, EngineInterrupted, EngineNotFound
 from . import discovery
 
 DEFAULT_TIMEOUT = 600.0
@@ -42,19 +47,59 @@ class RunOutput:
     warnings: list[str] = field(default_factory=list)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread where SIGINT raises KeyboardInterrupt (see ``handle_sigterm``)."""
+
+
+def handle_sigterm() -> None:
+    """Make SIGTERM interrupt demcheck as SIGINT does: ``Terminated`` is raised in the main thread, so the
+    same handlers stop the engines and write the partial report (exit 143 instead of 130)."""
+
+    def raise_terminated(signum, frame):
+        raise Terminated()
+
+    signal.signal(signal.SIGTERM, raise_terminated)
+
+
+def interrupt_exit_code(exc: BaseException | None) -> int:
+    """128 + the signal: 143 for a SIGTERM (``Terminated``, also as the cause of a wrapping exception), 130
+    for a SIGINT."""
+    while exc is not None:
+        if isinstance(exc, Terminated):
+            return 128 + signal.SIGTERM
+        exc = exc.__cause__ or exc.__context__
+    return 128 + signal.SIGINT
+
+
 _RUNNING: set = set()
+_KILLED: set = set()  # the runs kill_all stopped: interrupted, not failed
+_STOP = threading.Event()  # set by an interrupt: no engine starts until reset()
 _LOCK = threading.Lock()
 
 
 def kill_all() -> None:
-    """Stop every engine this process has running (an interrupted suite)."""
+    """Stop every engine this process has running (their process groups) and start no new one until
+    ``reset()``: an interrupt."""
     with _LOCK:
+        _STOP.set()
         procs = list(_RUNNING)
+        _KILLED.update(procs)
     for proc in procs:
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
+        _kill_group(proc)
+
+
+def reset() -> None:
+    """Allow engine runs again after an interrupt (a new suite in the same process)."""
+    with _LOCK:
+        _STOP.clear()
+        _KILLED.clear()
+
+
+def _kill_group(proc) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
 
 
 def log_tail(text: str, lines: int = 15) -> str:
@@ -91,7 +136,9 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     engine's own domain decomposition)."""
     info = discovery.find(engine)
     if info is None:
-        raise EngineNotFound(f"{engine} is not installed: {discovery.HOW_TO_INSTALL[engine]}")
+        raise EngineNotFound(discovery.missing(engine))
+    if _STOP.is_set():
+        raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
     wd.mkdir(parents=True, exist_ok=True)
     (wd / "in.deck").write_text(deck)
@@ -104,21 +151,29 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         cmd += ["-echo", "none"]
     env = dict(os.environ, OMP_NUM_THREADS="1")
     started = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
-    with _LOCK:
+    with _LOCK:  # an interrupt (kill_all) either sees this run or stops it from starting
+        if _STOP.is_set():
+            raise _interrupted(engine, wd, workdir, interrupt_exit_code(None), "not started: demcheck was interrupted")
+        proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
         _RUNNING.add(proc)
     try:
         out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
+        _kill_group(proc)
         out, _ = proc.communicate()
         log = _read_log(wd, out)
         raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
                             f"kept: {wd}\n{log_tail(log)}", pid=proc.pid) from None
+    except KeyboardInterrupt as exc:  # SIGINT or SIGTERM while waiting on the engine: stop it, and the others
+        kill_all()
+        proc.communicate()
+        raise _interrupted(engine, wd, workdir, interrupt_exit_code(exc)) from exc
     finally:
         with _LOCK:
             _RUNNING.discard(proc)
+    if proc in _KILLED:  # stopped by an interrupt handled elsewhere (another thread's kill_all)
+        raise _interrupted(engine, wd, workdir, interrupt_exit_code(None))
     wall = time.perf_counter() - started
     log = _read_log(wd, out)
     errors = _ERROR.findall(log)
@@ -126,6 +181,19 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         what = errors[0] if errors else f"exit code {proc.returncode}"
         raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
     return RunOutput(engine, info.version, wd, log, wall, warnings_of(log))
+
+
+def _interrupted(engine: str, wd: Path, workdir, code: int, what: str = "was stopped by the interrupt"
+                 ) -> EngineInterrupted:
+    """The error of a run an interrupt stopped (or kept from starting); its temporary work directory (a
+    partial dump) removed."""
+    if workdir is None:
+        import shutil
+
+        shutil.rmtree(wd, ignore_errors=True)
+    exc = EngineInterrupted(f"{engine} {what}")
+    exc.exit_code = code
+    return exc
 
 
 def _read_log(wd: Path, out: str | None) -> str:
