@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from ..errors import EngineInterrupted
 from . import packing_metrics as PM, verdicts as V
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
@@ -134,6 +135,8 @@ def run_packing(case, opts, found, file=None) -> dict:
             continue
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
+        except EngineInterrupted:
+            raise  # the case did not finish: it is left out of the (partial) report
         except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
             comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))

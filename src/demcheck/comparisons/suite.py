@@ -29,7 +29,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from .. import __version__
 from ..case import Case, expand
-from ..errors import DemcheckError
+from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.model import resolve
@@ -57,7 +57,8 @@ def discover(engines) -> dict:
         info = discovery.find(e)
         out[e] = {"found": info is not None, "version": info.version if info else None,
                   "executable": info.executable if info else None,
-                  "how_to_install": None if info else discovery.HOW_TO_INSTALL[e]}
+                  "how_to_install": None if info else discovery.HOW_TO_INSTALL[e],
+                  "why": None if info else discovery.missing(e)}
     return out
 
 
@@ -140,9 +141,16 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
             continue
         try:
             res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout)
+        except EngineInterrupted:
+            raise  # the case did not finish: it is left out of the (partial) report
         except DemcheckError as exc:
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
             comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
+            continue
+        if not res.ok:  # a run its health checks refuse (unstable, unresolved, failed): its metrics mean nothing
+            entry["sources"][engine] = {"status": res.status, "message": res.message, "fidelity": mp.fidelity,
+                                        "engine_version": res.engine_version}
+            comps.append(V.status_comparison(engine, V.FAILED, f"{res.status}: {res.message}"))
             continue
         me = res.metrics()
         twin = twin_states(case, engine, res.dt).metrics()
@@ -212,7 +220,7 @@ def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
         comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
         return True
     if not found[engine]["found"]:
-        why = f"{engine} is not installed: {found[engine]['how_to_install']}"
+        why = found[engine].get("why") or f"{engine} is not installed: {found[engine]['how_to_install']}"
         entry["sources"][engine] = {"status": "engine missing", "message": why}
         comps.append(V.status_comparison(engine, V.MISSING, why))
         return True
@@ -227,19 +235,28 @@ def _source(result) -> dict:
 
 
 def collect(paths) -> list[tuple[Path, Case]]:
+    """Every case of the files (each variant), read and checked before any is run: an error names the file
+    (and the variant, when case.expand says which) at fault, ``cases/x.toml[speed=2]: key = value: rule``."""
     cases = []
     for path in paths:
-        for case in expand(path):
-            cases.append((Path(path), case))
+        try:
+            cases.extend((Path(path), case) for case in expand(path))
+        except ConfigError as exc:
+            if exc.key == "CASE" or str(path) in exc.key:  # already names the file
+                raise
+            where = f"{path}[{exc.variant}]" if getattr(exc, "variant", None) else str(path)
+            raise ConfigError(f"{where}: {exc.key}", exc.value, exc.rule) from None
     return cases
 
 
 def run_suite(files: list[Path], report_root: Path, opts: Options | None = None, quiet: bool = False,
               junit: Path | None = None, argv: list[str] | None = None) -> dict:
+    from ..engines import run as runner
     from . import report
 
     opts = opts or Options()
     console = Console(stderr=True, quiet=quiet)
+    cases = collect(files)  # bad input: one line before any work
     run_id = _dt.datetime.now().strftime("%Y%m%d-%H%M%S") + f"-{os.getpid()}"
     out_dir = report_root / run_id
     found = discover(opts.engines)
@@ -247,11 +264,11 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                "started": _dt.datetime.now().isoformat(timespec="seconds"),
                "command": argv if argv is not None else sys.argv, "engines": found,
                "tolerances": opts.tolerances.__dict__, "cases": [], "failed": 0}
-    cases = collect(files)
     summary["planned"] = len(cases)
     started = time.perf_counter()
     entries: dict[int, dict] = {}
-    interrupted = False
+    interrupted: KeyboardInterrupt | None = None  # SIGINT, or SIGTERM (engines.run.Terminated)
+    runner.reset()
     try:
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=console, transient=True) as progress:
@@ -265,37 +282,40 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                         i = futures[fut]
                         entries[i] = fut.result()
                         progress.update(task, advance=1, description=cases[i][1].name[:50])
-                except KeyboardInterrupt:
-                    interrupted = True
+                except KeyboardInterrupt as exc:
+                    interrupted = exc
                     for f in futures:
                         f.cancel()
-                    from ..engines import run as runner
-
+                    # the engines stopped, and none starts: the cases running finish without them (raising
+                    # EngineInterrupted: left out) or, needing none, finish and are reported
                     runner.kill_all()
                     pool.shutdown(wait=True, cancel_futures=True)
+                    runner.reset()  # every worker has stopped: engines may run again in this process
                     for f, i in futures.items():
                         if f.done() and not f.cancelled() and i not in entries and f.exception() is None:
                             entries[i] = f.result()
-        summary["partial"] = interrupted
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as exc:  # outside the wait (or a second one during the shutdown)
+        interrupted = interrupted or exc
+        runner.kill_all()
     finally:
         summary["cases"] = [entries[i] for i in sorted(entries)]
         summary["failed"] = sum(e["status"] in ("failed", "unexpected") for e in summary["cases"])
         summary["wall_time"] = time.perf_counter() - started
-        summary["partial"] = interrupted or len(summary["cases"]) < len(cases)
+        summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
         if opts.cache is not None:
             summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
         report.write_all(summary, out_dir, report_root, junit=junit)
     _print(console, summary)
-    if interrupted:
-        raise KeyboardInterrupt
+    if interrupted is not None:
+        raise interrupted
     return summary
 
 
 def _safe_case(case, path, opts, found) -> dict:
     try:
         return run_case(case, path, opts, found)
+    except EngineInterrupted:
+        raise
     except DemcheckError as exc:
         return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
                 "verdict": V.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
