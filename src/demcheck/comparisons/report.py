@@ -10,6 +10,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+import logging
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -38,7 +39,7 @@ def clean(obj):
 
 def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None) -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
-    PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]).parent / "plots" if "cache" in summary else None
+    PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]) / "plots" if "cache" in summary else None
     data = {k: v for k, v in summary.items()}
     data["cases"] = [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]
     write_json(out_dir / "results.json", clean(data))
@@ -261,11 +262,16 @@ def _png(fig) -> str:
     return base64.b64encode(buf.getvalue()).decode()
 
 
-PLOT_CACHE: dict = {"dir": None}  # set by write_all when the run uses the cache
+# the plot cache: <engine-run cache>/plots (under $DEMCHECK_CACHE), set by write_all when the run uses the cache
+PLOT_CACHE: dict = {"dir": None}
+_PNG_START, _PNG_END = b"\x89PNG\r\n\x1a\n", b"IEND\xaeB`\x82"
+_DAMAGED_LOGGED: set = set()
 
 
-def _cached(key_obj, render):
-    """A plot's PNG (base64), from the plot cache when the same data was drawn before (warm runs)."""
+def _cached(key_obj, render, valid):
+    """A plot's text (a PNG in base64, or a JSON list of them), from the plot cache when the same data was
+    drawn before (warm runs). An entry that does not read back ``valid`` (truncated, changed) is a miss: drawn
+    again and replaced. A cache that cannot be written only costs the drawing."""
     import hashlib
     import json
 
@@ -274,12 +280,46 @@ def _cached(key_obj, render):
         return render()
     k = hashlib.sha256(json.dumps(clean(key_obj), sort_keys=True, default=str).encode()).hexdigest()
     path = Path(d) / f"{k}.b64"
-    if path.exists():
-        return path.read_text()
-    b64 = render()
-    if b64:
-        write_text(path, b64)
-    return b64
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        text = None
+    except (OSError, UnicodeDecodeError):
+        text = ""
+    if text is not None:
+        if valid(text):
+            return text
+        if path not in _DAMAGED_LOGGED:  # once, as the engine-run cache does (logger demcheck.cache)
+            _DAMAGED_LOGGED.add(path)
+            logging.getLogger("demcheck.cache").warning(
+                "demcheck: plot cache: ignoring the damaged entry %s; it is drawn again and replaced", path)
+    out = render()
+    try:
+        write_text(path, out)
+    except OSError:
+        pass
+    return out
+
+
+def _png_ok(b64) -> bool:
+    """A whole PNG in base64: its signature first, its IEND chunk last."""
+    try:
+        data = base64.b64decode(b64, validate=True)
+    except (ValueError, TypeError):
+        return False
+    return data.startswith(_PNG_START) and data.endswith(_PNG_END)
+
+
+def _plot_list_ok(text: str) -> bool:
+    """A JSON list of [title, PNG in base64] pairs."""
+    import json
+
+    try:
+        items = json.loads(text)
+    except ValueError:
+        return False
+    return isinstance(items, list) and all(isinstance(x, list) and len(x) == 2 and isinstance(x[0], str)
+                                           and _png_ok(x[1]) for x in items)
 
 
 def _img(b64: str, alt: str) -> str:
@@ -294,7 +334,7 @@ def case_panels(entry: dict) -> str | None:
     series = entry.get("series") or []
     if not series:
         return None
-    return _cached({"case": entry["case"], "series": series}, lambda: _draw_case(entry["case"], series))
+    return _cached({"case": entry["case"], "series": series}, lambda: _draw_case(entry["case"], series), _png_ok)
 
 
 def _draw_case(name, series) -> str:
@@ -331,7 +371,7 @@ def suite_plots(summary: dict) -> list[tuple[str, str]]:
 
     key = [(c["case"], c.get("impact"), {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()})
            for c in summary["cases"]]
-    text = _cached({"suite": key}, lambda: json.dumps(_suite_plots(summary)))
+    text = _cached({"suite": key}, lambda: json.dumps(_suite_plots(summary)), _plot_list_ok)
     return [tuple(x) for x in json.loads(text)]
 
 
