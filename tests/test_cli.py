@@ -147,3 +147,102 @@ def test_models_shows_the_engine_mapping():
     assert rows[("normal", "hls")]["engines"]["lammps"]["fidelity"] == "none"
     assert rows[("normal", "hls")]["engines"]["liggghts"]["fidelity"] == "exact"
     assert rows[("tangential", "ddt")]["engines"]["lammps"]["config"].endswith("tangential mindlin")
+
+
+# ----------------------------------------------------------------------------- numbers on the command line
+
+
+def _one_line_exit_2(p, needle):
+    assert p.returncode == 2, (p.returncode, p.stderr[-2000:])
+    assert p.stdout == ""
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("demcheck: error: ") and needle in lines[0], p.stderr[-2000:]
+
+
+GLASS = CASES / "glass-pair.toml"
+PACKING = CASES / "packing" / "column-lsd.toml"
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["collide", GLASS, "--dt", "inf"], "--dt = inf: must be a finite number > 0 (s)"),
+    (["collide", GLASS, "--dt", "nan"], "--dt = nan: must be a finite number > 0 (s)"),
+    (["collide", GLASS, "--dt", "fast"], "--dt = 'fast': must be a finite number > 0 (s)"),
+    (["collide", GLASS, "--engine", "lammps", "--timeout", "nan"], "--timeout = nan: must be a finite number > 0"),
+    (["collide", GLASS, "--timeout", "0"], "--timeout = 0.0: must be > 0 and <= 1e+06 (s)"),
+    (["collide", GLASS, "--timeout", "1e300"], "--timeout = 1e+300: must be > 0 and <= 1e+06 (s)"),
+    (["deck", GLASS, "--engine", "lammps", "--dt", "-inf"], "--dt = -inf: must be a finite number > 0 (s)"),
+    (["sweep", GLASS, "--vary", "impact.speed=1,2", "--dt", "nan"], "--dt = nan: must be a finite number"),
+    (["verify", GLASS, "--engines", "none", "--timeout", "nan"], "--timeout = nan: must be a finite number"),
+    (["verify", GLASS, "--engines", "none", "--jobs", "0"], "--jobs = 0: must be >= 1 and <= 256"),
+    (["verify", GLASS, "--engines", "none", "-j", "1.5"], "--jobs = '1.5': must be an integer >= 1 and <= 256"),
+    (["pack", PACKING, "--duration", "inf"], "--duration = inf: must be a finite number > 0 (s)"),
+    (["pack", PACKING, "--engine", "lammps", "--mpi", "0"], "--mpi = 0: must be >= 1 and <= 256 (MPI ranks)"),
+    (["pack", PACKING, "--engine", "lammps", "--timeout", "nan"], "--timeout = nan: must be a finite number"),
+    (["dt", GLASS, "--target", "nan"], "--target = nan: must be a finite number > 0 and < 1"),
+    (["dt", GLASS, "--target", "1"], "--target = 1.0: must be > 0 and < 1"),
+    (["bench", GLASS, "--steps", "10,inf"], "--steps = inf: must be a finite number >= 1 and <= 1e+06"),
+    (["bench", GLASS, "--steps", "10,x"], "--steps = 'x': must be a finite number >= 1"),
+    (["bench", GLASS, "--batch", "0"], "--batch = 0: must be >= 1 and <= 10000"),
+])
+def test_every_numeric_option_is_finite_and_in_range(args, needle, tmp_path):
+    _one_line_exit_2(demcheck(*args, cwd=tmp_path), needle)
+    assert list(tmp_path.iterdir()) == []  # refused before any work: no report, no deck, no cache
+
+
+# ----------------------------------------------------------------------------- output paths, checked up front
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["verify", GLASS, "--engines", "none", "--report", "{file}/reports"],
+     "--report = '{file}/reports': {file} is a file"),
+    (["verify", GLASS, "--engines", "none", "--report", "{file}"], "--report = '{file}': is a file, not a directory"),
+    (["verify", GLASS, "--engines", "none", "--report", "/sys/demcheck-reports"],
+     "--report = '/sys/demcheck-reports': cannot write in /sys (Permission denied)"),
+    (["verify", GLASS, "--engines", "none", "--junit", "{file}/j.xml"], "--junit = '{file}/j.xml': {file} is a file"),
+    (["verify", GLASS, "--engines", "none", "--junit", "{dir}"], "--junit = '{dir}': is a directory, not a file"),
+    (["deck", GLASS, "--engine", "lammps", "-o", "{file}/in.deck"], "--output = '{file}/in.deck': {file} is a file"),
+    (["collide", GLASS, "--plot", "{file}/p.png"], "--plot = '{file}/p.png': {file} is a file"),
+    (["collide", GLASS, "--csv", "{dir}"], "--csv = '{dir}': is a directory, not a file"),
+    (["sweep", GLASS, "--vary", "impact.speed=1,2", "--csv", "{file}/s.csv"],
+     "--csv = '{file}/s.csv': {file} is a file"),
+    (["sweep", GLASS, "--vary", "impact.speed=1,2", "--plot", "{file}/a/s.png"],
+     "--plot = '{file}/a/s.png': {file} is a file"),
+    (["pack", PACKING, "--csv", "{file}/state"], "--csv = '{file}/state': {file} is a file"),
+    (["bench", GLASS, "--report", "{file}/r"], "--report = '{file}/r': {file} is a file"),
+    (["stress", GLASS, "--report", "{file}/r"], "--report = '{file}/r': {file} is a file"),
+])
+def test_output_paths_are_checked_before_any_work(args, needle, tmp_path):
+    file, out = tmp_path / "a-file", tmp_path / "work"
+    file.write_text("x")
+    out.mkdir()
+    fill = {"file": file, "dir": tmp_path}
+    p = demcheck(*[str(a).format(**fill) for a in args], cwd=out)
+    _one_line_exit_2(p, needle.format(**fill))
+    assert list(out.iterdir()) == []
+
+
+def test_a_cache_that_is_a_file_is_refused_up_front(tmp_path):
+    import os
+
+    cache = tmp_path / "cache"
+    cache.write_text("not a directory")
+    p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(GLASS), "--engines", "none", "--report",
+                        str(tmp_path / "r")], capture_output=True, text=True, cwd=tmp_path, timeout=300,
+                       env=dict(os.environ, DEMCHECK_CACHE=str(cache)))
+    _one_line_exit_2(p, f"DEMCHECK_CACHE = '{cache}': is a file, not a directory")
+    assert not (tmp_path / "r").exists()
+
+
+# ----------------------------------------------------------------------------- sweep: every point checked first
+
+
+@pytest.mark.parametrize("vary,needle", [
+    ("impact.angle=0-80", "--vary impact.angle = '0-80': '0-80' is not a value; must be KEY=START:STOP:N"),
+    ("impact.angle=0:80", "--vary impact.angle = '0:80': must be KEY=START:STOP:N"),
+    ("impact.angle=1:2:0", "--vary impact.angle = '1:2:0': N must be in [1, 10000]"),
+    ("impact.angle=1:2:100000000", "--vary impact.angle = '1:2:100000000': N must be in [1, 10000]"),
+    ("impact.angel=10,20", "impact.angel = 10: unknown key; did you mean 'angle'?"),
+    ("impact.angle=10,95", "impact.angle = 95.0: must be in [0, 90)"),
+])
+def test_sweep_refuses_a_bad_key_or_value_before_solving(vary, needle):
+    _one_line_exit_2(demcheck("sweep", CASES / "oblique-lsd-wall.toml", "--vary", vary), needle)

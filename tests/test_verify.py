@@ -76,8 +76,9 @@ def test_a_metric_that_does_not_apply_agrees():
     assert c.verdict == V.AGREE and c.rel_diff == 0.0
 
 
-def test_a_metric_missing_on_one_side_is_unexpected():
-    assert judge(value=math.nan, twin=math.nan).verdict == V.UNEXPECTED
+def test_a_metric_missing_on_the_engines_side_fails():
+    # a broken run is never "agree" nor "differs as expected" (issue 12 item 5: judge_engine)
+    assert judge(value=math.nan, twin=math.nan).verdict == V.FAILED
 
 
 def test_scales_of_the_metrics():
@@ -293,3 +294,129 @@ def test_report_html_renders_its_plots_in_a_headless_browser(tmp_path):
     n = int(re.search(r'data-plots="(\d+)"', dom).group(1))
     ok = int(re.search(r'data-plots-ok="(\d+)"', dom).group(1))
     assert n >= 4 and ok == n  # every plot decoded and laid out with a size
+
+
+# ----------------------------------------------------------------------------- the plot cache
+
+
+def test_the_plot_cache_lives_under_the_cache_and_a_damaged_entry_is_drawn_again(tmp_path, caplog):
+    files = [CASES / "glass-pair.toml"]
+    first = _run(tmp_path, files)
+    plots = sorted((tmp_path / "cache" / "plots").glob("*.b64"))
+    assert len(plots) >= 2 and not (tmp_path / "plots").exists()  # under $DEMCHECK_CACHE, not beside it
+    good = {p: p.read_text() for p in plots}
+    damage = [lambda t: t[: len(t) // 2], lambda t: "", lambda t: t.replace(t[40:60], "#" * 20, 1)]
+    for k, p in enumerate(plots):
+        p.write_text(damage[k % len(damage)](good[p]))
+    second = _run(tmp_path, files)
+    out = Path(second["report"])
+    assert (tmp_path / "reports" / "latest").resolve() == out.resolve()
+    assert (out / "report.html").read_text().count('<img class="plot"') >= 2
+    assert {p: p.read_text() for p in plots} == good  # each damaged entry replaced by a sound one
+    logged = [r.getMessage() for r in caplog.records if r.name == "demcheck.cache"]
+    assert len(logged) == len(plots) and all("plot cache: ignoring the damaged entry" in m for m in logged)
+
+
+# ----------------------------------------------------------------------------- errors name their file
+
+
+def test_a_bad_case_file_is_named_before_any_case_runs(tmp_path):
+    good, bad = tmp_path / "good.toml", tmp_path / "bad.toml"
+    good.write_text((CASES / "glass-pair.toml").read_text())
+    bad.write_text((CASES / "glass-pair.toml").read_text().replace('normal = "hertz"', 'normal = "hertzz"'))
+    with pytest.raises(ConfigError, match=rf"^{bad}: contact.normal = 'hertzz': unknown normal model"):
+        _run(tmp_path, [good, bad])
+    assert not (tmp_path / "reports").exists()
+
+
+def test_a_bad_variant_is_named_with_its_file(tmp_path):
+    bad = tmp_path / "bad.toml"
+    text = (CASES / "glass-pair.toml").read_text().replace('normal = "hertz"', 'normal = "lsd"')
+    bad.write_text(text + '\n[variants]\n"contact.stiffness_method" = ["energy", "bogus"]\n')
+    # the variant's label too once case.expand says which variant failed (ConfigError.variant)
+    with pytest.raises(ConfigError, match=rf"^{bad}(\[stiffness_method=bogus\])?: contact.stiffness_method = 'bogus'"):
+        _run(tmp_path, [bad])
+    bad.write_text((CASES / "glass-pair.toml").read_text() + '\n[variants]\n"impact.speed" = [1.0, -2.0]\n')
+    with pytest.raises(ConfigError, match=rf"^{bad}(\[speed=-2\])?: impact.speed = -2.0: must be > 0"):
+        _run(tmp_path, [bad])
+
+
+def test_cli_verify_names_the_file_at_fault_in_one_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((CASES / "glass-pair.toml").read_text().replace("[impact]", "[impact]\nsped = 1.0"))
+    p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(CASES / "hertz-wall.toml"), str(bad),
+                        "--engines", "none"], capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert p.returncode == 2 and p.stdout == ""
+    assert p.stderr.strip().splitlines() == [f"demcheck: error: {bad}: impact.sped = 1.0: unknown key; did you "
+                                             "mean 'speed'?"]
+    assert not (tmp_path / "reports").exists()
+
+
+# ----------------------------------------------------------------------------- engine runs the suite refuses
+
+
+def test_an_engine_run_that_is_not_ok_fails_its_case_and_its_metrics_are_not_judged(monkeypatch):
+    from demcheck.case import load
+    from demcheck.engines import collide as engine_collide
+    from demcheck.reference.collision import collide
+
+    def unstable(case, engine, **kw):
+        res = collide(case, "verlet")
+        res.source, res.method, res.engine_version = engine, "engine", "fake 1.0"
+        res.status, res.message = "unstable", "the overlap reached 3.2 radii"
+        return res
+
+    monkeypatch.setattr(engine_collide, "collide", unstable)
+    found = {"lammps": {"found": True, "version": "fake 1.0", "executable": "lmp", "how_to_install": None}}
+    opts = suite.Options(engines=("lammps",), jobs=1, cache=None)
+    entry = suite.run_case(load(CASES / "glass-pair.toml"), CASES / "glass-pair.toml", opts, found)
+    lam = [k for k in entry["comparisons"] if k["source"] == "lammps"]
+    assert [(k["verdict"], k["reason"]) for k in lam] == [(V.FAILED, "unstable: the overlap reached 3.2 radii")]
+    assert entry["status"] == "failed" and entry["sources"]["lammps"]["status"] == "unstable"
+
+
+# ----------------------------------------------------------------------------- --timeout reaches every engine run
+
+SLEEPER = """#!/bin/sh
+case "$1" in -h) echo "Large-scale Atomic/Molecular Massively Parallel Simulator - 22 Jul 2025 - fake"; exit 0;; esac
+exec sleep 300
+"""
+
+
+def test_the_timeout_applies_to_every_engine_run_collisions_and_packings(tmp_path, monkeypatch):
+    from demcheck.engines import discovery
+
+    fake = tmp_path / "lmp"
+    fake.write_text(SLEEPER)
+    fake.chmod(0o755)
+    monkeypatch.setenv("DEMCHECK_LAMMPS", str(fake))
+    discovery.find.cache_clear()
+    try:
+        s = _run(tmp_path, [CASES / "glass-pair.toml", CASES / "packing" / "layer-kk.toml"], engines=("lammps",),
+                 timeout=1.0)
+    finally:
+        discovery.find.cache_clear()
+    for c in s["cases"]:
+        lam = [k for k in c["comparisons"] if k["source"] == "lammps"]
+        assert [k["verdict"] for k in lam] == [V.FAILED], c["case"]
+        assert lam[0]["reason"].startswith("lammps ran past its timeout of 1 s and was stopped"), lam[0]["reason"]
+
+
+def test_no_cache_runs_afresh_and_replaces_the_cached_entries(tmp_path):
+    env = dict(os.environ, DEMCHECK_CACHE=str(tmp_path / "cache"))
+
+    def verify(*extra):
+        p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(CASES / "packing" / "layer-kk.toml"),
+                            "--engines", "none", "--report", str(tmp_path / "r"), "--json", *extra],
+                           capture_output=True, text=True, env=env, cwd=tmp_path, timeout=600)
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout)
+
+    first = verify()
+    entries = sorted((tmp_path / "cache").rglob("*.npz"))
+    assert entries and first["cache"]["misses"] > 0
+    for e in entries:
+        os.utime(e, (946684800, 946684800))  # 2000-01-01: an old entry
+    fresh = verify("--no-cache")
+    assert fresh["cache"]["hits"] == 0
+    assert all(e.stat().st_mtime > 946684800 for e in entries)  # written over by the fresh run

@@ -35,6 +35,87 @@ def emit_json(obj) -> None:
     click.echo(json.dumps(_jsonable(obj), indent=2, allow_nan=False))
 
 
+# ----------------------------------------------------------------------------- checked options
+
+
+def number(key: str, value, *, lo=None, hi=None, lo_open=False, hi_open=False, integer=False, unit=""):
+    """``value`` (text or a number) as a finite number in [lo, hi] (an open end with lo_open/hi_open), else
+    ConfigError naming ``key``, the value and the rule."""
+    kind = "an integer" if integer else "a finite number"
+    bounds = []
+    if lo is not None:
+        bounds.append(f"{'>' if lo_open else '>='} {lo:g}")
+    if hi is not None:
+        bounds.append(f"{'<' if hi_open else '<='} {hi:g}")
+    where = " and ".join(bounds) + (f" ({unit})" if unit else "")
+    try:
+        parsed = (int(value) if isinstance(value, int) else int(str(value).strip())) if integer \
+            else float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(key, value, f"must be {kind} {where}".rstrip()) from None
+    if not math.isfinite(parsed):
+        raise ConfigError(key, parsed, f"must be {kind} {where}".rstrip())
+    if (lo is not None and (parsed < lo or (lo_open and parsed == lo))) or \
+            (hi is not None and (parsed > hi or (hi_open and parsed == hi))):
+        raise ConfigError(key, parsed, f"must be {where}")
+    return parsed
+
+
+class Number(click.ParamType):
+    """A command-line number: finite and in range, else one line ``demcheck: error: --dt = inf: must be a
+    finite number > 0 (s)`` and exit 2 (``number``)."""
+
+    def __init__(self, **bounds):
+        self.bounds = bounds
+        self.name = "integer" if bounds.get("integer") else "number"
+
+    def convert(self, value, param, ctx):
+        return number(_option_name(param), value, **self.bounds)
+
+
+def _option_name(param) -> str:
+    return max(param.opts, key=len) if param is not None and param.opts else "value"
+
+
+def check_output(key: str, path, directory: bool = False) -> None:
+    """An output path demcheck can write (a file, or a ``directory`` it creates or fills), checked before any
+    work: nothing on the way is a file, the path is not of the other kind, and its first existing directory
+    takes a new file. Else ConfigError naming ``key``, the path and the rule."""
+    import tempfile
+
+    p = Path(path).absolute()
+    if p.is_dir() != directory and p.exists():
+        raise ConfigError(key, str(path), "is a file, not a directory" if directory else "is a directory, not a file")
+    where = p if directory and p.is_dir() else p.parent
+    while not where.exists() and not where.is_symlink() and where != where.parent:
+        where = where.parent
+    if not where.is_dir():
+        raise ConfigError(key, str(path), f"{where} is a file, not a directory")
+    try:
+        with tempfile.TemporaryFile(dir=where):
+            pass
+    except OSError as exc:
+        raise ConfigError(key, str(path), f"cannot write in {where} ({exc.strerror or exc})") from None
+
+
+class OutputPath(click.ParamType):
+    """An output file (or ``directory``) checked up front by ``check_output``."""
+
+    name = "path"
+
+    def __init__(self, directory: bool = False):
+        self.directory = directory
+
+    def convert(self, value, param, ctx):
+        check_output(_option_name(param), value, self.directory)
+        return str(value)
+
+
+DT = Number(lo=0, lo_open=True, unit="s")
+TIMEOUT = Number(lo=0, lo_open=True, hi=1e6, unit="s")  # the pipes' poll() takes at most ~2.1e6 s
+OUT_FILE, OUT_DIR = OutputPath(), OutputPath(directory=True)
+
+
 def _load(case_path: str, overrides) -> "object":
     from . import case as case_mod
 
@@ -107,23 +188,19 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
               help="the source(s): the reference, an engine (its deck run for real), or all side by side")
 @click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
               help="reference method (default: the case's run.method, adaptive)")
-@click.option("--dt", type=float, default=None, help="time step of the verlet method and of the engines (s)")
+@click.option("--dt", type=DT, default=None, help="time step of the verlet method and of the engines (s)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-@click.option("--plot", type=click.Path(dir_okay=False), default=None, help="write force–overlap and force–time panels")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
+@click.option("--plot", type=OUT_FILE, default=None, help="write force–overlap and force–time panels")
+@click.option("--csv", "csv_path", type=OUT_FILE, default=None,
               help="write the contact time series (of the first source)")
-@click.option("--timeout", type=float, default=600.0, show_default=True, help="engine run timeout (s)")
+@click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="engine run timeout (s)")
 def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout):
     """Solve one collision case and print its metrics (per source, side by side)."""
     from .errors import EngineNotFound, UnsupportedByEngine
     from .reference.collision import collide as run
 
     case = _load(case_path, overrides)
-    if dt is not None and not dt > 0:
-        raise ConfigError("--dt", dt, "must be > 0 (s)")
-    if timeout <= 0:
-        raise ConfigError("--timeout", timeout, "must be > 0 (s)")
     sources = ["reference", "lammps", "liggghts"] if engine == "all" else [engine]
     results, skipped = {}, {}
     for src in sources:
@@ -200,9 +277,9 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
 @cli.command()
 @click.argument("case_path", metavar="CASE")
 @click.option("--engine", type=click.Choice(["lammps", "liggghts"]), required=True)
-@click.option("-o", "--output", type=click.Path(dir_okay=False), default=None,
+@click.option("-o", "--output", type=OUT_FILE, default=None,
               help="write the deck here (files it reads go beside it); default: stdout")
-@click.option("--dt", type=float, default=None, help="time step (s); default: the case's")
+@click.option("--dt", type=DT, default=None, help="time step (s); default: the case's")
 @_set_option
 def deck(case_path, engine, output, dt, overrides):
     """Write the engine's input deck of a collision or packing case (runnable by hand: lmp -in / liggghts
@@ -210,8 +287,6 @@ def deck(case_path, engine, output, dt, overrides):
     from .engines.collide import deck as make_deck
 
     case = _load(case_path, overrides)
-    if dt is not None and not dt > 0:
-        raise ConfigError("--dt", dt, "must be > 0 (s)")
     if case.kind == "packing":
         from .inputs import packing_decks
 
@@ -268,25 +343,21 @@ def _print_summary(s: dict) -> None:
 @click.option("--vary", "varies", multiple=True, required=True, metavar="KEY=START:STOP:N",
               help="a case key and its values (N evenly spaced, or KEY=a,b,c); several make a grid")
 @click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None)
-@click.option("--dt", type=float, default=None, help="time step of the verlet method (s)")
+@click.option("--dt", type=DT, default=None, help="time step of the verlet method (s)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="write the table")
-@click.option("--plot", type=click.Path(dir_okay=False), default=None, help="plot metrics against the first key")
+@click.option("--csv", "csv_path", type=OUT_FILE, default=None, help="write the table")
+@click.option("--plot", type=OUT_FILE, default=None, help="plot metrics against the first key")
 def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
     """Metrics of a collision over one or more case keys, e.g. --vary impact.angle=5:85:17."""
     from rich.progress import Progress
 
-    from .comparisons.sweep import parse_vary, plot_sweep, run_sweep
+    from .comparisons.sweep import parse_vary, plot_sweep, run_sweep, sweep_points
 
-    if dt is not None and not dt > 0:
-        raise ConfigError("--dt", dt, "must be > 0 (s)")
-    total = 1
-    for v in varies:
-        total *= len(parse_vary(v)[1])
+    points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
     with Progress(transient=True, disable=as_json) as progress:
-        task = progress.add_task("sweep", total=total)
-        table = run_sweep(case_path, overrides, list(varies), method, dt, lambda: progress.advance(task))
+        task = progress.add_task("sweep", total=len(points))
+        table = run_sweep(points, method, dt, lambda: progress.advance(task))
     if csv_path:
         from .io import atomic_path
 
@@ -317,34 +388,34 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
 @click.argument("paths", nargs=-1, metavar="[CASE|DIR]...")
 @click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST",
               help="comma-separated engines to compare (lammps, liggghts), or 'none' for the reference alone")
-@click.option("--jobs", "-j", type=int, default=2, show_default=True, help="cases run in parallel")
-@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True,
+@click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
+              help="cases run in parallel")
+@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest go")
-@click.option("--junit", "junit", type=click.Path(dir_okay=False), default=None, help="also write JUnit XML here")
+@click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-@click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again (ignore the run cache)")
-@click.option("--timeout", type=float, default=600.0, show_default=True, help="per engine run (s)")
+@click.option("--no-cache", "no_cache", is_flag=True,
+              help="run every engine deck again (read no cached run; the fresh runs replace the cached ones)")
+@click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="per engine run (s)")
 def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
     from .comparisons.suite import Options, run_suite
-    from .engines.cache import Cache
+    from .engines import run as runner
+    from .engines.cache import Cache, default_dir
 
     names = _engine_list(engines)
-    if jobs < 1:
-        raise ConfigError("--jobs", jobs, "must be >= 1")
-    if timeout <= 0:
-        raise ConfigError("--timeout", timeout, "must be > 0 (s)")
+    check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)
-    opts = Options(engines=tuple(names), jobs=jobs, cache=None if no_cache else Cache(), timeout=timeout)
+    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout)
     try:
         summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
                             argv=["demcheck", "verify", *sys.argv[2:]])
-    except KeyboardInterrupt:
-        click.echo("demcheck: interrupted; the finished cases are in the partial report "
-                   f"{Path(report_dir) / 'latest'}", err=True)
-        sys.exit(130)
+    except KeyboardInterrupt as exc:
+        click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
+                   f"report {Path(report_dir) / 'latest'}", err=True)
+        sys.exit(runner.interrupt_exit_code(exc))
     if as_json:
         from .comparisons.report import clean
 
@@ -357,15 +428,17 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
 @click.argument("case_path", metavar="CASE")
 @click.option("--engine", type=click.Choice(["reference", "lammps", "liggghts"]), default="reference",
               show_default=True)
-@click.option("--duration", type=float, default=None, help="simulated time (s); default: the case's packing.duration")
-@click.option("--mpi", "mpi", type=int, default=1, show_default=True,
+@click.option("--duration", type=DT, default=None, help="simulated time (s); default: the case's packing.duration")
+@click.option("--mpi", "mpi", type=Number(lo=1, hi=256, integer=True, unit="MPI ranks"), default=1,
+              show_default=True,
               help="run the engine on this many MPI ranks (its own domain decomposition)")
-@click.option("--csv", "csv_dir", type=click.Path(file_okay=False), default=None,
+@click.option("--timeout", type=TIMEOUT, default=3600.0, show_default=True, help="engine run timeout (s)")
+@click.option("--csv", "csv_dir", type=OUT_DIR, default=None,
               help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "
                    "(i, j, overlap, fn, ft of every particle pair in contact)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
+def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json):
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics."""
     from .comparisons import packing_metrics as PM
@@ -374,10 +447,6 @@ def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
     case = _load(case_path, overrides)
     if case.kind != "packing":
         raise ConfigError("kind", case.kind, "demcheck pack runs packing cases (kind = \"packing\")")
-    if duration is not None and not duration > 0:
-        raise ConfigError("--duration", duration, "must be > 0 (s)")
-    if mpi < 1:
-        raise ConfigError("--mpi", mpi, "must be >= 1 (MPI ranks)")
     if mpi > 1 and engine == "reference":
         raise ConfigError("--mpi", mpi, "applies to an engine (--engine lammps|liggghts); the reference runs on one core")
     box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
@@ -397,7 +466,7 @@ def pack(case_path, engine, duration, mpi, csv_dir, overrides, as_json):
     else:
         from .inputs.packing_decks import run_engine
 
-        run = run_engine(case, engine, duration=duration, mpi=mpi)
+        run = run_engine(case, engine, duration=duration, mpi=mpi, timeout=timeout)
         m = PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
                        forces=run.contacts["fn"].to_numpy(), overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
@@ -453,8 +522,9 @@ def _engine_text(names) -> str:
               help="comma-separated engines (lammps, liggghts), or 'none'")
 @click.option("--steps", "steps", default=None, metavar="LIST",
               help="steps per elastic contact time to sweep (default 5,10,20,50,100,200,500,1000,2000,5000)")
-@click.option("--batch", type=int, default=16, show_default=True, help="copies per engine batch run")
-@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True)
+@click.option("--batch", type=Number(lo=1, hi=10000, integer=True), default=16, show_default=True,
+              help="copies per engine batch run")
+@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @_set_option
 def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
@@ -470,14 +540,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     names = _engine_list(engines)
     grid = B.STEPS_PER_CONTACT
     if steps:
-        try:
-            grid = tuple(float(x) for x in steps.split(","))
-        except ValueError:
-            raise ConfigError("--steps", steps, "must be comma-separated numbers of steps per contact") from None
-        if not grid or any(not (x >= 1) for x in grid):
-            raise ConfigError("--steps", steps, "must be numbers >= 1")
-    if batch < 1:
-        raise ConfigError("--batch", batch, "must be >= 1")
+        grid = tuple(number("--steps", x, lo=1, hi=1e6, unit="steps per contact") for x in steps.split(","))
     files = _case_files(paths)
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
@@ -502,7 +565,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
 @click.option("--only", "only", multiple=True, metavar="NAME",
               help="stress only parameters whose name contains NAME (stiffness, restitution, radius, speed, "
                    "angle, mass); repeatable")
-@click.option("--report", "report_dir", type=click.Path(file_okay=False), default="reports", show_default=True)
+@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 def stress(paths, engines, only, report_dir, as_json):
     """Numerical stability: the largest stable time step of each source against stiffness, mass ratio,
@@ -533,7 +596,7 @@ def stress(paths, engines, only, report_dir, as_json):
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
-@click.option("--target", type=float, default=1e-3, show_default=True,
+@click.option("--target", type=Number(lo=0, hi=1, lo_open=True, hi_open=True), default=1e-3, show_default=True,
               help="the worst relative error to allow (restitution, contact time, max overlap, peak force)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
@@ -542,8 +605,6 @@ def dt(case_path, target, overrides, as_json):
     work–precision of the engines' scheme, with the error to expect."""
     from .comparisons.bench import recommend
 
-    if not (0 < target < 1):
-        raise ConfigError("--target", target, "must be between 0 and 1 (a relative error)")
     case = _load(case_path, overrides)
     rec = recommend(case, target)
     if as_json:
@@ -584,11 +645,23 @@ def _case_files(paths) -> list[Path]:
 
 
 def main(argv=None) -> None:
+    import threading
+
+    from .engines import run as runner
+    from .errors import EngineInterrupted
+
+    if threading.current_thread() is threading.main_thread():
+        runner.handle_sigterm()  # SIGTERM as SIGINT: engines stopped, a partial report, exit 143
     try:
         cli.main(args=argv, prog_name="demcheck", standalone_mode=False)
-    except click.exceptions.Abort:
+    except click.exceptions.Abort as exc:  # click's KeyboardInterrupt (or Terminated)
+        runner.kill_all()
         click.echo("demcheck: interrupted", err=True)
-        sys.exit(130)
+        sys.exit(runner.interrupt_exit_code(exc))
+    except EngineInterrupted as exc:
+        runner.kill_all()
+        click.echo(f"demcheck: interrupted: {str(exc).splitlines()[0]}", err=True)
+        sys.exit(exc.exit_code)
     except click.exceptions.ClickException as exc:
         exc.show()
         sys.exit(2 if isinstance(exc, click.UsageError) else exc.exit_code)

@@ -13,38 +13,59 @@ from ..errors import ConfigError, DemcheckError
 from ..reference.collision import collide
 
 
+FORM = "must be KEY=START:STOP:N (N values, ends included) or KEY=a,b,c"
+MAX_POINTS = 10_000  # a grid's points, each a collision solved
+
+
 def parse_vary(text: str) -> tuple[str, list]:
-    """``KEY=START:STOP:N`` (N evenly spaced values, ends included) or ``KEY=a,b,c``."""
-    if "=" not in text:
-        raise ConfigError("--vary", text, "must be KEY=START:STOP:N or KEY=a,b,c")
-    key, _, spec = text.partition("=")
-    key = key.strip()
-    if spec.count(":") == 2:
+    """``KEY=START:STOP:N`` (N evenly spaced values, ends included) or ``KEY=a,b,c`` (TOML values; a bare
+    word is a string, so a word that starts like a number — ``0-80`` — is refused, not taken as a string)."""
+    key, sep, spec = text.partition("=")
+    key, spec = key.strip(), spec.strip()
+    if not sep or not key or not spec:
+        raise ConfigError("--vary", text, FORM)
+    if ":" in spec:
+        if spec.count(":") != 2:
+            raise ConfigError(f"--vary {key}", spec, FORM)
         start, stop, n = spec.split(":")
         try:
             a, b, count = float(start), float(stop), int(n)
         except ValueError:
             raise ConfigError(f"--vary {key}", spec, "START and STOP must be numbers and N an integer") from None
-        if count < 1 or not (math.isfinite(a) and math.isfinite(b)):
-            raise ConfigError(f"--vary {key}", spec, "N must be >= 1 and the ends finite")
+        if not (1 <= count <= MAX_POINTS) or not (math.isfinite(a) and math.isfinite(b)):
+            raise ConfigError(f"--vary {key}", spec, f"N must be in [1, {MAX_POINTS}] and the ends finite")
         return key, list(np.linspace(a, b, count))
-    values = [parse_value(v.strip()) for v in spec.split(",") if v.strip()]
-    if not values:
-        raise ConfigError(f"--vary {key}", spec, "needs at least one value")
+    values = []
+    for part in spec.split(","):
+        v = parse_value(part.strip()) if part.strip() else None
+        if v is None or (isinstance(v, str) and v[:1] in "0123456789+-."):
+            raise ConfigError(f"--vary {key}", spec, f"{part.strip()!r} is not a value; {FORM}")
+        values.append(v)
     return key, values
 
 
-def run_sweep(case_path, overrides, varies: list[str], method=None, dt=None, progress=None) -> pd.DataFrame:
+def sweep_points(case_path, overrides, varies: list[str]) -> list[tuple[dict, object]]:
+    """Every point of the grid as (its values by key, its Case), all loaded and validated before any is
+    solved: a bad key or value is one ConfigError (exit 2), not a row of errors."""
     axes = [parse_vary(v) for v in varies]
     keys = [k for k, _ in axes]
+    total = math.prod(len(vals) for _, vals in axes)
+    if total > MAX_POINTS:
+        raise ConfigError("--vary", " ".join(varies), f"makes a grid of {total} points; at most {MAX_POINTS}")
     load(case_path, list(overrides))  # the base case must be valid on its own
-    rows = []
-    points = list(itertools.product(*[vals for _, vals in axes]))
-    for point in points:
+    points = []
+    for point in itertools.product(*[vals for _, vals in axes]):
         sets = list(overrides) + [f"{k}={_text(v)}" for k, v in zip(keys, point)]
-        row = dict(zip(keys, point))
+        points.append((dict(zip(keys, point)), load(case_path, sets)))
+    return points
+
+
+def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None) -> pd.DataFrame:
+    """Solve each point (``sweep_points``); a point whose solve fails keeps its row, with the status."""
+    rows = []
+    for values, case in points:
+        row = dict(values)
         try:
-            case = load(case_path, sets)
             result = collide(case, method=method, dt=dt)
             row.update(result.metrics())
             row["status"] = result.status

@@ -1,0 +1,199 @@
+"""Interrupts: SIGINT (exit 130) and SIGTERM (exit 143) stop the engines of the run (their process groups),
+and verify writes the partial report of the cases that finished. demcheck runs as a user runs it (a
+subprocess); the engines it starts are found in /proc as its children."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from demcheck.engines import discovery, run as runner
+from demcheck.errors import EngineFailed, EngineInterrupted
+
+from .conftest import CASES
+
+# a fake LAMMPS: answers -h with a banner; a run starts a child and waits on it forever (a process group
+# of two, as an MPI launch has)
+FAKE_LAMMPS = """#!/bin/sh
+case "$1" in -h) echo "Large-scale Atomic/Molecular Massively Parallel Simulator - 22 Jul 2025 - fake"; exit 0;; esac
+sleep 600 &
+wait
+"""
+SIGNALS = [(signal.SIGINT, 130), (signal.SIGTERM, 143)]
+
+
+def _stat(pid) -> list[str] | None:
+    """/proc/<pid>/stat after the command name: [state, ppid, pgrp, ...], or None once it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+
+
+def _children(pid: int) -> list[int]:
+    out = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            st = _stat(d)
+            if st and st[1] == str(pid) and st[0] != "Z":
+                out.append(int(d))
+    return out
+
+
+def _group_alive(pgid: int) -> list[int]:
+    """The live (not zombie) processes of a process group."""
+    out = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            st = _stat(d)
+            if st and st[2] == str(pgid) and st[0] != "Z":
+                out.append(int(d))
+    return out
+
+
+def _start(args, cwd, env=None):
+    return subprocess.Popen([sys.executable, "-m", "demcheck", *map(str, args)], cwd=cwd, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for_engine(proc, within=240.0) -> int:
+    """The pid of the engine ``proc`` has started (its child running a deck), once there is one."""
+    deadline = time.monotonic() + within
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, f"demcheck ended before its engine started: {proc.communicate()}"
+        for pid in _children(proc.pid):
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+            except FileNotFoundError:
+                continue
+            if b"in.deck" in cmd:
+                return pid
+        time.sleep(0.1)
+    proc.kill()
+    pytest.fail(f"no engine started within {within} s")
+
+
+def _interrupt(proc, engine: int, sig) -> tuple[int, str, str]:
+    """Send ``sig`` to demcheck while its engine runs; (exit code, stdout, stderr) once it has exited."""
+    pgid = int(_stat(engine)[2])
+    assert pgid == engine, "the engine runs in a process group of its own"
+    assert _group_alive(pgid), "the engine ended before the signal: the case must run longer"
+    proc.send_signal(sig)
+    try:
+        out, err = proc.communicate(timeout=240)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        pytest.fail(f"demcheck did not exit within 240 s of signal {sig!r}")
+    assert _group_alive(pgid) == [], f"processes of the engine's group {pgid} survive"
+    return proc.returncode, out, err
+
+
+@pytest.fixture
+def fake_lammps(tmp_path):
+    fake = tmp_path / "bin" / "lmp"
+    fake.parent.mkdir()
+    fake.write_text(FAKE_LAMMPS)
+    fake.chmod(0o755)
+    return fake
+
+
+# ----------------------------------------------------------------------------- verify
+
+
+@pytest.mark.parametrize("sig,code", SIGNALS)
+def test_verify_stops_its_engines_and_writes_the_partial_report(sig, code, tmp_path, fake_lammps):
+    env = dict(os.environ, DEMCHECK_LAMMPS=str(fake_lammps), DEMCHECK_CACHE=str(tmp_path / "cache"))
+    # hls-constant-pair: LAMMPS cannot express it, so it finishes without an engine; glass-pair waits on one
+    proc = _start(["verify", CASES / "hls-constant-pair.toml", CASES / "glass-pair.toml", "--engines", "lammps",
+                   "--jobs", "2", "--report", tmp_path / "reports"], tmp_path, env)
+    engine = _wait_for_engine(proc)
+    code_got, _, err = _interrupt(proc, engine, sig)
+    assert code_got == code, err[-3000:]
+    assert "demcheck: interrupted; the engines were stopped" in err
+    data = json.loads((tmp_path / "reports" / "latest" / "results.json").read_text())
+    assert data["partial"] is True and data["planned"] == 2
+    # the case whose engine the interrupt stopped did not finish: neither reported nor counted as failed
+    assert [c["case"] for c in data["cases"]] == ["hls-constant-pair"] and data["failed"] == 0
+    assert "exit code -9" not in (tmp_path / "reports" / "latest" / "report.md").read_text()
+    assert "PARTIAL REPORT" in (tmp_path / "reports" / "latest" / "report.md").read_text()
+
+
+# ----------------------------------------------------------------------------- collide
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.parametrize("sig,code", SIGNALS)
+def test_collide_stops_a_real_lammps_and_removes_its_partial_dump(sig, code, tmp_path):
+    # a step of 3.2e-11 s: 1.9 million steps of the glass pair, each dumped (seconds of LAMMPS)
+    proc = _start(["collide", CASES / "glass-pair.toml", "--engine", "lammps", "--dt", "3.2e-11"], tmp_path)
+    engine = _wait_for_engine(proc)
+    workdir = Path(os.readlink(f"/proc/{engine}/cwd"))
+    code_got, out, err = _interrupt(proc, engine, sig)
+    assert code_got == code, err[-3000:]
+    assert out == "" and err.strip().splitlines()[-1] == "demcheck: interrupted: lammps was stopped by the interrupt"
+    assert "exit code" not in err
+    assert not workdir.exists()  # the partial dump of an interrupted run is not left behind
+
+
+@pytest.mark.parametrize("sig,code", SIGNALS)
+def test_collide_stops_the_engine_and_what_it_started(sig, code, tmp_path, fake_lammps):
+    env = dict(os.environ, DEMCHECK_LAMMPS=str(fake_lammps))
+    proc = _start(["collide", CASES / "glass-pair.toml", "--engine", "lammps"], tmp_path, env)
+    engine = _wait_for_engine(proc)
+    code_got, _, err = _interrupt(proc, engine, sig)
+    assert code_got == code and "demcheck: interrupted" in err, err[-3000:]
+
+
+# ----------------------------------------------------------------------------- engines.run, in process
+
+
+@pytest.fixture
+def lammps_is(fake_lammps, monkeypatch):
+    monkeypatch.setenv("DEMCHECK_LAMMPS", str(fake_lammps))
+    discovery.find.cache_clear()
+    yield fake_lammps
+    runner.reset()
+    discovery.find.cache_clear()
+
+
+def test_a_run_stopped_by_kill_all_is_interrupted_not_failed_and_no_new_run_starts(lammps_is, tmp_path):
+    caught = []
+
+    def target():
+        try:
+            runner.run("lammps", "run 1\n", workdir=tmp_path / "wd", timeout=300)
+        except EngineFailed as exc:
+            caught.append(exc)
+
+    t = threading.Thread(target=target)
+    t.start()
+    deadline = time.monotonic() + 60
+    while not runner._RUNNING and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert runner._RUNNING, "the fake engine did not start"
+    pgid = next(iter(runner._RUNNING)).pid
+    runner.kill_all()
+    t.join(60)
+    assert not t.is_alive() and len(caught) == 1
+    assert isinstance(caught[0], EngineInterrupted), caught[0]  # not "failed (exit code -9)"
+    assert _group_alive(pgid) == []
+    with pytest.raises(EngineInterrupted, match="not started"):  # after an interrupt, no engine starts
+        runner.run("lammps", "run 1\n", workdir=tmp_path / "wd2", timeout=300)
+    runner.reset()
+    with pytest.raises(runner.EngineTimeout):  # until reset() (a new suite)
+        runner.run("lammps", "run 1\n", workdir=tmp_path / "wd3", timeout=0.5)
+
+
+def test_interrupt_exit_codes():
+    assert runner.interrupt_exit_code(KeyboardInterrupt()) == 130
+    assert runner.interrupt_exit_code(runner.Terminated()) == 143
+    wrapped = RuntimeError("wrapped")
+    wrapped.__cause__ = runner.Terminated()
+    assert runner.interrupt_exit_code(wrapped) == 143
