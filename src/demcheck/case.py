@@ -482,21 +482,38 @@ def from_dict(raw: dict) -> Case:
 MAX_FLIGHT = 10.0
 
 
-def time_to_contact(case: Case) -> float:
-    """When the bodies of a collision first touch in free flight without gravity (s; inf if never)."""
-    p = case.particles[0]
-    x, v = np.asarray(p.position, float), np.asarray(p.velocity, float)
+def free_flight(case: Case) -> tuple[float, bool]:
+    """(t, touches) of a collision's free flight (gravity included: both bodies fall alike, so only a wall
+    sees it): the time until the surfaces first touch, touches = True (0 when they touch at the start); for
+    bodies that never touch, the time of their closest approach (0 when they only separate), False."""
+    p0 = case.particles[0]
+    x0, v0 = np.asarray(p0.position, float), np.asarray(p0.velocity, float)
     if case.walls:
         w = case.walls[0]
-        n = np.asarray(w.normal, float)
-        gap, rate = float((x - np.asarray(w.point)) @ n) - p.radius, -float(v @ n)
-        return gap / rate if rate > 0 else math.inf
-    q = case.particles[1]
-    d, u = np.asarray(q.position, float) - x, np.asarray(q.velocity, float) - v  # d(t) = d + u t
-    a, b, c = float(u @ u), float(d @ u), float(d @ d) - (p.radius + q.radius) ** 2
-    if a == 0.0 or b >= 0.0 or b * b - a * c < 0.0:
-        return math.inf
-    return max(c / (-b + math.sqrt(b * b - a * c)), 0.0)  # the smaller root, without cancellation
+        nw = np.asarray(w.normal, float)
+        gap = float((x0 - np.asarray(w.point, float)) @ nw) - p0.radius
+        vn, an = -float(v0 @ nw), -float(np.asarray(case.run.gravity, float) @ nw)
+        if gap <= 0:
+            return 0.0, True
+        disc = vn * vn + 2.0 * an * gap  # gap − vn t − an t²/2 = 0
+        if disc < 0:  # turns back before the wall
+            return (-vn / an if an < 0 and vn > 0 else 0.0), False
+        root = math.sqrt(disc)
+        if vn + root <= 0:
+            return 0.0, False
+        return 2.0 * gap / (vn + root), True
+    p1 = case.particles[1]
+    d0 = np.asarray(p1.position, float) - x0
+    v_rel = v0 - np.asarray(p1.velocity, float)  # d(t) = d0 − v_rel t
+    a, b = float(v_rel @ v_rel), float(d0 @ v_rel)
+    c = float(d0 @ d0) - (p0.radius + p1.radius) ** 2
+    if c <= 0:
+        return 0.0, True
+    if a == 0.0 or b <= 0:
+        return 0.0, False
+    if b * b < a * c:
+        return b / a, False
+    return c / (b + math.sqrt(b * b - a * c)), True  # the smaller root of a t² − 2 b t + c, without cancellation
 
 
 def _near_contact(case: Case) -> tuple[Particle, ...] | None:
@@ -505,8 +522,8 @@ def _near_contact(case: Case) -> tuple[Particle, ...] | None:
     None when they already start close enough, under gravity, or never meet."""
     if any(case.run.gravity):
         return None
-    tau = time_to_contact(case)
-    if not math.isfinite(tau):
+    tau, touches = free_flight(case)
+    if not touches:
         return None
     from .reference.collision import characteristic_time
     from .reference.model import resolve

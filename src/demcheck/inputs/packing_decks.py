@@ -225,7 +225,8 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     if cache is not None and discovery.find(engine) is not None:
         k = cache_key(engine, discovery.find(engine).version,
                       dk.text + f"\n# mpi {mpi}\n# contact reader {CONTACT_READER}", dk.files)
-        hit, hit_contacts = cache.get(k), cache.get(k + "-contacts")
+        hit = cache.get(k, columns=FINAL_COLUMNS, meta_keys=("version", "ke"))
+        hit_contacts = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
         if hit is not None and hit_contacts is not None:
             table, meta = hit
             contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})

@@ -19,7 +19,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..case import Case
+from ..case import Case, free_flight
 from ..errors import ConfigError
 from ..result import Result
 from . import health, kernels
@@ -94,32 +94,9 @@ def characteristic_time(model: ResolvedModel) -> float:
 
 
 def time_to_contact(case: Case) -> float:
-    """The free flight until the surfaces first touch (0 when they touch at the start; for bodies that
-    turn back before touching, the time of their closest approach)."""
-    p0 = case.particles[0]
-    x0, v0 = np.asarray(p0.position, float), np.asarray(p0.velocity, float)
-    if case.walls:
-        w = case.walls[0]
-        nw = np.asarray(w.normal, float)
-        gap = float((x0 - np.asarray(w.point, float)) @ nw) - p0.radius
-        vn, an = -float(v0 @ nw), -float(np.asarray(case.run.gravity, float) @ nw)
-        if gap <= 0:
-            return 0.0
-        disc = vn * vn + 2.0 * an * gap  # gap − vn t − an t²/2 = 0
-        if disc < 0:
-            return -vn / an if an < 0 else 0.0
-        root = math.sqrt(disc)
-        return 2.0 * gap / (vn + root) if vn + root > 0 else 0.0
-    p1 = case.particles[1]
-    d0 = np.asarray(p1.position, float) - x0
-    v_rel = v0 - np.asarray(p1.velocity, float)  # the bodies fall alike: d(t) = d0 − v_rel t
-    a, b = float(v_rel @ v_rel), float(d0 @ v_rel)
-    c = float(d0 @ d0) - (p0.radius + p1.radius) ** 2
-    if c <= 0 or a == 0.0:
-        return 0.0
-    if b <= 0 or b * b < a * c:
-        return max(b / a, 0.0)
-    return c / (b + math.sqrt(b * b - a * c))  # the smaller root of a t² − 2 b t + c
+    """The free flight until the surfaces first touch (for bodies that never touch, until their closest
+    approach): case.free_flight's time."""
+    return free_flight(case)[0]
 
 
 def verlet_capacity(case: Case, dt: float, dt_given: bool, t_free: float, t_c: float, t_max: float,
