@@ -469,3 +469,15 @@ def test_the_command_line_writes_decks_reports_and_junit_by_the_umask(tmp_path):
     assert len(written) > 5
     for path in written:
         assert path.stat().st_mode & 0o777 == 0o644, path
+
+
+def test_the_runner_refuses_a_deck_with_a_command_demcheck_does_not_write(tmp_path):
+    """The last line of defence: whatever built the deck, engines.run checks it before any engine starts."""
+    from demcheck.engines import run as runner
+    from demcheck.errors import DemcheckError
+
+    target = tmp_path / "pwned"
+    for engine in ("lammps", "liggghts"):
+        with pytest.raises(DemcheckError, match="not a command demcheck writes"):
+            runner.run(engine, f"units si\nshell touch {target}\n", workdir=tmp_path / engine)
+        assert not target.exists() and not (tmp_path / engine / "in.deck").exists()

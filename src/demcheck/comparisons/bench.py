@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..case import Case
-from ..errors import DemcheckError
+from ..errors import DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference.model import resolve
 
@@ -187,13 +187,15 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
             res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
             continue
         if discovery.find(engine) is None:
-            res.skipped[engine] = f"not installed: {discovery.HOW_TO_INSTALL[engine]}"
+            res.skipped[engine] = discovery.missing(engine)
             continue
         for spc in steps:
             dt = t_c / spc
             try:
                 one = run_engine(case, engine, dt=dt, cache=None)
                 many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
+            except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
+                raise
             except DemcheckError as exc:
                 res.points.append(Point(engine, spc, dt, None, math.nan, math.nan, {k: math.nan for k in metrics},
                                         "failed", str(exc).splitlines()[0]))

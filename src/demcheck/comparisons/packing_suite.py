@@ -89,7 +89,8 @@ def reference_packing(case, cache=None):
     if cache is not None:
         what = json.dumps({"case": case.hash, "dt": P.packing_dt(case), "rest": 0.0})
         k = cache_key("reference-packing", P.solver_fingerprint(), what, {})
-        hit, hit_c = cache.get(k), cache.get(k + "-contacts")
+        hit = cache.get(k, columns=("x", "y", "z", "radius"), meta_keys=("ke", "time", "seconds"))
+        hit_c = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
         if hit is not None and hit_c is not None:
             (table, meta), (con, _) = hit, hit_c
             return (table[["x", "y", "z"]].to_numpy(), table["radius"].to_numpy(), con.to_numpy(),

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..case import Case, _read, from_dict
-from ..errors import ConfigError, DemcheckError
+from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference import health
 from ..reference.model import resolve
@@ -140,6 +140,8 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
     that) but stable as long as it stays finite, bounded and does not create energy."""
     try:
         r = collide(case, "verlet", dt=dt)
+    except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
+        raise
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
     if r.status not in ("ok", "unresolved", "unstable"):
@@ -153,6 +155,8 @@ def _stable_engine(case: Case, engine: str, dt: float, t_c: float) -> tuple[bool
 
     try:
         r = run_engine(case, engine, dt=dt, timeout=120.0)
+    except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
+        raise
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
     status, why = health.check(r, case, min_steps=1)
@@ -200,6 +204,8 @@ def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | No
             try:
                 case = from_dict(transform(copy.deepcopy(raw0)))
                 t_c = characteristic_time(resolve(case))
+            except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
+                raise
             except DemcheckError as exc:
                 res.limits.append(Limit(name, value, "reference-verlet", None, None, f"invalid: {exc}"))
                 continue
@@ -209,7 +215,7 @@ def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | No
                 if mp.native is None:
                     res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
                 elif discovery.find(e) is None:
-                    res.skipped[e] = f"not installed: {discovery.HOW_TO_INSTALL[e]}"
+                    res.skipped[e] = discovery.missing(e)
                 else:
                     sources.append(e)
             for src in sources:

@@ -54,7 +54,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             if info is None:
                 from ..errors import EngineNotFound
 
-                raise EngineNotFound(f"{engine} is not installed: {discovery.HOW_TO_INSTALL[engine]}")
+                raise EngineNotFound(discovery.missing(engine))
             from .cache import key as cache_key
 
             k = cache_key(engine, info.version, text, dk.files)

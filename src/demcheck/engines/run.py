@@ -139,6 +139,9 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         raise EngineNotFound(discovery.missing(engine))
     if _STOP.is_set():
         raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
+    from ..inputs.common import check_deck
+
+    check_deck(deck, files)  # a deck is code the engine executes: only the commands demcheck writes
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
     wd.mkdir(parents=True, exist_ok=True)
     (wd / "in.deck").write_text(deck)
