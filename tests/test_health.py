@@ -538,3 +538,28 @@ def test_a_time_step_beyond_the_contact_is_named_as_the_cause(path):
     r = collide(case, "verlet", dt=1e-3)
     assert r.status == "unresolved"
     assert "dt = 0.001 s" in r.message and "steps per elastic contact time" in r.message
+
+
+@pytest.mark.engine("lammps")
+def test_non_finite_packing_output_is_a_failed_run_never_cached(tmp_path, monkeypatch):
+    """A packing whose final state holds NaN fails (it would otherwise drop out of every finite-only
+    comparison and pass), and nothing of it is cached."""
+    from demcheck import case as C
+    from demcheck.errors import EngineFailed
+    from demcheck.inputs.packing_decks import run_engine
+
+    real = discovery.find("lammps")
+    exe = tmp_path / "fake-lmp"
+    exe.write_text(FAKE.format(python=sys.executable, real=real.executable, bad="nan")
+                   .replace('pathlib.Path("dump.txt")', 'pathlib.Path("final.txt")'))
+    exe.chmod(0o755)
+    monkeypatch.setenv("DEMCHECK_LAMMPS", str(exe))
+    discovery.find.cache_clear()
+    try:
+        case = C.load(CASES / "packing" / "column-lsd.toml")
+        with pytest.raises(EngineFailed, match="NaN or infinite values .*column vx"):
+            run_engine(case, "lammps", cache=Cache(tmp_path / "cache"))
+        assert not list((tmp_path / "cache").rglob("*.npz"))
+    finally:
+        monkeypatch.delenv("DEMCHECK_LAMMPS")
+        discovery.find.cache_clear()

@@ -67,7 +67,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         else:
             out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
-            non_finite = _non_finite(table)
+            non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
                 cache.put(k, table, {"version": out.version, "workdir": str(out.workdir),
                                      "wall_time": out.wall_time, "warnings": out.warnings})
@@ -115,16 +115,6 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
 
         shutil.rmtree(out.workdir, ignore_errors=True)  # a temporary directory of a run that succeeded
     return result
-
-
-def _non_finite(table: pd.DataFrame) -> str:
-    """Where a dump first holds NaN or infinite values ("step 12, column vx"), or ""."""
-    data = table.to_numpy(dtype=float)
-    bad = ~np.isfinite(data)
-    if not bad.any():
-        return ""
-    row, col = np.argwhere(bad)[0]
-    return f"first at step {int(table['step'].iloc[row])}, column {table.columns[col]}"
 
 
 def _copies_spread(table: pd.DataFrame, n: int, copies: int) -> float:

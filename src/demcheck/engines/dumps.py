@@ -124,3 +124,15 @@ def read_dump_mdanalysis(path):
     import MDAnalysis as mda
 
     return mda.Universe(str(path), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled")
+
+
+def non_finite(table: pd.DataFrame) -> str:
+    """Where a dump first holds NaN or infinite values ("first at step 12, column vx"), or "" (a table without
+    steps, such as a contact list, is named by row)."""
+    data = table.to_numpy(dtype=float)
+    bad = ~np.isfinite(data)
+    if not bad.any():
+        return ""
+    row, col = np.argwhere(bad)[0]
+    where = f"step {int(table['step'].iloc[row])}" if "step" in table else f"row {int(row)}"
+    return f"first at {where}, column {table.columns[col]}"

@@ -239,6 +239,12 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
     contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
                              table[["x", "y", "z"]].to_numpy(), (case.raw.get("packing") or {}).get("box"))
+    from ..errors import EngineFailed
+
+    bad = dumps.non_finite(table) or dumps.non_finite(contacts)
+    if bad or not all(np.isfinite(e) for _, e in ke):
+        raise EngineFailed(f"{engine} wrote NaN or infinite values ({bad or 'kinetic energy'}): the packing is not "
+                           f"used and not cached; work directory kept: {out.workdir}")
     if k is not None:
         cache.put(k + "-contacts", contacts, {})
         cache.put(k, table, {"version": out.version, "ke": ke})
