@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from demcheck import case as C  # noqa: E402
 from demcheck.comparisons import packing_metrics as PM  # noqa: E402
-from demcheck.inputs.packing_decks import run_engine  # noqa: E402
+from demcheck.engines.packing import run_engine  # noqa: E402
 from demcheck.reference import packing as P  # noqa: E402
 
 CASE = Path(__file__).resolve().parents[1] / "cases" / "packing" / "poured.toml"  # the default suite's, 2000 spheres

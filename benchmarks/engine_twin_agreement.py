@@ -12,7 +12,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from demcheck.engines import discovery  # noqa: E402
 from demcheck.engines.collide import collide, twin_states  # noqa: E402
-from demcheck.inputs.mapping import ENGINES, Native  # noqa: E402
+from demcheck.engines.mapping import Native  # noqa: E402
+from demcheck.engines.registry import names as engine_names  # noqa: E402
 from tests.helpers import glass_case  # noqa: E402
 from tests.test_engines import (NORMAL_CASES, OBLIQUE_CASES, _expressible, _normal_case,  # noqa: E402
                                 _oblique_case)
@@ -22,9 +23,9 @@ KEYS = ("peak_force", "restitution", "contact_time", "max_overlap", "tangential_
 
 
 def main():
-    for e in ENGINES:
+    for e in engine_names():
         print(f"{e}: {discovery.find(e).version}")
-    worst = {(e, k): (0.0, "") for e in ENGINES for k in KEYS}
+    worst = {(e, k): (0.0, "") for e in engine_names() for k in KEYS}
     runs = 0
     for make, n in ((_normal_case, len(NORMAL_CASES)), (_oblique_case, len(OBLIQUE_CASES))):
         for p in _expressible(make, n):

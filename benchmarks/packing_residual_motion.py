@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from demcheck.case import load  # noqa: E402
-from demcheck.inputs.mapping import RULES  # noqa: E402
+from demcheck.engines.registry import get as engine  # noqa: E402
 from demcheck.reference import packing as P  # noqa: E402
 
 CASE = ROOT / "cases" / "optin" / "poured-hertz.toml"
@@ -25,7 +25,7 @@ def main():
     print(f"{CASE.name}: 2000 spheres, TTIn × TTIt, settled for 0.3 s in the reference")
     print(f"{'tangential law':44s} {'KE transl. (J)':>14s} {'KE rot. (J)':>12s} {'max |ξ| (m)':>12s} {'max δ (m)':>10s}")
     for label, over, rules in (("seed TTIt, min() cap (truncation force)", [], None),
-                               ("LAMMPS's: Maw limit, LAMMPS rules", ["contact.truncation=overlap"], RULES["lammps"])):
+                               ("LAMMPS's: Maw limit, LAMMPS rules", ["contact.truncation=overlap"], engine("lammps").rules)):
         case = load(CASE, over)
         st = P.simulate(case, rest=0.0, rules=rules)
         rot = 0.5 * float((0.4 * st.mass * st.rad**2 * (st.w**2).sum(1)).sum())

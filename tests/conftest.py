@@ -30,7 +30,7 @@ def pytest_collection_modifyitems(config, items):
             continue
         name = marker.args[0]
         if discovery.find(name) is None and not require:
-            item.add_marker(pytest.mark.skip(reason=f"{name} not installed ({discovery.HOW_TO_INSTALL[name]})"))
+            item.add_marker(pytest.mark.skip(reason=f"{name} not installed ({discovery.how_to_install(name)})"))
 
 
 @pytest.fixture

@@ -282,7 +282,8 @@ def test_a_tiny_impact_speed_starts_the_bodies_near_contact(wall, normal):
     assert pair_of(case).impact_speed == pytest.approx(1e-9, rel=1e-6)
     flight = _time_to_contact(case)
     assert 0 < flight <= 50 * _hertz_duration(case)
-    from demcheck.inputs import lammps, liggghts
+    from demcheck.engines.lammps import deck as lammps
+    from demcheck.engines.liggghts import deck as liggghts
 
     for writer in (lammps.deck, liggghts.deck):
         steps = int(next(line.split()[1] for line in writer(case).text.splitlines() if line.startswith("run ")))
@@ -324,7 +325,7 @@ def test_a_run_too_long_to_write_is_refused(overrides, key):
 
 
 def test_a_deck_dt_too_small_for_the_run_is_refused():
-    from demcheck.inputs import lammps
+    from demcheck.engines.lammps import deck as lammps
 
     from .helpers import glass_case
 
@@ -358,9 +359,9 @@ normal = "hertz"
 
 @pytest.mark.parametrize("engine", ["lammps", "liggghts"])
 def test_a_tilted_wall_is_not_expressible_in_an_engine(engine):
-    from demcheck.inputs import common
+    from demcheck.engines import mapping
 
-    mp = common.contact_mapping(C.loads(TILTED), engine)
+    mp = mapping.contact_mapping(C.loads(TILTED), engine)
     assert mp.native is None and mp.fidelity == "none"
     assert any("walls.0.normal" in r and "axis" in r for r in mp.reasons)
 

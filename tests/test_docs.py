@@ -1,6 +1,6 @@
 """docs/models.md stays true: its engine-mapping table is the one the code computes."""
 
-from demcheck.inputs import mapping
+from demcheck.engines import mapping
 
 from .conftest import ROOT
 

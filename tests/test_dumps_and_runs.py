@@ -55,7 +55,7 @@ def test_engine_contact_dumps_parse(engine):
     """Each engine's per-contact dump (dump local) of the settled five-sphere column (recorded by the
     packing decks): the four pairs, each carrying the weight of the spheres above it (closed form), with
     the overlap δ = F/kn of the case's LSDn (kn = 2000 N/m)."""
-    from demcheck.inputs.packing_decks import CONTACT_COLUMNS, read_contacts
+    from demcheck.engines.packing import CONTACT_COLUMNS, read_contacts
 
     c = read_contacts(engine, DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3))
     assert tuple(c.columns) == CONTACT_COLUMNS

@@ -12,8 +12,8 @@ import pytest
 
 from demcheck.engines import discovery
 from demcheck.engines.collide import collide, twin_states
-from demcheck.inputs import common, mapping
-from demcheck.inputs.mapping import Native
+from demcheck.engines import mapping, registry
+from demcheck.engines.mapping import Native
 
 from .helpers import glass_case, oblique_case
 
@@ -42,7 +42,7 @@ def _agree(engine_result, twin_result, keys):
 
 
 def _run(case, engine):
-    mp = common.contact_mapping(case, engine)
+    mp = mapping.contact_mapping(case, engine)
     res = collide(case, engine)
     assert res.engine_version == discovery.find(engine).version
     assert res.meta["fidelity"] == mp.fidelity
@@ -70,8 +70,8 @@ def _expressible(make, n):
     out = []
     for i in range(n):
         for wall in (False, True):
-            for e in mapping.ENGINES:
-                if common.contact_mapping(make(i, wall), e).native is not None:
+            for e in registry.names():
+                if mapping.contact_mapping(make(i, wall), e).native is not None:
                     out.append(pytest.param(i, wall, e, marks=pytest.mark.engine(e),
                                             id=f"{i}-{'wall' if wall else 'pair'}-{e}"))
     return out
@@ -98,7 +98,7 @@ def test_every_expressible_case_is_covered():
     """The exact mappings the issue names all have an engine test: both engines, pair and wall."""
     ids = {p.id for p in _expressible(_normal_case, len(NORMAL_CASES))}
     for i, (normal, _) in enumerate(NORMAL_CASES):
-        engines = ("liggghts",) if normal == "hls" else mapping.ENGINES
+        engines = ("liggghts",) if normal == "hls" else registry.names()
         for e in engines:
             assert f"{i}-pair-{e}" in ids and f"{i}-wall-{e}" in ids
 
@@ -192,7 +192,7 @@ def test_lammps_mindlin_variants_match_their_twins(style, wall):
     damping): they differ from plain mindlin, and the twin reproduces each."""
     case = oblique_case("tti", {"truncation": "overlap"}, normal="tti", normal_params={}, wall=wall, angle=30.0,
                         spin=500.0)
-    base = common.contact_mapping(case, "lammps").native
+    base = mapping.contact_mapping(case, "lammps").native
     nat = Native("lammps", base.normal, base.normal_args, damping=base.damping, damping_coeff=base.damping_coeff,
                  tangential=style, tangential_args=base.tangential_args)
     res = collide(case, "lammps", native=nat)
@@ -213,7 +213,7 @@ def test_liggghts_hooke_with_characteristic_velocity_matches_its_twin(wall):
     nat = Native("liggghts", "hooke", tangential="history",
                  props={"restitution": 0.9, "youngs_eff": model.pair.e_eff, "friction": 0.3,
                         "characteristic_velocity": model.pair.impact_speed})
-    nl, tl = nat.twin(model.pair.m_eff, model.pair.r_eff)
+    nl, tl = registry.get(nat.engine).twin(nat, model.pair.m_eff, model.pair.r_eff)
     assert nl.k == pytest.approx(model.normal_law.k, rel=1e-13)  # the seed's energy calibration (example)
     assert tl.kt == nl.k and tl.eta == nl.eta
     res = collide(case, "liggghts", native=nat)

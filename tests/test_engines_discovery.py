@@ -8,14 +8,14 @@ from demcheck.engines import discovery
 @pytest.mark.engine("lammps")
 def test_lammps_is_found_with_its_version():
     info = discovery.find("lammps")
-    assert info is not None, discovery.HOW_TO_INSTALL["lammps"]
+    assert info is not None, discovery.how_to_install("lammps")
     assert "22 Jul 2025" in info.version
 
 
 @pytest.mark.engine("liggghts")
 def test_liggghts_is_found_with_its_version():
     info = discovery.find("liggghts")
-    assert info is not None, discovery.HOW_TO_INSTALL["liggghts"]
+    assert info is not None, discovery.how_to_install("liggghts")
     assert info.version.startswith("LIGGGHTS-PUBLIC 3.8.0")
 
 

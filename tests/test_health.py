@@ -546,7 +546,7 @@ def test_non_finite_packing_output_is_a_failed_run_never_cached(tmp_path, monkey
     comparison and pass), and nothing of it is cached."""
     from demcheck import case as C
     from demcheck.errors import EngineFailed
-    from demcheck.inputs.packing_decks import run_engine
+    from demcheck.engines.packing import run_engine
 
     real = discovery.find("lammps")
     exe = tmp_path / "fake-lmp"

@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from demcheck.inputs import common, mapping
+from demcheck.engines import mapping, registry
 from demcheck.reference import collision3d
 from demcheck.reference.model import resolve
 
@@ -42,12 +42,12 @@ TANGENTIAL_ROWS = [
 
 
 def _compare(case, engine, keys):
-    mp = common.contact_mapping(case, engine)
+    mp = mapping.contact_mapping(case, engine)
     if mp.native is None:
         return mp, None
     seed = resolve(case)
     twin = mapping.twin_model(seed, mp.native)
-    rules = mapping.RULES[engine]
+    rules = registry.get(engine).rules
     a = collision3d.collide(case, seed, "adaptive", rules=rules).metrics()
     b = collision3d.collide(case, twin, "adaptive", rules=rules).metrics()
     return mp, max(abs(a[k] - b[k]) / max(abs(a[k]), 1e-300) for k in keys)
@@ -64,7 +64,7 @@ def _check(mp, diff):
         assert mp.native is None and mp.reasons
 
 
-@pytest.mark.parametrize("engine", mapping.ENGINES)
+@pytest.mark.parametrize("engine", registry.names())
 @pytest.mark.parametrize("wall", [False, True], ids=["pair", "wall"])
 @pytest.mark.parametrize("normal,params", NORMAL_ROWS, ids=[f"{n}-{i}" for i, (n, _) in enumerate(NORMAL_ROWS)])
 def test_normal_mapping_claims(normal, params, wall, engine):
@@ -73,7 +73,7 @@ def test_normal_mapping_claims(normal, params, wall, engine):
     _check(mp, diff)
 
 
-@pytest.mark.parametrize("engine", mapping.ENGINES)
+@pytest.mark.parametrize("engine", registry.names())
 @pytest.mark.parametrize("normal,nparams,tangential,tparams", TANGENTIAL_ROWS,
                          ids=[f"{t}-{i}" for i, (_, _, t, _) in enumerate(TANGENTIAL_ROWS)])
 def test_tangential_mapping_claims(normal, nparams, tangential, tparams, engine):
@@ -97,15 +97,15 @@ def test_every_registered_model_has_a_mapping_row():
     rows = mapping.by_model()
     assert {("normal", m) for m in normal.REGISTRY} | {("tangential", m) for m in tangential.REGISTRY} == set(rows)
     for row in rows.values():
-        for engine in mapping.ENGINES:
+        for engine in registry.names():
             assert row[engine]["fidelity"] in (mapping.EXACT, mapping.APPROXIMATE, mapping.NONE_)
             assert row[engine]["fidelity"] == mapping.EXACT or row[engine]["reason"]
 
 
 def test_static_and_kinetic_friction_is_approximate_in_both_engines():
     case = oblique_case("spring_sliding", None, overrides=["contact.friction_kinetic=0.2"])
-    for engine in mapping.ENGINES:
-        mp = common.contact_mapping(case, engine)
+    for engine in registry.names():
+        mp = mapping.contact_mapping(case, engine)
         assert mp.fidelity == mapping.APPROXIMATE and any("μk" in r for r in mp.reasons)
 
 
@@ -117,7 +117,7 @@ def test_tti_transform_carries_ttin_damping_exactly():
         case = glass_case("tti", {}, restitution=e)
         model = resolve(case)
         mp = mapping.map_model(model, "lammps")
-        nl, _ = mp.native.twin(model.pair.m_eff, model.pair.r_eff)
+        nl, _ = registry.get(mp.native.engine).twin(mp.native, model.pair.m_eff, model.pair.r_eff)
         assert nl.eta == pytest.approx(model.normal_law.eta, rel=1e-13)
         assert nl.b == 0.25
     # the transform's fixed points from ENGINES.md: ε = 0.1 → 0.0983, 0.5 → 0.4997, 0.9 → 0.9000

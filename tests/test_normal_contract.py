@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from demcheck.comparisons.metrics import NORMAL_METRICS
+from demcheck.metrics import NORMAL_METRICS
 from demcheck.reference import kernels, normal
 from demcheck.reference.collision import auto_dt, collide
 from demcheck.reference.model import resolve

@@ -135,7 +135,7 @@ def test_poured_layout_is_seeded_and_does_not_overlap():
 def test_engines_settle_the_column_to_the_closed_form(engine, normal):
     """The same data file, coefficients from the mapping, the engine's final dump (float64): every overlap
     within 1e-6 of the closed form, as the reference."""
-    from demcheck.inputs.packing_decks import run_engine
+    from demcheck.engines.packing import run_engine
 
     text = COLUMN if normal == "lsd" else COLUMN.replace('normal = "lsd"\nkn = 2000.0', 'normal = "kk"\neta_n = 200.0') \
         .replace("duration = 0.05", "duration = 0.2")
@@ -208,7 +208,7 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
 
     from .helpers import oblique_case
 
-    from demcheck.inputs.mapping import RULES
+    from demcheck.engines import registry
 
     case = oblique_case(tangential, params, wall=False, angle=30.0, spin=500.0,
                         overrides=["contact.reference_velocity=1.0"])  # one species pair: calibrate explicitly
@@ -216,7 +216,7 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
     # the seed's rules, and each engine twin's for the laws the engines express (LTH, ZZYt, Walton and the
     # slider's stick have no engine twin)
     engine_laws = tangential not in ("lth", "zzy", "walton")
-    for rules in (None, RULES["lammps"], RULES["liggghts"]) if engine_laws else (None,):
+    for rules in (None, registry.get("lammps").rules, registry.get("liggghts").rules) if engine_laws else (None,):
         _same_as_two_body(case, dt, rules)
 
 
@@ -224,14 +224,14 @@ def test_the_packing_solver_is_the_two_body_verlet_method_for_two_bodies(tangent
                                                ("lsd_sliding", {"truncation": "overlap", "tangential_restitution": 0.5})])
 def test_the_packing_solver_is_the_two_body_verlet_method_against_a_wall(tangential, params):
     """The same against a rigid plane wall (the solver's wall path), with the seed's and the engines' rules."""
-    from demcheck.inputs.mapping import RULES
+    from demcheck.engines import registry
     from demcheck.reference.collision import auto_dt
 
     from .helpers import oblique_case
 
     case = oblique_case(tangential, params, wall=True, angle=30.0, spin=500.0,
                         overrides=["contact.reference_velocity=1.0"])
-    for rules in (None, RULES["lammps"], RULES["liggghts"]) if tangential != "walton" else (None,):
+    for rules in (None, registry.get("lammps").rules, registry.get("liggghts").rules) if tangential != "walton" else (None,):
         _same_as_two_body(case, auto_dt(case), rules)
 
 
@@ -273,7 +273,7 @@ def test_verify_runs_the_small_packings_in_every_source(tmp_path):
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
 def test_engines_run_packings_under_mpi(engine):
     """Two MPI ranks (each engine's own launcher and domain decomposition): the same settled column."""
-    from demcheck.inputs.packing_decks import run_engine
+    from demcheck.engines.packing import run_engine
 
     case = C.loads(COLUMN)
     run = run_engine(case, engine, mpi=2)
@@ -286,7 +286,8 @@ def test_engines_run_packings_under_mpi(engine):
 
 @pytest.mark.engine("lammps")
 def test_polydisperse_species_pairs_run_in_the_reference_and_lammps():
-    from demcheck.inputs.packing_decks import lammps_deck, run_engine
+    from demcheck.engines.lammps.packing import deck as lammps_deck
+    from demcheck.engines.packing import run_engine
 
     from .conftest import CASES
 
@@ -330,7 +331,7 @@ def test_engine_contact_dumps_match_the_engine_positions(engine):
     """The engine's per-contact dump against its own final positions (an independent path): the same
     touching pairs (minimum image across the periodic box), each overlap R_i + R_j − |x_j − x_i|, and
     normal forces of the law's size (LSDn: ≈ kn δ at rest-ish speeds, within the dashpot's share)."""
-    from demcheck.inputs.packing_decks import run_engine
+    from demcheck.engines.packing import run_engine
 
     from .conftest import CASES
 
@@ -396,7 +397,8 @@ def test_packing_decks_run_by_hand(engine, tmp_path):
     import sys
 
     from demcheck.engines import discovery, dumps
-    from demcheck.inputs.packing_decks import CONTACT_DUMP, FINAL_COLUMNS, FINAL_DUMP, read_contacts
+    from demcheck.engines.packing import read_contacts
+    from demcheck.inputs.packing_decks import CONTACT_DUMP, FINAL_COLUMNS, FINAL_DUMP
 
     from .conftest import CASES
 

@@ -20,15 +20,18 @@ import pytest
 
 from demcheck import case as C
 from demcheck.errors import ConfigError, DemcheckError
-from demcheck.inputs import common, mapping, packing_decks
-from demcheck.inputs import lammps as L
-from demcheck.inputs import liggghts as G
+from demcheck.engines import mapping
+from demcheck.inputs import common, packing_decks
+from demcheck.engines.lammps import deck as L
+from demcheck.engines.lammps import packing as LP
+from demcheck.engines.liggghts import deck as G
+from demcheck.engines.liggghts import packing as GP
 
 from .conftest import CASES, ROOT
 
 ENGINES = ("lammps", "liggghts")
 WRITERS = {"lammps": L.deck, "liggghts": G.deck}
-PACKING_WRITERS = {"lammps": packing_decks.lammps_deck, "liggghts": packing_decks.liggghts_deck}
+PACKING_WRITERS = {"lammps": LP.deck, "liggghts": GP.deck}
 
 # {f}: a file the injected command would create
 HOSTILE = {
@@ -262,7 +265,7 @@ def test_mapping_comments_and_reasons_stay_comments(kind, engine, tmp_path, monk
     comment lines through the same helper."""
     case = _collision_case(True)
     text = hostile(kind, tmp_path / "PWNED")
-    nat = common.contact_mapping(case, engine).native
+    nat = mapping.contact_mapping(case, engine).native
     real = mapping.map_model
 
     def with_reason(reason):
@@ -411,7 +414,7 @@ def test_the_engines_run_the_deck_of_the_strongest_string_and_create_nothing(eng
     texts = _strongest(f)
     work = tmp_path / "run"
     case = _renamed(_collision_case(True), texts[0])
-    nat = common.contact_mapping(case, engine).native
+    nat = mapping.contact_mapping(case, engine).native
     decks = {"in.deck": WRITERS[engine](case, native=dataclasses.replace(nat, comments=[*texts, *nat.comments])),
              "in.packing": PACKING_WRITERS[engine](_renamed(_packing_case(), texts[0]), duration=1e-3)}
     for name, dk in decks.items():

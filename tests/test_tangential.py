@@ -260,14 +260,14 @@ def test_a_graze_is_taken_once_per_instant():
     the guard the run re-located the same stick→slip event 244 times at one instant and gave up (too many
     steps). Now it completes — at most two stick→slip events at one instant, the graze and the slip — and
     agrees with the seed model it twins exactly (the mapping's claim, 1e-9)."""
-    from demcheck.inputs import common, mapping
+    from demcheck.engines import mapping, registry
 
     case = oblique_case("tti", {"truncation": "overlap"}, normal="tti", normal_params={}, wall=False, angle=30.0,
                         spin=500.0)
     seed = resolve(case)
-    twin = mapping.twin_model(seed, common.contact_mapping(case, "lammps").native)
-    a = collision3d.collide(case, seed, "adaptive", rules=mapping.RULES["lammps"])
-    b = collision3d.collide(case, twin, "adaptive", rules=mapping.RULES["lammps"])
+    twin = mapping.twin_model(seed, mapping.contact_mapping(case, "lammps").native)
+    a = collision3d.collide(case, seed, "adaptive", rules=registry.get("lammps").rules)
+    b = collision3d.collide(case, twin, "adaptive", rules=registry.get("lammps").rules)
     assert b.status == "ok"
     slips = b.events[b.events["event"] == "slip_start"]["t"].to_numpy()
     assert np.unique(slips, return_counts=True)[1].max() <= 2

@@ -465,8 +465,6 @@ def from_dict(raw: dict) -> Case:
         near = _near_contact(case)
         if near is not None:
             case = build(near)
-        from .inputs.common import run_length
-
         model = _model.resolve(case)
         if model.pair.impact_speed > 0:  # bodies that never meet are the solvers' to report
             if impact is None:
@@ -525,8 +523,7 @@ def _near_contact(case: Case) -> tuple[Particle, ...] | None:
     tau, touches = free_flight(case)
     if not touches:
         return None
-    from .reference.collision import characteristic_time
-    from .reference.model import resolve
+    from .reference.model import characteristic_time, resolve
 
     shift = tau - MAX_FLIGHT * characteristic_time(resolve(case))
     if not shift > 0:
@@ -753,3 +750,37 @@ def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) ->
             raise ConfigError(f"particles.{i}.position", list(particles[i].position),
                               f"is {s[i]:.3g} m in front of wall {k}, less than its radius: "
                               "particles must not start overlapping a wall")
+
+
+# An engine run dumps every step (~1 kB a step for two bodies): a collision's run is refused past this many steps
+# (500 MB of dump; the default suite's longest run, bench at 5000 steps per contact, takes 120 000).
+MAX_STEPS = 500_000
+
+
+def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=None,
+               flight: tuple[str, object] | None = None) -> tuple[float, float, int]:
+    """(dt, t_end, steps) of a collision's run in an engine (and in the verlet reference): dt (``dt``, the
+    case's, or auto), free flight to contact plus ``length`` × 6 elastic contact times. More than MAX_STEPS
+    steps is a ConfigError naming what makes the run long: the free flight (``flight``: its key and value,
+    default the first particle's position) or the step (``dt`` given here: --dt; run.dt; the auto dt's
+    run.steps_per_contact)."""
+    from .reference.model import characteristic_time, resolve
+
+    model = model or resolve(case)
+    t_c = characteristic_time(model)
+    step = dt or case.run.dt or t_c / case.run.steps_per_contact  # dt = auto
+    t_flight, t_contact = free_flight(case)[0], 6.0 * t_c * length
+    t_end = t_flight + t_contact
+    steps = t_end / step
+    if steps > MAX_STEPS:
+        if t_flight > t_contact:
+            key, value = flight or ("particles.0.position", list(case.particles[0].position))
+            why = f"{t_flight:.3g} s of free flight before the contact"
+        else:
+            key, value = (("--dt", dt) if dt else ("run.dt", case.run.dt) if case.run.dt else
+                          ("run.steps_per_contact", case.run.steps_per_contact))
+            why = f"{t_contact:.3g} s of contact"
+        raise ConfigError(key, value, f"the run would take {steps:.3g} steps ({why} at dt = {step:.3g} s), more "
+                                      f"than the {MAX_STEPS:,} a time-stepped run (the verlet method, an engine: "
+                                      "every step recorded) is allowed")
+    return step, t_end, int(math.ceil(steps))

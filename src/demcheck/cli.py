@@ -19,6 +19,15 @@ from .errors import ConfigError, DemcheckError
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 
+def _engine_names() -> list[str]:
+    from .engines import registry
+
+    return list(registry.names())
+
+
+ENGINE_NAMES = _engine_names()  # the registered engines (built-ins, then plug-ins): every --engine choice
+
+
 def _jsonable(obj):
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
@@ -145,7 +154,7 @@ def models(as_json):
                         "params": {p.name: p.meaning for p in m.params}})
         return out
 
-    from .inputs import mapping
+    from .engines import mapping, registry as engine_registry
 
     table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
     engines = mapping.by_model()
@@ -159,11 +168,11 @@ def models(as_json):
 
     t = Table(title="demcheck models (engine mapping of each model, on a glass pair, with the partner shown)",
               show_lines=True)
-    for col in ("slot", "id", "seed", "formula", "source", "lammps 22Jul2025", "liggghts 3.8.0"):
+    for col in ("slot", "id", "seed", "formula", "source", *(e.release for e in engine_registry.all_engines())):
         t.add_column(col)
     for row in table:
         cells = [row["slot"], row["id"], row["seed_name"], row["formula"], row["source"]]
-        for e in mapping.ENGINES:
+        for e in engine_registry.names():
             m = row["engines"][e]
             text = f"[bold]{m['fidelity']}[/] ({m['with']})"
             if m["config"]:
@@ -183,7 +192,7 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
-@click.option("--engine", "engine", type=click.Choice(["reference", "lammps", "liggghts", "all"]),
+@click.option("--engine", "engine", type=click.Choice(["reference", *ENGINE_NAMES, "all"]),
               default="reference", show_default=True,
               help="the source(s): the reference, an engine (its deck run for real), or all side by side")
 @click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
@@ -201,7 +210,7 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
     from .reference.collision import collide as run
 
     case = _load(case_path, overrides)
-    sources = ["reference", "lammps", "liggghts"] if engine == "all" else [engine]
+    sources = ["reference", *ENGINE_NAMES] if engine == "all" else [engine]
     results, skipped = {}, {}
     for src in sources:
         if src == "reference":
@@ -276,7 +285,7 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
-@click.option("--engine", type=click.Choice(["lammps", "liggghts"]), required=True)
+@click.option("--engine", type=click.Choice(ENGINE_NAMES), required=True)
 @click.option("-o", "--output", type=OUT_FILE, default=None,
               help="write the deck here (files it reads go beside it); default: stdout")
 @click.option("--dt", type=DT, default=None, help="time step (s); default: the case's")
@@ -288,9 +297,9 @@ def deck(case_path, engine, output, dt, overrides):
 
     case = _load(case_path, overrides)
     if case.kind == "packing":
-        from .inputs import packing_decks
+        from .engines import registry
 
-        dk = (packing_decks.lammps_deck if engine == "lammps" else packing_decks.liggghts_deck)(case, dt=dt)
+        dk = registry.get(engine).packing_deck(case, dt=dt)
     else:
         dk = make_deck(case, engine, dt)
     if output:
@@ -386,8 +395,9 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
 
 @cli.command()
 @click.argument("paths", nargs=-1, metavar="[CASE|DIR]...")
-@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST",
-              help="comma-separated engines to compare (lammps, liggghts), or 'none' for the reference alone")
+@click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
+              help=f"comma-separated engines to compare ({', '.join(ENGINE_NAMES)}), or 'none' for the reference "
+                   "alone")
 @click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
               help="cases run in parallel")
 @click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True,
@@ -426,7 +436,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
-@click.option("--engine", type=click.Choice(["reference", "lammps", "liggghts"]), default="reference",
+@click.option("--engine", type=click.Choice(["reference", *ENGINE_NAMES]), default="reference",
               show_default=True)
 @click.option("--duration", type=DT, default=None, help="simulated time (s); default: the case's packing.duration")
 @click.option("--mpi", "mpi", type=Number(lo=1, hi=256, integer=True, unit="MPI ranks"), default=1,
@@ -464,7 +474,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
         x, rad = st.x, st.rad
         contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
     else:
-        from .inputs.packing_decks import run_engine
+        from .engines.packing import run_engine
 
         run = run_engine(case, engine, duration=duration, mpi=mpi, timeout=timeout)
         m = PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
@@ -501,8 +511,8 @@ def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
 def _engine_list(engines: str) -> list[str]:
     names = [] if engines.strip().lower() == "none" else [e.strip() for e in engines.split(",") if e.strip()]
     for e in names:
-        if e not in ("lammps", "liggghts"):
-            raise ConfigError("--engines", e, "must be lammps, liggghts (comma-separated) or none")
+        if e not in ENGINE_NAMES:
+            raise ConfigError("--engines", e, f"must be {', '.join(ENGINE_NAMES)} (comma-separated) or none")
     return names
 
 
@@ -512,14 +522,14 @@ def _engine_text(names) -> str:
     out = []
     for e in names:
         info = discovery.find(e)
-        out.append(f"{e} {info.version}" if info else f"{e}: missing ({discovery.HOW_TO_INSTALL[e]})")
+        out.append(f"{e} {info.version}" if info else f"{e}: missing ({discovery.how_to_install(e)})")
     return "; ".join(out) or "none (reference only)"
 
 
 @cli.command()
 @click.argument("paths", nargs=-1, required=True, metavar="CASE|DIR...")
-@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST",
-              help="comma-separated engines (lammps, liggghts), or 'none'")
+@click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
+              help=f"comma-separated engines ({', '.join(ENGINE_NAMES)}), or 'none'")
 @click.option("--steps", "steps", default=None, metavar="LIST",
               help="steps per elastic contact time to sweep (default 5,10,20,50,100,200,500,1000,2000,5000)")
 @click.option("--batch", type=Number(lo=1, hi=10000, integer=True), default=16, show_default=True,
@@ -561,7 +571,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
 
 @cli.command()
 @click.argument("paths", nargs=-1, required=True, metavar="CASE|DIR...")
-@click.option("--engines", "engines", default="lammps,liggghts", show_default=True, metavar="LIST")
+@click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST")
 @click.option("--only", "only", multiple=True, metavar="NAME",
               help="stress only parameters whose name contains NAME (stiffness, restitution, radius, speed, "
                    "angle, mass); repeatable")

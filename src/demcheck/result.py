@@ -56,7 +56,7 @@ class Result:
 
     def metrics(self) -> dict:
         """The metrics (computed once per contact table: a pure function of it)."""
-        from .comparisons.metrics import compute
+        from .metrics import compute
 
         memo = self.__dict__.get("_metrics_memo")
         if memo is None or memo[0] is not self.contact or memo[1] is not self.events:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..case import Case
+from ..engines import registry
 from ..errors import DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference.model import resolve
@@ -156,16 +157,16 @@ class BenchResult:
         return out
 
 
-def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
+def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
                batch: int = BATCH, cache=None, progress=None) -> BenchResult:
     from ..engines import discovery
     from ..engines.collide import collide as run_engine
-    from ..inputs import common
+    from ..engines.mapping import contact_mapping
 
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
-    from .suite import impact_scales
+    from ..reference.health import impact_scales
 
     metrics, scales = metrics_of(case, model), impact_scales(case, model)
     res = BenchResult(case.name, model.describe(), t_c, ref)
@@ -181,8 +182,8 @@ def bench_case(case: Case, engines=("lammps", "liggghts"), steps=STEPS_PER_CONTA
         errors = _errors(r.metrics(), ref, metrics, scales)
         res.points.append(Point("reference-verlet", spc, dt, None, wall, None, errors, r.status, r.message))
         tick()
-    for engine in engines:
-        mp = common.contact_mapping(case, engine)
+    for engine in registry.names() if engines is None else engines:
+        mp = contact_mapping(case, engine)
         if mp.native is None:
             res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
             continue
@@ -269,7 +270,7 @@ def speed_goal_text(results: list[dict]) -> str:
         a = (src.get("reference-adaptive") or {}).get("cheapest", {}).get("1e-08")
         if a is None:
             continue
-        for e in ("lammps", "liggghts"):
+        for e in registry.names():
             c = (src.get(e) or {}).get("cheapest", {}).get("0.001")
             if c is None:
                 continue

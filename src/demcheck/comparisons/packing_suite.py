@@ -108,8 +108,8 @@ def reference_packing(case, cache=None):
 
 
 def run_packing(case, opts, found, file=None) -> dict:
-    from ..inputs.common import pair_mapping
-    from ..inputs.packing_decks import run_engine
+    from ..engines.mapping import pair_mapping
+    from ..engines.packing import run_engine
     from ..reference import packing as P
 
     entry = {"case": case.name, "file": str(file), "kind": "packing", "case_hash": case.hash, "sources": {},
@@ -129,10 +129,9 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": t_end, "wall_time": seconds}
     entry["packing"]["reference"] = {"ke": ke, "forces": PM.force_distribution(ref_forces),
                                      "profile": PM.profile(x, rad, box) if box else None}
-    from .suite import unavailable
 
     for engine in opts.engines:
-        if unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
+        if V.unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
             continue
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)

@@ -11,8 +11,8 @@ from pathlib import Path
 
 from ..io import write_json, write_text
 from .report import _img, _png, clean
+from .styles import style
 
-MARKERS = {"reference-adaptive": "o", "reference-verlet": "s", "lammps": "^", "liggghts": "v"}
 
 
 def _f(v, spec=".3g"):
@@ -91,11 +91,13 @@ def bench_plots(b: dict) -> str:
                and p["error"] > 0]
         if not pts:
             continue
-        m = MARKERS.get(src, "x")
-        a1.loglog([p["wall_time"] for p in pts], [p["error"] for p in pts], m + "-", label=f"{src} (per process)")
+        st = style(src)
+        m = st.marker
+        a1.loglog([p["wall_time"] for p in pts], [p["error"] for p in pts], m + "-", color=st.colour,
+                  label=f"{src} (per process)")
         batched = [p for p in pts if p.get("batch_time")]
         if batched:
-            a1.loglog([p["batch_time"] for p in batched], [p["error"] for p in batched], m + ":",
+            a1.loglog([p["batch_time"] for p in batched], [p["error"] for p in batched], m + ":", color=st.colour,
                       label=f"{src} (batched)")
         steps = [p for p in pts if p["steps_per_contact"]]
         if steps:
@@ -167,7 +169,7 @@ def stress_plots(s: dict) -> str:
             pts = [(l["value"], l["dt_max_over_tc"]) for l in s["limits"]
                    if l["parameter"] == prm and l["source"] == src and l["dt_max_over_tc"]]
             if pts:
-                ax.plot(*zip(*pts), MARKERS.get(src, "x") + "-", label=src, alpha=0.8)
+                ax.plot(*zip(*pts), style(src).marker + "-", color=style(src).colour, label=src, alpha=0.8)
         if any(l["value"] > 0 for l in s["limits"] if l["parameter"] == prm) and "angle" not in prm \
                 and "restitution" not in prm:
             ax.set_xscale("log")

@@ -19,8 +19,8 @@ from pathlib import Path
 
 from ..io import write_json, write_text
 from . import verdicts as V
+from .styles import engine_sources, style
 
-ENGINE_SOURCES = ("lammps", "liggghts")
 METRIC_ORDER = ("restitution", "contact_time", "force_contact_time", "max_overlap", "peak_force",
                 "energy_dissipated", "tangential_restitution", "rebound_angle", "rebound_angular_velocity")
 
@@ -117,7 +117,7 @@ def render_markdown(summary: dict) -> str:
 
     # the agreement matrix: models × sources × metrics
     mat = matrix(summary)
-    sources = ["closed-form", "reference-verlet", *[s for s in ENGINE_SOURCES if s in summary["engines"]]]
+    sources = ["closed-form", "reference-verlet", *[s for s in engine_sources() if s in summary["engines"]]]
     models = sorted({m for m, _, _ in mat})
     lines += ["## Agreement matrix", "",
               "Worst verdict over the cases of each model: ✓ agree, ≈ differs as expected, ✗ differs unexpectedly, "
@@ -326,9 +326,6 @@ def _img(b64: str, alt: str) -> str:
     return f'<img class="plot" alt="{html.escape(alt)}" src="data:image/png;base64,{b64}">'
 
 
-STYLE = {"reference": ("-", 2.0), "reference-verlet": (":", 1.2), "lammps": ("--", 1.2), "liggghts": ("-.", 1.2)}
-
-
 def case_panels(entry: dict) -> str | None:
     """Force–overlap loop and force–time curve of one case, one line per source."""
     series = entry.get("series") or []
@@ -346,9 +343,10 @@ def _draw_case(name, series) -> str:
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.2))
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.16, top=0.85, wspace=0.25)
     for s in series:
-        ls, lw = STYLE.get(s["source"], ("-", 1))
-        a1.plot([d * 1e6 for d in s["delta"]], s["fn"], ls, lw=lw, label=s["source"])
-        a2.plot([t * 1e6 for t in s["t"]], s["fn"], ls, lw=lw, label=s["source"])
+        st = style(s["source"])
+        lw = 2.0 if s["source"] == "reference" else 1.2
+        for ax, x in ((a1, [d * 1e6 for d in s["delta"]]), (a2, [t * 1e6 for t in s["t"]])):
+            ax.plot(x, s["fn"], st.linestyle, color=st.colour, lw=lw, label=s["source"])
     a1.set(xlabel="overlap δ (µm)", ylabel="Fn (N)", title="force–overlap")
     a2.set(xlabel="time since contact start (µs)", ylabel="Fn (N)", title="force–time")
     for a in (a1, a2):
@@ -382,17 +380,18 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
     import matplotlib.pyplot as plt
 
     out = []
-    sources = ["reference", *ENGINE_SOURCES]
+    sources = ["reference", *engine_sources()]
     collisions = [c for c in summary["cases"] if c.get("kind") != "packing"]
     normal = [c for c in collisions if c.get("model") and c["model"]["tangential"] == "none"]
     if normal:
         fig, ax = plt.subplots(figsize=(4.5, 4))
-        for src, marker in zip(sources, "o^s"):
+        for src in sources:
             xs = [c["impact"]["restitution_input"] for c in normal if c["impact"].get("restitution_input") is not None]
             ys = [_metric_of(c, src, "restitution") for c in normal if c["impact"].get("restitution_input") is not None]
             pts = [(x, y) for x, y in zip(xs, ys) if y is not None and math.isfinite(y)]
             if pts:
-                ax.plot(*zip(*pts), marker, ms=4, alpha=0.6, label=src)
+                st = style(src)
+                ax.plot(*zip(*pts), st.marker, color=st.colour, ms=4, alpha=0.6, label=src)
         ax.plot([0, 1], [0, 1], color="0.5", lw=0.8)
         ax.set(xlabel="input restitution", ylabel="measured restitution", title="restitution: in vs out")
         ax.legend(fontsize=7)
@@ -434,11 +433,12 @@ def _panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_
     fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
     for ax, (name, cs) in zip(axes.ravel(), sorted(panels.items())):
         cs = sorted(cs, key=lambda c: c["impact"][x_key])
-        for src, marker in zip(sources, "o^s"):
+        for src in sources:
+            st = style(src)
             pts = [(c["impact"][x_key], _metric_of(c, src, metric)) for c in cs]
             pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
             if pts:
-                ax.plot(*zip(*pts), marker + "-", ms=4, lw=0.8, label=src)
+                ax.plot(*zip(*pts), st.marker + "-", color=st.colour, ms=4, lw=0.8, label=src)
         if log_x:
             ax.set_xscale("log")
         ax.set_title(name, fontsize=8)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..case import Case, _read, from_dict
+from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference import health
@@ -186,10 +187,10 @@ def largest_stable(check) -> tuple[float | None, str]:
     return GRID[hi], failure
 
 
-def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | None = None,
+def stress_file(path: Path, engines=None, only: list[str] | None = None,
                 progress=None) -> StressResult:
     from ..engines import discovery
-    from ..inputs import common
+    from ..engines.mapping import contact_mapping
 
     raw0 = _read(path)
     raw0.pop("variants", None)
@@ -210,8 +211,8 @@ def stress_file(path: Path, engines=("lammps", "liggghts"), only: list[str] | No
                 res.limits.append(Limit(name, value, "reference-verlet", None, None, f"invalid: {exc}"))
                 continue
             sources = ["reference-verlet"]
-            for e in engines:
-                mp = common.contact_mapping(case, e)
+            for e in registry.names() if engines is None else engines:
+                mp = contact_mapping(case, e)
                 if mp.native is None:
                     res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
                 elif discovery.find(e) is None:

@@ -29,19 +29,20 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from .. import __version__
 from ..case import Case, expand
+from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
+from ..reference.health import impact_scales
 from ..reference.model import resolve
 from . import curves, verdicts as V
 
-ENGINES = ("lammps", "liggghts")
 SERIES_POINTS = 400
 
 
 @dataclass
 class Options:
-    engines: tuple[str, ...] = ENGINES
+    engines: tuple[str, ...] = field(default_factory=lambda: registry.names())
     jobs: int = 1
     cache: object | None = None  # engines.cache.Cache
     timeout: float = 600.0
@@ -57,7 +58,7 @@ def discover(engines) -> dict:
         info = discovery.find(e)
         out[e] = {"found": info is not None, "version": info.version if info else None,
                   "executable": info.executable if info else None,
-                  "how_to_install": None if info else discovery.HOW_TO_INSTALL[e],
+                  "how_to_install": None if info else discovery.how_to_install(e),
                   "why": None if info else discovery.missing(e)}
     return out
 
@@ -92,7 +93,7 @@ def restate(result, case):
 
 def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     from ..engines.collide import collide as run_engine, twin_states
-    from ..inputs import common
+    from ..engines.mapping import contact_mapping
     from ..reference import collision3d
 
     tol = opts.tolerances
@@ -136,8 +137,8 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
 
     seed_cache: dict = {}
     for engine in opts.engines:
-        mp = common.contact_mapping(case, engine)
-        if unavailable(entry, comps, engine, mp, found):
+        mp = contact_mapping(case, engine)
+        if V.unavailable(entry, comps, engine, mp, found):
             continue
         try:
             res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout)
@@ -173,26 +174,6 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     return entry
 
 
-def impact_scales(case: Case, model) -> dict:
-    """The units the oblique metrics are measured in (verdicts.scale): the impact energy, and v_in/R for a
-    spin. Shared with bench and dt, so that their errors and the suite's verdicts speak the same units."""
-    return {"impact_energy": _impact_energy(case, model), "spin": model.pair.impact_speed / case.particles[0].radius}
-
-
-def _impact_energy(case: Case, model) -> float:
-    """Kinetic energy of the relative motion, m̄|v_rel|²/2, plus the bodies' spin energy."""
-    import numpy as np
-
-    v = np.asarray(case.particles[0].velocity, float)
-    if not case.walls:
-        v = v - np.asarray(case.particles[1].velocity, float)
-    e = 0.5 * model.pair.m_eff * float(v @ v)
-    for i, p in enumerate(case.particles):
-        w = np.asarray(p.angular_velocity, float)
-        e += 0.5 * 0.4 * case.mass(i) * p.radius**2 * float(w @ w)
-    return max(e, 0.5 * model.pair.m_eff * model.pair.impact_speed**2)
-
-
 def _incidence(case: Case) -> dict:
     """Incidence angle from the normal (degrees) of the initial relative velocity, and the spin |ω| of
     particle 0 (rad/s) — the axes of the suite's tangential plots."""
@@ -211,20 +192,6 @@ def _incidence(case: Case) -> dict:
     vt = float(np.linalg.norm(v - vn * n))
     return {"angle": float(np.degrees(np.arctan2(vt, abs(vn)))) if vn else None,
             "spin": float(np.linalg.norm(p0.angular_velocity))}
-
-
-def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
-    """Record an engine that cannot run this case (the model is not expressible, or it is not installed)."""
-    if mp.native is None:
-        entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
-        comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
-        return True
-    if not found[engine]["found"]:
-        why = found[engine].get("why") or f"{engine} is not installed: {found[engine]['how_to_install']}"
-        entry["sources"][engine] = {"status": "engine missing", "message": why}
-        comps.append(V.status_comparison(engine, V.MISSING, why))
-        return True
-    return False
 
 
 def _source(result) -> dict:

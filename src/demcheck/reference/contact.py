@@ -16,7 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..case import Case, Material
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the case layer sits above the laws: types only
+    from ..case import Case, Material
 
 
 @dataclass(frozen=True)

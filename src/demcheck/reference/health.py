@@ -21,6 +21,8 @@ import math
 
 import numpy as np
 
+from ..case import Case
+
 MAX_OVERLAP_FRACTION = 0.5  # of the smaller radius: beyond it a contact law of small overlaps means nothing
 ENERGY_GAIN_TOLERANCE = 0.01  # of the impact kinetic energy, for laws that cannot create energy
 MIN_STEPS = 5  # inside the contact, for a time-stepped answer to count as resolved
@@ -77,9 +79,8 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
 def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, str]:
     """:func:`health` of a time-stepped result of ``case``: the elastic contact time of its seed model, its
     smaller radius, and its impact energy (translation, tangential motion and spin: the units of the
-    suite's energy metric, comparisons/suite.py ``impact_scales``)."""
-    from ..comparisons.suite import impact_scales
-    from .collision import characteristic_time
+    suite's energy metric, :func:`impact_scales`)."""
+    from .model import characteristic_time
     from .model import resolve
 
     model = model or resolve(case)
@@ -97,3 +98,21 @@ def apply(result, case, model=None, min_steps: int = MIN_STEPS):
 
 def smallest_radius(case) -> float:
     return min(p.radius for p in case.particles)
+
+
+def impact_scales(case: Case, model) -> dict:
+    """The units the oblique metrics are measured in (verdicts.scale): the impact energy, and v_in/R for a
+    spin. Shared with bench and dt, so that their errors and the suite's verdicts speak the same units."""
+    return {"impact_energy": _impact_energy(case, model), "spin": model.pair.impact_speed / case.particles[0].radius}
+
+
+def _impact_energy(case: Case, model) -> float:
+    """Kinetic energy of the relative motion, m̄|v_rel|²/2, plus the bodies' spin energy."""
+    v = np.asarray(case.particles[0].velocity, float)
+    if not case.walls:
+        v = v - np.asarray(case.particles[1].velocity, float)
+    e = 0.5 * model.pair.m_eff * float(v @ v)
+    for i, p in enumerate(case.particles):
+        w = np.asarray(p.angular_velocity, float)
+        e += 0.5 * 0.4 * case.mass(i) * p.radius**2 * float(w @ w)
+    return max(e, 0.5 * model.pair.m_eff * model.pair.impact_speed**2)

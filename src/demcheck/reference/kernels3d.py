@@ -39,7 +39,7 @@ G_SIZE = 17
 # rules array
 R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION = 0, 1, 2, 3
 ARM_CONTACT, ARM_RADIUS = 0, 1
-ROT_NONE, ROT_PROJECT, ROT_RESCALE, ROT_LAMMPS = 0, 1, 2, 3
+ROT_NONE, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT = 0, 1, 2, 3
 # aux array: dmax, L*(3), t_ref(3), normal mode, tangential mode (0 stick, 1 slip)
 A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
 A_SIZE = 9
@@ -884,8 +884,8 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
                 if rules[R_ROTATION] == ROT_RESCALE:
                     hist = _rotate_history(hist, n, ROT_RESCALE)
-                elif rules[R_ROTATION] == ROT_LAMMPS:
-                    # LAMMPS turns the history only when its normal part matters: |ξ·n| Kt > 1e-10 μ|Fn|
+                elif rules[R_ROTATION] == ROT_RESCALE_SIGNIFICANT:
+                    # turned only when its normal part matters (LAMMPS's rule): |ξ·n| Kt > 1e-10 μ|Fn|
                     # (|F·n| > 1e-10 μ|Fn| for a force history)
                     scale = 1.0 if force_hist else kt_of(tl, delta)
                     if abs(_dot(hist, n)) * scale > 1e-10 * tl[T_MU_K] * fabs:

@@ -5,7 +5,10 @@ from __future__ import annotations
 import difflib
 from dataclasses import dataclass
 
-from ..case import Case
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the case layer sits above the laws: types only
+    from ..case import Case
 from ..errors import ConfigError
 from . import normal as _normal
 from . import tangential as _tangential
@@ -73,3 +76,11 @@ def check_contact(case: Case) -> None:
                               f"is not a parameter of normal '{normal.id}' or tangential '{tangential.id}'{hint}")
     if case.kind == "collision":
         resolve(case)
+
+
+def characteristic_time(model: ResolvedModel) -> float:
+    """The elastic contact time of the model's spring at the impact speed (dt = auto, solver scales)."""
+    v = model.pair.impact_speed
+    if not (v > 0):
+        raise ConfigError("particles", "(initial state)", "the bodies never meet: no collision to solve")
+    return model.normal_law.characteristic_time(model.pair.m_eff, v)

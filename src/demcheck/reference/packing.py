@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from .kernels import normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_LAMMPS,
+from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_RESCALE_SIGNIFICANT,
                         ROT_PROJECT, ROT_RESCALE, eta_of, kt_of, return_map, slip_surface, tangential_force,
                         walton_stiffness)
 from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
@@ -186,7 +186,7 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
         # in verlet_3d's order
         hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-        if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs):
+        if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and abs(hn) * kt_of(tl, delta) > 1e-10 * tl[T_MU_K] * fabs):
             old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
             for k in range(3):
                 hist[k] -= hn * n[k]
@@ -237,7 +237,7 @@ def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
     h0, h1, h2 = hist[row, 0], hist[row, 1], hist[row, 2]
     kt = kt_of(tl, delta)
     hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-    if rot == ROT_RESCALE or (rot == ROT_LAMMPS and abs(hn) * kt > 1e-10 * tl[T_MU_K] * fabs):
+    if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and abs(hn) * kt > 1e-10 * tl[T_MU_K] * fabs):
         old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
         h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
         new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
@@ -609,7 +609,7 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
     """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
     energy falls below ``rest`` × N m g R (settled). ``rules``: the kinematic rules (collision3d's names;
-    default the seed's), e.g. inputs.mapping.RULES[engine] for an engine twin."""
+    default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin."""
     from ..errors import ConfigError
 
     sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..case import Case
-from ..errors import UnsupportedByEngine
-from . import common
-from .common import fmt
+from ...case import Case
+from ...errors import UnsupportedByEngine
+from ...inputs import common
+from ...inputs.common import fmt
+from ..mapping import contact_mapping, pair_mapping
 
 VERSION_NOTE = "written for LIGGGHTS-PUBLIC 3.8.0 (pair_style gran)"
 RIGID_WALL_MODULUS = 1e30
@@ -86,7 +87,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     """The deck of a collision case (``native``: one configuration for every type pair instead of the case's
     mapped model; ``copies``: independent copies of the collision in one run, as in lammps.deck)."""
     sc = common.scene(case, dt, length)
-    mp = common.contact_mapping(case, "liggghts", native)
+    mp = contact_mapping(case, "liggghts", native)
     nat = mp.require()
     n = len(case.particles)
     ntypes = n * copies + (1 if case.walls else 0)
@@ -94,11 +95,11 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     batch_axis, spacing = 0, 0.0
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
-    lines = common.header("liggghts", sc, mp, VERSION_NOTE) + common.notes(nat.comments)
+    lines = common.header("liggghts", sc, mp, VERSION_NOTE, "liggghts -in") + common.notes(nat.comments)
     # every type pair's configuration (the wall type pairs with each particle)
     natives = {}
     for i, j in common.type_pairs(case):
-        pm = common.pair_mapping(case, "liggghts", i, j, native)
+        pm = pair_mapping(case, "liggghts", i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"type pair {i + 1} {j + 1 if j is not None else 'wall'}: "
                                       f"{'; '.join(pm.reasons)}")
@@ -165,4 +166,4 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
               f"run {sc.steps}", ""]
     data = common.data_file(case, ntypes, (lo, hi), f"demcheck: case {case.name} (hash {case.hash})", copies=copies,
                             axis=batch_axis, spacing=spacing)
-    return common.Deck("liggghts", "\n".join(lines), {data_name: data})
+    return common.Deck("liggghts", "\n".join(lines), {data_name: data}, dt=sc.dt)

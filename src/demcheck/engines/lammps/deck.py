@@ -9,11 +9,12 @@ demcheck passes the Hertz stiffness directly (``hertz k``), which sidesteps that
 
 from __future__ import annotations
 
-from ..case import Case
-from ..errors import UnsupportedByEngine
-from . import common
-from .common import fmt
-from .mapping import Native
+from ...case import Case
+from ...errors import UnsupportedByEngine
+from ...inputs import common
+from ...inputs.common import fmt
+from ..mapping import contact_mapping, pair_mapping
+from ..base import Native
 
 VERSION_NOTE = "written for LAMMPS 22 Jul 2025 (pair_style granular)"
 
@@ -42,14 +43,14 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
     independent copies of the collision in one run, far apart, each body with its own type (atom ids
     k·n + 1 … k·n + n for copy k), so that engine start-up is paid once."""
     sc = common.scene(case, dt, length)
-    mp = common.contact_mapping(case, "lammps", native)
+    mp = contact_mapping(case, "lammps", native)
     mp.require()
     n = len(case.particles)
     lo, hi = sc.box
     batch_axis, spacing = 0, 0.0
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
-    lines = common.header("lammps", sc, mp, VERSION_NOTE) + common.notes(mp.native.comments)
+    lines = common.header("lammps", sc, mp, VERSION_NOTE, "lmp -in") + common.notes(mp.native.comments)
     lines += ["", "units si", "atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
               "comm_modify vel yes",
               f"region box block {fmt(lo[0])} {fmt(hi[0])} {fmt(lo[1])} {fmt(hi[1])} {fmt(lo[2])} {fmt(hi[2])} "
@@ -71,7 +72,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
     for i, j in common.type_pairs(case):
         if j is None:
             continue
-        pm = common.pair_mapping(case, "lammps", i, j, native)
+        pm = pair_mapping(case, "lammps", i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"type pair {i + 1} {j + 1}: {'; '.join(pm.reasons)}")
         coeffs[(i, j)] = coeffs[(j, i)] = coeff_args(pm.native)
@@ -82,7 +83,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
                 continue
             lines.append(f"pair_coeff {a + 1} {b + 1} {coeffs[(a % n, b % n)]}")
     if case.walls:
-        pm = common.pair_mapping(case, "lammps", 0, None, native)
+        pm = pair_mapping(case, "lammps", 0, None, native)
         axis = "xyz"[sc.wall_axis]
         where = f"{fmt(sc.wall_position)} NULL" if sc.wall_side == "lo" else f"NULL {fmt(sc.wall_position)}"
         if n > 1:
@@ -98,4 +99,4 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
               "dump_modify state format float %.17g sort id",
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]
-    return common.Deck("lammps", "\n".join(lines), {})
+    return common.Deck("lammps", "\n".join(lines), {}, dt=sc.dt)

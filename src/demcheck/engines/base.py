@@ -1,0 +1,176 @@
+"""The engine contract: everything demcheck knows about one DEM engine, in one object.
+
+An engine package (``demcheck/engines/<name>/``) defines one subclass of :class:`Engine` and registers an
+instance (:mod:`demcheck.engines.registry`). Nothing outside ``engines/`` names an engine: the CLI's
+choices, the suite's sources, the report's columns, colours and markers, bench and stress all iterate
+over the registry. What an engine owns:
+
+* discovery and version: :meth:`Engine.candidates` (executables to try) and :attr:`Engine.banner` (how its
+  ``-h`` names its version);
+* the vocabulary, seed model → native settings with a fidelity (:meth:`Engine.map`), and native settings →
+  the reference laws that compute exactly what it computes (:meth:`Engine.twin`), with the kinematic rules
+  its scheme uses (:attr:`Engine.rules`: slip arm, torque arms, rotation of the tangential history);
+* deck writers for every scenario (:meth:`Engine.collision_deck`, :meth:`Engine.packing_deck`);
+* how it is launched (:meth:`Engine.argv`, :meth:`Engine.mpi_launcher`) and how its per-contact output is
+  read (:meth:`Engine.read_contacts`);
+* how a report draws it (:attr:`Engine.style`).
+
+Its expected differences live in ``data/expected_differences.toml``, keyed by the engine's name and version.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import sys
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+from pathlib import Path
+
+EXACT, APPROXIMATE, NONE_ = "exact", "approximate", "none"
+NATIVE = "native"  # a configuration given in the engine's own terms, not mapped from a seed model
+FIDELITIES = (EXACT, APPROXIMATE, NONE_)
+
+
+@dataclass(frozen=True)
+class Style:
+    """How reports draw an engine's results: fixed per source, whatever else a report shows."""
+
+    colour: str
+    marker: str
+    linestyle: str = "--"
+
+
+@dataclass
+class Native:
+    """One type pair's contact in an engine's own terms. ``normal``, ``normal_args``, ``damping``,
+    ``damping_coeff``, ``tangential``, ``tangential_args``, ``limit``, ``props`` and
+    ``tangential_damping`` mean what the engine's package says they mean; ``comments`` are written into
+    decks as they are (the engine's own words for what the numbers are)."""
+
+    engine: str
+    normal: str
+    normal_args: tuple = ()
+    damping: str = ""
+    damping_coeff: float = 0.0
+    tangential: str = "linear_nohistory"
+    tangential_args: tuple = ()
+    limit: bool = False
+    props: dict = field(default_factory=dict)
+    tangential_damping: bool = True
+    comments: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Mapping:
+    """A seed model in an engine's terms: the fidelity (exact, approximate, none), the reasons, and the
+    native configuration (None when the engine cannot express the model)."""
+
+    engine: str
+    fidelity: str
+    reasons: list[str]
+    native: Native | None
+
+    def require(self) -> Native:
+        from ..errors import UnsupportedByEngine
+
+        if self.native is None:
+            raise UnsupportedByEngine(f"{self.engine} cannot express this model: {'; '.join(self.reasons)}")
+        return self.native
+
+
+def refused(engine: str, reason: str) -> Mapping:
+    """The mapping of a model the engine cannot express, with the one reason why."""
+    return Mapping(engine, NONE_, [reason], None)
+
+
+def worst(*fidelities: str) -> str:
+    order = {EXACT: 0, APPROXIMATE: 1, NONE_: 2}
+    return max(fidelities, key=order.__getitem__)
+
+
+class Engine(ABC):
+    """One DEM engine. Subclasses set the class attributes and implement the abstract methods."""
+
+    name: str  # lower-case id: CLI choices, report columns, cache keys, expected differences
+    title: str  # for people: "LAMMPS", "LIGGGHTS"
+    release: str  # the release its vocabulary is written for, as a column heading: "LAMMPS 22Jul2025"
+    how_to_install: str
+    version_note: str  # the release the decks are written for
+    banner: re.Pattern  # group 1 of a match on the output of ``<exe> -h`` is the version
+    rules: dict  # kinematic rules of its scheme for the twin (reference/collision3d.SEED_RULES's keys)
+    style: Style
+    hand_command: str  # how a person runs a deck by hand: "<hand_command> <deck>"
+    deck_name: str = "in.deck"
+    packing: bool = True  # whether it can pour and settle a packing
+
+    # ------------------------------------------------------------------ discovery and launch
+
+    def candidates(self) -> list[str]:
+        """Executables to try, in order: ``$DEMCHECK_<NAME>`` alone when set, else :meth:`default_candidates`."""
+        env = os.environ.get(f"DEMCHECK_{self.name.upper()}")
+        if env:
+            return [env]
+        return self.default_candidates()
+
+    def default_candidates(self) -> list[str]:
+        out = []
+        for exe in self.executables():
+            beside = Path(sys.executable).parent / exe
+            if beside.exists():
+                out.append(str(beside))
+            found = shutil.which(exe)
+            if found:
+                out.append(found)
+        return out
+
+    def executables(self) -> tuple[str, ...]:
+        return ()
+
+    def argv(self, executable: str, deck: str) -> list[str]:
+        """The command that runs ``deck`` (a file name in the work directory) with its log files there."""
+        return [executable, "-in", deck, "-log", "log.txt", "-screen", "screen.txt"]
+
+    def check_deck(self, text: str, files: dict | None = None) -> None:
+        """The final guard before the engine runs a deck: every line is one demcheck writes (raises
+        otherwise). The default is the LAMMPS input language's guard (inputs.common.check_deck)."""
+        from ..inputs.common import check_deck
+
+        check_deck(text, files)
+
+    def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
+        from ..errors import EngineNotFound
+
+        raise EngineNotFound(f"{self.name} has no MPI launcher")
+
+    # ------------------------------------------------------------------ vocabulary
+
+    @abstractmethod
+    def map(self, model, contact_params: dict) -> Mapping:
+        """A resolved seed model (reference.model.ResolvedModel) of one type pair in the engine's terms."""
+
+    @abstractmethod
+    def twin(self, native: Native, m_eff: float, r_eff: float):
+        """(NormalLaw, TangentialLaw) computing exactly what ``native`` computes for a pair (m̄, R̄)."""
+
+    @abstractmethod
+    def summary(self, native: Native) -> str:
+        """A native configuration in one line of the engine's own words."""
+
+    # ------------------------------------------------------------------ decks and output
+
+    @abstractmethod
+    def collision_deck(self, case, dt: float | None = None, length: float = 1.0, native: Native | None = None,
+                       **options):
+        """The deck (inputs.common.Deck) of a two-body collision case."""
+
+    def packing_deck(self, case, duration=None, dt=None):
+        from ..errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
+
+    def read_contacts(self, raw, radius, x=None, box=None):
+        """(overlap, fn, ft) of the engine's per-contact dump ``raw`` (its columns as an array, one row per
+        listed pair; ``i``, ``j`` the 0-based particle indices of the first two columns), fn repulsive > 0."""
+        raise NotImplementedError(f"{self.name} writes no per-contact output")

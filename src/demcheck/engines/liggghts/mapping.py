@@ -1,0 +1,193 @@
+"""LIGGGHTS-PUBLIC 3.8.0's vocabulary: a seed model → ``pair_style gran`` settings with their fidelity
+(:func:`map_model`), and settings → the reference laws that compute exactly what LIGGGHTS computes
+(:func:`twin`)."""
+
+from __future__ import annotations
+
+import math
+
+from ...reference import twins
+from ...reference.model import ResolvedModel
+from ...reference.normal import HYSTERETIC, NormalLaw
+from ...reference.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
+                                     VISCOUS_SLIDING, WALTON, ZZY, TangentialLaw)
+from ..damping import damping
+from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from ..mapping import HUGE_MU, SLIDING_XT, mu_of
+
+
+def map_model(model: ResolvedModel, cp: dict) -> Mapping:
+    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    m, r = pair.m_eff, pair.r_eff
+    reasons: list[str] = []
+    comments: list[str] = []
+    nid = model.normal.id
+    nat = Native("liggghts", normal="", limit=model.limit_force)
+    fid = EXACT
+    p = nat.props
+    if nl.kind == HYSTERETIC:
+        if nl.ku == 0.0:
+            return refused("liggghts", "HLS with variable unloading (K_U = K_L + S·F_max) maps to luding "
+                                        "only while δ_max < δ_lim; that route is not generated")
+        # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
+        nat.normal = "edinburgh"
+        p.update(kl=nl.kl, unloading=nl.ku / nl.kl, adhesion=0.0, pulloff=0.0, surface_energy=0.0,
+                 restitution=1.0)
+        comments.append(f"edinburgh (fixKc on, overlapExponent 1, no adhesion, coefficientRestitution 1): "
+                        f"K_L = 2E*R̄ = {nl.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
+                        f"K_U/K_L = {nl.ku / nl.kl:.17g}")
+        if tl.kind != NONE:
+            return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
+                                        "no seed tangential law shares it")
+        nat.tangential = "off"
+        nat.comments = comments
+        return Mapping("liggghts", fid, reasons, nat)
+    # the law's shape picks the model, never its id: F = k δ^a + c δ^b δ̇
+    if nl.a == 1.0 and (nl.eta == 0.0 or nl.b == 0.0):
+        nat.normal = "hooke/stiffness"
+        p.update(kn=nl.k, gamman=nl.eta / m, kt=0.0, gammat=0.0)
+        comments.append(f"hooke/stiffness kn = {nl.k:.10g} N/m, gamman = ηn/m̄ = {nl.eta / m:.10g} 1/s (per pair, "
+                        f"m̄ = {m:.10g} kg)")
+    elif nl.a == 1.5 and (nl.eta == 0.0 or nl.b == 0.5):
+        nat.normal = "hertz/stiffness"
+        gamman = nl.eta / (m * math.sqrt(r))
+        p.update(kn=nl.k / math.sqrt(r), gamman=gamman, kt=0.0, gammat=0.0)
+        comments.append(f"hertz/stiffness kn = (4/3)Ē = {nl.k / math.sqrt(r):.10g} Pa, gamman = ηn/(m̄√R̄) = "
+                        f"{gamman:.10g} (per pair, m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
+    elif nl.a == 1.5 and nl.b == 0.25:
+        nat.normal = "hertz"
+        e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
+        if not (0.05 < e_prime <= 1.0):
+            return refused("liggghts", f"TTIn's ηn = {nl.eta:g} needs coefficientRestitution e′ = "
+                                        f"{e_prime:.4g}, outside LIGGGHTS's 0.05 < e ≤ 1")
+        # E*, G* as LIGGGHTS mixes the types' moduli (a rigid wall is a type of modulus 1e30 Pa: the same
+        # to round-off)
+        p.update(restitution=e_prime, youngs_eff=pair.e_eff, shear_eff=pair.g_eff)
+        comments.append(f"hertz coefficientRestitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} through "
+                        "√5 β(e′)√(m̄K_HZ) (ENGINES.md §3)")
+    else:
+        return refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
+    if model.limit_force:
+        comments.append("limitForce on: total normal force ≥ 0")
+    kind = tl.kind
+    tid = model.tangential.id
+    stiff = nat.normal == "hooke/stiffness"
+    if kind == NONE:
+        nat.tangential = "off"
+    elif kind in (LTH, ZZY, WALTON):
+        return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
+    else:
+        mu, f_mu = mu_of(model, reasons)
+        fid = worst(fid, f_mu)
+        p["friction"] = mu
+        if kind in (SLIDING, VISCOUS, VISCOUS_SLIDING):
+            if not stiff:
+                return refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
+                                            f"needs hooke/stiffness, i.e. normal 'lsd' (not '{nid}')")
+            nat.tangential = "no_history"
+            if kind == SLIDING:
+                p["gammat"] = SLIDING_XT * max(nl.eta, 1.0) / m
+                fid = worst(fid, APPROXIMATE)
+                reasons.append(f"simple sliding friction as no_history with gammat = {p['gammat']:.4g} 1/s: a "
+                               "regularised slider near v_t = 0")
+            else:
+                p["gammat"] = tl.eta / m
+                if kind == VISCOUS:
+                    p["friction"] = HUGE_MU
+                    if model.limit_force:
+                        fid = worst(fid, APPROXIMATE)
+                        reasons.append("with limitForce the Coulomb cap μ|Fn| is 0 wherever the normal force is "
+                                       "held at 0, so the viscous force vanishes there too")
+                comments.append(f"no_history gammat = ηt/m̄ = {p['gammat']:.10g} 1/s"
+                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if kind == VISCOUS
+                                   else ""))
+        elif kind == SPRING:
+            nat.tangential = "history"
+            if tl.eta_normal:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot outside the cap
+                if not (nl.a == 1.5 and nl.b == 0.25):
+                    return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
+                fid = worst(fid, APPROXIMATE)
+                ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
+                reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
+                               "the dashpot lies outside the Coulomb cap (spring-only truncation)")
+            elif tl.kt_sqrt:  # DDt on hertz/stiffness
+                if nat.normal != "hertz/stiffness":
+                    return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
+                                                f"Hertz-type; normal '{nid}' is not")
+                if tl.eta > 0.0:
+                    return refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
+                p["kt"] = tl.kt
+                nat.tangential_damping = False
+                comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
+            else:
+                if not stiff:
+                    return refused("liggghts", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' "
+                                                f"(not '{nid}')")
+                p["kt"] = tl.kt
+                p["gammat"] = tl.eta / m
+                nat.tangential_damping = tl.eta > 0.0
+                comments.append(f"hooke/stiffness kt = {tl.kt:.10g} N/m, gammat = ηt/m̄ = {p['gammat']:.10g} 1/s")
+                if tl.truncation != TRUNC_SPRING and tl.eta > 0.0:
+                    fid = worst(fid, APPROXIMATE)
+                    name = {TRUNC_CAP: "force", TRUNC_MAW: "overlap"}[tl.truncation]
+                    reasons.append("LIGGGHTS caps the spring only (truncation = spring: the dashpot is added "
+                                   f"uncapped while sticking and dropped while slipping); the case asks for "
+                                   f"truncation = {name}")
+        else:
+            return refused("liggghts", f"no LIGGGHTS equivalent of tangential '{tid}'")
+    nat.comments = comments
+    return Mapping("liggghts", fid, reasons, nat)
+
+
+def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
+    p = nat.props
+    if nat.normal == "hooke/stiffness":
+        k_el, a = p["kn"], 1.0
+        c, b = damping("stiffness_hooke", p["gamman"], k_el, a, m, r)
+        kt, sqrt_law, eta_t = p["kt"], False, m * p["gammat"]
+    elif nat.normal == "hertz/stiffness":
+        k_el, a = p["kn"] * math.sqrt(r), 1.5
+        c, b = damping("stiffness_hertz", p["gamman"], k_el, a, m, r)
+        kt, sqrt_law, eta_t = p["kt"], True, None  # γt = gammat m̄ √(R̄δ): the normal law's δ^½
+    elif nat.normal == "hooke":  # characteristic velocity v_c: Kn from Hertz's energy at v_c; Kt = Kn, γt = γn
+        y_eff, vc = p["youngs_eff"], p["characteristic_velocity"]
+        k_el, a = 16.0 / 15.0 * math.sqrt(r) * y_eff * (15.0 * m * vc * vc / (16.0 * math.sqrt(r) * y_eff)) ** 0.2, 1.0
+        c, b = damping("restitution_hooke", p["restitution"], k_el, a, m, r)
+        kt, sqrt_law, eta_t = k_el, False, c
+    elif nat.normal == "edinburgh":
+        kl = p["kl"]
+        return (NormalLaw(HYSTERETIC, kl=kl, ku=kl * p["unloading"], limit=nat.limit), twins.no_friction())
+    elif nat.normal == "hertz":
+        y_eff, g_eff = p["youngs_eff"], p["shear_eff"]
+        k_el, a = 4.0 / 3.0 * y_eff * math.sqrt(r), 1.5
+        c, b = damping("restitution_hertz", p["restitution"], k_el, a, m, r)
+        kt, sqrt_law, eta_t = 8.0 * g_eff, True, None
+    else:
+        raise ValueError(f"no twin for LIGGGHTS model {nat.normal!r}")
+    nl = twins.normal_law(k_el, a, c, b, nat.limit)
+    mu = p.get("friction", 0.0)
+    if nat.tangential == "off" or mu == 0.0 and nat.tangential == "no_history":
+        return nl, twins.no_friction()
+    # the tangential dashpot: constant (hooke/stiffness), or a factor of the normal η(δ)
+    if not nat.tangential_damping:
+        factor, const = 0.0, 0.0
+    elif nat.normal in ("hooke/stiffness", "hooke"):
+        factor, const = None, eta_t
+    elif nat.normal == "hertz/stiffness":
+        factor = p["gammat"] / p["gamman"] if p["gamman"] > 0 else math.nan
+        const = None
+    else:  # hertz: γt = γn √(4G*/E*)
+        factor, const = math.sqrt(4.0 * p["shear_eff"] / p["youngs_eff"]), None
+    if factor is not None and math.isnan(factor):
+        raise ValueError("hertz/stiffness with gammat > 0 and gamman = 0 has no twin")
+
+    def law(kind, **kw):
+        if factor is None:
+            return TangentialLaw(kind, eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+        return TangentialLaw(kind, eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+
+    if nat.tangential == "no_history":
+        return nl, law(VISCOUS_SLIDING)
+    return nl, law(SPRING, kt=kt, kt_sqrt=sqrt_law, truncation=TRUNC_SPRING)
+
+

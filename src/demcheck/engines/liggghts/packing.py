@@ -1,0 +1,73 @@
+"""LIGGGHTS decks for packing cases, from the layout every engine shares (inputs/packing_decks)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...case import Case
+from ...errors import UnsupportedByEngine
+from ...inputs import common, packing_decks as PD
+from ...inputs.common import fmt
+from ..mapping import pair_mapping
+from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
+
+
+def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+    species, rep, rad, lo, hi, periodic, dt, steps = PD.layout(case, duration, dt)
+    ns = len(rep)
+    natives = {}
+    for a in range(ns):
+        for b in range(a, ns):
+            natives[(a, b)] = pair_mapping(case, "liggghts", rep[a], rep[b])
+        if case.walls:
+            natives[(a, ns)] = pair_mapping(case, "liggghts", rep[a], None)
+    for mp in natives.values():
+        if mp.native is None:
+            raise UnsupportedByEngine(f"liggghts cannot express this model: {'; '.join(mp.reasons)}")
+    nat = natives[(0, 0)].native
+    if nat.normal == "edinburgh" or any(mp.native.normal != nat.normal for mp in natives.values()):
+        raise UnsupportedByEngine("this packing's species map to different LIGGGHTS models (or to edinburgh, whose "
+                                  "moduli are set per contact): not expressible in one pair style")
+    ntypes = ns + (1 if case.walls else 0)
+
+    def native_of_types(a, b):
+        mp = natives.get((min(a, b), max(a, b)))
+        return mp.native if mp else None
+
+    matrices = property_matrices(nat, ntypes, native_of_types)
+    moduli, ratios = [], []
+    if nat.normal in ("hertz", "hooke"):
+        for i in rep:
+            m = case.materials[case.particles[i].material]
+            moduli.append(m.youngs_modulus)
+            ratios.append(m.poisson_ratio)
+        if case.walls:
+            moduli.append(RIGID_WALL_MODULUS)
+            ratios.append(ratios[0])
+    model_lines, style, flags = model_setup(nat, matrices, moduli, ratios)
+    lines = PD.head(case, "liggghts", VERSION_NOTE, ns, dt, steps, periodic,
+                  ["atom_style granular", "atom_modify map array", "BOUNDS", "newton off",
+                   "communicate single vel yes"])
+    lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
+              f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
+    for k, w in enumerate(case.walls):
+        ax, _ = common.wall_axis(w, k)
+        lines.append(f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[ax]}plane "
+                     f"{fmt(w.point[ax])} {' '.join(flags)}")
+    g = np.asarray(case.run.gravity, float)
+    gn = float(np.linalg.norm(g))
+    if gn > 0:
+        lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
+    every = max(1, steps // 50)
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(PD.FINAL_COLUMNS) - 2))
+    local_fmt = " ".join(["%.17g"] * 10)  # compute values are doubles, the ids too
+    lines += ["# per contact: the two ids, a periodic flag, the force on the first and its normal part, the overlap",
+              "# (defined before the first run, as LIGGGHTS requires; dumped at the final state only)",
+              "compute pairs all pair/gran/local id force force_normal delta",
+              "fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
+              "thermo_modify norm no", f"thermo {every}", f"run {steps}",
+              f"dump final all custom 1 {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)}",
+              f'dump_modify final format "{fmt_line}" sort id',
+              f"dump contacts all local 1 {PD.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
+              f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": PD.data_file(case, species, lo, hi, ntypes)}, dt=dt)

@@ -1,0 +1,82 @@
+"""A packing in an engine: its deck (the engine's package writes it from the shared layout of
+inputs/packing_decks), the run, the final state and the engine's own per-contact output, read back into the
+tables every source yields."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from ..case import Case
+from ..inputs.packing_decks import CONTACT_COLUMNS, CONTACT_DUMP, CONTACT_READER, FINAL_COLUMNS, FINAL_DUMP
+from . import dumps, registry
+
+__all__ = ["PackingRun", "read_contacts", "run_engine", "CONTACT_COLUMNS"]
+
+
+@dataclass
+class PackingRun:
+    """An engine's settled packing: the final per-particle table (FINAL_COLUMNS), its particle-particle
+    contacts (CONTACT_COLUMNS), the kinetic energy series [(step, ke)] and the engine's version."""
+
+    table: pd.DataFrame
+    contacts: pd.DataFrame
+    ke: list
+    version: str
+
+
+def read_contacts(engine: str, path, radius: np.ndarray, x: np.ndarray | None = None, box=None) -> pd.DataFrame:
+    """The engine's per-contact dump (its last block) as CONTACT_COLUMNS: touching pairs only (overlap > 0),
+    each once (with newton off a pair across a periodic or processor boundary may be listed from both
+    sides). ``radius`` (and ``x``): per particle, indexed by id − 1; ``box``: the periodic [lx, ly]. The
+    engine's package turns its own columns into (i, j, overlap, fn, ft) (:meth:`Engine.read_contacts`)."""
+    raw = dumps.read_dump(path)
+    raw = raw[raw["step"] == raw["step"].max()] if len(raw) else raw
+    v = raw.drop(columns="step").to_numpy(float)
+    i, j = v[:, 0].astype(np.int64) - 1, v[:, 1].astype(np.int64) - 1
+    overlap, fn, ft = registry.get(engine).read_contacts(v, i, j, radius, x, box)
+    out = pd.DataFrame({"i": np.minimum(i, j), "j": np.maximum(i, j), "overlap": overlap, "fn": fn, "ft": ft})
+    out = out[out["overlap"] > 0].drop_duplicates(subset=["i", "j"]).sort_values(["i", "j"])
+    return out.reset_index(drop=True)
+
+
+def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
+               cache=None) -> PackingRun:
+    """Run the packing in an engine (``mpi`` ranks). ``cache`` (engines.cache.Cache) skips decks already
+    run (keyed with the ranks too)."""
+    import re
+
+    from . import discovery, run as runner
+    from .cache import key as cache_key
+
+    dk = registry.get(engine).packing_deck(case, duration, dt)
+    k = None
+    if cache is not None and discovery.find(engine) is not None:
+        k = cache_key(engine, discovery.find(engine).version,
+                      dk.text + f"\n# mpi {mpi}\n# contact reader {CONTACT_READER}", dk.files)
+        hit = cache.get(k, columns=FINAL_COLUMNS, meta_keys=("version", "ke"))
+        hit_contacts = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
+        if hit is not None and hit_contacts is not None:
+            table, meta = hit
+            contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
+            return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
+    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi)
+    table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
+    table = table[table["step"] == table["step"].max()]
+    ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
+    table = table.sort_values("id").reset_index(drop=True)
+    # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
+    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
+                             table[["x", "y", "z"]].to_numpy(), (case.raw.get("packing") or {}).get("box"))
+    from ..errors import EngineFailed
+
+    bad = dumps.non_finite(table) or dumps.non_finite(contacts)
+    if bad or not all(np.isfinite(e) for _, e in ke):
+        raise EngineFailed(f"{engine} wrote NaN or infinite values ({bad or 'kinetic energy'}): the packing is not "
+                           f"used and not cached; work directory kept: {out.workdir}")
+    if k is not None:
+        cache.put(k + "-contacts", contacts, {})
+        cache.put(k, table, {"version": out.version, "ke": ke})
+    return PackingRun(table, contacts, ke, out.version)

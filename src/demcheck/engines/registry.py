@@ -1,0 +1,66 @@
+"""The registry of engines: the built-in packages, then plug-ins.
+
+Plug-ins: modules named in ``$DEMCHECK_ENGINE_PLUGINS`` (comma-separated, importable), and the entry points
+of the group ``demcheck.engines`` of installed distributions. A plug-in module registers its engine on
+import (``registry.register(MyEngine())``). Order is registration order: the built-ins first, as a report
+lists its columns.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+
+from .base import Engine
+
+BUILTIN = ("demcheck.engines.lammps", "demcheck.engines.liggghts")
+_ENGINES: dict[str, Engine] = {}
+_loaded = False
+
+
+def register(engine: Engine) -> Engine:
+    """Add (or replace) an engine under its name."""
+    if not engine.name or not engine.name.isidentifier() or engine.name != engine.name.lower():
+        raise ValueError(f"an engine's name must be a lower-case identifier, not {engine.name!r}")
+    if engine.name in ("reference", "all", "none"):
+        raise ValueError(f"{engine.name!r} is a reserved source name")
+    _ENGINES[engine.name] = engine
+    return engine
+
+
+def _load() -> None:
+    global _loaded
+    if _loaded:
+        return
+    _loaded = True
+    for module in BUILTIN:
+        importlib.import_module(module)
+    for module in filter(None, (m.strip() for m in os.environ.get("DEMCHECK_ENGINE_PLUGINS", "").split(","))):
+        importlib.import_module(module)
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group="demcheck.engines"):
+        try:
+            ep.load()
+        except Exception as exc:  # noqa: BLE001 - a broken third-party plug-in must not stop the built-ins
+            import logging
+
+            logging.getLogger("demcheck.engines").warning("engine plug-in %s not loaded: %s", ep.name, exc)
+
+
+def names() -> tuple[str, ...]:
+    _load()
+    return tuple(_ENGINES)
+
+
+def all_engines() -> tuple[Engine, ...]:
+    _load()
+    return tuple(_ENGINES.values())
+
+
+def get(name: str) -> Engine:
+    _load()
+    try:
+        return _ENGINES[name]
+    except KeyError:
+        raise ValueError(f"unknown engine {name!r} (registered: {', '.join(_ENGINES)})") from None
