@@ -375,6 +375,19 @@ def test_an_engine_run_that_is_not_ok_fails_its_case_and_its_metrics_are_not_jud
     assert entry["status"] == "failed" and entry["sources"]["lammps"]["status"] == "unstable"
 
 
+def test_a_case_whose_own_time_step_is_unhealthy_fails(tmp_path):
+    """At the case's run.dt the reference's verlet method resolves nothing (one step inside the contact): the case
+    fails — a run that is not ok is never "differs as expected" (docs/reliability.md)."""
+    from demcheck.case import load
+
+    opts = suite.Options(engines=(), jobs=1, cache=None)
+    case = load(CASES / "glass-pair.toml", ["run.dt=3e-5"])
+    entry = suite.run_case(case, CASES / "glass-pair.toml", opts, {})
+    ver = [k for k in entry["comparisons"] if k["source"] == "reference-verlet"]
+    assert [k["verdict"] for k in ver] == [V.FAILED] and ver[0]["reason"].startswith("unresolved:")
+    assert entry["status"] == "failed"
+
+
 # ----------------------------------------------------------------------------- --timeout reaches every engine run
 
 SLEEPER = """#!/bin/sh
