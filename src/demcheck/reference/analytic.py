@@ -107,10 +107,6 @@ def lsd_restitution(m: float, k: float, eta: float) -> float:
     return math.exp(-psi * math.pi / w)
 
 
-def lsd_rebound_velocity(m: float, k: float, eta: float, v: float) -> float:
-    return v * lsd_restitution(m, k, eta)
-
-
 def lsd_max_overlap(m: float, k: float, eta: float, v: float) -> float:
     """δ_max = v √(m/K) exp(−tan⁻¹(β)/β) with Ψ/W = −1/β, i.e. (v/Φ) exp(−(Ψ/W) tan⁻¹(W/Ψ))."""
     psi, w = lsd_frequencies(m, k, eta)
@@ -187,14 +183,6 @@ def lsd_stiffness(method: str, m: float, r_eff: float, e_eff: float, v: float, e
 
 
 # ----------------------------------------------------------------------------- HLS
-
-
-def hls_unloading_stiffness(kl: float, *, e: float | None = None, s: float | None = None,
-                            f_max: float | None = None) -> float:
-    """K_U = K_L/ε² (constant) or K_L + S F_max (variable)."""
-    if s is not None:
-        return kl + s * f_max
-    return kl / (e * e)
 
 
 def hls_max_overlap(m: float, kl: float, v: float) -> float:

@@ -333,12 +333,6 @@ def _fn_at(y, aux, nl, geo, rules):
 
 
 @njit(cache=True)
-def _vt_at(y, geo, rules):
-    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    return vt
-
-
-@njit(cache=True)
 def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
     """Tangential part of dv_t/dt with no tangential force (the normal force and gravity act along n for a
     pair; a wall sees gravity's tangential part): b in v̇_t = A F_t + b."""
