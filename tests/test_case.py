@@ -393,3 +393,105 @@ def test_a_bad_variant_says_which_one(tmp_path):
     with pytest.raises(ConfigError) as info:
         C.expand(path)
     assert info.value.key == "impact.speed" and info.value.variant == "speed=-2,angle=0"
+
+
+# ----------------------------------------------------------------------------- [contact] pair keys
+
+GLASS_LSD = ["contact.normal=lsd", "contact.stiffness_method=duration"]
+OBLIQUE = ["contact.normal=lsd", "contact.stiffness_method=energy", "contact.tangential=lsd_sliding",
+           "materials.glass.friction=0.3", "materials.glass.tangential_restitution=0.5",
+           "particles.1.velocity=[0.0, 0.5, 0.0]"]
+HLS = ["contact.normal=hls", "contact.kl=1e6"]
+
+# (overrides, key, words of the rule): the same rules as a material's values (case._material)
+BAD_PAIR = [
+    (GLASS_LSD + ['contact.restitution="abc"'], "contact.restitution", "must be a finite number"),
+    (GLASS_LSD + ["contact.restitution=nan"], "contact.restitution", "must be a finite number"),
+    (GLASS_LSD + ["contact.restitution=inf"], "contact.restitution", "must be a finite number"),
+    (GLASS_LSD + ["contact.restitution=true"], "contact.restitution", "must be a finite number"),
+    (GLASS_LSD + ["contact.restitution=5"], "contact.restitution", "must be in (0, 1]"),
+    (GLASS_LSD + ["contact.restitution=0"], "contact.restitution", "must be in (0, 1]"),
+    (GLASS_LSD + ["contact.restitution=-0.5"], "contact.restitution", "must be in (0, 1]"),
+    (OBLIQUE + ['contact.friction="x"'], "contact.friction", "must be a finite number"),
+    (OBLIQUE + ["contact.friction=-1"], "contact.friction", "must be >= 0"),
+    (OBLIQUE + ["contact.friction_kinetic=-0.1"], "contact.friction_kinetic", "must be >= 0"),
+    (OBLIQUE + ["contact.friction=0.2", "contact.friction_kinetic=0.25"], "contact.friction_kinetic",
+     "must not exceed the static coefficient friction = 0.2"),
+    (OBLIQUE + ["contact.tangential_restitution=1.5"], "contact.tangential_restitution", "must be in [0, 1]"),
+    (OBLIQUE + ["contact.tangential_restitution=-0.1"], "contact.tangential_restitution", "must be in [0, 1]"),
+    (OBLIQUE + ['contact.tangential_restitution="x"'], "contact.tangential_restitution", "must be a finite number"),
+    # string-valued parameters: strings of their allowed set (a list is not hashable: once a TypeError)
+    (OBLIQUE + ["contact.truncation=[1]"], "contact.truncation", "must be one of force, overlap, spring"),
+    (OBLIQUE + ["contact.truncation=1"], "contact.truncation", "must be one of force, overlap, spring"),
+    (OBLIQUE + ['contact.truncation={a = 1}'], "contact.truncation", "must be one of force, overlap, spring"),
+    (HLS + ["contact.unloading=[1]"], "contact.unloading", "must be one of constant, variable"),
+    (GLASS_LSD[:1] + ["contact.stiffness_method=[1]"], "contact.stiffness_method",
+     "must be one of duration, overlap, energy"),
+    # a string parameter the resolved path does not read (kn given) is still checked
+    (GLASS_LSD[:1] + ["contact.kn=1e6", "contact.stiffness_method=[1]"], "contact.stiffness_method",
+     "must be one of duration, overlap, energy"),
+    # a pair key no model of the case uses is an unknown key, whatever its value
+    (['contact.restitution="abc"'], "contact.restitution", "is not a parameter of normal 'hertz'"),
+    (["contact.restitution=0.5"], "contact.restitution", "is not a parameter of normal 'hertz'"),
+    (["contact.friction=0.3"], "contact.friction", "is not a parameter of normal 'hertz'"),
+    (GLASS_LSD + ["contact.tangential_restitution=0.5"], "contact.tangential_restitution",
+     "is not a parameter of normal 'lsd'"),
+]
+
+
+@pytest.mark.parametrize("overrides,key,rule", BAD_PAIR)
+def test_contact_pair_keys_obey_the_materials_rules(overrides, key, rule):
+    with pytest.raises(ConfigError) as info:
+        C.loads(BASE, overrides)
+    assert info.value.key == key, str(info.value)
+    assert rule in info.value.rule, str(info.value)
+    assert "\n" not in str(info.value) and info.value.exit_code == 2
+
+
+@pytest.mark.parametrize("overrides,key,rule", [
+    (["contact.restitution=5"], "contact.restitution", "must be in (0, 1]"),
+    (['contact.restitution="abc"'], "contact.restitution", "must be a finite number"),
+    (["contact.friction=0.3"], "contact.friction", "is not a parameter of normal 'lsd'"),
+])
+def test_a_packing_checks_its_pair_keys_when_loaded(overrides, key, rule):
+    """A packing resolves its laws only when it runs: its [contact] values are checked when it is loaded."""
+    with pytest.raises(ConfigError) as info:
+        C.loads(PACKING, overrides)
+    assert info.value.key == key and rule in info.value.rule, str(info.value)
+
+
+def test_valid_pair_keys_override_the_materials():
+    """Each rule's edge is admitted and the pair takes the [contact] value over the materials' (which are
+    restitution 0.97, friction 0.3, tangential restitution 0.5)."""
+    pair = pair_of(C.loads(BASE, OBLIQUE + ["contact.restitution=1", "contact.friction=0",
+                                            "contact.friction_kinetic=0", "contact.tangential_restitution=0"]))
+    assert (pair.restitution, pair.friction, pair.friction_kinetic, pair.tangential_restitution) == (1, 0, 0, 0)
+    pair = pair_of(C.loads(BASE, OBLIQUE + ["contact.restitution=0.5", "contact.friction_kinetic=0.3",
+                                            "contact.tangential_restitution=1"]))
+    assert (pair.restitution, pair.friction, pair.friction_kinetic, pair.tangential_restitution) == (0.5, 0.3,
+                                                                                                     0.3, 1)
+
+
+@pytest.mark.parametrize("case,sets,needle", [
+    ("glass-pair.toml", ["contact.normal=lsd", "contact.stiffness_method=duration", 'contact.restitution="abc"'],
+     "contact.restitution = 'abc': must be a finite number"),
+    ("glass-pair.toml", ["contact.normal=lsd", "contact.stiffness_method=duration", "contact.restitution=5"],
+     "contact.restitution = 5: must be in (0, 1]"),
+    ("oblique-lsd-wall.toml", ["contact.friction=-1"], "contact.friction = -1: must be >= 0"),
+    ("oblique-lsd-wall.toml", ["contact.truncation=[1]"],
+     "contact.truncation = [1]: must be one of force, overlap, spring"),
+    ("glass-pair.toml", ['contact.restitution="abc"'], "contact.restitution = 'abc': is not a parameter"),
+])
+def test_cli_bad_pair_keys_are_one_line_and_exit_2(tmp_path, case, sets, needle):
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    args = [a for s in sets for a in ("--set", s)]
+    p = subprocess.run([sys.executable, "-m", "demcheck", "collide", str(CASES / case), *args], capture_output=True,
+                       text=True, timeout=120, cwd=tmp_path)
+    assert p.returncode == 2, p.stderr[-2000:]
+    assert p.stdout == "" and p.stderr.count("\n") == 1, p.stderr
+    assert p.stderr.startswith(f"demcheck: error: {needle}"), p.stderr
+    assert not list(tmp_path.iterdir()), "nothing is written before the case is checked"

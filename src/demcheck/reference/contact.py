@@ -18,8 +18,41 @@ import numpy as np
 
 from typing import TYPE_CHECKING
 
+from ..errors import ConfigError
+from .registry import contact_number
+
 if TYPE_CHECKING:  # the case layer sits above the laws: types only
     from ..case import Case, Material
+
+
+# The rules of a pair's coefficients: one set for a material's values (``materials.NAME.KEY``) and the pair's own
+# (``[contact] KEY``, which overrides the materials'): key → (rule, check).
+PAIR_RULES = {
+    "restitution": ("must be in (0, 1]", lambda v: 0 < v <= 1),
+    "friction": ("must be >= 0", lambda v: v >= 0),
+    "friction_kinetic": ("must be >= 0", lambda v: v >= 0),
+    "tangential_restitution": ("must be in [0, 1]", lambda v: 0 <= v <= 1),
+}
+
+
+def kinetic_rule(friction: float) -> str:
+    """The rule of a kinetic friction coefficient against the static one it goes with."""
+    return f"must not exceed the static coefficient friction = {friction}"
+
+
+def pair_params(params: dict) -> dict[str, float]:
+    """The pair's own coefficients given in ``[contact]`` ({key: value} of those present), each checked by its
+    rule in PAIR_RULES, and friction_kinetic against friction when both are given; a bad one is a ConfigError
+    naming ``contact.KEY``, the value and the rule."""
+    out = {}
+    for key, (rule, check) in PAIR_RULES.items():
+        v = contact_number(params, key, rule=rule, check=check)
+        if v is not None:
+            out[key] = v
+    kinetic, static = out.get("friction_kinetic"), out.get("friction")
+    if kinetic is not None and static is not None and kinetic > static:
+        raise ConfigError("contact.friction_kinetic", params["friction_kinetic"], kinetic_rule(static))
+    return out
 
 
 @dataclass(frozen=True)
@@ -82,7 +115,7 @@ def pair_of(case: Case, i: int = 0, j: int | None = 1) -> Pair:
         r_eff = p1.radius * p2.radius / (p1.radius + p2.radius)
         m_eff = m1 * m2 / (m1 + m2)
         partner = [mat1, mat2]
-    params = case.contact.params
+    params = pair_params(case.contact.params)
     restitution = params.get("restitution", _combine([m.restitution for m in partner], "mean"))
     friction = params.get("friction", _combine([m.friction for m in partner], "min"))
     friction_kinetic = params.get("friction_kinetic", _combine([m.friction_kinetic for m in partner], "min"))

@@ -12,10 +12,11 @@ if TYPE_CHECKING:  # the case layer sits above the laws: types only
 from ..errors import ConfigError
 from . import normal as _normal
 from . import tangential as _tangential
-from .contact import Pair, pair_of
+from .contact import PAIR_RULES, Pair, pair_of, pair_params
 
-# keys of [contact] that belong to the pair rather than to a model
-PAIR_KEYS = {"restitution", "friction", "friction_kinetic", "tangential_restitution"}
+# keys of [contact] that belong to the pair rather than to a model (allowed where a model of the case reads them:
+# each declares it among its parameters)
+PAIR_KEYS = frozenset(PAIR_RULES)
 
 
 @dataclass(frozen=True)
@@ -65,15 +66,22 @@ def resolve(case: Case, i: int = 0, j: int | None = 1) -> ResolvedModel:
 
 
 def check_contact(case: Case) -> None:
-    """Validate model ids and parameters: unknown keys (with the nearest known one), missing values."""
+    """Validate model ids and parameters, for every kind of case before anything runs: a key that neither model
+    reads (a pair key too: restitution with an elastic Hertz law) is unknown (with the nearest known one); the
+    pair's coefficients obey the materials' rules (contact.PAIR_RULES); string parameters are among their
+    choices; a collision's laws resolve (numbers in range, nothing missing)."""
     normal, tangential = models_of(case)
-    allowed = PAIR_KEYS | {p.name for p in normal.params} | {p.name for p in tangential.params}
-    for key, value in case.contact.params.items():
+    params = case.contact.params
+    allowed = {p.name for p in normal.params} | {p.name for p in tangential.params}
+    for key, value in params.items():
         if key not in allowed:
             near = difflib.get_close_matches(key, sorted(allowed), n=1)
             hint = f"; did you mean '{near[0]}'?" if near else ""
             raise ConfigError(f"contact.{key}", value,
                               f"is not a parameter of normal '{normal.id}' or tangential '{tangential.id}'{hint}")
+    pair_params(params)
+    _normal.check_choices(normal, params)
+    _normal.check_choices(tangential, params)
     if case.kind == "collision":
         resolve(case)
 

@@ -12,6 +12,7 @@ cover every law of the notes:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Callable
@@ -59,6 +60,8 @@ class Param:
     name: str
     meaning: str
     default: object = None
+    choices: tuple[str, ...] = ()  # a string parameter: its allowed values (checked by contact_choice)
+    numeric: bool = False  # with choices: a number > 0 is allowed too
 
 
 @dataclass(frozen=True)
@@ -89,6 +92,28 @@ def _get(params: dict, key: str, *, rule: str, check=None, required_by: str | No
                           required_by=f"normal model '{required_by}'" if required_by else None)
 
 
+def contact_choice(params: dict, key: str, choices: tuple[str, ...], default=None, *, numeric: bool = False,
+                   hint: str = ""):
+    """``[contact].key`` (``default`` when absent): one of the strings ``choices``, or with ``numeric`` a number
+    > 0 (as a float); anything else (another string, a number, a list, a table, missing) is a ConfigError naming
+    the key, the value and the rule."""
+    rule = f"must be one of {', '.join(choices)}" + (" or a number > 0" if numeric else "") + hint
+    v = params.get(key, default)
+    if isinstance(v, str) and v in choices:
+        return v
+    if numeric and isinstance(v, (int, float)) and not isinstance(v, bool):
+        return contact_number(params, key, rule=rule, check=_positive)
+    raise ConfigError(f"contact.{key}", v, rule)
+
+
+def check_choices(model, params: dict) -> None:
+    """Every string parameter of ``model`` given in ``params`` is one of its choices (whether or not the
+    resolved law reads it: a stiffness_method beside an explicit kn)."""
+    for p in model.params:
+        if p.choices and p.name in params:
+            contact_choice(params, p.name, p.choices, numeric=p.numeric)
+
+
 def _restitution(pair: Pair, model: str) -> float:
     if pair.restitution is None:
         raise ConfigError("materials.*.restitution", None,
@@ -108,21 +133,16 @@ def _reference_velocity(pair: Pair, params: dict, model: str) -> float:
 
 
 def _method(params: dict, model: str) -> str:
-    method = params.get("stiffness_method")
-    if method not in analytic.STIFFNESS_METHODS:
-        raise ConfigError("contact.stiffness_method", method,
-                          f"must be one of {', '.join(analytic.STIFFNESS_METHODS)} (or give contact.kn/kl)")
-    return method
+    return contact_choice(params, "stiffness_method", analytic.STIFFNESS_METHODS, hint=" (or give contact.kn/kl)")
+
+
+DURATION_CONSTANTS = {"exact": analytic.HERTZ_DURATION_CONSTANT, "notes": analytic.HERTZ_DURATION_CONSTANT_NOTES}
+UNLOADINGS = ("constant", "variable")
 
 
 def _duration_constant(params: dict) -> float:
-    c = params.get("duration_constant", "exact")
-    if c == "exact":
-        return analytic.HERTZ_DURATION_CONSTANT
-    if c == "notes":
-        return analytic.HERTZ_DURATION_CONSTANT_NOTES
-    return _get(params, "duration_constant", rule="must be \"exact\", \"notes\" or a number > 0",
-                check=lambda x: x > 0)
+    c = contact_choice(params, "duration_constant", tuple(DURATION_CONSTANTS), "exact", numeric=True)
+    return DURATION_CONSTANTS[c] if isinstance(c, str) else c
 
 
 def _positive(x):
@@ -192,9 +212,7 @@ def _resolve_tti(pair: Pair, params: dict, limit: bool):
 
 
 def _resolve_hls(pair: Pair, params: dict, limit: bool):
-    unloading = params.get("unloading", "constant")
-    if unloading not in ("constant", "variable"):
-        raise ConfigError("contact.unloading", unloading, "must be constant or variable")
+    unloading = contact_choice(params, "unloading", UNLOADINGS, "constant")
     s = None
     e = None
     if unloading == "variable":
@@ -221,6 +239,11 @@ def _resolve_hls(pair: Pair, params: dict, limit: bool):
 
 
 _COMMON = (Param("restitution", "normal coefficient of restitution of the pair (default: the materials')"),)
+_STIFFNESS_METHOD = Param("stiffness_method", "calibrate Kn to Hertz: duration | overlap | energy",
+                          choices=analytic.STIFFNESS_METHODS)
+_REFERENCE_VELOCITY = Param("reference_velocity", "impact speed of the calibration (m/s; default: the case's)")
+_DURATION_CONSTANT = Param("duration_constant", "Hertz duration constant of the duration calibration", "exact",
+                           choices=tuple(DURATION_CONSTANTS), numeric=True)
 
 register(NormalModel(
     id="lsd", seed_name="LSDn", aliases=("lsdn", "linear", "hooke"),
@@ -228,9 +251,7 @@ register(NormalModel(
     formula="F = Kn δ + ηn δ̇; ηn = −2 ln ε √(m̄Kn)/√(ln²ε + π²)",
     source="seed 000 §3.3 'Normal Linear Spring-Dashpot (LSDn)'; seed 001 'Damped Linear Spring'",
     params=(Param("kn", "spring stiffness Kn (N/m)"),
-            Param("stiffness_method", "calibrate Kn to Hertz: duration | overlap | energy"),
-            Param("reference_velocity", "impact speed of the calibration (m/s; default: the case's)"),
-            Param("duration_constant", "Hertz duration constant of the duration calibration", "exact"),
+            _STIFFNESS_METHOD, _REFERENCE_VELOCITY, _DURATION_CONSTANT,
             Param("eta_n", "damping ηn (N·s/m; default: from restitution)"), *_COMMON),
     resolve=_resolve_lsd,
     example={"stiffness_method": "energy"},
@@ -276,10 +297,9 @@ register(NormalModel(
     formula="F = min(K_L δ, K_U (δ − δ_res)) ≥ 0; K_U = K_L/ε² (constant) or K_L + S F_max (variable)",
     source="seed 000 §3.5 'Hysteric Linear Spring (HLS)'",
     params=(Param("kl", "loading stiffness K_L (N/m)"),
-            Param("stiffness_method", "calibrate K_L to Hertz: duration | overlap | energy"),
-            Param("reference_velocity", "impact speed of the calibration (m/s; default: the case's)"),
-            Param("duration_constant", "Hertz duration constant of the duration calibration", "exact"),
-            Param("unloading", "constant | variable", "constant"),
+            dataclasses.replace(_STIFFNESS_METHOD, meaning="calibrate K_L to Hertz: duration | overlap | energy"),
+            _REFERENCE_VELOCITY, _DURATION_CONSTANT,
+            Param("unloading", "constant | variable", "constant", choices=UNLOADINGS),
             Param("S", "variable unloading: K_U = K_L + S·F_max (1/m)"), *_COMMON),
     resolve=_resolve_hls,
     example={"stiffness_method": "overlap"},

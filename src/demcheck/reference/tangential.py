@@ -27,9 +27,9 @@ from typing import Callable
 import numpy as np
 
 from ..errors import ConfigError
-from .contact import Pair
+from .contact import Pair, kinetic_rule
 from .registry import Registry, contact_number
-from .normal import HYSTERETIC, NormalLaw, Param
+from .normal import HYSTERETIC, NormalLaw, Param, contact_choice
 
 NONE, SLIDING, VISCOUS, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON = range(8)
 TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING = 0, 1, 2
@@ -110,7 +110,7 @@ def _friction(pair: Pair, model: str) -> tuple[float, float]:
     mu_s = float(pair.friction)
     mu_k = float(pair.friction_kinetic) if pair.friction_kinetic is not None else mu_s
     if mu_k > mu_s:
-        raise ConfigError("contact.friction_kinetic", mu_k, f"must not exceed the static coefficient {mu_s}")
+        raise ConfigError("contact.friction_kinetic", mu_k, kinetic_rule(mu_s))
     return mu_s, mu_k
 
 
@@ -171,10 +171,7 @@ def _base(pair: Pair, mu: tuple[float, float]) -> dict:
 
 
 def _truncation(params: dict, default: str = "force") -> int:
-    t = params.get("truncation", default)
-    if t not in TRUNCATIONS:
-        raise ConfigError("contact.truncation", t, f"must be one of {', '.join(TRUNCATIONS)}")
-    return TRUNCATIONS[t]
+    return TRUNCATIONS[contact_choice(params, "truncation", tuple(TRUNCATIONS), default)]
 
 
 # ----------------------------------------------------------------------------- resolvers
@@ -266,6 +263,7 @@ def _walton(pair, params, normal):
                                                               "friction": mu[0], "friction_kinetic": mu[1]}
 
 
+_TRUNCATION = Param("truncation", "force | overlap | spring", "force", choices=tuple(TRUNCATIONS))
 _MU = (Param("friction", "μ (static); default: the smaller of the materials'"),
        Param("friction_kinetic", "μk while slipping; default μ"))
 _ETA = (Param("eta_t", "ηt (N·s/m)"), Param("eta_t_ratio", "ηt = ratio·Kt (Cundall & Strack; s)"),
@@ -302,7 +300,7 @@ register(TangentialModel(
     formula="Ft = min(|Kt ξ + ηt v_t|, μ|Fn|); truncation = force (cap only) or overlap (Maw: ξ such that "
             "Kt ξ + ηt δ̇t = μ|Fn|)",
     source="seed 000 §4.6 'Linear Spring-Dashpot with Sliding Friction'",
-    params=(*_KT, *_ETA, Param("truncation", "force | overlap | spring", "force"), *_MU), resolve=_lsd_sliding,
+    params=(*_KT, *_ETA, _TRUNCATION, *_MU), resolve=_lsd_sliding,
     example={"friction": 0.3, "tangential_restitution": 0.5},
 ))
 register(TangentialModel(
@@ -326,7 +324,7 @@ register(TangentialModel(
 register(TangentialModel(
     id="tti", seed_name="TTIt", aliases=("ttit",), title="Tsuji, Tanaka & Ishida tangential",
     formula="Ft = −Kt ξ − ηn δn^{b} v_t, Kt = 8Ḡ√(R̄δn) (= √(2R)E/((2−ν)(1+ν))√δn for like spheres), |Ft| ≤ μ|Fn|",
-    source="seed 000 §4.7 '4) TTIt model'", params=(Param("truncation", "force | overlap | spring", "force"), *_MU),
+    source="seed 000 §4.7 '4) TTIt model'", params=(_TRUNCATION, *_MU),
     resolve=_tti, example={"friction": 0.3},
 ))
 register(TangentialModel(
