@@ -44,7 +44,6 @@ class Toy(Engine):
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "rescale"}
     style = Style(colour="#9467bd", marker="P", linestyle="-")
     hand_command = "toy-engine -in"
-    packing = False
 
     def default_candidates(self) -> list[str]:
         """A wrapper script that runs runner.py with this Python (written once per process)."""

@@ -103,7 +103,6 @@ class Engine(ABC):
     style: Style
     hand_command: str  # how a person runs a deck by hand: "<hand_command> <deck>"
     deck_name: str = "in.deck"
-    packing: bool = True  # whether it can pour and settle a packing
 
     # ------------------------------------------------------------------ discovery and launch
 
