@@ -246,3 +246,74 @@ def test_a_cache_that_is_a_file_is_refused_up_front(tmp_path):
 ])
 def test_sweep_refuses_a_bad_key_or_value_before_solving(vary, needle):
     _one_line_exit_2(demcheck("sweep", CASES / "oblique-lsd-wall.toml", "--vary", vary), needle)
+
+
+# ----------------------------------------------------------------------------- files derived from an option
+
+
+def _tree(root):
+    """Every path under ``root`` (files, directories and links), relative: what a refused command must leave."""
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*"))
+
+
+@pytest.mark.parametrize("command", [
+    ["verify", GLASS, "--engines", "none"],
+    ["bench", GLASS, "--engines", "none", "--steps", "10"],
+    ["stress", GLASS, "--engines", "none", "--only", "speed"],
+])
+@pytest.mark.parametrize("kind", ["directory", "file"])
+def test_a_latest_that_is_not_demcheck_s_symlink_is_refused_up_front(command, kind, tmp_path):
+    """<report>/latest is the symlink demcheck moves to each new run: a real directory or file there is refused
+    before any case runs (it was an IsADirectoryError after every case, with a stray .latest.PID left)."""
+    reports = tmp_path / "rep"
+    reports.mkdir()
+    if kind == "directory":
+        (reports / "latest").mkdir()
+        (reports / "latest" / "mine.txt").write_text("keep")
+    else:
+        (reports / "latest").write_text("keep")
+    before = _tree(reports)
+    p = demcheck(*command, "--report", reports, cwd=tmp_path)
+    _one_line_exit_2(p, f"--report = '{reports}': {reports / 'latest'} is a {kind}, not the symlink demcheck "
+                        "moves to each new run")
+    assert _tree(reports) == before
+
+
+def test_latest_moves_when_it_is_demcheck_s_symlink(tmp_path):
+    reports = tmp_path / "rep"
+    p = demcheck("verify", GLASS, "--engines", "none", "--report", reports, "--json")
+    assert p.returncode == 0, p.stderr[-2000:]
+    first = (reports / "latest").resolve()
+    p = demcheck("verify", GLASS, "--engines", "none", "--report", reports, "--json")
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert (reports / "latest").is_symlink() and (reports / "latest").resolve() != first
+    assert not [x for x in reports.iterdir() if x.name.startswith(".latest")]
+
+
+def test_a_latest_link_that_cannot_be_moved_leaves_no_stray_link(tmp_path):
+    """Should the place change under a run (the up-front check passed), the error leaves no .latest.* behind."""
+    from demcheck.comparisons.report import link_latest
+
+    (tmp_path / "run-1").mkdir()
+    (tmp_path / "latest").mkdir()
+    with pytest.raises(OSError):
+        link_latest(tmp_path, tmp_path / "run-1")
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["latest", "run-1"]
+
+
+@pytest.mark.parametrize("name", ["particles.csv", "contacts.csv"])
+def test_pack_checks_the_files_of_its_csv_directory_up_front(name, tmp_path):
+    out = tmp_path / "pc"
+    (out / name).mkdir(parents=True)
+    p = demcheck("pack", PACKING, "--csv", out, cwd=tmp_path)
+    _one_line_exit_2(p, f"--csv = '{out}': {out / name} is a directory, not a file")
+    assert _tree(out) == [name]  # neither table written
+
+
+@pytest.mark.parametrize("case,engine", [(GLASS, "liggghts"), (PACKING, "lammps"), (PACKING, "liggghts")])
+def test_deck_checks_the_files_it_writes_beside_the_deck_up_front(case, engine, tmp_path):
+    out = tmp_path / "dk"
+    (out / "data.lmp").mkdir(parents=True)
+    p = demcheck("deck", case, "--engine", engine, "-o", out / "deck.in", cwd=tmp_path)
+    _one_line_exit_2(p, f"--output = '{out / 'deck.in'}': {out / 'data.lmp'} is a directory, not a file")
+    assert _tree(out) == ["data.lmp"]  # the deck was not written without its data file

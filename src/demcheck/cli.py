@@ -86,10 +86,13 @@ def _option_name(param) -> str:
     return max(param.opts, key=len) if param is not None and param.opts else "value"
 
 
-def check_output(key: str, path, directory: bool = False) -> None:
+def check_output(key: str, path, directory: bool = False, files=(), link: str | None = None) -> None:
     """An output path demcheck can write (a file, or a ``directory`` it creates or fills), checked before any
     work: nothing on the way is a file, the path is not of the other kind, and its first existing directory
-    takes a new file. Else ConfigError naming ``key``, the path and the rule."""
+    takes a new file. So are the files derived from it: ``files``, names written in the directory (or beside
+    the file), each not a directory; and ``link``, the symlink demcheck moves in the directory (``latest``),
+    which is demcheck's: absent or a symlink, never a real file or directory. Else ConfigError naming ``key``,
+    the path and the rule."""
     import tempfile
 
     p = Path(path).absolute()
@@ -100,6 +103,14 @@ def check_output(key: str, path, directory: bool = False) -> None:
         where = where.parent
     if not where.is_dir():
         raise ConfigError(key, str(path), f"{where} is a file, not a directory")
+    beside = Path(path) if directory else Path(path).parent
+    for name in files:
+        if (beside / name).is_dir():
+            raise ConfigError(key, str(path), f"{beside / name} is a directory, not a file")
+    if link is not None and (beside / link).exists() and not (beside / link).is_symlink():
+        what = "directory" if (beside / link).is_dir() else "file"
+        raise ConfigError(key, str(path), f"{beside / link} is a {what}, not the symlink demcheck moves to each "
+                                          "new run (move it away, or choose another --report)")
     try:
         with tempfile.TemporaryFile(dir=where):
             pass
@@ -108,21 +119,24 @@ def check_output(key: str, path, directory: bool = False) -> None:
 
 
 class OutputPath(click.ParamType):
-    """An output file (or ``directory``) checked up front by ``check_output``."""
+    """An output file (or ``directory``) checked up front by ``check_output``, with the files and the link
+    the command derives from it."""
 
     name = "path"
 
-    def __init__(self, directory: bool = False):
-        self.directory = directory
+    def __init__(self, directory: bool = False, files=(), link: str | None = None):
+        self.directory, self.files, self.link = directory, tuple(files), link
 
     def convert(self, value, param, ctx):
-        check_output(_option_name(param), value, self.directory)
+        check_output(_option_name(param), value, self.directory, self.files, self.link)
         return str(value)
 
 
 DT = Number(lo=0, lo_open=True, unit="s")
 TIMEOUT = Number(lo=0, lo_open=True, hi=1e6, unit="s")  # the pipes' poll() takes at most ~2.1e6 s
-OUT_FILE, OUT_DIR = OutputPath(), OutputPath(directory=True)
+OUT_FILE = OutputPath()
+REPORT_DIR = OutputPath(directory=True, link="latest")  # <report>/<run-id>/… and the symlink <report>/latest
+PACK_CSV_DIR = OutputPath(directory=True, files=("particles.csv", "contacts.csv"))
 
 
 def _load(case_path: str, overrides) -> "object":
@@ -302,7 +316,8 @@ def deck(case_path, engine, output, dt, overrides):
         dk = registry.get(engine).packing_deck(case, dt=dt)
     else:
         dk = make_deck(case, engine, dt)
-    if output:
+    if output:  # the files the deck reads go beside it: each checked before any is written
+        check_output("--output", output, files=list(dk.files))
         for path in dk.write(output):
             click.echo(f"wrote {path}", err=True)
     else:
@@ -400,7 +415,7 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
                    "alone")
 @click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
               help="cases run in parallel")
-@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True,
+@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest go")
 @click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
@@ -443,7 +458,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
               show_default=True,
               help="run the engine on this many MPI ranks (its own domain decomposition)")
 @click.option("--timeout", type=TIMEOUT, default=3600.0, show_default=True, help="engine run timeout (s)")
-@click.option("--csv", "csv_dir", type=OUT_DIR, default=None,
+@click.option("--csv", "csv_dir", type=PACK_CSV_DIR, default=None,
               help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "
                    "(i, j, overlap, fn, ft of every particle pair in contact)")
 @_set_option
@@ -487,7 +502,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
         from .io import write_text
 
         parts = pd.DataFrame({"id": range(len(x)), "x": x[:, 0], "y": x[:, 1], "z": x[:, 2], "radius": rad})
-        for name, table in (("particles.csv", parts), ("contacts.csv", contacts)):
+        for name, table in zip(PACK_CSV_DIR.files, (parts, contacts)):  # both checked up front
             write_text(Path(csv_dir) / name, table.to_csv(index=False, float_format="%.17g"))
             click.echo(f"wrote {Path(csv_dir) / name}", err=True)
     if as_json:
@@ -534,7 +549,7 @@ def _engine_text(names) -> str:
               help="steps per elastic contact time to sweep (default 5,10,20,50,100,200,500,1000,2000,5000)")
 @click.option("--batch", type=Number(lo=1, hi=10000, integer=True), default=16, show_default=True,
               help="copies per engine batch run")
-@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True)
+@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @_set_option
 def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
@@ -575,7 +590,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
 @click.option("--only", "only", multiple=True, metavar="NAME",
               help="stress only parameters whose name contains NAME (stiffness, restitution, radius, speed, "
                    "angle, mass); repeatable")
-@click.option("--report", "report_dir", type=OUT_DIR, default="reports", show_default=True)
+@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 def stress(paths, engines, only, report_dir, as_json):
     """Numerical stability: the largest stable time step of each source against stiffness, mass ratio,

@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 
 from ..io import write_json, write_text
-from .report import _img, _png, clean
+from .report import _img, _png, clean, link_latest
 from .styles import style
 
 
@@ -28,11 +28,7 @@ def _publish(out_dir: Path, root: Path, data: dict, md: str, page: str) -> None:
     write_json(out_dir / "results.json", clean(data))
     write_text(out_dir / "report.md", md)
     write_text(out_dir / "report.html", page)
-    tmp = root / f".latest.{os.getpid()}"
-    if tmp.is_symlink() or tmp.exists():
-        tmp.unlink()
-    tmp.symlink_to(out_dir.name)
-    os.replace(tmp, root / "latest")
+    link_latest(root, out_dir)
 
 
 # ----------------------------------------------------------------------------- work–precision

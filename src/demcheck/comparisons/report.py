@@ -49,12 +49,23 @@ def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = Non
     if junit is not None:
         write_text(junit, junit_text)
     write_text(out_dir / "report.html", render_html(summary))
-    latest = root / "latest"
+    link_latest(root, out_dir)
+
+
+def link_latest(root: Path, out_dir: Path) -> None:
+    """Point the symlink ``<root>/latest`` at ``out_dir`` (a run directory in ``root``) in one step: a new
+    link beside it renamed over it. ``latest`` is demcheck's own link — the command line refuses a real file
+    or directory there before any work (cli.check_output) — and should the rename fail all the same, the new
+    link is removed, never left behind."""
     tmp = root / f".latest.{os.getpid()}"
     if tmp.is_symlink() or tmp.exists():
         tmp.unlink()
     tmp.symlink_to(out_dir.name)
-    os.replace(tmp, latest)
+    try:
+        os.replace(tmp, root / "latest")
+    finally:
+        if tmp.is_symlink():
+            tmp.unlink()
 
 
 # ----------------------------------------------------------------------------- helpers
