@@ -173,3 +173,30 @@ class Engine(ABC):
         """(overlap, fn, ft) of the engine's per-contact dump ``raw`` (its columns as an array, one row per
         listed pair; ``i``, ``j`` the 0-based particle indices of the first two columns), fn repulsive > 0."""
         raise NotImplementedError(f"{self.name} writes no per-contact output")
+
+
+class PackageEngine(Engine):
+    """An engine whose package keeps its parts in the usual modules: ``mapping.py`` (``map_model(model,
+    contact_params)``, ``twin(native, m̄, R̄)``), ``deck.py`` (``deck(case, dt, length, native=…, **options)``,
+    ``VERSION_NOTE``) and ``packing.py`` (``deck(case, duration, dt)``), imported when first needed."""
+
+    def _part(self, name: str):
+        import importlib
+
+        return importlib.import_module(f"{type(self).__module__}.{name}")
+
+    @property
+    def version_note(self) -> str:
+        return self._part("deck").VERSION_NOTE
+
+    def map(self, model, contact_params: dict) -> Mapping:
+        return self._part("mapping").map_model(model, contact_params)
+
+    def twin(self, native: Native, m_eff: float, r_eff: float):
+        return self._part("mapping").twin(native, m_eff, r_eff)
+
+    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
+        return self._part("deck").deck(case, dt, length, native=native, **options)
+
+    def packing_deck(self, case, duration=None, dt=None):
+        return self._part("packing").deck(case, duration, dt)

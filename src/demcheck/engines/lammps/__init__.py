@@ -7,10 +7,10 @@ import shutil
 from pathlib import Path
 
 from .. import registry
-from ..base import Engine, Native, Style
+from ..base import Native, PackageEngine, Style
 
 
-class Lammps(Engine):
+class Lammps(PackageEngine):
     name = "lammps"
     title = "LAMMPS"
     release = "LAMMPS 22Jul2025"
@@ -23,12 +23,6 @@ class Lammps(Engine):
              "rotation": "rescale_significant"}
     style = Style(colour="#1f77b4", marker="^", linestyle="--")
     hand_command = "lmp -in"
-
-    @property
-    def version_note(self) -> str:
-        from .deck import VERSION_NOTE
-
-        return VERSION_NOTE
 
     def executables(self) -> tuple[str, ...]:
         return ("lmp",)
@@ -43,31 +37,11 @@ class Lammps(Engine):
             raise EngineNotFound("no mpiexec for LAMMPS (the mpich wheel installs one beside lmp)")
         return [launcher, "-n", str(ranks)]
 
-    def map(self, model, contact_params: dict):
-        from .mapping import map_model
-
-        return map_model(model, contact_params)
-
-    def twin(self, native: Native, m_eff: float, r_eff: float):
-        from .mapping import twin
-
-        return twin(native, m_eff, r_eff)
-
     def summary(self, native: Native) -> str:
         parts = [native.normal, f"damping {native.damping}", f"tangential {native.tangential}"]
         if native.limit:
             parts.append("limit_damping")
         return " ".join(parts)
-
-    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
-        from .deck import deck
-
-        return deck(case, dt, length, native=native, **options)
-
-    def packing_deck(self, case, duration=None, dt=None):
-        from .packing import deck
-
-        return deck(case, duration, dt)
 
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/local dist force p4`` after the two ids: centre distance, Fn (repulsive > 0), |Ft|."""

@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 
 from .. import registry
-from ..base import Engine, Native, Style
+from ..base import Native, PackageEngine, Style
 
 
-class Liggghts(Engine):
+class Liggghts(PackageEngine):
     name = "liggghts"
     title = "LIGGGHTS"
     release = "LIGGGHTS 3.8.0"
@@ -23,12 +23,6 @@ class Liggghts(Engine):
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
     style = Style(colour="#d62728", marker="v", linestyle="-.")
     hand_command = "liggghts -in"
-
-    @property
-    def version_note(self) -> str:
-        from .deck import VERSION_NOTE
-
-        return VERSION_NOTE
 
     def executables(self) -> tuple[str, ...]:
         return ("liggghts",)
@@ -47,16 +41,6 @@ class Liggghts(Engine):
         extra = ["--allow-run-as-root"] if os.geteuid() == 0 else []
         return [launcher, *extra, "--oversubscribe", "-np", str(ranks)]
 
-    def map(self, model, contact_params: dict):
-        from .mapping import map_model
-
-        return map_model(model, contact_params)
-
-    def twin(self, native: Native, m_eff: float, r_eff: float):
-        from .mapping import twin
-
-        return twin(native, m_eff, r_eff)
-
     def summary(self, native: Native) -> str:
         parts = [f"model {native.normal}", f"tangential {native.tangential}"]
         if native.tangential == "history" and not native.tangential_damping:
@@ -64,16 +48,6 @@ class Liggghts(Engine):
         if native.limit:
             parts.append("limitForce on")
         return " ".join(parts)
-
-    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
-        from .deck import deck
-
-        return deck(case, dt, length, native=native, **options)
-
-    def packing_deck(self, case, duration=None, dt=None):
-        from .packing import deck
-
-        return deck(case, duration, dt)
 
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/gran/local id force force_normal delta``: id1 id2 periodic-flag, the force on the
