@@ -169,3 +169,38 @@ def test_cli_stress_reference_only_writes_reports(tmp_path):
     out = json.loads(p.stdout)
     assert len(out["cases"][0]["limits"]) == 4
     assert "## Stability" in (tmp_path / "latest" / "report.md").read_text()
+
+
+# ----------------------------------------------------------------------------- every case file read first
+
+# demcheck as a user runs it, except that the work of a case (a stress bisection, a bench sweep) announces itself
+# and stops: a bad file after a good one must be refused before any of that starts
+_NO_WORK = """
+import sys
+from demcheck import cli
+from demcheck.comparisons import bench, stress
+
+def work(*args, **kwargs):
+    print("WORK STARTED", file=sys.stderr)
+    raise SystemExit(99)
+
+stress.largest_stable = bench.bench_case = work
+cli.main(sys.argv[1:])
+"""
+
+
+@pytest.mark.parametrize("command", [["stress", "--only", "speed"], ["bench", "--steps", "10"]])
+@pytest.mark.parametrize("bad,needle", [
+    ('name = "bad"\nkind = "collision"\nbogus = 1\n', "bogus = 1: unknown key"),
+    ("name = [", "= '(file)': not valid TOML"),
+])
+def test_every_case_file_is_read_before_any_work_and_named_in_the_error(command, bad, needle, tmp_path):
+    bad_file = tmp_path / "bad.toml"
+    bad_file.write_text(bad)
+    p = subprocess.run([sys.executable, "-c", _NO_WORK, command[0], str(CASES / "glass-pair.toml"), str(bad_file),
+                        *command[1:], "--engines", "none", "--report", str(tmp_path / "reports")],
+                       capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1, p.stderr[-2000:]
+    assert lines[0].startswith(f"demcheck: error: {bad_file}") and needle in lines[0], lines
+    assert not (tmp_path / "reports").exists()

@@ -6,6 +6,7 @@ is reported as a :class:`~demcheck.errors.ConfigError` naming the key, the value
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import difflib
 import hashlib
@@ -158,6 +159,20 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
             exc.variant = label  # which variant broke the rule (verify names it with the file)
             raise
     return cases
+
+
+@contextlib.contextmanager
+def naming_file(path: str | Path):
+    """A ConfigError raised inside names the case file (and the variant, given ``exc.variant``) at fault,
+    ``cases/x.toml[speed=2]: key = value: rule``, unless it names the file already. The commands that take
+    several case files (verify, bench, stress) read every one so before any work."""
+    try:
+        yield
+    except ConfigError as exc:
+        if exc.key == "CASE" or str(path) in exc.key:
+            raise
+        where = f"{path}[{exc.variant}]" if getattr(exc, "variant", None) else str(path)
+        raise ConfigError(f"{where}: {exc.key}", exc.value, exc.rule) from None
 
 
 def _label(v) -> str:

@@ -558,7 +558,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     order of convergence and find the cheapest step for each target error."""
     from rich.progress import Progress
 
-    from .case import load
+    from .case import load, naming_file
     from .comparisons import bench as B
     from .comparisons.perf_report import new_run_dir, write_bench
 
@@ -566,15 +566,17 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     grid = B.STEPS_PER_CONTACT
     if steps:
         grid = tuple(number("--steps", x, lo=1, hi=1e6, unit="steps per contact") for x in steps.split(","))
-    files = _case_files(paths)
+    cases = []
+    for f in _case_files(paths):  # every file read and checked before any work; an error names the file
+        with naming_file(f):
+            cases.append(load(f, list(overrides)))
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
     per_case = len(B.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
     with Progress(transient=True, disable=as_json) as progress:
-        task = progress.add_task("bench", total=per_case * len(files))
-        for f in files:
-            case = load(f, list(overrides))
+        task = progress.add_task("bench", total=per_case * len(cases))
+        for case in cases:
             results.append(B.bench_case(case, names, grid, batch=batch,
                                         progress=lambda: progress.advance(task)).summary())
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names), "batch": batch,
@@ -599,17 +601,17 @@ def stress(paths, engines, only, report_dir, as_json):
     from rich.progress import Progress
 
     from .comparisons.perf_report import new_run_dir, write_stress
-    from .comparisons.stress import stress_file
+    from .comparisons.stress import read_stress, stress_case
 
     names = _engine_list(engines)
-    files = _case_files(paths)
+    cases = [read_stress(f) for f in _case_files(paths)]  # every file read and checked before any work
     root = Path(report_dir)
     out_dir = new_run_dir(root, "stress")
     results = []
     with Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("stress", total=None)
-        for f in files:
-            results.append(stress_file(f, names, list(only) or None,
+        for raw, case in cases:
+            results.append(stress_case(raw, case, names, list(only) or None,
                                        progress=lambda: progress.advance(task)).summary())
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names),
             "command": ["demcheck", "stress", *sys.argv[2:]], "cases": results}

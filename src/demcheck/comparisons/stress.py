@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..case import Case, _read, from_dict
+from ..case import Case, _read, from_dict, naming_file
 from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
@@ -187,14 +187,26 @@ def largest_stable(check) -> tuple[float | None, str]:
     return GRID[hi], failure
 
 
+def read_stress(path: Path) -> tuple[dict, Case]:
+    """A stress case file, read and checked (its variants dropped: stress pushes parameters of its own): its
+    raw table and its Case. A bad file is a ConfigError naming the file (case.naming_file)."""
+    with naming_file(path):
+        raw0 = _read(path)
+        raw0.pop("variants", None)
+        return raw0, from_dict(copy.deepcopy(raw0))
+
+
 def stress_file(path: Path, engines=None, only: list[str] | None = None,
                 progress=None) -> StressResult:
+    return stress_case(*read_stress(path), engines=engines, only=only, progress=progress)
+
+
+def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = None,
+                progress=None) -> StressResult:
+    """Stress one case (``read_stress``'s raw table and Case) over its parameters."""
     from ..engines import discovery
     from ..engines.mapping import contact_mapping
 
-    raw0 = _read(path)
-    raw0.pop("variants", None)
-    base = from_dict(copy.deepcopy(raw0))
     res = StressResult(base.name, resolve(base).describe())
     params = parameters(raw0)
     if only:
