@@ -201,3 +201,78 @@ def test_interrupt_exit_codes():
     wrapped = RuntimeError("wrapped")
     wrapped.__cause__ = runner.Terminated()
     assert runner.interrupt_exit_code(wrapped) == 143
+
+
+# ----------------------------------------------------------------------------- the reference's compiled solvers
+
+# demcheck as a user runs it, with a hook in the packing solver: the signal is sent to demcheck itself a moment
+# into the second chunk of steps, while the compiled kernel runs (numba holds a signal until its kernel returns,
+# and then raises it inside its own Python callback: a SystemError whose cause is the KeyboardInterrupt)
+_SIGNAL_IN_THE_SOLVER = """
+import os, signal, sys, threading
+from demcheck import cli
+from demcheck.reference import packing as P
+
+real, calls = P.advance, []
+
+def advance(*args, **kwargs):
+    calls.append(1)
+    if len(calls) == 2:
+        threading.Timer(0.3, os.kill, (os.getpid(), int(sys.argv[1]))).start()
+    return real(*args, **kwargs)
+
+P.advance = advance
+cli.main(sys.argv[2:])
+"""
+
+# the same signal while numba compiles: its handler's exception raised in a ctypes callback is printed and lost
+# ("Exception ignored on calling ctypes callback function"), and numba fails later with an unrelated error
+_SIGNAL_IN_A_CALLBACK = """
+import ctypes, signal, sys
+from demcheck import cli
+from demcheck.reference import packing as P
+
+def simulate(*args, **kwargs):
+    ctypes.CFUNCTYPE(None)(lambda: signal.raise_signal(int(sys.argv[1])))()
+    raise RuntimeError("no compiled object yet for <Library 'run'>")
+
+P.simulate = simulate
+cli.main(sys.argv[2:])
+"""
+
+
+def _script(script, *args, cwd):
+    proc = subprocess.Popen([sys.executable, "-c", script, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        out, err = proc.communicate(timeout=600)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        pytest.fail("demcheck did not exit within 600 s")
+    return proc.returncode, out, err
+
+
+@pytest.mark.parametrize("sig,code", SIGNALS)
+def test_an_interrupt_in_the_reference_packing_solver_is_an_interrupt(sig, code, tmp_path):
+    code_got, out, err = _script(_SIGNAL_IN_THE_SOLVER, int(sig), "pack", CASES / "packing" / "poured.toml",
+                                 cwd=tmp_path)
+    assert code_got == code, err[-3000:]
+    assert out == "" and err.strip().splitlines()[-1] == "demcheck: interrupted", err[-3000:]
+    assert "Traceback" not in err and "SystemError" not in err
+
+
+@pytest.mark.parametrize("sig,code", SIGNALS)
+def test_an_interrupt_lost_in_a_callback_is_still_an_interrupt(sig, code, tmp_path):
+    code_got, out, err = _script(_SIGNAL_IN_A_CALLBACK, int(sig), "pack", CASES / "packing" / "column-lsd.toml",
+                                 cwd=tmp_path)
+    assert code_got == code, err[-3000:]
+    assert out == "" and err.strip().splitlines()[-1] == "demcheck: interrupted", err[-3000:]
+
+
+def test_a_system_error_without_an_interrupt_is_not_hidden(tmp_path):
+    script = ("import sys\nfrom demcheck import cli\nfrom demcheck.reference import packing as P\n"
+              "def simulate(*a, **k):\n    raise SystemError('a real fault')\n"
+              "P.simulate = simulate\ncli.main(sys.argv[1:])\n")
+    code_got, _, err = _script(script, "pack", CASES / "packing" / "column-lsd.toml", cwd=tmp_path)
+    assert code_got == 1 and "SystemError: a real fault" in err and "interrupted" not in err

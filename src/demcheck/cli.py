@@ -677,8 +677,11 @@ def main(argv=None) -> None:
     from .engines import run as runner
     from .errors import EngineInterrupted
 
+    received: list[int] = []  # the signals that reached demcheck during this command
+    restore = lambda: None  # noqa: E731
     if threading.current_thread() is threading.main_thread():
         runner.handle_sigterm()  # SIGTERM as SIGINT: engines stopped, a partial report, exit 143
+        restore = _record_signals(received)
     try:
         cli.main(args=argv, prog_name="demcheck", standalone_mode=False)
     except click.exceptions.Abort as exc:  # click's KeyboardInterrupt (or Terminated)
@@ -697,6 +700,61 @@ def main(argv=None) -> None:
     except DemcheckError as exc:
         click.echo(f"demcheck: error: {exc}", err=True)
         sys.exit(exc.exit_code)
+    except Exception as exc:  # an interrupt that surfaced as another error, or a fault (raised again)
+        code = _interrupt_behind(exc, received)
+        if code is None:
+            raise
+        runner.kill_all()
+        click.echo("demcheck: interrupted", err=True)
+        sys.exit(code)
+    finally:
+        restore()
+
+
+def _record_signals(received: list[int]):
+    """Let the SIGINT and SIGTERM handlers (KeyboardInterrupt, engines.run's Terminated) note each signal in
+    ``received`` before they raise; returns the function that puts them back. An interrupt raised where Python
+    cannot pass it on (a ctypes callback during numba's compilation prints it and drops it, and numba then
+    fails with an error of its own) is still known to have happened."""
+    import signal
+
+    previous = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        handler = signal.getsignal(sig)
+        if callable(handler):  # not SIG_IGN (a background job's SIGINT) nor SIG_DFL
+
+            def noted(signum, frame, handler=handler):
+                received.append(signum)
+                handler(signum, frame)
+
+            previous[sig] = handler
+            signal.signal(sig, noted)
+
+    def restore():
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+    return restore
+
+
+def _interrupt_behind(exc: BaseException, received: list[int]) -> int | None:
+    """The exit code (128 + the signal) when ``exc`` is an interrupt's doing, else None: a KeyboardInterrupt
+    (or engines.run.Terminated) among its causes and contexts — numba raises a pending signal inside its own
+    callback (_numba_unpickle) as it returns from a compiled kernel, and reports it as ``SystemError:
+    CPUDispatcher(...) returned a result with an exception set`` caused by the KeyboardInterrupt — or, where
+    the chain lost it, a signal received during the command."""
+    from .engines import run as runner
+
+    todo, seen = [exc], set()
+    while todo:
+        e = todo.pop()
+        if e is None or id(e) in seen:
+            continue
+        seen.add(id(e))
+        if isinstance(e, KeyboardInterrupt):
+            return runner.interrupt_exit_code(e)
+        todo += [e.__cause__, e.__context__]
+    return 128 + received[-1] if received else None
 
 
 if __name__ == "__main__":  # pragma: no cover
