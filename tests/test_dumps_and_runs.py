@@ -222,3 +222,90 @@ def test_golden_decks_run_by_hand(name, engine, tmp_path):
     m = res.metrics()
     for k in ("peak_force", "restitution", "contact_time"):
         assert m[k] == pytest.approx(twin[k], rel=1e-9), k
+
+
+# ----------------------------------------------------------------------------- contact tables under gravity
+
+G = (0.0, 0.0, -9.81)
+
+
+def _gravity_wall_case(gravity=G):
+    """cases/hertz-wall.toml at 0.5 m/s under gravity (the wall's normal is +z: gravity -z points into it)."""
+    from demcheck import case as C
+
+    return C.load(CASES / "hertz-wall.toml", ["impact.speed=0.5", f"run.gravity={list(gravity)}"])
+
+
+def _hertz_force(case, delta):
+    from demcheck.reference.model import resolve
+
+    return resolve(case).normal_law.k * delta ** 1.5
+
+
+def test_the_contact_force_of_a_wall_contact_is_the_bodys_force_less_its_weight():
+    """An engine's dump gives the body's whole force: the contact's plus the weight m·g of fix gravity. The
+    contact table holds the contact's alone: Hertz's K δ^{3/2} along the wall normal, no tangential part."""
+    import pandas as pd
+
+    from demcheck.engines.states import from_particles
+
+    for gravity in (G, (3.0, -4.0, -9.81)):  # along the normal; tilted (a tangential part too)
+        case = _gravity_wall_case(gravity)
+        r, m = case.particles[0].radius, case.mass(0)
+        delta = np.array([1e-7, 2e-6, 5e-6])
+        fc = _hertz_force(case, delta)
+        weight = m * np.asarray(gravity)
+        zeros = np.zeros_like(delta)
+        parts = pd.DataFrame({"t": [0.0, 1e-6, 2e-6], "id": 0, "x": zeros, "y": zeros, "z": r - delta,
+                              "vx": zeros, "vy": zeros, "vz": -0.5 + zeros, "wx": zeros, "wy": zeros, "wz": zeros,
+                              "fx": weight[0] + zeros, "fy": weight[1] + zeros, "fz": fc + weight[2]})
+        c = from_particles(parts, case)
+        assert c["delta"].to_numpy() == pytest.approx(delta, rel=1e-9)
+        # m·g/F is 5e-5 .. 2e-3 here: 1e-12 separates the weight's share from round-off
+        assert c["fn"].to_numpy() == pytest.approx(fc, rel=1e-12)
+        assert np.abs(c[["ftx", "fty", "ftz"]].to_numpy()).max() <= 1e-12 * fc.max()
+
+
+def test_the_contact_force_of_a_pair_is_the_bodys_force_less_its_weight():
+    """Between two particles gravity is normal to the line of centres (x): the body's weight was read as a
+    tangential force m₀·g."""
+    import pandas as pd
+
+    from demcheck import case as C
+    from demcheck.engines.states import from_particles
+
+    case = C.load(CASES / "glass-pair.toml", [f"run.gravity={list(G)}"])
+    r0, r1, m0 = case.particles[0].radius, case.particles[1].radius, case.mass(0)
+    delta = np.array([1e-7, 2e-6])
+    fc = _hertz_force(case, delta)
+    zeros = np.zeros_like(delta)
+    p0 = pd.DataFrame({"t": [0.0, 1e-6], "id": 0, "x": zeros, "y": zeros, "z": zeros, "vx": 0.5 + zeros,
+                       "vy": zeros, "vz": zeros, "wx": zeros, "wy": zeros, "wz": zeros,
+                       "fx": -fc, "fy": zeros, "fz": m0 * G[2] + zeros})
+    p1 = p0.assign(id=1, x=r0 + r1 - delta, vx=-0.5 + zeros, fx=fc, fz=case.mass(1) * G[2] + zeros)
+    c = from_particles(pd.concat([p0, p1], ignore_index=True), case)
+    assert c["fn"].to_numpy() == pytest.approx(fc, rel=1e-12)
+    assert np.abs(c[["ftx", "fty", "ftz"]].to_numpy()).max() <= 1e-12 * fc.max()
+
+
+@pytest.mark.parametrize("engine", ["lammps", "liggghts"])
+def test_the_twin_read_off_its_states_gives_its_own_contact_force_under_gravity(engine):
+    """The twin's particle forces are written as an engine's are (contact + weight) and read back through the
+    same function: the contact table is the kernel's own, row for row (no engine needed)."""
+    from demcheck.engines.mapping import contact_mapping, twin_model
+    from demcheck.engines import registry
+    from demcheck.reference import collision3d
+    from demcheck.reference.collision import auto_dt
+    from demcheck.reference.model import resolve
+
+    case = _gravity_wall_case((3.0, -4.0, -9.81))
+    model = resolve(case)
+    dt = auto_dt(case, model)
+    twin = twin_states(case, engine, dt)
+    own = collision3d.collide(case, twin_model(model, contact_mapping(case, engine).require()), "verlet", dt=dt,
+                              rules=registry.get(engine).rules).contact
+    n = len(twin.contact)
+    assert n > 50 and (twin.contact["fn"] > 0).any()
+    scale = own["fn"].abs().max()
+    for col in ("fn", "ftx", "fty", "ftz"):
+        assert np.abs(twin.contact[col].to_numpy() - own[col].to_numpy()[:n]).max() <= 1e-12 * scale, col

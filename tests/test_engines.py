@@ -218,3 +218,87 @@ def test_liggghts_hooke_with_characteristic_velocity_matches_its_twin(wall):
     assert tl.kt == nl.k and tl.eta == nl.eta
     res = collide(case, "liggghts", native=nat)
     _agree(res, twin_states(case, "liggghts", res.dt, native=nat), OBLIQUE_KEYS)
+
+
+# ----------------------------------------------------------------------------- a collision under gravity
+
+
+def _gravity_case(gravity):
+    """cases/hertz-wall.toml at 0.5 m/s under gravity (the wall's normal is +z: gravity's z part points into it),
+    or an oblique spring-dashpot impact with friction under a tilted gravity."""
+    from demcheck import case as C
+
+    from .conftest import CASES
+
+    if gravity[0] == 0.0:
+        return C.load(CASES / "hertz-wall.toml", ["impact.speed=0.5", f"run.gravity={list(gravity)}"])
+    return C.load(CASES / "oblique-lsd-wall.toml", ["impact.speed=0.5", f"run.gravity={list(gravity)}"])
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
+@pytest.mark.parametrize("gravity", [(0.0, 0.0, -9.81), (3.0, -4.0, -9.81)], ids=["normal", "tilted"])
+def test_an_impact_under_gravity_matches_the_twin(engine, gravity):
+    """The engine's dump holds each body's whole force, its weight m·g included; the contact is read without
+    it (once m·g/F_peak = 5.07e-05 on the peak force: "the engine does not compute its own formula")."""
+    case = _gravity_case(gravity)
+    res, twin = _run(case, engine)
+    keys = NORMAL_KEYS + ("max_overlap", "force_contact_time")
+    m = _agree(res, twin, keys + (OBLIQUE_KEYS[3:] if gravity[0] else ()))
+    mg = case.mass(0) * 9.81
+    assert mg / m["peak_force"] > 1e3 * TOL, "the weight's share of the peak force is far above the bar"
+
+
+@pytest.fixture(scope="module")
+def gravity_verify(tmp_path_factory):
+    """`demcheck verify` of the probe's case (cases/hertz-wall.toml at 0.5 m/s under gravity [0, 0, -9.81]) with
+    the installed engines: (process, engines)."""
+    import os
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    engines = [e for e in ("lammps", "liggghts") if discovery.find(e) is not None]
+    if not engines:
+        pytest.skip("no engine installed")
+    tmp_path = tmp_path_factory.mktemp("gravity-verify")
+    path = tmp_path / "hertz-wall-gravity.toml"
+    text = (CASES / "hertz-wall.toml").read_text().replace("speed = 1.0", "speed = 0.5")
+    path.write_text(text.replace('name = "hertz-wall"', 'name = "hertz-wall-gravity"')
+                    + "\n[run]\ngravity = [0.0, 0.0, -9.81]\n")
+    env = {**os.environ, "DEMCHECK_CACHE": str(tmp_path / "cache")}
+    p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(path), "--engines", ",".join(engines),
+                        "--report", str(tmp_path / "reports"), "--json"], capture_output=True, text=True,
+                       cwd=tmp_path, timeout=600, env=env)
+    return p, engines
+
+
+def test_verify_under_gravity_passes_with_the_engines_on_their_twins(gravity_verify):
+    """Exit 0, each engine within 1e-9 of its twin, and no closed form judged (they are the gravity-free
+    model's)."""
+    import json
+
+    p, engines = gravity_verify
+    assert p.returncode == 0, p.stderr[-3000:]
+    (entry,) = json.loads(p.stdout)["cases"]
+    assert entry["status"] == "ok", [c for c in entry["comparisons"] if c["verdict"] != "agree"]
+    assert not [c for c in entry["comparisons"] if c["source"] == "closed-form"]
+    for engine in engines:
+        comps = [c for c in entry["comparisons"] if c["source"] == engine]
+        assert comps and all(c["parts"]["implementation"] <= TOL for c in comps
+                             if math.isfinite(c["parts"]["implementation"])), comps
+
+
+@pytest.mark.xfail(strict=True, reason="comparisons/suite.restate still writes the seed's verlet forces without "
+                                       "the weight (it should be engines.states.restate): not this change's file")
+def test_verify_under_gravity_reads_the_seed_verlet_run_as_the_engines(gravity_verify):
+    """The seed law's verlet run at the engine's dt (the time step's own error) is read off its states as the
+    engine and the twin are: Hertz maps exactly, so the twin is the seed law and both agree to round-off."""
+    import json
+
+    p, engines = gravity_verify
+    (entry,) = json.loads(p.stdout)["cases"]
+    for engine in engines:
+        src = entry["sources"][engine]
+        for k in NORMAL_KEYS:
+            assert src["seed_verlet_metrics"][k] == pytest.approx(src["twin_metrics"][k], rel=TOL), (engine, k)

@@ -125,3 +125,29 @@ def test_metrics_are_physical(model_id):
     assert all(math.isfinite(m[k]) for k in NORMAL_METRICS)
     assert m["rebound_angle"] == 0.0  # head-on in, head-on out
     assert math.isnan(m["tangential_restitution"])  # undefined without tangential velocity
+
+
+@pytest.mark.parametrize("model_id", ["lsd", "hertz", "hls"])
+@pytest.mark.parametrize("gravity", [[0.0, 0.0, -9.81], [0.0, 1e-3, 0.0]], ids=["into-the-wall", "sideways"])
+def test_closed_forms_are_not_applied_under_gravity(model_id, gravity):
+    """The closed forms are the gravity-free model's (under gravity a wall contact carries the weight too, and
+    the energy of the bodies is not the impact's): a case with any gravity has none."""
+    from demcheck.reference.expected import closed_form_metrics
+
+    free = example_case(model_id, wall=True, speed=0.5)
+    assert set(closed_form_metrics(resolve(free))) >= {"restitution", "peak_force", "contact_time"}
+    heavy = example_case(model_id, wall=True, speed=0.5, overrides=[f"run.gravity={gravity}"])
+    assert closed_form_metrics(resolve(heavy)) == {}
+
+
+def test_the_adaptive_method_under_gravity_misses_the_gravity_free_peak_force():
+    """Why the closed forms must not judge a case under gravity: the converged answer differs from them by about
+    the weight's share m·g/F of the peak force (5e-5 here), beyond round-off."""
+    from demcheck.reference.expected import closed_form_metrics
+
+    free = example_case("hertz", wall=True, speed=0.5)
+    heavy = example_case("hertz", wall=True, speed=0.5, overrides=["run.gravity=[0.0, 0.0, -9.81]"])
+    exact = closed_form_metrics(resolve(free))["peak_force"]
+    got = collide(heavy).metrics()["peak_force"]
+    mg = heavy.mass(0) * 9.81
+    assert abs(got / exact - 1) > 0.3 * mg / exact

@@ -142,22 +142,14 @@ def _native_summary(native) -> dict:
 
 def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
     """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
-    off its states exactly as an engine's is."""
+    off its states exactly as an engine's is (states.restate: the bodies' forces with their weights, as an
+    engine dumps them, read back less the weights)."""
     from ..reference import collision3d
     from ..reference.model import resolve
 
     mp = contact_mapping(case, engine, native)
     model = twin_model(resolve(case), mp.require())
-    res = collision3d.collide(case, model, "verlet", dt=dt, rules=registry.get(engine).rules)
-    c = res.contact
-    parts = res.particles.copy()
-    f0 = -c["fn"].to_numpy()[:, None] * c[["nx", "ny", "nz"]].to_numpy() + c[["ftx", "fty", "ftz"]].to_numpy()
-    p0 = parts["id"] == 0
-    for k, col in enumerate(("fx", "fy", "fz")):
-        parts[col] = np.nan
-        parts.loc[p0, col] = f0[:, k]
-    res.contact = states.trim(states.from_particles(parts, case))
-    res.particles = parts
+    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=registry.get(engine).rules), case)
     res.source = f"{engine}-twin"
     res.meta["fidelity"] = mp.fidelity
     return res

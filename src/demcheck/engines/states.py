@@ -2,8 +2,11 @@
 
 An engine's dump gives, per step, the end-of-step positions, velocities, angular velocities and the forces
 of that step; a two-body contact is read off them (per-contact output would be re-evaluated at output
-time, ENGINES.md §1.6 and §2.4). The reference's verlet twin is read off its own states through the same
-function, so engine and twin are compared quantity by quantity with nothing but the engine in between.
+time, ENGINES.md §1.6 and §2.4). A body's force in the dump is the whole force on it: the contact's plus its
+weight m·g (``fix gravity``), so the contact's is the body's force less its weight (the case's run.gravity).
+The reference's verlet twin writes its bodies' forces the same way (``body_forces``: contact + weight) and is
+read off its states through the same function (``restate``), so engine and twin are compared quantity by
+quantity with nothing but the engine in between.
 """
 
 from __future__ import annotations
@@ -62,14 +65,21 @@ def trim(table: pd.DataFrame) -> pd.DataFrame:
     return table.iloc[: inside[0] + int(after[0]) + 1].reset_index(drop=True)
 
 
+def weight(case, i: int = 0) -> np.ndarray:
+    """Body i's weight m·g (N), from the case's run.gravity."""
+    return case.mass(i) * np.asarray(case.run.gravity, float)
+
+
 def from_particles(particles: pd.DataFrame, case) -> pd.DataFrame:
     """The contact table of a case's two bodies from a particles table with forces (t, id, x.., v.., w..,
-    fx..) — ids 0 and 1 in the case's order."""
+    fx..) — ids 0 and 1 in the case's order. The forces are the bodies' whole forces, as an engine dumps them:
+    the contact's is body 0's force less its weight."""
     p0 = particles[particles["id"] == 0].sort_values("t")
     t = p0["t"].to_numpy()
     r0, m0 = case.particles[0].radius, case.mass(0)
     cols = (["x", "y", "z"], ["vx", "vy", "vz"], ["wx", "wy", "wz"], ["fx", "fy", "fz"])
     a0 = [p0[c].to_numpy() for c in cols]
+    a0[3] = a0[3] - weight(case, 0)
     if case.walls:
         w = case.walls[0]
         return contact_table(t, *a0, r0, m0, wall_point=w.point, wall_normal=w.normal)
@@ -77,3 +87,27 @@ def from_particles(particles: pd.DataFrame, case) -> pd.DataFrame:
     a1 = [p1[c].to_numpy() for c in cols[:3]]
     return contact_table(t, *a0, r0, m0, x1=a1[0], v1=a1[1], w1=a1[2], r1=case.particles[1].radius,
                          m1=case.mass(1))
+
+
+def body_forces(contact: pd.DataFrame, particles: pd.DataFrame, case) -> pd.DataFrame:
+    """A copy of ``particles`` (a reference run's states: t, id, x.., v.., w..) with body 0's forces as an
+    engine dumps them: the contact's force on it (−Fn n + Ft, from ``contact``, row for row) plus its weight
+    m₀·g. Body 1's forces are not read (NaN)."""
+    parts = particles.copy()
+    f0 = -contact["fn"].to_numpy()[:, None] * contact[["nx", "ny", "nz"]].to_numpy() \
+        + contact[["ftx", "fty", "ftz"]].to_numpy() + weight(case, 0)
+    p0 = (parts["id"] == 0).to_numpy()
+    for k, col in enumerate(("fx", "fy", "fz")):
+        parts[col] = np.nan
+        parts.loc[p0, col] = f0[:, k]
+    return parts
+
+
+def restate(result, case):
+    """A reference run (the verlet method: its contact table row for row with body 0's states) read off its
+    states exactly as an engine's is: the bodies' forces written as an engine's (``body_forces``), the contact
+    table read back (``from_particles``) and trimmed. Returns ``result`` with both tables replaced."""
+    parts = body_forces(result.contact, result.particles, case)
+    result.contact = trim(from_particles(parts, case))
+    result.particles = parts
+    return result

@@ -11,11 +11,13 @@ from .normal import HYSTERETIC
 
 
 def closed_form_metrics(model: ResolvedModel) -> dict:
-    """Metric name → closed-form value, for the metrics this model has one for (may be empty)."""
+    """Metric name → closed-form value, for the metrics this model has one for (may be empty). The closed forms
+    are the gravity-free collision's: a case with any gravity has none (a wall contact also carries the weight,
+    and the bodies' kinetic energy changes with their fall)."""
     law, pair = model.normal_law, model.pair
     m, v = pair.m_eff, pair.impact_speed
     nid = model.normal.id
-    if model.tangential.id != "none" or not (v > 0):
+    if model.tangential.id != "none" or not (v > 0) or any(model.gravity):
         return {}
     if nid == "lsd":
         k, eta = law.k, law.eta

@@ -28,6 +28,7 @@ class ResolvedModel:
     tangential_law: _tangential.TangentialLaw
     params: dict
     limit_force: bool
+    gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # the case's run.gravity (m/s²)
 
     def describe(self) -> dict:
         return {"normal": self.normal.id, "tangential": self.tangential.id, "limit_force": self.limit_force}
@@ -62,7 +63,7 @@ def resolve(case: Case, i: int = 0, j: int | None = 1) -> ResolvedModel:
     if pair.restitution is not None:
         resolved.setdefault("restitution", pair.restitution)
     return ResolvedModel(normal, tangential, pair, normal_law, tangential_law, resolved,
-                         case.contact.limit_force)
+                         case.contact.limit_force, tuple(case.run.gravity))
 
 
 def check_contact(case: Case) -> None:
