@@ -30,6 +30,7 @@ from demcheck import case as C
 from demcheck.comparisons import verdicts as V
 from demcheck.engines import discovery
 from demcheck.engines.cache import Cache
+from demcheck.engines.collide import META_KEYS as COLLIDE_META
 from demcheck.reference import health as H
 from demcheck.reference.collision import characteristic_time, collide
 from demcheck.reference.model import resolve
@@ -282,6 +283,8 @@ def test_cli_collide_with_non_finite_engine_output_exits_1(nan_lammps, glass_pai
 
 META = {"version": "v", "workdir": "/w", "wall_time": 1.0, "warnings": []}
 COLUMNS = ("step", "id", "x")
+# what an engine collision asks of an entry (engines/collide.py): its columns, its metadata's keys and types, rows
+GET = dict(columns=COLUMNS, meta_keys=COLLIDE_META, min_rows=1)
 
 
 def _table():
@@ -309,6 +312,16 @@ DAMAGE = {
     "meta-not-an-object": lambda p: _rewrite_meta(p, [1, 2]),
     "non-finite": lambda p: _put_raw(p, pd.DataFrame({"step": [0], "id": [1], "x": [math.nan]})),
     "missing-column": lambda p: _put_raw(p, pd.DataFrame({"step": [0], "id": [1]})),
+    # metadata of the wrong type (once a TypeError in collide: Path(None))
+    "meta-workdir-null": lambda p: _rewrite_meta(p, {**META, "workdir": None}),
+    "meta-version-a-number": lambda p: _rewrite_meta(p, {**META, "version": 5}),
+    "meta-wall-time-a-string": lambda p: _rewrite_meta(p, {**META, "wall_time": "1.0"}),
+    "meta-wall-time-nan": lambda p: _rewrite_meta(p, {**META, "wall_time": math.nan}),
+    "meta-wall-time-true": lambda p: _rewrite_meta(p, {**META, "wall_time": True}),
+    "meta-warnings-a-string": lambda p: _rewrite_meta(p, {**META, "warnings": "w"}),
+    "meta-warnings-not-strings": lambda p: _rewrite_meta(p, {**META, "warnings": [1]}),
+    # a table without rows (once a silent hit)
+    "zero-rows": lambda p: _put_raw(p, _table().iloc[:0]),
 }
 
 
@@ -343,21 +356,78 @@ def test_a_damaged_entry_is_a_logged_miss_and_is_replaced(tmp_path, caplog, dama
     k, path = _entry(cache)
     DAMAGE[damage](path)
     with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
-        assert cache.get(k, columns=COLUMNS, meta_keys=tuple(META)) is None
-        assert cache.get(k, columns=COLUMNS, meta_keys=tuple(META)) is None
+        assert cache.get(k, **GET) is None
+        assert cache.get(k, **GET) is None
     logged = [r for r in caplog.records if r.name == "demcheck.cache"]
     assert len(logged) == 1 and str(path) in logged[0].getMessage() and "\n" not in logged[0].getMessage()
     assert cache.misses == 2 and cache.hits == 0
     cache.put(k, _table(), META)
-    table, meta = cache.get(k, columns=COLUMNS, meta_keys=tuple(META))
+    table, meta = cache.get(k, **GET)
     assert table.equals(_table()) and meta == META
 
 
 def test_a_healthy_entry_round_trips(tmp_path):
     cache = Cache(tmp_path)
     k, _ = _entry(cache)
-    table, meta = cache.get(k, columns=COLUMNS, meta_keys=tuple(META))
+    table, meta = cache.get(k, **GET)
     assert table.equals(_table()) and table["id"].dtype == np.int64 and meta == META and cache.hits == 1
+
+
+def test_an_entry_failing_the_callers_own_check_is_a_logged_miss(tmp_path, caplog):
+    """The caller's check of what it reads (an engine collision: a row for every body) makes a miss of an entry
+    that loads but cannot be its run."""
+    cache = Cache(tmp_path)
+    k, path = _entry(cache)
+    one_body = lambda table, meta: None if set(table["id"]) == {1, 2} else "not every body"  # noqa: E731
+    _put_raw(path, _table()[_table()["id"] == 1])
+    with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
+        assert cache.get(k, **GET, check=one_body) is None
+    assert "not every body" in caplog.records[-1].getMessage() and cache.misses == 1
+    cache.put(k, _table(), META)
+    assert cache.get(k, **GET, check=one_body)[0].equals(_table())
+
+
+def _shard_a_file(cache, k):
+    path = cache._path(k)
+    if path.parent.exists():
+        path.unlink(missing_ok=True)
+        path.parent.rmdir()
+    path.parent.parent.mkdir(parents=True, exist_ok=True)
+    path.parent.write_text("a file where the shard directory goes")
+
+
+def _entry_a_directory(cache, k):
+    path = cache._path(k)
+    path.unlink(missing_ok=True)
+    (path / "inside").mkdir(parents=True)
+
+
+def _cache_a_file(cache, k):
+    import shutil
+
+    shutil.rmtree(cache.dir, ignore_errors=True)
+    cache.dir.write_text("a file where the cache directory goes")
+
+
+PUT_DAMAGE = {"shard-a-file": _shard_a_file, "entry-a-directory": _entry_a_directory, "cache-a-file": _cache_a_file}
+
+
+@pytest.mark.parametrize("damage", list(PUT_DAMAGE))
+def test_a_put_that_cannot_write_logs_once_and_goes_on(tmp_path, caplog, damage):
+    """A file where a directory goes, a directory where the entry goes: once FileExistsError / IsADirectoryError
+    out of Cache.put. The result is not cached, one line says so, and nothing is raised."""
+    cache = Cache(tmp_path / "cache")
+    k = "ab" * 32
+    PUT_DAMAGE[damage](cache, k)
+    with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
+        assert cache.put(k, _table(), META) is False
+        assert cache.put(k, _table(), META) is False
+        assert cache.get(k, **GET) is None
+    logged = [r.getMessage() for r in caplog.records if r.name == "demcheck.cache"]
+    not_cached = [m for m in logged if "not cached" in m]
+    assert len(not_cached) == 1 and str(cache._path(k)) in not_cached[0] and "\n" not in not_cached[0], logged
+    assert len(logged) <= 2  # and, for a directory at the entry's path, its one line as a damaged entry
+    assert not list(tmp_path.rglob("*.tmp")), "no temporary file left behind"
 
 
 def test_the_cache_never_stores_non_finite_tables(tmp_path):
@@ -376,19 +446,54 @@ def test_refresh_never_reads_and_writes_over(tmp_path):
     assert Cache(tmp_path).get(k)[0].equals(newer)
 
 
+def _rows_of(path, query):
+    """Rewrite a real entry keeping its columns and metadata and only the rows of ``query``."""
+    with np.load(path) as z:
+        cols, data, meta = [str(c) for c in z["columns"]], z["data"], z["meta"]
+    kept = pd.DataFrame(data, columns=cols).query(query)
+    with open(path, "wb") as fh:
+        np.savez(fh, columns=np.array(cols), data=kept.to_numpy(dtype=float), meta=meta)
+
+
+ENGINE_DAMAGE = {"zero-rows": lambda p: _rows_of(p, "id < 0"), "one-body-only": lambda p: _rows_of(p, "id == 1")}
+
+
 @pytest.mark.engine("lammps")
-@pytest.mark.parametrize("damage", ["truncated", "zero-bytes", "meta-without-keys"])
-def test_an_engine_run_over_a_damaged_entry_runs_again_and_replaces_it(tmp_path, damage):
+@pytest.mark.parametrize("damage", ["truncated", "zero-bytes", "meta-without-keys", "meta-workdir-null",
+                                    "meta-wall-time-a-string", "zero-rows", "one-body-only"])
+def test_an_engine_run_over_a_damaged_entry_runs_again_and_replaces_it(tmp_path, damage, caplog):
     from demcheck.engines.collide import collide as run_engine
 
     case = glass_case("hertz", {})
     first = run_engine(case, "lammps", cache=Cache(tmp_path))
     (path,) = tmp_path.rglob("*.npz")
-    DAMAGE[damage](path)
-    again = run_engine(case, "lammps", cache=Cache(tmp_path))
+    ENGINE_DAMAGE.get(damage, DAMAGE.get(damage))(path)
+    with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
+        again = run_engine(case, "lammps", cache=Cache(tmp_path))
     assert again.status == "ok" and not again.meta["cached"]
     assert again.metrics()["restitution"] == first.metrics()["restitution"]
+    assert len([r for r in caplog.records if str(path) in r.getMessage()]) == 1
     assert run_engine(case, "lammps", cache=Cache(tmp_path)).meta["cached"]
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.parametrize("damage", list(PUT_DAMAGE))
+def test_an_engine_run_whose_entry_cannot_be_written_keeps_its_result(tmp_path, damage, caplog):
+    from demcheck.engines.cache import key
+    from demcheck.engines.collide import collide as run_engine, deck
+    from demcheck.engines.mapping import contact_mapping
+
+    case = glass_case("hertz", {})
+    cache = Cache(tmp_path / "cache")
+    dk = deck(case, "lammps", native=contact_mapping(case, "lammps").require())  # the deck collide runs
+    PUT_DAMAGE[damage](cache, key("lammps", discovery.find("lammps").version, dk.text, dk.files))
+    first = run_engine(case, "lammps")
+    with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
+        res = run_engine(case, "lammps", cache=cache)
+    assert res.status == "ok" and not res.meta["cached"]
+    assert res.metrics() == first.metrics()
+    assert len([r for r in caplog.records if "not cached" in r.getMessage()]) == 1
+    assert not run_engine(case, "lammps", cache=Cache(tmp_path / "cache")).meta["cached"]
 
 
 # ----------------------------------------------------------------------------- runaway records

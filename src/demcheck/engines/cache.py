@@ -5,10 +5,12 @@ Key: SHA-256 of the engine's name and version, the deck and the files it reads. 
 never leaves a half-written entry. Location: ``$DEMCHECK_CACHE``, else ``~/.cache/demcheck/engine-runs``.
 
 Only finite tables are stored (NaN or infinite output is a failed run, never reused). An entry that fails
-to load or to validate (truncated, changed bytes, no metadata keys, columns missing, non-finite values)
-is a miss, logged once (logger ``demcheck.cache``: one line naming the file and the fault), and the next
-``put`` writes over it. ``Cache(refresh=True)`` never reads an entry and writes fresh results over old
-ones (``--no-cache``).
+to load or to validate (truncated, changed bytes, a directory in its place, metadata keys missing or of the
+wrong type, columns missing, fewer rows than the caller needs, non-finite values, the caller's own check) is a
+miss, logged once (logger ``demcheck.cache``: one line naming the file and the fault), and the next ``put``
+writes over it. A ``put`` that cannot write (a file where a directory goes, a directory where the entry goes,
+no permission, a full disk) logs once and returns False: the caller keeps its result, uncached.
+``Cache(refresh=True)`` never reads an entry and writes fresh results over old ones (``--no-cache``).
 """
 
 from __future__ import annotations
@@ -16,8 +18,10 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 import os
 from pathlib import Path
+from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 import pandas as pd
@@ -44,6 +48,22 @@ class Damaged(Exception):
     """An entry that loads but does not validate."""
 
 
+# checks of metadata values, for ``Cache.get(meta_keys={key: check})``
+def text(v) -> bool:
+    """A string."""
+    return isinstance(v, str)
+
+
+def number(v) -> bool:
+    """A finite number (not a boolean)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def texts(v) -> bool:
+    """A list of strings."""
+    return isinstance(v, list) and all(isinstance(x, str) for x in v)
+
+
 class Cache:
     def __init__(self, directory: str | Path | None = None, refresh: bool = False):
         self.dir = Path(directory) if directory else default_dir()
@@ -51,53 +71,75 @@ class Cache:
         self.hits = 0
         self.misses = 0
         self._logged: set[Path] = set()
+        self._unwritable: set[Path] = set()
 
     def _path(self, k: str) -> Path:
         return self.dir / k[:2] / f"{k}.npz"
 
-    def get(self, k: str, columns: tuple[str, ...] = (), meta_keys: tuple[str, ...] = ()
+    def get(self, k: str, columns: tuple[str, ...] = (), meta_keys: Iterable[str] | Mapping[str, Callable] = (),
+            min_rows: int = 0, check: Callable[[pd.DataFrame, dict], str | None] | None = None
             ) -> tuple[pd.DataFrame, dict] | None:
         """(table, meta) of entry ``k``, or None: no entry, ``refresh``, or an entry that fails to load or
-        to validate — finite values, the ``columns`` and ``meta_keys`` the caller needs."""
+        to validate — finite values, the ``columns`` and ``meta_keys`` the caller needs (names, or names → a
+        check of the value such as ``text``, ``number``, ``texts``), at least ``min_rows`` rows, and the
+        caller's ``check(table, meta)`` (a fault's description, or None)."""
         path = self._path(k)
         if self.refresh or not path.exists():
             self.misses += 1
             return None
         try:
-            table, meta = _load(path, columns, meta_keys)
+            table, meta = _load(path, columns, meta_keys, min_rows)
+            fault = check(table, meta) if check is not None else None
+            if fault:
+                raise Damaged(fault)
         except Exception as exc:  # noqa: BLE001 — whatever the damage, the entry is a miss and is replaced
             self.misses += 1
             if path not in self._logged:
                 self._logged.add(path)
                 why = " ".join(str(exc).split())[:200]
-                log.warning("demcheck: engine-run cache: ignoring the damaged entry %s (%s: %s); it will be "
-                            "replaced", path, type(exc).__name__, why)
+                then = "it will be replaced" if path.is_file() else "a directory, it cannot be replaced"
+                log.warning("demcheck: engine-run cache: ignoring the damaged entry %s (%s: %s); %s", path,
+                            type(exc).__name__, why, then)
             return None
         self.hits += 1
         return table, meta
 
     def put(self, k: str, table: pd.DataFrame, meta: dict) -> bool:
-        """Store ``table`` and ``meta`` under ``k`` (over any old entry); a table with NaN or infinite values
-        is not stored (False)."""
+        """Store ``table`` and ``meta`` under ``k`` (over any old entry): True when stored. A table with NaN or
+        infinite values is not stored (False); nor is one the cache cannot write (False, logged once: a file
+        where a directory goes, a directory where the entry goes, no permission, a full disk)."""
         data = table.to_numpy(dtype=float)
         if not np.isfinite(data).all():
             return False
         path = self._path(k)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:
-            with open(tmp, "wb") as fh:
-                np.savez(fh, columns=np.array(list(table.columns)), data=data, meta=np.array(json.dumps(meta)))
+        try:
+            with atomic_path(path) as tmp:
+                with open(tmp, "wb") as fh:
+                    np.savez(fh, columns=np.array(list(table.columns)), data=data,
+                             meta=np.array(json.dumps(meta)))
+        except OSError as exc:
+            if path not in self._unwritable:
+                self._unwritable.add(path)
+                why = " ".join(str(exc).split())[:200]
+                log.warning("demcheck: engine-run cache: cannot write the entry %s (%s: %s); the result is used "
+                            "but not cached", path, type(exc).__name__, why)
+            return False
         self._logged.discard(path)
+        self._unwritable.discard(path)
         return True
 
 
-def _load(path: Path, columns, meta_keys) -> tuple[pd.DataFrame, dict]:
+def _load(path: Path, columns, meta_keys, min_rows: int = 0) -> tuple[pd.DataFrame, dict]:
+    if not path.is_file():
+        raise Damaged("not a file")
     with np.load(path, allow_pickle=False) as z:
         names = [str(c) for c in z["columns"]]
         data = np.asarray(z["data"], dtype=float)
         meta = json.loads(str(z["meta"]))
     if data.ndim != 2 or data.shape[1] != len(names):
         raise Damaged(f"data of shape {data.shape} for {len(names)} columns")
+    if data.shape[0] < min_rows:
+        raise Damaged(f"{data.shape[0]} rows, fewer than {min_rows}")
     if not np.isfinite(data).all():
         raise Damaged("non-finite values")
     missing = [c for c in columns if c not in names]
@@ -108,6 +150,11 @@ def _load(path: Path, columns, meta_keys) -> tuple[pd.DataFrame, dict]:
     missing = [m for m in meta_keys if m not in meta]
     if missing:
         raise Damaged(f"metadata without {', '.join(missing)}")
+    if isinstance(meta_keys, Mapping):
+        for m, ok in meta_keys.items():
+            if not ok(meta[m]):
+                doc = (ok.__doc__ or ok.__name__).strip().rstrip(".").lower()
+                raise Damaged(f"metadata {m} = {json.dumps(meta[m])[:60]}: not {doc}")
     table = pd.DataFrame(data, columns=names)
     for c in ("step", "id", "type"):
         if c in table:

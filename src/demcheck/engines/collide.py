@@ -12,7 +12,7 @@ from ..case import Case
 from ..inputs import common
 from ..reference import health
 from ..result import Result
-from . import dumps, registry, run as runner, states
+from . import cache as cache_checks, dumps, registry, run as runner, states
 from .mapping import contact_mapping, native_summary, twin_model
 
 
@@ -22,7 +22,19 @@ def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, 
     return registry.get(engine).collision_deck(case, dt, length, native=native, **options)
 
 
-META_KEYS = ("version", "workdir", "wall_time", "warnings")
+# what a cached run's metadata must hold (engines/cache.py checks each value)
+META_KEYS = {"version": cache_checks.text, "workdir": cache_checks.text, "wall_time": cache_checks.number,
+             "warnings": cache_checks.texts}
+
+
+def _every_body(bodies: int):
+    """The check of a cached dump: every body's rows, as many for each (at every step the run wrote)."""
+    def check(table: pd.DataFrame, meta: dict) -> str | None:
+        counts = table["id"].value_counts()
+        if set(counts.index) != set(range(1, bodies + 1)) or counts.nunique() != 1:
+            return f"the dump's bodies {sorted(int(i) for i in counts.index)[:10]} are not 1..{bodies} at every step"
+        return None
+    return check
 
 
 def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
@@ -58,7 +70,9 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             from .cache import key as cache_key
 
             k = cache_key(engine, info.version, text, dk.files)
-            hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS)
+            bodies = len(case.particles) * max(1, int(options.get("copies", 1)))
+            hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
+                            check=_every_body(bodies))
         if hit is not None:
             table, meta = hit
             out = runner.RunOutput(engine, meta["version"], Path(meta["workdir"]), "", meta["wall_time"],
