@@ -5,10 +5,9 @@ Key: SHA-256 of the engine's name and version, the deck and the files it reads. 
 never leaves a half-written entry. Location: ``$DEMCHECK_CACHE``, else ``~/.cache/demcheck/engine-runs``.
 
 Only finite tables are stored (NaN or infinite output is a failed run, never reused). An entry that fails
-to load or to validate (truncated, changed bytes, a directory in its place, metadata keys missing or of the
-wrong type, columns missing, fewer rows than the caller needs, non-finite values, the caller's own check) is a
-miss, logged once (logger ``demcheck.cache``: one line naming the file and the fault), and the next ``put``
-writes over it. A ``put`` that cannot write (a file where a directory goes, a directory where the entry goes,
+to load or to validate (truncated, changed bytes, metadata keys missing or of the wrong type, columns missing,
+fewer rows than the caller needs, non-finite values, the caller's own check) is a miss, logged once (logger
+``demcheck.cache``: one line naming the file and the fault), and the next ``put`` writes over it. A ``put`` that cannot write (a file where a directory goes, a directory where the entry goes,
 no permission, a full disk) logs once and returns False: the caller keeps its result, uncached.
 ``Cache(refresh=True)`` never reads an entry and writes fresh results over old ones (``--no-cache``).
 """
@@ -84,7 +83,7 @@ class Cache:
         check of the value such as ``text``, ``number``, ``texts``), at least ``min_rows`` rows, and the
         caller's ``check(table, meta)`` (a fault's description, or None)."""
         path = self._path(k)
-        if self.refresh or not path.exists():
+        if self.refresh or not path.is_file():  # none, or a directory in its place (put says it cannot write)
             self.misses += 1
             return None
         try:
@@ -97,9 +96,8 @@ class Cache:
             if path not in self._logged:
                 self._logged.add(path)
                 why = " ".join(str(exc).split())[:200]
-                then = "it will be replaced" if path.is_file() else "a directory, it cannot be replaced"
-                log.warning("demcheck: engine-run cache: ignoring the damaged entry %s (%s: %s); %s", path,
-                            type(exc).__name__, why, then)
+                log.warning("demcheck: engine-run cache: ignoring the damaged entry %s (%s: %s); it will be "
+                            "replaced", path, type(exc).__name__, why)
             return None
         self.hits += 1
         return table, meta
@@ -120,7 +118,7 @@ class Cache:
         except OSError as exc:
             if path not in self._unwritable:
                 self._unwritable.add(path)
-                why = " ".join(str(exc).split())[:200]
+                why = " ".join((exc.strerror or str(exc)).split())[:200]
                 log.warning("demcheck: engine-run cache: cannot write the entry %s (%s: %s); the result is used "
                             "but not cached", path, type(exc).__name__, why)
             return False
@@ -130,8 +128,6 @@ class Cache:
 
 
 def _load(path: Path, columns, meta_keys, min_rows: int = 0) -> tuple[pd.DataFrame, dict]:
-    if not path.is_file():
-        raise Damaged("not a file")
     with np.load(path, allow_pickle=False) as z:
         names = [str(c) for c in z["columns"]]
         data = np.asarray(z["data"], dtype=float)
