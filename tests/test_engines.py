@@ -289,8 +289,6 @@ def test_verify_under_gravity_passes_with_the_engines_on_their_twins(gravity_ver
                              if math.isfinite(c["parts"]["implementation"])), comps
 
 
-@pytest.mark.xfail(strict=True, reason="comparisons/suite.restate still writes the seed's verlet forces without "
-                                       "the weight (it should be engines.states.restate): not this change's file")
 def test_verify_under_gravity_reads_the_seed_verlet_run_as_the_engines(gravity_verify):
     """The seed law's verlet run at the engine's dt (the time step's own error) is read off its states as the
     engine and the twin are: Hertz maps exactly, so the twin is the seed law and both agree to round-off."""

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import sys
 
+import numpy as np
+
 
 def main(argv: list[str]) -> int:
     if "-h" in argv:
@@ -36,7 +38,8 @@ def main(argv: list[str]) -> int:
             for i in range(n):
                 row = parts[(parts["id"] == i)].iloc[k]
                 p = case.particles[i]
-                f = f0[k] if i == 0 else -f0[k]
+                # an engine's force on a body: the contact's, and its weight
+                f = (f0[k] if i == 0 else -f0[k]) + case.mass(i) * np.asarray(case.run.gravity, float)
                 vals = [i + 1, i + 1, 2 * p.radius, case.mass(i), row["x"], row["y"], row["z"], row["vx"], row["vy"],
                         row["vz"], row["wx"], row["wy"], row["wz"], *f, 0.0, 0.0, 0.0]
                 out.write(" ".join(repr(float(v)) if j > 1 else str(int(v)) for j, v in enumerate(vals)) + "\n")

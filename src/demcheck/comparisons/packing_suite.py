@@ -82,6 +82,7 @@ def reference_packing(case, cache=None):
     import pandas as pd
 
     from ..engines.cache import key as cache_key
+    from ..engines.cache import ke_series, number
     from ..inputs.packing_decks import CONTACT_COLUMNS
     from ..reference import packing as P
 
@@ -89,7 +90,8 @@ def reference_packing(case, cache=None):
     if cache is not None:
         what = json.dumps({"case": case.hash, "dt": P.packing_dt(case), "rest": 0.0})
         k = cache_key("reference-packing", P.solver_fingerprint(), what, {})
-        hit = cache.get(k, columns=("x", "y", "z", "radius"), meta_keys=("ke", "time", "seconds"))
+        hit = cache.get(k, columns=("x", "y", "z", "radius"), min_rows=1,
+                        meta_keys={"ke": ke_series, "time": number, "seconds": number})
         hit_c = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
         if hit is not None and hit_c is not None:
             (table, meta), (con, _) = hit, hit_c

@@ -76,22 +76,8 @@ def _series(contact, source: str) -> dict | None:
     return {"source": source, "t": (c["t"] - t0).tolist(), "delta": c["delta"].tolist(), "fn": c["fn"].tolist()}
 
 
-def restate(result, case):
-    """A verlet result's contact table read off its states, as an engine's is (engines/states.py)."""
-    from ..engines import states
-
-    c = result.contact
-    parts = result.particles.copy()
-    f0 = -c["fn"].to_numpy()[:, None] * c[["nx", "ny", "nz"]].to_numpy() + c[["ftx", "fty", "ftz"]].to_numpy()
-    p0 = parts["id"] == 0
-    for k, col in enumerate(("fx", "fy", "fz")):
-        parts[col] = float("nan")
-        parts.loc[p0, col] = f0[:, k]
-    result.contact = states.trim(states.from_particles(parts, case))
-    return result
-
-
 def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
+    from ..engines import states
     from ..engines.collide import collide as run_engine, twin_states
     from ..engines.mapping import contact_mapping
     from ..reference import collision3d
@@ -158,7 +144,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         me = res.metrics()
         twin = twin_states(case, engine, res.dt).metrics()
         if res.dt not in seed_cache:
-            seed_cache[res.dt] = restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
+            seed_cache[res.dt] = states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
         seed_v = seed_cache[res.dt]
         entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
                                     "twin_metrics": twin, "seed_verlet_metrics": seed_v}

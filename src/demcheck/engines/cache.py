@@ -63,6 +63,11 @@ def texts(v) -> bool:
     return isinstance(v, list) and all(isinstance(x, str) for x in v)
 
 
+def ke_series(v) -> bool:
+    """A cached kinetic-energy series: [(step, ke), …] of finite numbers."""
+    return isinstance(v, list) and all(isinstance(p, list) and len(p) == 2 and all(map(number, p)) for p in v)
+
+
 class Cache:
     def __init__(self, directory: str | Path | None = None, refresh: bool = False):
         self.dir = Path(directory) if directory else default_dir()

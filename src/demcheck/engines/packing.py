@@ -12,6 +12,7 @@ import pandas as pd
 from ..case import Case
 from ..inputs.packing_decks import CONTACT_COLUMNS, CONTACT_DUMP, CONTACT_READER, FINAL_COLUMNS, FINAL_DUMP
 from . import dumps, registry
+from .cache import ke_series, text
 
 __all__ = ["PackingRun", "read_contacts", "run_engine", "CONTACT_COLUMNS"]
 
@@ -56,7 +57,7 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     if cache is not None and discovery.find(engine) is not None:
         k = cache_key(engine, discovery.find(engine).version,
                       dk.text + f"\n# mpi {mpi}\n# contact reader {CONTACT_READER}", dk.files)
-        hit = cache.get(k, columns=FINAL_COLUMNS, meta_keys=("version", "ke"))
+        hit = cache.get(k, columns=FINAL_COLUMNS, meta_keys={"version": text, "ke": ke_series}, min_rows=1)
         hit_contacts = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
         if hit is not None and hit_contacts is not None:
             table, meta = hit
