@@ -28,6 +28,7 @@ CLOSED_FORM_RTOL = 1e-6
 def static_overlaps(case, x) -> list[tuple[float, float]] | None:
     """(overlap, closed form) of every load-bearing contact of a settled column or floor layer: each contact
     carries the weight above it, δ = (F/k)^{1/a} on the law's loading branch. None for other layouts."""
+    from ..reference.normal import NormalLaw
     from ..reference.packing import resolve_laws
 
     layout = (case.raw.get("packing") or {}).get("layout")
@@ -37,9 +38,7 @@ def static_overlaps(case, x) -> list[tuple[float, float]] | None:
     g = float(np.linalg.norm(case.run.gravity))
 
     def solve(law, force):
-        if law[0] == 1.0:  # HLS loading branch
-            return force / law[5]
-        return (force / law[1]) ** (1.0 / law[2])
+        return NormalLaw.from_array(law).loading_overlap(force)
 
     out = []
     if layout == "layer":

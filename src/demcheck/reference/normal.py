@@ -41,8 +41,20 @@ class NormalLaw:
     limit: bool = False
 
     def array(self) -> np.ndarray:
+        """The law as the compiled kernels read it (kernels.L_KIND … L_LIMIT): the only positional form."""
         return np.array([self.kind, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s,
                          1.0 if self.limit else 0.0])
+
+    @classmethod
+    def from_array(cls, law) -> "NormalLaw":
+        kind, k, a, eta, b, kl, ku, s, limit = (float(x) for x in law)
+        return cls(int(kind), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0)
+
+    def loading_overlap(self, force: float) -> float:
+        """The overlap at which the loading branch carries ``force`` at rest: (F/k)^{1/a}, or F/K_L for HLS."""
+        if self.kind == HYSTERETIC:
+            return force / self.kl
+        return (force / self.k) ** (1.0 / self.a)
 
     @property
     def elastic(self) -> bool:
