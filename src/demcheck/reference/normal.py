@@ -56,10 +56,6 @@ class NormalLaw:
             return force / self.kl
         return (force / self.k) ** (1.0 / self.a)
 
-    @property
-    def elastic(self) -> bool:
-        return self.kind == VISCOELASTIC and self.eta == 0.0
-
     def characteristic_time(self, m: float, v: float) -> float:
         """The elastic contact time of the law's spring at speed v (for dt = auto and solver scales)."""
         if self.kind == HYSTERETIC:
