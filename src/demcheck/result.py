@@ -80,4 +80,19 @@ class Result:
             "message": self.message,
             "wall_time": self.wall_time,
             "metrics": self.metrics(),
+            "final": self.final_state(),
         }
+
+    def final_state(self) -> list[dict]:
+        """Every body's velocity and angular velocity (vectors, SI) at the end of the run, whatever solved it
+        (a law that was skipped — no tangential force can act — passes the initial spins through)."""
+        p = self.particles
+        if p is None or p.empty or not {"vx", "wx"} <= set(p.columns):
+            return []
+        out = []
+        for pid, rows in p.groupby("id", sort=True):
+            last = rows.sort_values("t").iloc[-1]
+            out.append({"id": int(pid), "t": float(last["t"]),
+                        "velocity": [float(last[c]) for c in ("vx", "vy", "vz")],
+                        "angular_velocity": [float(last[c]) for c in ("wx", "wy", "wz")]})
+        return out
