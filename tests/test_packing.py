@@ -472,3 +472,92 @@ def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncati
     else:
         eta = P.eta_of(tl, nl, delta)
         assert hist[0, 0] == pytest.approx((cap - eta * v) / kt_of(tl, delta), rel=1e-9)  # Maw's limit
+
+
+# ----------------------------------------------------------------------------- bounded packing runs
+
+
+def _packing_files():
+    from .conftest import CASES
+
+    return sorted((CASES / "packing").glob("*.toml")) + sorted((CASES / "optin").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", _packing_files(), ids=lambda p: p.stem)
+def test_the_suite_s_and_the_opt_in_packings_run_within_the_bound(path):
+    case = C.load(path)
+    dt, duration, steps = C.packing_run(case)
+    assert dt == P.packing_dt(case) and duration == case.raw["packing"]["duration"]
+    assert steps == math.ceil(duration / dt)
+    assert steps * 5 <= C.MAX_PACKING_STEPS and len(case.particles) * steps * 20 <= C.MAX_PARTICLE_STEPS
+
+
+def test_one_rule_bounds_a_packing_in_every_source():
+    """The reference solver and both engines' decks take dt and the step count from case.packing_run: a run
+    past the bound is refused before anything is built or run, naming what was asked for."""
+    from demcheck.engines import registry
+
+    case = C.loads(COLUMN)
+    for run in [lambda **kw: P.simulate(case, **kw),
+                *[lambda e=e, **kw: registry.get(e).packing_deck(case, **kw) for e in ("lammps", "liggghts")]]:
+        with pytest.raises(ConfigError) as info:
+            run(dt=1e-30)
+        assert str(info.value).startswith("--dt = 1e-30: the run would take 5e+28 steps (0.05 s at dt = 1e-30 s), "
+                                          "more than the 5,000,000 steps a packing run is allowed")
+        with pytest.raises(ConfigError) as info:
+            run(duration=1e6)
+        assert str(info.value).startswith("--duration = 1000000.0: the run would take 1.24e+12 steps")
+
+
+def _refused(p, needle):
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and p.stdout == "" and len(lines) == 1, (p.returncode, p.stderr[-2000:])
+    assert lines[0].startswith("demcheck: error: ") and needle in lines[0], lines[0]
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["deck", "column-lsd", "--engine", "lammps", "--dt", "1e-30"], "--dt = 1e-30: the run would take 5e+28 steps"),
+    (["deck", "column-lsd", "--engine", "liggghts", "--dt", "1e-30"], "--dt = 1e-30: the run would take 5e+28 steps"),
+    (["deck", "column-lsd", "--engine", "lammps", "--set", "packing.duration=1e4"],
+     "packing.duration = 10000.0: the run would take 1.24e+10 steps (10000 s at dt = 8.04e-07 s)"),
+    (["pack", "column-lsd", "--set", "run.steps_per_contact=100000000"],
+     "run.steps_per_contact = 100000000: the run would take 3.11e+10 steps (0.05 s at dt = 1.61e-12 s), more than "
+     "the 5,000,000 steps a packing run is allowed"),
+    (["pack", "column-lsd", "--engine", "lammps", "--set", "run.steps_per_contact=1000000000000"],
+     "run.steps_per_contact = 1000000000000: the run would take 3.11e+14 steps"),
+    (["pack", "column-lsd", "--engine", "liggghts", "--set", "run.steps_per_contact=1000000000000"],
+     "run.steps_per_contact = 1000000000000: the run would take 3.11e+14 steps"),
+    (["pack", "column-lsd", "--set", "run.dt=1e-12"], "run.dt = 1e-12: the run would take 5e+10 steps"),
+    (["pack", "column-lsd", "--duration", "1e6"], "--duration = 1000000.0: the run would take 1.24e+12 steps"),
+    (["pack", "column-lsd", "--engine", "lammps", "--duration", "1e6"], "--duration = 1000000.0: the run would take"),
+    (["pack", "optin/poured-large", "--set", "packing.duration=10"],
+     "packing.duration = 10: the run would take 1.24e+06 steps of 10,000 particles (1.24e+10 particle-steps; 10 s at "
+     "dt = 8.04e-06 s), more than the 1e+10 particle-steps a packing run is allowed"),
+])
+def test_a_packing_run_too_long_is_refused_before_any_work(args, needle, tmp_path):
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    args = [str(CASES / ("packing/" if "/" not in a else "") / f"{a}.toml") if a in ("column-lsd", "optin/poured-large")
+            else a for a in args]
+    p = subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, timeout=300,
+                       cwd=tmp_path)
+    _refused(p, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_verify_refuses_a_packing_too_long_before_any_case_runs(tmp_path):
+    import subprocess
+    import sys
+
+    from .conftest import CASES
+
+    bad = tmp_path / "long.toml"
+    bad.write_text(COLUMN.replace("[run]", "[run]\nsteps_per_contact = 100000000"))
+    p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(CASES / "glass-pair.toml"), str(bad),
+                        "--engines", "none", "--report", str(tmp_path / "reports")], capture_output=True, text=True,
+                       timeout=300, cwd=tmp_path)
+    _refused(p, f"{bad}: run.steps_per_contact = 100000000: the run would take 3.11e+10 steps")
+    assert not (tmp_path / "reports").exists()

@@ -487,6 +487,8 @@ def from_dict(raw: dict) -> Case:
             else:
                 flight = ("impact.gap", impact["gap"]) if "gap" in impact else ("impact.speed", impact.get("speed"))
             run_length(case, model=model, flight=flight)
+    elif (raw.get("packing") or {}).get("duration") is not None:
+        packing_run(case)  # a packing too long to run is refused here too, before any work
     return case
 
 
@@ -799,3 +801,61 @@ def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=N
                                       f"than the {MAX_STEPS:,} a time-stepped run (the verlet method, an engine: "
                                       "every step recorded) is allowed")
     return step, t_end, int(math.ceil(steps))
+
+
+# A packing runs N particles for many steps; its engines write the final state and a thermo line every steps/50
+# only, so what bounds it is the time it takes: at most this many steps, and this many particle-steps (the
+# reference solver takes about 0.4 µs a particle-step on one core, an engine about as long: 1e10 is about an
+# hour). The default suite's longest packing takes 89 109 steps (layer-kk) and 7.5e7 particle-steps (poured); the
+# opt-in cases at most 521 654 steps (poured-small-poly) and 3.7e8 particle-steps (poured-large).
+MAX_PACKING_STEPS = 5_000_000
+MAX_PARTICLE_STEPS = 1e10
+
+
+def packing_step(case: Case, steps_per_contact: int | None = None) -> float:
+    """A packing's dt: the case's run.dt, or auto — the shortest elastic contact time of a species' pair law (at
+    the speed of a one-diameter drop) over run.steps_per_contact (``steps_per_contact`` instead: auto regardless
+    of run.dt)."""
+    if case.run.dt and steps_per_contact is None:
+        return case.run.dt
+    from .reference.contact import pair_of
+    from .reference.model import models_of
+
+    normal, _ = models_of(case)
+    g = float(np.linalg.norm(case.run.gravity)) or 9.81
+    best = math.inf
+    for i in _species(case.particles):
+        pair = pair_of(case, i, i)
+        law, _ = normal.resolve(pair, case.contact.params, case.contact.limit_force)
+        best = min(best, law.characteristic_time(pair.m_eff, math.sqrt(2.0 * g * 2.0 * case.particles[i].radius)))
+    return best / (steps_per_contact or case.run.steps_per_contact)
+
+
+def packing_run(case: Case, duration: float | None = None, dt: float | None = None) -> tuple[float, float, int]:
+    """(dt, duration, steps) of a packing's run, in the reference solver and in every engine: dt (``dt``, else
+    ``packing_step``), the duration (``duration``, else packing.duration). More than MAX_PACKING_STEPS steps or
+    MAX_PARTICLE_STEPS particle-steps is a ConfigError naming what makes the run long: the step (``dt`` given here:
+    --dt; run.dt; the auto dt's run.steps_per_contact) when the run would fit at the default auto step, else the
+    duration (``duration`` given here: --duration; packing.duration)."""
+    given = duration
+    duration = duration or (case.raw.get("packing") or {}).get("duration")
+    if not duration:
+        raise ConfigError("packing.duration", None, "missing: how long to let the packing settle (s)")
+    step = dt or packing_step(case)
+    n, steps = len(case.particles), duration / step
+    if steps <= MAX_PACKING_STEPS and n * steps <= MAX_PARTICLE_STEPS:
+        return step, duration, int(math.ceil(steps))
+    default = duration / packing_step(case, Run.steps_per_contact)  # the steps at the default auto step
+    if default <= MAX_PACKING_STEPS and n * default <= MAX_PARTICLE_STEPS:
+        key, value = (("--dt", dt) if dt else ("run.dt", case.run.dt) if case.run.dt else
+                      ("run.steps_per_contact", case.run.steps_per_contact))
+    else:
+        key, value = ("--duration", given) if given else ("packing.duration", duration)
+    if steps > MAX_PACKING_STEPS:
+        rule = (f"the run would take {steps:.3g} steps ({duration:g} s at dt = {step:.3g} s), more than the "
+                f"{MAX_PACKING_STEPS:,} steps a packing run is allowed")
+    else:
+        rule = (f"the run would take {steps:.3g} steps of {n:,} particles ({n * steps:.3g} particle-steps; "
+                f"{duration:g} s at dt = {step:.3g} s), more than the {MAX_PARTICLE_STEPS:.3g} particle-steps a "
+                "packing run is allowed")
+    raise ConfigError(key, value, rule)

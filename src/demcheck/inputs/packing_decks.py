@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..case import Case
+from ..case import Case, packing_run
 from ..errors import UnsupportedByEngine
 from ..reference import packing as P
 from . import common
@@ -55,15 +55,15 @@ def head(case: Case, engine: str, note: str, n_species: int, dt: float, steps: i
 
 def layout(case: Case, duration, dt):
     """What both decks take from the case: species and their representatives, radii, the box (lo, hi,
-    periodic), dt and the number of steps."""
+    periodic), dt and the number of steps (case.packing_run: the reference solver's, refused past its bound
+    before anything is built)."""
     if case.kind != "packing":
         raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
+    dt, _, steps = packing_run(case, duration, dt)
     species, rep = P.species_of(case)
     x = np.array([p.position for p in case.particles], float)
     rad = np.array([p.radius for p in case.particles], float)
     lo, hi, periodic = P.box_of(case, x, rad)
-    dt = dt or P.packing_dt(case)
-    duration = duration or (case.raw.get("packing") or {}).get("duration")
-    return species, rep, rad, lo, hi, periodic, dt, int(np.ceil(duration / dt))
+    return species, rep, rad, lo, hi, periodic, dt, steps
 
 

@@ -522,24 +522,10 @@ def resolve_laws(case):
 
 def packing_dt(case) -> float:
     """dt: the case's, or the elastic contact time of the smallest species' pair law at the speed of a
-    one-diameter drop, over steps_per_contact."""
-    if case.run.dt:
-        return case.run.dt
-    from .contact import pair_of
+    one-diameter drop, over steps_per_contact (case.packing_step: the rule every source shares)."""
+    from ..case import packing_step
 
-    sp, rep = species_of(case)
-    sp_laws = resolve_laws(case)
-    g = float(np.linalg.norm(case.run.gravity)) or 9.81
-    best = math.inf
-    for a, i in enumerate(rep):
-        pair = pair_of(case, i, i)
-        v = math.sqrt(2.0 * g * 2.0 * case.particles[i].radius)
-        from .normal import NormalLaw
-
-        nl = sp_laws[1][a, a]
-        law = NormalLaw(int(nl[0]), k=nl[1], a=nl[2], eta=nl[3], b=nl[4], kl=nl[5], ku=nl[6], s=nl[7])
-        best = min(best, law.characteristic_time(pair.m_eff, v))
-    return best / case.run.steps_per_contact
+    return packing_step(case)
 
 
 class PackState:
@@ -608,21 +594,18 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 1e-14,
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
     """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
-    energy falls below ``rest`` × N m g R (settled). ``rules``: the kinematic rules (collision3d's names;
+    energy falls below ``rest`` × N m g R (settled); dt and the number of steps are case.packing_run's (a run
+    past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin."""
+    from ..case import packing_run
     from ..errors import ConfigError
 
+    dt, duration, total = packing_run(case, duration, dt)  # dt and steps, bounded, as every engine's deck
     sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
-    dt = dt or packing_dt(case)
     st = state or PackState(case)
-    spec_duration = (case.raw.get("packing") or {}).get("duration")
-    duration = duration or spec_duration
-    if not duration:
-        raise ConfigError("packing.duration", None, "missing: how long to let the packing settle (s)")
     walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
     g = np.asarray(case.run.gravity, float)
     scale = len(case.particles) * float(st.mass.mean()) * max(float(np.linalg.norm(g)), 1e-300) * float(st.rad.mean())
-    total = int(math.ceil(duration / dt))
     done = 0
     while done < total:
         n_steps = min(chunk, total - done)
