@@ -28,9 +28,9 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from .. import __version__
-from ..case import Case, expand
+from ..case import Case, expand, naming_file
 from ..engines import registry
-from ..errors import ConfigError, DemcheckError, EngineInterrupted
+from ..errors import DemcheckError, EngineInterrupted
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
@@ -194,13 +194,8 @@ def collect(paths) -> list[tuple[Path, Case]]:
     (and the variant, when case.expand says which) at fault, ``cases/x.toml[speed=2]: key = value: rule``."""
     cases = []
     for path in paths:
-        try:
+        with naming_file(path):
             cases.extend((Path(path), case) for case in expand(path))
-        except ConfigError as exc:
-            if exc.key == "CASE" or str(path) in exc.key:  # already names the file
-                raise
-            where = f"{path}[{exc.variant}]" if getattr(exc, "variant", None) else str(path)
-            raise ConfigError(f"{where}: {exc.key}", exc.value, exc.rule) from None
     return cases
 
 
