@@ -24,7 +24,8 @@ OBLIQUE_KEYS = NORMAL_KEYS + ("tangential_restitution", "rebound_angular_velocit
 NORMAL_CASES = [("lsd", {"stiffness_method": "energy"}), ("lsd", {"kn": 3e6, "eta_n": 0.5}),
                 ("lsd", {"stiffness_method": "duration", "limit_force": True}), ("hertz", {}),
                 ("bshp", {"dissipative_constant": 1e-7}), ("kk", {"eta_n": 20.0}), ("tti", {}),
-                ("tti", {"limit_force": True}), ("hls", {"stiffness_method": "overlap"})]
+                ("tti", {"limit_force": True}), ("hls", {"stiffness_method": "overlap"}),
+                ("hls", {"stiffness_method": "overlap", "unloading": "variable", "S": 1e4})]
 OBLIQUE_CASES = [("lsd", None, "spring_sliding", None),
                  ("lsd", None, "lsd_sliding", {"truncation": "overlap", "tangential_restitution": 0.5}),
                  ("lsd", None, "lsd_sliding", {"truncation": "spring", "tangential_restitution": 0.5}),
@@ -161,6 +162,57 @@ def test_lammps_wall_moduli_are_pair_values():
     rigid = collide(case, "lammps").metrics()  # demcheck's deck: hertz k = (4/3)Ē of the rigid wall
     # Hertz: F_max ∝ E*^{2/5} at equal m, R, v
     assert m["peak_force"] / rigid["peak_force"] == pytest.approx(0.5**0.4, rel=1e-3)
+
+
+# ----------------------------------------------------------------------------- HLS with variable unloading: luding
+
+
+def _plastic_case(wall, speed=1.0):
+    """HLS with variable unloading, strongly plastic: S·δ_max ≈ 3 (e ≈ 0.5), so the mapping raises δ_lim
+    above the floor 1/S (r > 2) to stay above the impact's overlap."""
+    return glass_case("hls", {"stiffness_method": "overlap", "unloading": "variable", "S": 1e6}, wall=wall,
+                      speed=speed)
+
+
+@pytest.mark.engine("liggghts")
+@pytest.mark.parametrize("wall", [False, True], ids=["pair", "wall"])
+def test_liggghts_luding_is_hls_with_variable_unloading(wall):
+    """luding (δ_max < δ_lim, r free) computes HLS's K_U = K_L + S·F_max: the engine meets the seed law (its
+    twin is the seed law itself) at equal dt to the bar, the maximum overlap included, and the closed forms
+    δ_max = v√(m̄/K_L), F_max = K_L δ_max, ε = [1 + S v √(m̄/K_L)]^{-½} to the scheme's O(dt)."""
+    from demcheck.reference.model import resolve
+
+    case = _plastic_case(wall)
+    nat = mapping.contact_mapping(case, "liggghts").require()
+    assert nat.normal == "luding" and nat.props["unloading"] > 2.0
+    res, twin = _run(case, "liggghts")
+    m = _agree(res, twin, NORMAL_KEYS + ("max_overlap", "force_contact_time"))
+    law, pair = resolve(case).normal_law, resolve(case).pair
+    d_max = pair.impact_speed * math.sqrt(pair.m_eff / law.kl)
+    e = (1.0 + law.s * d_max) ** -0.5
+    assert 0.4 < e < 0.6  # the unloading stiffness is far from the loading one: the test can fail
+    # sampled maxima and the rebound carry the scheme's O(dt): measured 1e-5 … 3e-5 at the default dt
+    assert m["max_overlap"] == pytest.approx(d_max, rel=1e-4)
+    assert m["peak_force"] == pytest.approx(law.kl * d_max, rel=1e-4)
+    assert m["restitution"] == pytest.approx(e, rel=1e-4)
+
+
+@pytest.mark.engine("liggghts")
+def test_liggghts_luding_departs_from_hls_when_delta_max_passes_delta_lim():
+    """The condition is real: with δ_lim below the impact's δ_max luding loads along r·K_L beyond δ_lim, and
+    the engine leaves the HLS law (what the twin computes from the same numbers) far above the bar."""
+    case = _plastic_case(wall=True)
+    mapped = mapping.contact_mapping(case, "liggghts").require()
+    res = collide(case, "liggghts")
+    d_max = res.metrics()["max_overlap"]
+    # the same S = (r − 1)/δ_lim, with δ_lim at half the overlap: phiF = δ_lim (r − 1)/(2R̄r)
+    d_lim = 0.5 * d_max
+    r = 1.0 + 1e6 * d_lim
+    nat = Native("liggghts", "luding", tangential="off",
+                 props={**mapped.props, "unloading": r, "plasticity_depth": d_lim * (r - 1.0) / (2 * 1.59e-3 * r)})
+    broken = collide(case, "liggghts", native=nat)
+    twin = twin_states(case, "liggghts", broken.dt, native=nat).metrics()
+    assert abs(broken.metrics()["peak_force"] / twin["peak_force"] - 1.0) > 1e-2
 
 
 # ----------------------------------------------------------------------------- results carry the engine

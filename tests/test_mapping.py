@@ -125,3 +125,38 @@ def test_tti_transform_carries_ttin_damping_exactly():
         model = resolve(glass_case("tti", {}, restitution=eps))
         c = model.normal_law.eta / math.sqrt(model.pair.m_eff * model.normal_law.k)
         assert twins.restitution_for_eta(c, math.sqrt(5.0)) == pytest.approx(e_prime, abs=1e-4)
+
+
+# ----------------------------------------------------------------------------- luding: HLS with variable unloading
+
+
+@pytest.mark.parametrize("wall", [False, True], ids=["pair", "wall"])
+@pytest.mark.parametrize("speed,s,gravity", [(1.0, 1e4, 0.0), (1.0, 1e6, 0.0), (20.0, 1e6, 0.0), (0.05, 1e6, 9.81)])
+def test_luding_limit_lies_above_the_impacts_overlap(speed, s, gravity, wall):
+    """luding unloads as HLS (K_U = K_L + S·F_max) only while δ_max < δ_lim = (r − 1)/S: the mapping picks r so
+    that δ_lim lies above the overlap the impact reaches — the reference's adaptive δ_max (an independent path)
+    — with gravity pressing along, and keeps r ≥ 2 (δ_lim ≥ 1/S) so that (r − 1)k1 loses no digits."""
+    from demcheck.engines.liggghts.mapping import luding_limit
+
+    case = glass_case("hls", {"stiffness_method": "overlap", "unloading": "variable", "S": s}, wall=wall,
+                      speed=speed, overrides=[f"run.gravity=[0.0, 0.0, {-gravity}]"])
+    model = resolve(case)
+    mp = mapping.map_model(model, "liggghts")
+    assert mp.fidelity == mapping.EXACT and mp.native.normal == "luding"
+    p, r_eff = mp.native.props, model.pair.r_eff
+    d_lim = luding_limit(p, r_eff)
+    assert (p["unloading"] - 1.0) / d_lim == pytest.approx(s, rel=1e-14)
+    assert p["unloading"] >= 2.0 and p["loading"] == model.normal_law.kl
+    assert p["adhesion"] == p["pulloff"] == 0.0 and p["restitution"] == 1.0  # no cohesion, no dashpot
+    d_max = collision3d.collide(case, model, "adaptive").metrics()["max_overlap"]
+    assert d_max < d_lim
+    # the twin is the seed law: the same loading stiffness and S, read back from LIGGGHTS's numbers
+    nl, _ = registry.get("liggghts").twin(mp.native, model.pair.m_eff, r_eff)
+    assert nl.kl == model.normal_law.kl and nl.ku == 0.0 and nl.s == pytest.approx(s, rel=1e-14)
+
+
+def test_luding_carries_no_tangential_law():
+    case = oblique_case("spring_sliding", None, normal="hls",
+                        normal_params={"stiffness_method": "overlap", "unloading": "variable", "S": 1e4})
+    mp = mapping.contact_mapping(case, "liggghts")
+    assert mp.native is None and "luding" in mp.reasons[0]

@@ -22,7 +22,8 @@ RIGID_WALL_MODULUS = 1e30
 
 NAMES = {"kn": "kn", "kt": "kt", "gamman": "gamman", "gammat": "gammat", "friction": "coefficientFriction",
          "restitution": "coefficientRestitution", "unloading": "UnloadingStiffness",
-         "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy"}
+         "adhesion": "coefficientAdhesionStiffness", "pulloff": "pullOffForce", "surface_energy": "surfaceEnergy",
+         "loading": "LoadingStiffness", "plasticity_depth": "coefficientPlasticityDepth"}
 
 
 def property_matrices(nat, ntypes: int, native_of_types) -> dict:

@@ -27,8 +27,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     p = nat.props
     if nl.kind == HYSTERETIC:
         if nl.ku == 0.0:
-            return refused("liggghts", "HLS with variable unloading (K_U = K_L + S·F_max) maps to luding "
-                                        "only while δ_max < δ_lim; that route is not generated")
+            return _luding(model, nat)
         # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
         nat.normal = "edinburgh"
         p.update(kl=nl.kl, unloading=nl.ku / nl.kl, adhesion=0.0, pulloff=0.0, surface_energy=0.0,
@@ -139,8 +138,58 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     return Mapping("liggghts", fid, reasons, nat)
 
 
+def luding_limit(props: dict, r: float) -> float:
+    """luding's δ_lim = r/(r − 1) · phiF · 2R̄ (r = UnloadingStiffness, phiF = coefficientPlasticityDepth), as
+    normal_model_luding.h computes it (R̄: the particle's radius on a wall)."""
+    ratio = props["unloading"]
+    return ratio / (ratio - 1.0) * props["plasticity_depth"] * 2.0 * r
+
+
+def _luding(model: ResolvedModel, nat: Native) -> Mapping:
+    """HLS with variable unloading as LIGGGHTS ``luding`` (no adhesion, no pull-off, e = 1: no dashpot).
+
+    luding loads along k1 δ (k1 = LoadingStiffness) and, while δ_max < δ_lim, unloads along
+    k2 (δ − δ_max) + k1 δ_max ≥ 0 with k2 = k1 + (r − 1) k1 δ_max/δ_lim: HLS's K_U = K_L + S·K_L·δ_max
+    exactly when (r − 1)/δ_lim = S. r is free: δ_lim is chosen above the largest overlap the impact can reach
+    (and r ≥ 2, so that k2Max − k1 = (r − 1)k1 loses no digits), and phiF follows."""
+    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    if tl.kind != NONE:
+        return refused("liggghts", "luding's tangential stiffness is its loading stiffness (kt = kn); no seed "
+                                    "tangential law shares it")
+    kl, s, r_eff, m = nl.kl, nl.s, pair.r_eff, pair.m_eff
+    v = pair.impact_speed
+    if not math.isfinite(v):
+        v = model.params.get("reference_velocity", math.nan)
+    # the largest overlap of the loading line K_L δ at impact speed v, with the weight pressing along
+    # (an upper bound for a pair, where gravity moves both bodies alike): ½K_L δ² − m̄|g|δ = ½m̄v²
+    w = m * math.sqrt(sum(g * g for g in model.gravity))
+    bound = (w + math.sqrt(w * w + kl * m * v * v)) / kl if math.isfinite(v) else math.nan
+    d_lim = max(1.0 / s, 2.0 * bound) if math.isfinite(bound) else max(1.0 / s, r_eff)
+    ratio = 1.0 + s * d_lim
+    p = nat.props
+    p.update(loading=kl, unloading=ratio, plasticity_depth=d_lim * (ratio - 1.0) / (2.0 * r_eff * ratio),
+             adhesion=0.0, pulloff=0.0, restitution=1.0)
+    d_lim = luding_limit(p, r_eff)  # as LIGGGHTS will compute it from the written numbers
+    if math.isfinite(bound) and not bound < d_lim:
+        return refused("liggghts", f"luding: δ_lim = {d_lim:.4g} m does not lie above the largest overlap "
+                                    f"{bound:.4g} m; beyond δ_lim it loads along r·K_L, not K_L")
+    nat.normal = "luding"
+    nat.tangential = "off"
+    reach = (f"above the impact's largest overlap {bound:.6g} m (K_L δ² = m̄v² with the weight)"
+             if math.isfinite(bound) else "no impact speed: δ_lim at max(1/S, R̄)")
+    nat.comments = [f"luding (coefficientAdhesionStiffness 0, pullOffForce 0, coefficientRestitution 1): "
+                    f"LoadingStiffness = K_L = {kl:.10g} N/m, UnloadingStiffness r = {ratio:.17g}, "
+                    f"coefficientPlasticityDepth phiF = {p['plasticity_depth']:.17g}",
+                    f"δ_lim = r/(r−1)·phiF·2R̄ = {d_lim:.6g} m = (r − 1)/S, {reach}: "
+                    f"K_U = K_L + (r − 1)K_L δ_max/δ_lim = K_L + S·F_max (S = {s:.10g} 1/m)"]
+    return Mapping("liggghts", EXACT, [], nat)
+
+
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     p = nat.props
+    if nat.normal == "luding":  # δ_max < δ_lim: K_U = k1 + (r − 1)k1 δ_max/δ_lim, i.e. S = (r − 1)/δ_lim
+        s = (p["unloading"] - 1.0) / luding_limit(p, r)
+        return NormalLaw(HYSTERETIC, kl=p["loading"], ku=0.0, s=s, limit=nat.limit), twins.no_friction()
     if nat.normal == "hooke/stiffness":
         k_el, a = p["kn"], 1.0
         c, b = damping("stiffness_hooke", p["gamman"], k_el, a, m, r)

@@ -25,6 +25,11 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
         if mp.native is None:
             raise UnsupportedByEngine(f"liggghts cannot express this model: {'; '.join(mp.reasons)}")
     nat = natives[(0, 0)].native
+    if nat.normal == "luding":
+        raise UnsupportedByEngine("luding (HLS with variable unloading) lowers δ_max once the unloading force "
+                                  "reaches 0, so a contact that reloads before it separates reloads from its "
+                                  "lowest overlap, not along the reference's unloading line (Walton & Braun): "
+                                  "exact for one load–unload cycle (collisions), not in a packing")
     if nat.normal == "edinburgh" or any(mp.native.normal != nat.normal for mp in natives.values()):
         raise UnsupportedByEngine("this packing's species map to different LIGGGHTS models (or to edinburgh, whose "
                                   "moduli are set per contact): not expressible in one pair style")
