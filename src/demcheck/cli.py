@@ -15,6 +15,7 @@ import click
 
 from . import __version__
 from .errors import ConfigError, DemcheckError
+from .io import plain
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
@@ -28,20 +29,15 @@ def _engine_names() -> list[str]:
 ENGINE_NAMES = _engine_names()  # the registered engines (built-ins, then plug-ins): every --engine choice
 
 
-def _jsonable(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "item"):
-        return _jsonable(obj.item())
-    return obj
+def show(v) -> str:
+    """A value in a CLI table: the reports' formatter, ten significant digits."""
+    from .io import number as as_text
+
+    return as_text(v, ".10g")
 
 
 def emit_json(obj) -> None:
-    click.echo(json.dumps(_jsonable(obj), indent=2, allow_nan=False))
+    click.echo(json.dumps(plain(obj), indent=2, allow_nan=False))
 
 
 # ----------------------------------------------------------------------------- checked options
@@ -283,8 +279,8 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
         t.add_column(label, justify="right")
     keys = list(first["metrics"]) if first else []
     for k in keys:
-        t.add_row(k, *[_fmt(s["metrics"].get(k)) for s in summaries.values()])
-    t.add_row("dt / rtol", *[_fmt(s["dt"] or s["rtol"]) for s in summaries.values()])
+        t.add_row(k, *[show(s["metrics"].get(k)) for s in summaries.values()])
+    t.add_row("dt / rtol", *[show(s["dt"] or s["rtol"]) for s in summaries.values()])
     t.add_row("mapping", *[str(s["params"].get("mapping", "—")) for s in summaries.values()])
     con.print(t)
     for name, s in summaries.items():
@@ -327,14 +323,6 @@ def deck(case_path, engine, output, dt, overrides):
                        + "\n".join(f"# {line}" for line in text.splitlines()))
 
 
-def _fmt(v):
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "—"
-    if isinstance(v, float):
-        return f"{v:.10g}"
-    return str(v)
-
-
 def _print_summary(s: dict) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -343,18 +331,18 @@ def _print_summary(s: dict) -> None:
     m = s["model"]
     head = f"[bold]{s['case']}[/]  normal={m['normal']} tangential={m['tangential']}"
     head += f" limit_force={m['limit_force']}  method={s['method']}"
-    head += f"  dt={_fmt(s['dt'])}" if s["dt"] else f"  rtol={_fmt(s['rtol'])}"
+    head += f"  dt={show(s['dt'])}" if s["dt"] else f"  rtol={show(s['rtol'])}"
     con.print(head)
     t = Table(show_header=True)
     t.add_column("metric")
     t.add_column("value", justify="right")
     for k, v in s["metrics"].items():
-        t.add_row(k, _fmt(v))
+        t.add_row(k, show(v))
     p = Table(show_header=True)
     p.add_column("parameter")
     p.add_column("value", justify="right")
     for k, v in s["params"].items():
-        p.add_row(k, _fmt(v))
+        p.add_row(k, show(v))
     con.print(t)
     con.print(p)
 
@@ -399,7 +387,7 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
         for c in table.columns:
             t.add_column(c, justify="right")
         for _, row in table.iterrows():
-            t.add_row(*[_fmt(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
+            t.add_row(*[show(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
         Console().print(t)
     if (table["status"] != "ok").any():
         sys.exit(1)
@@ -442,9 +430,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
                    f"report {Path(report_dir) / 'latest'}", err=True)
         sys.exit(runner.interrupt_exit_code(exc))
     if as_json:
-        from .comparisons.report import clean
-
-        emit_json(clean({k: v for k, v in summary.items() if k != "cases"}
+        emit_json(({k: v for k, v in summary.items() if k != "cases"}
                         | {"cases": [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]}))
     sys.exit(0 if summary["failed"] == 0 else 1)
 
@@ -510,14 +496,12 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
         return
     click.echo(f"{case.name} in {out['source']}: {out['particles']} particles")
     for k, v in m.items():
-        click.echo(f"  {k:22s} {_fmt(v)}")
+        click.echo(f"  {k:22s} {show(v)}")
 
 
 def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
     if as_json:
-        from .comparisons.report import clean
-
-        emit_json(clean(data))
+        emit_json((data))
     else:
         click.echo(Path(out_dir / "report.md").read_text())
         click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import secrets
 from pathlib import Path
@@ -43,3 +44,25 @@ def write_text(path, text: str) -> None:
 
 def write_json(path, obj) -> None:
     write_text(path, json.dumps(obj, indent=2, allow_nan=False) + "\n")
+
+
+def plain(obj):
+    """``obj`` as strict JSON takes it: non-finite floats as null, numpy scalars as Python numbers, tuples as
+    lists, keys as strings — every JSON demcheck writes or prints goes through here."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {str(k): plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [plain(v) for v in obj]
+    if hasattr(obj, "item"):
+        return plain(obj.item())
+    return obj
+
+
+def number(v, spec: str = ".6g") -> str:
+    """A value in a table or a line of text: "—" for a missing or non-finite number, ``format(v, spec)`` for a
+    number, ``str(v)`` otherwise — the one formatter of every report and CLI table."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    return format(v, spec) if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)

@@ -9,14 +9,10 @@ import math
 import os
 from pathlib import Path
 
-from ..io import write_json, write_text
-from .report import _img, _png, clean, link_latest
+from ..io import number, plain, write_json, write_text
+from .report import _img, _png, link_latest
 from .styles import style
 
-
-
-def _f(v, spec=".3g"):
-    return "—" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, spec)
 
 
 def new_run_dir(root: Path, kind: str) -> Path:
@@ -25,7 +21,7 @@ def new_run_dir(root: Path, kind: str) -> Path:
 
 
 def _publish(out_dir: Path, root: Path, data: dict, md: str, page: str) -> None:
-    write_json(out_dir / "results.json", clean(data))
+    write_json(out_dir / "results.json", plain(data))
     write_text(out_dir / "report.md", md)
     write_text(out_dir / "report.html", page)
     link_latest(root, out_dir)
@@ -57,17 +53,17 @@ def bench_markdown(data: dict) -> str:
                 if c is None:
                     cells.append("not reached")
                 elif src == "reference-adaptive":
-                    cells.append(f"rtol {c['rtol']:g}: {_f(c['wall_time'] * 1e3)} ms")
+                    cells.append(f"rtol {c['rtol']:g}: {number(c['wall_time'] * 1e3, '.3g')} ms")
                 else:
-                    batch = f", {_f(c['batch_time'] * 1e3)} ms batched" if c.get("batch_time") else ""
-                    cells.append(f"{c['steps_per_contact']:g} steps: {_f(c['wall_time'] * 1e3)} ms{batch}")
-            lines.append(f"| {src} | {_f(s['order'], '.2f')} | " + " | ".join(cells) + " |")
+                    batch = f", {number(c['batch_time'] * 1e3, '.3g')} ms batched" if c.get("batch_time") else ""
+                    cells.append(f"{c['steps_per_contact']:g} steps: {number(c['wall_time'] * 1e3, '.3g')} ms{batch}")
+            lines.append(f"| {src} | {number(s['order'], '.2f')} | " + " | ".join(cells) + " |")
         lines += ["", "| source | steps per contact / rtol | error | ms per collision | ms batched | status |",
                   "|---|---|---|---|---|---|"]
         for p in b["points"]:
             where = f"rtol {p['rtol']:g}" if p["rtol"] else f"{p['steps_per_contact']:g}"
-            lines.append(f"| {p['source']} | {where} | {_f(p['error'])} | {_f(p['wall_time'] * 1e3)} | "
-                         f"{_f(p['batch_time'] * 1e3) if p['batch_time'] else '—'} | {p['status']} |")
+            lines.append(f"| {p['source']} | {where} | {number(p['error'], '.3g')} | {number(p['wall_time'] * 1e3, '.3g')} | "
+                         f"{number(p['batch_time'] * 1e3, '.3g') if p['batch_time'] else '—'} | {p['status']} |")
         lines.append("")
     if data.get("speed_goal"):
         lines += ["## Speed goal", "", data["speed_goal"], ""]
@@ -138,13 +134,13 @@ def stress_markdown(data: dict) -> str:
             lines.append(f"* {src}: {why}")
         lines += ["", "| parameter | value | source | dt_max / t_c | failure beyond |", "|---|---|---|---|---|"]
         for l in s["limits"]:
-            lines.append(f"| {l['parameter']} | {l['value']:g} | {l['source']} | {_f(l['dt_max_over_tc'])} | "
+            lines.append(f"| {l['parameter']} | {l['value']:g} | {l['source']} | {number(l['dt_max_over_tc'], '.3g')} | "
                          f"{l['failure'][:140]} |")
         flags = s["disagreements"]
         lines += ["", f"Disagreements about stability (more than one grid step): {len(flags)}", ""]
         for f in flags:
-            lines.append(f"* {f['parameter']} = {f['value']:g}: reference {_f(f['reference_dt_max_over_tc'])}, "
-                         f"{f['source']} {_f(f['engine_dt_max_over_tc'])} ({f['engine_failure'][:100]})")
+            lines.append(f"* {f['parameter']} = {f['value']:g}: reference {number(f['reference_dt_max_over_tc'], '.3g')}, "
+                         f"{f['source']} {number(f['engine_dt_max_over_tc'], '.3g')} ({f['engine_failure'][:100]})")
         lines.append("")
     return "\n".join(lines) + "\n"
 

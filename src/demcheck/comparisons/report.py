@@ -17,32 +17,16 @@ import xml.etree.ElementTree as ET
 from collections import defaultdict
 from pathlib import Path
 
-from ..io import write_json, write_text
+from ..io import number, plain, write_json, write_text
 from . import verdicts as V
 from .styles import engine_sources, style
-
-METRIC_ORDER = ("restitution", "contact_time", "force_contact_time", "max_overlap", "peak_force",
-                "energy_dissipated", "tangential_restitution", "rebound_angle", "rebound_angular_velocity")
-
-
-def clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {str(k): clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [clean(v) for v in obj]
-    if hasattr(obj, "item"):
-        return clean(obj.item())
-    return obj
-
 
 def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None) -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
     PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]) / "plots" if "cache" in summary else None
     data = {k: v for k, v in summary.items()}
     data["cases"] = [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]
-    write_json(out_dir / "results.json", clean(data))
+    write_json(out_dir / "results.json", plain(data))
     write_text(out_dir / "report.md", render_markdown(summary))
     junit_text = render_junit(summary)
     write_text(out_dir / "junit.xml", junit_text)
@@ -69,12 +53,6 @@ def link_latest(root: Path, out_dir: Path) -> None:
 
 
 # ----------------------------------------------------------------------------- helpers
-
-
-def _f(v, spec=".6g"):
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "—"
-    return format(v, spec) if isinstance(v, (int, float)) else str(v)
 
 
 def _model(c: dict) -> str:
@@ -182,19 +160,19 @@ def render_markdown(summary: dict) -> str:
                     return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
 
                 cf, ks = comp("static_overlap"), comp("force_distribution_ks")
-                lines.append(f"| {c['case']} | {src} | {_f(m.get('solid_fraction'), '.4f')} | "
-                             f"{_f(m.get('coordination_number'), '.3f')} | {_f(m.get('bed_height'), '.5g')} | "
-                             f"{_f(m.get('mean_contact_force'), '.4g')} | "
-                             f"{_f(ks['value'], '.3f') + ' (' + _f(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
-                             f"{_f(m.get('max_overlap_ratio'), '.3g')} | "
-                             f"{_f(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
+                lines.append(f"| {c['case']} | {src} | {number(m.get('solid_fraction'), '.4f')} | "
+                             f"{number(m.get('coordination_number'), '.3f')} | {number(m.get('bed_height'), '.5g')} | "
+                             f"{number(m.get('mean_contact_force'), '.4g')} | "
+                             f"{number(ks['value'], '.3f') + ' (' + number(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
+                             f"{number(m.get('max_overlap_ratio'), '.3g')} | "
+                             f"{number(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
     # per case
     lines += ["", "## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
               "|---|---|---|---|---|"]
     for c in summary["cases"]:
         srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
         worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
-        lines.append(f"| {c['case']} | {_model(c)} | {c['status']} | {srcs} | {_f(worst_curve, '.3g')} |")
+        lines.append(f"| {c['case']} | {_model(c)} | {c['status']} | {srcs} | {number(worst_curve, '.3g')} |")
     return "\n".join(lines) + "\n"
 
 
@@ -225,15 +203,15 @@ def render_junit(summary: dict) -> str:
             elif bad:
                 fails += 1
                 ET.SubElement(tc, "failure", message=f"{len(bad)} unexpected difference(s)").text = "\n".join(
-                    f"{k['metric']}: {_f(k['value'])} vs {_f(k['reference'])} (scaled {_f(k['rel_diff'], '.3g')} > "
-                    f"{_f(k['tolerance'], '.3g')}): {k['reason']}" for k in bad)
+                    f"{k['metric']}: {number(k['value'])} vs {number(k['reference'])} (scaled {number(k['rel_diff'], '.3g')} > "
+                    f"{number(k['tolerance'], '.3g')}): {k['reason']}" for k in bad)
             elif skipped:
                 skips += 1
                 ET.SubElement(tc, "skipped", message=skipped[0]["reason"][:500])
             expected = [k for k in comps if k["verdict"] == V.EXPECTED]
             if expected:
                 ET.SubElement(tc, "system-out").text = "\n".join(
-                    f"differs as expected: {k['metric']} ({_f(k['rel_diff'], '.3g')}): {k['reason']}" for k in expected)
+                    f"differs as expected: {k['metric']} ({number(k['rel_diff'], '.3g')}): {k['reason']}" for k in expected)
     suite.set("tests", str(n))
     suite.set("failures", str(fails))
     suite.set("errors", str(errors))
@@ -289,7 +267,7 @@ def _cached(key_obj, render, valid):
     d = PLOT_CACHE["dir"]
     if d is None:
         return render()
-    k = hashlib.sha256(json.dumps(clean(key_obj), sort_keys=True, default=str).encode()).hexdigest()
+    k = hashlib.sha256(json.dumps(plain(key_obj), sort_keys=True, default=str).encode()).hexdigest()
     path = Path(d) / f"{k}.b64"
     try:
         text = path.read_text()
@@ -505,9 +483,9 @@ def render_html(summary: dict) -> str:
         for k in rows:
             vcls = {V.AGREE: "agree", V.EXPECTED: "expected", V.UNEXPECTED: "unexpected", V.FAILED: "failed"}.get(
                 k["verdict"], "")
-            parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{_f(k['value'])}</td>"
-                         f"<td>{_f(k['reference'])}</td><td>{_f(k['rel_diff'], '.3g')}</td>"
-                         f"<td>{_f(k['tolerance'], '.3g')}</td><td class='{vcls}'>{esc(k['verdict'])}</td>"
+            parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{number(k['value'])}</td>"
+                         f"<td>{number(k['reference'])}</td><td>{number(k['rel_diff'], '.3g')}</td>"
+                         f"<td>{number(k['tolerance'], '.3g')}</td><td class='{vcls}'>{esc(k['verdict'])}</td>"
                          f"<td>{esc(k['reason'])}</td></tr>")
         parts.append("</table></details>")
     parts.append("</body></html>")
