@@ -317,3 +317,17 @@ def test_deck_checks_the_files_it_writes_beside_the_deck_up_front(case, engine, 
     p = demcheck("deck", case, "--engine", engine, "-o", out / "deck.in", cwd=tmp_path)
     _one_line_exit_2(p, f"--output = '{out / 'deck.in'}': {out / 'data.lmp'} is a directory, not a file")
     assert _tree(out) == ["data.lmp"]  # the deck was not written without its data file
+
+
+def test_models_is_a_compact_table_and_one_model_in_full():
+    """One line a model that fits 80 columns (plain text when piped, as here); `models ID` (or an alias) in
+    full; an unknown id is one line with the nearest, exit 2."""
+    p = demcheck("models")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.splitlines()
+    assert len(lines) < 30 and max(len(line) for line in lines) <= 80
+    assert any(line.split()[:2] == ["normal", "hls"] for line in lines)
+    full = demcheck("models", "TTIn")
+    assert full.returncode == 0 and "formula:" in full.stdout and "LAMMPS 22Jul2025: exact" in full.stdout
+    bad = demcheck("models", "ttx")
+    assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0 and "did you mean 'tti'" in bad.stderr

@@ -151,47 +151,60 @@ def cli():
 
 
 @cli.command()
+@click.argument("model_id", metavar="[ID]", required=False)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def models(as_json):
-    """Registered models: ids, seed names, formulas, sources, parameters."""
+def models(model_id, as_json):
+    """Registered models: one line each (id, seed name, each engine's fidelity); `demcheck models ID` shows one
+    model in full (formula, source, parameters, each engine's configuration and reason)."""
+    from .engines import mapping, registry as engine_registry
     from .reference import normal, tangential
 
     def rows(registry, slot):
-        out = []
-        for m in registry.values():
-            out.append({"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
-                        "title": m.title, "formula": m.formula, "source": m.source,
-                        "params": {p.name: p.meaning for p in m.params}})
-        return out
-
-    from .engines import mapping, registry as engine_registry
+        return [{"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
+                 "title": m.title, "formula": m.formula, "source": m.source,
+                 "params": {p.name: p.meaning for p in m.params}} for m in registry.values()]
 
     table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
+    if model_id is not None:
+        key = model_id.strip().lower()
+        table = [r for r in table if key == r["id"] or key in (a.lower() for a in r["aliases"])]
+        if not table:
+            import difflib
+
+            known = [m.id for m in (*normal.REGISTRY.values(), *tangential.REGISTRY.values())]
+            near = difflib.get_close_matches(key, known, n=1)
+            raise ConfigError("ID", model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
+                                                                             else f"; known: {', '.join(known)}"))
     engines = mapping.by_model()
     for row in table:
         row["engines"] = engines[(row["slot"], row["id"])]
     if as_json:
         emit_json({"models": table})
         return
-    from rich.console import Console
-    from rich.table import Table
+    names = engine_registry.names()
+    if model_id is None:  # one line a model: fits 80 columns, plain text when piped
+        def cut(text, width):
+            return text if len(text) < width else text[:width - 2] + "… "
 
-    t = Table(title="demcheck models (engine mapping of each model, on a glass pair, with the partner shown)",
-              show_lines=True)
-    for col in ("slot", "id", "seed", "formula", "source", *(e.release for e in engine_registry.all_engines())):
-        t.add_column(col)
+        click.echo(f"{'slot':<11}{'id':<16}{'seed':<15}" + "".join(f"{n:<12}" for n in names).rstrip())
+        for row in table:
+            click.echo((f"{row['slot']:<11}{row['id']:<16}{cut(row['seed_name'], 15):<15}"
+                        + "".join(f"{row['engines'][n]['fidelity']:<12}" for n in names)).rstrip())
+        click.echo("\n`demcheck models ID` shows a model in full; --json gives everything.")
+        return
     for row in table:
-        cells = [row["slot"], row["id"], row["seed_name"], row["formula"], row["source"]]
-        for e in engine_registry.names():
-            m = row["engines"][e]
-            text = f"[bold]{m['fidelity']}[/] ({m['with']})"
-            if m["config"]:
-                text += f"\n{m['config']}"
+        click.echo(f"{row['id']} ({row['slot']}; seed name {row['seed_name']}"
+                   + (f"; aliases {', '.join(row['aliases'])}" if row["aliases"] else "") + f"): {row['title']}")
+        click.echo(f"  formula: {row['formula']}")
+        click.echo(f"  source:  {row['source']}")
+        for p, meaning in row["params"].items():
+            click.echo(f"  {p}: {meaning}")
+        for e in engine_registry.all_engines():
+            m = row["engines"][e.name]
+            click.echo(f"  {e.release}: {m['fidelity']} (with {m['with']})"
+                       + (f": {m['config']}" if m["config"] else ""))
             if m["reason"]:
-                text += f"\n{m['reason']}"
-            cells.append(text)
-        t.add_row(*cells)
-    Console().print(t)
+                click.echo(f"    {m['reason']}")
 
 
 # ----------------------------------------------------------------------------- collide
