@@ -1,6 +1,7 @@
 """Run time against error, stability, the recommended time step, and results that are never garbage."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -204,3 +205,42 @@ def test_every_case_file_is_read_before_any_work_and_named_in_the_error(command,
     assert p.returncode == 2 and len(lines) == 1, p.stderr[-2000:]
     assert lines[0].startswith(f"demcheck: error: {bad_file}") and needle in lines[0], lines
     assert not (tmp_path / "reports").exists()
+
+
+# ----------------------------------------------------------------------------- metrics a scene does not produce
+
+
+def test_a_metric_undefined_on_both_sides_is_left_out_and_one_side_only_is_an_error():
+    """A head-on impact has no tangential restitution and no rebound spin, neither in the converged answer
+    nor in a time-stepped run: those metrics are left out of the error, not poisoned into it. A metric that
+    one side defines and the other does not is a real disagreement and stays an error (NaN)."""
+    ref = {"restitution": 0.9, "tangential_restitution": float("nan"), "rebound_angular_velocity": None}
+    run = {"restitution": 0.9009, "tangential_restitution": float("nan"), "rebound_angular_velocity": None}
+    metrics = ("restitution", "tangential_restitution", "rebound_angular_velocity")
+    e = B._errors(run, ref, metrics, scales={})
+    assert list(e) == ["restitution"] and e["restitution"] == pytest.approx(1e-3)
+    one_side = B._errors({**run, "tangential_restitution": 0.5}, ref, metrics, scales={})
+    assert math.isnan(one_side["tangential_restitution"])
+    p = B.Point("x", 10, 1e-6, None, 1.0, None, one_side)
+    assert math.isnan(p.error)
+    assert math.isnan(B.Point("x", 10, 1e-6, None, 1.0, None, {}).error)  # nothing measured: no error
+
+
+def test_head_on_impact_with_a_friction_law_gets_a_time_step():
+    """`demcheck dt` and `bench` on a head-on case with a tangential law: the error is the normal metrics'
+    (the tangential ones are undefined on both sides), finite, and dt answers with a time step."""
+    args = ["--set", "contact.normal=lsd", "--set", "contact.stiffness_method=energy",
+            "--set", "contact.tangential=spring_sliding", "--set", "materials.glass.friction=0.3"]
+    p = subprocess.run([sys.executable, "-m", "demcheck", "dt", str(CASES / "glass-pair.toml"), *args],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "recommended dt" in p.stdout
+    assert "errors of restitution, contact_time, max_overlap, peak_force)" in p.stdout, p.stdout
+    from demcheck import case as C
+
+    case = C.load(CASES / "glass-pair.toml", [a for a in args if a != "--set"])
+    b = B.bench_case(case, engines=(), rtols=(1e-6,), steps=(50, 500))
+    assert all(list(pt.errors) == list(B.METRICS) for pt in b.points)
+    assert all(math.isfinite(pt.error) for pt in b.points)
+    rec = B.recommend(case)
+    assert rec["dt"] is not None and rec["metrics"] == list(B.METRICS) and rec["limited_by"] in B.METRICS

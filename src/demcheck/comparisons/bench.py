@@ -14,7 +14,10 @@ Errors are relative (|x − x_ref| / |x_ref|); a source's error is the worst of 
 oblique impact with friction, also of tangential restitution and rebound spin, in the suite's units (1 for
 a restitution, v_in/R for a spin: a near-zero tangential restitution is not divided by itself). Without
 them an oblique case's time step would be chosen on its normal motion alone, blind to the friction law's
-own error (Walton's at the Coulomb limit: docs/models.md, "A false plateau").
+own error (Walton's at the Coulomb limit: docs/models.md, "A false plateau"). A metric the scene does not
+produce — undefined (NaN or absent) in both the converged answer and the run, as tangential restitution and
+rebound spin are for a head-on impact with a friction law — is left out of the error; a metric defined on one
+side only is a real disagreement and keeps the error undefined (NaN).
 """
 
 from __future__ import annotations
@@ -54,7 +57,7 @@ class Point:
     @property
     def error(self) -> float:
         vals = [v for v in self.errors.values() if v is not None and math.isfinite(v)]
-        return max(vals) if len(vals) == len(self.errors) else math.nan
+        return max(vals) if vals and len(vals) == len(self.errors) else math.nan
 
     def as_dict(self) -> dict:
         return {"source": self.source, "steps_per_contact": self.steps_per_contact, "dt": self.dt,
@@ -72,13 +75,22 @@ def metrics_of(case: Case, model) -> tuple[str, ...]:
     return METRICS + OBLIQUE_METRICS
 
 
+def _defined(x) -> bool:
+    return x is not None and math.isfinite(x)
+
+
 def _errors(m: dict, ref: dict, metrics=METRICS, scales=None) -> dict:
+    """The error of each of ``metrics`` of ``m`` against ``ref``. A metric undefined on both sides (the
+    scene does not produce it: a head-on impact has no tangential restitution) is left out; one defined on
+    one side only is NaN — a disagreement, which makes the point's error NaN."""
     from .verdicts import scale
 
     out = {}
     for k in metrics:
         a, b = m.get(k), ref.get(k)
-        if not (a is not None and b is not None and math.isfinite(a) and math.isfinite(b)):
+        if not _defined(a) and not _defined(b):
+            continue
+        if not (_defined(a) and _defined(b)):
             out[k] = math.nan
         elif k in OBLIQUE_METRICS:
             out[k] = abs(a - b) / scale(k, b, scales)
@@ -141,7 +153,7 @@ class BenchResult:
                "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {}}
         for src in self.sources():
             pts = [p for p in self.points if p.source == src]
-            names = list(pts[0].errors) if pts else list(METRICS)
+            names = _used(pts) if pts else list(METRICS)
             s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in names},
                  "cheapest": {}}
             for tgt in TARGETS + ((1e-7, 1e-8) if src == "reference-adaptive" else ()):
@@ -231,6 +243,13 @@ def hertz_time(case: Case) -> float:
     return HERTZ_DURATION_CONSTANT * (p.m_eff**2 / (p.r_eff * p.e_eff**2 * p.impact_speed)) ** 0.2
 
 
+def _used(points: list[Point]) -> list[str]:
+    """The metrics the points' errors are made of, in the order of METRICS + OBLIQUE_METRICS (a metric
+    undefined on both sides is in none of them)."""
+    seen = {k for p in points for k in p.errors}
+    return [k for k in METRICS + OBLIQUE_METRICS if k in seen] + sorted(seen - set(METRICS + OBLIQUE_METRICS))
+
+
 def recommend(case: Case, target: float = 1e-3) -> dict:
     """A time step for the case's model meeting ``target`` (worst relative error of restitution, contact
     time, maximum overlap and peak force; for an oblique impact with friction also of tangential restitution
@@ -242,7 +261,7 @@ def recommend(case: Case, target: float = 1e-3) -> dict:
     t_r, t_h = rayleigh_time(case), hertz_time(case)
     out = {"case": case.name, "model": b.model, "target": target, "t_contact": b.t_contact,
            "rayleigh_time": t_r, "hertz_time": t_h, "order": fit_order(pts),
-           "metrics": list(pts[0].errors) if pts else list(METRICS),
+           "metrics": _used(b.points),
            "rules_of_thumb": {"0.2 t_Rayleigh": 0.2 * t_r, "t_Hertz / 50": t_h / 50},
            "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
                       "status": p.status} for p in pts]}
@@ -251,8 +270,9 @@ def recommend(case: Case, target: float = 1e-3) -> dict:
         why = ""
         if finest is not None:
             worst = sorted(((v, k) for k, v in finest.errors.items() if math.isfinite(v)), reverse=True)
-            why = ": at t_c/{:g} the error is still {}".format(
-                finest.steps_per_contact, ", ".join(f"{v:.2g} in {k}" for v, k in worst if v > target) or "—")
+            parts = [f"{v:.2g} in {k}" for v, k in worst if v > target]
+            parts += [f"undefined in {k} (one side only)" for k, v in finest.errors.items() if not math.isfinite(v)]
+            why = ": at t_c/{:g} the error is still {}".format(finest.steps_per_contact, ", ".join(parts) or "—")
         out.update(dt=None, message=f"no time step of the grid (down to t_c/10000) meets {target:g}{why}")
     else:
         out.update(dt=c.dt, steps_per_contact=c.steps_per_contact, expected_error=c.error,
