@@ -668,3 +668,29 @@ def test_non_finite_packing_output_is_a_failed_run_never_cached(tmp_path, monkey
     finally:
         monkeypatch.delenv("DEMCHECK_LAMMPS")
         discovery.find.cache_clear()
+
+
+@pytest.mark.engine("lammps")
+def test_a_contact_that_outlasts_the_step_bound_is_no_separation_and_not_cached(tmp_path, monkeypatch):
+    """The engine collide reruns a contact that has not ended four times longer; when the longer run would
+    pass the step bound it stops there (never a bad-input error after an engine has run), and the unhealthy
+    result is not cached."""
+    import dataclasses
+
+    from demcheck.engines import collide as EC
+    from demcheck.errors import ConfigError
+
+    real = EC.deck
+
+    def short_then_bounded(case, engine, dt=None, length=1.0, native=None, **options):
+        if length > 1.0:
+            raise ConfigError("run.steps_per_contact", 20000, "the run would take too many steps")
+        dk = real(case, engine, dt, length, native=native, **options)
+        steps = int(re.search(r"^run (\d+)$", dk.text, re.M).group(1))
+        return dataclasses.replace(dk, text=dk.text.replace(f"\nrun {steps}\n", f"\nrun {steps // 10}\n"))
+
+    monkeypatch.setattr(EC, "deck", short_then_bounded)
+    cache = Cache(tmp_path / "cache")
+    res = EC.collide(glass_case("hertz", {}), "lammps", cache=cache)
+    assert res.status == "no-separation", res.message
+    assert not list((tmp_path / "cache").rglob("*.npz"))  # an unhealthy run is never cached

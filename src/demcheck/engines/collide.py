@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..case import Case
+from ..errors import ConfigError
 from ..inputs import common
 from ..reference import health
 from ..result import Result
@@ -55,10 +56,18 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     length = 1.0
     cached = False
     non_finite = ""
+    copies = max(1, int(options.get("copies", 1)))
+    fresh = []  # (key, table, meta) of the runs made here, cached once the result is known to be healthy
     for attempt in range(4):
         if attempt:
+            try:  # a longer run past the step bound: the contact did not end within what may be run
+                longer = deck(case, engine, dt, length * 4.0, native=native, **options)
+            except ConfigError:
+                break
             length *= 4.0
-        dk = deck(case, engine, dt, length, native=native, **options)
+            dk = longer
+        else:
+            dk = deck(case, engine, dt, length, native=native, **options)
         text = dk.text
         hit = None
         if cache is not None:
@@ -70,7 +79,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             from .cache import key as cache_key
 
             k = cache_key(engine, info.version, text, dk.files)
-            bodies = len(case.particles) * max(1, int(options.get("copies", 1)))
+            bodies = len(case.particles) * copies
             hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
                             check=_every_body(bodies))
         if hit is not None:
@@ -83,10 +92,9 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
-                cache.put(k, table, {"version": out.version, "workdir": str(out.workdir),
-                                     "wall_time": out.wall_time, "warnings": out.warnings})
+                fresh.append((k, table, {"version": out.version, "workdir": str(out.workdir),
+                                         "wall_time": out.wall_time, "warnings": out.warnings}))
         n = len(case.particles)
-        copies = int(options.get("copies", 1))
         if copies > 1:
             spread = _copies_spread(table, n, copies)
             table = table[table["id"] <= n]
@@ -110,8 +118,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         message="; ".join(mp.reasons),
         meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": text, "fidelity": mp.fidelity,
               "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons),
-              "copies": int(options.get("copies", 1)),
-              "copies_spread": spread if int(options.get("copies", 1)) > 1 else 0.0},
+              "copies": copies, "copies_spread": spread if copies > 1 else 0.0},
     )
     if non_finite:
         result.status = "failed"
@@ -119,6 +126,9 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
                           f"cached; work directory kept: {out.workdir}")
         return result
     health.apply(result, case, sc.model)
+    # the shorter runs that were extended are sound, only short; the final one is cached only when healthy
+    for k, table, meta in fresh if result.ok else fresh[:-1]:
+        cache.put(k, table, meta)
     if not result.ok:
         if length > 1.0:
             result.message += f" (after runs up to {length:g}× the expected duration)"
