@@ -56,10 +56,9 @@ def _imports(name: str, path: Path, modules) -> set[str]:
                           if a.name.startswith("demcheck")]
         else:
             continue
-        for c in candidates:
-            if c in modules and c != name:
-                out.add(c)
-                break
+        # ``from pkg import a, b`` depends on every named submodule (a, b), else on pkg itself
+        named = [c for c in candidates[:-1] if c in modules]
+        out.update(c for c in (named or candidates[-1:]) if c in modules and c != name)
     return out
 
 
