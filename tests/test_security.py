@@ -484,3 +484,25 @@ def test_the_runner_refuses_a_deck_with_a_command_demcheck_does_not_write(tmp_pa
         with pytest.raises(DemcheckError, match="not a command demcheck writes"):
             runner.run(engine, f"units si\nshell touch {target}\n", workdir=tmp_path / engine)
         assert not target.exists() and not (tmp_path / engine / "in.deck").exists()
+
+
+@pytest.mark.parametrize("line", [
+    'units si "#" $(1+1)',                              # a "#" inside quotes is no comment to LAMMPS
+    'fix 1 all nve/sphere "#" ${x}',
+    "fix 1 all nve/sphere # trailing text",
+    "dump d all custom 1 /home/x/.bashrc id",           # a file outside the work directory
+    "dump d all custom 1 ../dump.txt id",
+    "write_dump all custom /tmp/x id",
+    "write_dump all atom dump.txt",
+    "read_data /etc/passwd",
+])
+def test_the_guard_refuses_hidden_comments_variables_and_paths(line):
+    with pytest.raises(DemcheckError):
+        common.check_deck(f"units si\n{line}\n")
+
+
+def test_a_comment_never_carries_a_triple_quote():
+    for text in ['"""', '""""" tail', 'a"b""c"""d']:
+        line = common.comment(text)
+        assert '"""' not in line and line.startswith("# ")
+        common.check_deck(line + "\nunits si\n")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -106,9 +107,9 @@ def header(engine: str, sc: Scene, mp, version_note: str, hand_command: str) -> 
 
 def comment(text: str) -> str:
     """``text`` as one comment line: characters that are not printable (line breaks of any kind, control and
-    format characters) escaped, triple quotes broken, and no "&" at the end."""
+    format characters) escaped, every double quote escaped, and no "&" at the end."""
     out = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
-    out = out.replace('"""', '\\"\\"\\"')
+    out = out.replace('"', '\\"')  # no run of quotes can open a triple-quoted string
     if out.rstrip().endswith("&"):
         out = out.rstrip()[:-1] + "\\x26"
     return f"# {out}"
@@ -129,7 +130,10 @@ STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/
           "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local"})),
           "dump": (3, frozenset({"custom", "local"})), "pair_style": (1, frozenset({"granular", "gran"})),
           "atom_style": (1, frozenset({"sphere", "granular"})), "region": (2, frozenset({"block"})),
-          "thermo_style": (1, frozenset({"custom"}))}
+          "thermo_style": (1, frozenset({"custom"})), "write_dump": (2, frozenset({"custom"}))}
+# the file a command reads or writes: a plain name in the work directory (no path, no option-looking word)
+FILE_ARGUMENT = {"dump": 5, "write_dump": 3, "read_data": 1}
+SAFE_FILE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 DATA_WORDS = frozenset({"atoms", "atom", "types", "xlo", "xhi", "ylo", "yhi", "zlo", "zhi", "Atoms", "Velocities"})
 
 
@@ -151,16 +155,22 @@ def _check_text(text: str, what: str) -> list[str]:
 
 def check_deck(text: str, files: dict | None = None) -> None:
     """The final guard on a deck (and its data files): every line is a comment, blank, or one of the commands
-    demcheck writes (``run N`` a plain step count, no variable substitution); anything else raises."""
+    demcheck writes (``run N`` a plain step count, no variable substitution, no comment after a command, files
+    by plain names in the work directory); anything else raises."""
     for n, line in enumerate(_check_text(text, "a deck"), 1):
-        words = line.split("#", 1)[0].split()
-        if not words:
+        words = line.split()
+        if not words or words[0].startswith("#"):  # a comment is a whole line: "#" inside quotes is not one
             continue
         command = words[0]
         if command not in COMMANDS:
             _refuse("a deck", n, line, "is not a command demcheck writes")
-        if "$" in line.split("#", 1)[0]:
+        if "#" in line:
+            _refuse("a deck", n, line, "has a comment after a command (demcheck writes comments as lines)")
+        if "$" in line:
             _refuse("a deck", n, line, "substitutes a variable")
+        at = FILE_ARGUMENT.get(command)
+        if at is not None and (len(words) <= at or not SAFE_FILE.fullmatch(words[at])):
+            _refuse("a deck", n, line, "names a file that is not a plain name in the work directory")
         at, styles = STYLES.get(command, (0, None))
         if styles is not None and (len(words) <= at or words[at] not in styles):
             _refuse("a deck", n, line, f"is not a {command} style demcheck writes")

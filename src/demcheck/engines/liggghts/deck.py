@@ -71,9 +71,9 @@ def model_setup(nat, matrices: dict, moduli: list, ratios: list) -> tuple[list[s
         flags.append("tangential_damping off")
     flags.append(f"limitForce {'on' if nat.limit else 'off'}")
     if moduli and max(moduli) > 1e9:
-        lines.append("hard_particles yes  # a Young's modulus above LIGGGHTS's 1e9 Pa sanity limit")
+        lines += ["# a Young's modulus above LIGGGHTS's 1e9 Pa sanity limit", "hard_particles yes"]
     if moduli and min(moduli) < 5e6:
-        lines.append("soft_particles yes  # a Young's modulus below LIGGGHTS's 5e6 Pa sanity limit")
+        lines += ["# a Young's modulus below LIGGGHTS's 5e6 Pa sanity limit", "soft_particles yes"]
     return lines, style, flags
 
 
