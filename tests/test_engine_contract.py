@@ -2,8 +2,9 @@
 
 Each engine's vocabulary makes a claim about every seed model (engines.base.Mapping): ``exact`` — its twin
 computes the seed model's force law, so the two run to round-off at equal dt (the same scheme and the same
-kinematic rules: only the laws differ); ``approximate`` — the twin differs, and the reasons say how (the
-difference is measured here and must be real); ``none`` — no deck, with a reason. A new law or a new engine
+kinematic rules: only the laws differ); ``approximate`` — the twin is a named variant and the reasons say how
+it differs (whether it differs in this one geometry is tests/test_mapping.py's question); ``none`` — no deck,
+with a reason. A new law or a new engine
 is tested here without new test code: the cases are the mapping table's (one row per normal law with no
 friction, one per tangential law with its natural partner, and the parameter variants whose mapping
 differs)."""

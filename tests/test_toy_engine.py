@@ -50,3 +50,10 @@ def test_verify_judges_the_plugged_in_engine(tmp_path):
     toy = [c for c in case["comparisons"] if c["source"] == "toy"]
     assert toy and all(c["verdict"] == "agree" for c in toy)
     assert "toy" in (tmp_path / "r" / "latest" / "report.md").read_text()
+
+
+def test_a_plug_in_that_cannot_be_imported_is_one_line(tmp_path):
+    env = dict(os.environ, DEMCHECK_ENGINE_PLUGINS="tests.no_such_engine", PYTHONPATH=str(ROOT))
+    p = subprocess.run([sys.executable, "-m", "demcheck", "models"], capture_output=True, text=True, env=env,
+                       cwd=tmp_path, timeout=120)
+    assert p.returncode == 2 and p.stderr.count("\n") == 1 and "DEMCHECK_ENGINE_PLUGINS" in p.stderr

@@ -21,9 +21,14 @@ CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 
 def _engine_names() -> list[str]:
+    """The registered engines; a plug-in that cannot be loaded is one line and exit 2, before anything runs."""
     from .engines import registry
 
-    return list(registry.names())
+    try:
+        return list(registry.names())
+    except DemcheckError as exc:
+        click.echo(f"demcheck: error: {exc}", err=True)
+        sys.exit(exc.exit_code)
 
 
 ENGINE_NAMES = _engine_names()  # the registered engines (built-ins, then plug-ins): every --engine choice
@@ -472,7 +477,8 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
     if case.kind != "packing":
         raise ConfigError("kind", case.kind, "demcheck pack runs packing cases (kind = \"packing\")")
     if mpi > 1 and engine == "reference":
-        raise ConfigError("--mpi", mpi, "applies to an engine (--engine lammps|liggghts); the reference runs on one core")
+        raise ConfigError("--mpi", mpi, f"applies to an engine (--engine {'|'.join(ENGINE_NAMES)}); the reference runs on one "
+                          "core")
     box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
     import pandas as pd
 
@@ -514,7 +520,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
 
 def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
     if as_json:
-        emit_json((data))
+        emit_json(data)
     else:
         click.echo(Path(out_dir / "report.md").read_text())
         click.echo(f"report: {out_dir}/report.md (and report.html, results.json)", err=True)

@@ -39,11 +39,9 @@ class Toy(Engine):
     title = "Toy"
     release = "toy 1.0"
     how_to_install = "a test engine: DEMCHECK_ENGINE_PLUGINS=tests.toy_engine"
-    version_note = "written for the toy engine 1.0"
     banner = re.compile(r"^toy engine (\S+)", re.M)
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "rescale"}
     style = Style(colour="#9467bd", marker="P", linestyle="-")
-    hand_command = "toy-engine -in"
 
     def default_candidates(self) -> list[str]:
         """A wrapper script that runs runner.py with this Python (written once per process)."""

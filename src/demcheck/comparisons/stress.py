@@ -141,8 +141,6 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
     that) but stable as long as it stays finite, bounded and does not create energy."""
     try:
         r = collide(case, "verlet", dt=dt)
-    except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
-        raise
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
     if r.status not in ("ok", "unresolved", "unstable"):
@@ -217,8 +215,6 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
             try:
                 case = from_dict(transform(copy.deepcopy(raw0)))
                 t_c = characteristic_time(resolve(case))
-            except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
-                raise
             except DemcheckError as exc:
                 res.limits.append(Limit(name, value, "reference-verlet", None, None, f"invalid: {exc}"))
                 continue

@@ -97,12 +97,9 @@ class Engine(ABC):
     title: str  # for people: "LAMMPS", "LIGGGHTS"
     release: str  # the release its vocabulary is written for, as a column heading: "LAMMPS 22Jul2025"
     how_to_install: str
-    version_note: str  # the release the decks are written for
     banner: re.Pattern  # group 1 of a match on the output of ``<exe> -h`` is the version
     rules: dict  # kinematic rules of its scheme for the twin (reference/collision3d.SEED_RULES's keys)
     style: Style
-    hand_command: str  # how a person runs a deck by hand: "<hand_command> <deck>"
-    deck_name: str = "in.deck"
 
     # ------------------------------------------------------------------ discovery and launch
 
@@ -169,10 +166,13 @@ class Engine(ABC):
 
         raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
 
-    def read_contacts(self, raw, radius, x=None, box=None):
-        """(overlap, fn, ft) of the engine's per-contact dump ``raw`` (its columns as an array, one row per
-        listed pair; ``i``, ``j`` the 0-based particle indices of the first two columns), fn repulsive > 0."""
-        raise NotImplementedError(f"{self.name} writes no per-contact output")
+    def read_contacts(self, values, i, j, radius, x=None, box=None):
+        """(overlap, fn, ft) of the engine's per-contact dump: ``values`` its columns as an array (one row per
+        listed pair), ``i``, ``j`` the 0-based particle indices of the first two columns, ``radius`` and ``x``
+        per particle, ``box`` the periodic [lx, ly]; fn repulsive > 0."""
+        from ..errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{self.name} writes no per-contact output")
 
 
 class PackageEngine(Engine):
@@ -184,10 +184,6 @@ class PackageEngine(Engine):
         import importlib
 
         return importlib.import_module(f"{type(self).__module__}.{name}")
-
-    @property
-    def version_note(self) -> str:
-        return self._part("deck").VERSION_NOTE
 
     def map(self, model, contact_params: dict) -> Mapping:
         return self._part("mapping").map_model(model, contact_params)

@@ -54,8 +54,9 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
 
     dk = registry.get(engine).packing_deck(case, duration, dt)
     k = None
-    if cache is not None and discovery.find(engine) is not None:
-        k = cache_key(engine, discovery.find(engine).version,
+    info = discovery.find(engine) if cache is not None else None
+    if info is not None:
+        k = cache_key(engine, info.version,
                       dk.text + f"\n# mpi {mpi}\n# contact reader {CONTACT_READER}", dk.files)
         hit = cache.get(k, columns=FINAL_COLUMNS, meta_keys={"version": text, "ke": ke_series}, min_rows=1)
         hit_contacts = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)

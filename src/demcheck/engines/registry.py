@@ -32,11 +32,18 @@ def _load() -> None:
     global _loaded
     if _loaded:
         return
-    _loaded = True
     for module in BUILTIN:
         importlib.import_module(module)
-    for module in filter(None, (m.strip() for m in os.environ.get("DEMCHECK_ENGINE_PLUGINS", "").split(","))):
-        importlib.import_module(module)
+    text = os.environ.get("DEMCHECK_ENGINE_PLUGINS", "")
+    for module in filter(None, (m.strip() for m in text.split(","))):
+        try:
+            importlib.import_module(module)
+        except Exception as exc:  # noqa: BLE001 - whatever the plug-in's fault, one line names it
+            from ..errors import ConfigError
+
+            raise ConfigError("DEMCHECK_ENGINE_PLUGINS", text, f"module {module!r} cannot be imported "
+                              f"({type(exc).__name__}: {exc})") from None
+    _loaded = True
     from importlib.metadata import entry_points
 
     for ep in entry_points(group="demcheck.engines"):

@@ -78,8 +78,9 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
     started = time.perf_counter()
     if method == "adaptive":
         if model.tangential_law.force_history or model.tangential_law.rescale_history:
-            raise ConfigError("--method", method, "the twins of LAMMPS mindlin/force and mindlin_rescale are "
-                              "defined for the engines' scheme only: use the verlet method")
+            raise ConfigError("--method", method, "a force history or a contact-radius rescale of the "
+                              "tangential history (engine twins) is defined for the engines' scheme only: use the "
+                              "verlet method")
         rtol = rtol or case.run.rtol
         l_scale = 0.3 * v * t_c
         f_scale = model.pair.m_eff * v / t_c

@@ -508,7 +508,7 @@ def resolve_laws(case):
         if arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:  # every tangential kind runs, these two variants not
             raise ConfigError("contact.tangential", tangential.id,
                               "is not supported by the packing solver (a force history or a contact-radius "
-                              "rescale: LAMMPS's mindlin/force and mindlin_rescale twins)")
+                              "rescale of the history: engine twins of the two-body solver)")
         return nl.array(), arr
 
     for a in range(ns):

@@ -22,7 +22,6 @@ class Lammps(PackageEngine):
     rules = {"slip_arm": "radius", "torque_arm": "contact", "wall_torque_arm": "radius",
              "rotation": "rescale_significant"}
     style = Style(colour="#1f77b4", marker="^", linestyle="--")
-    hand_command = "lmp -in"
 
     def executables(self) -> tuple[str, ...]:
         return ("lmp",)

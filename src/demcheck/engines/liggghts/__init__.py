@@ -22,7 +22,6 @@ class Liggghts(PackageEngine):
     # slip velocity and torques at the contact point; the history is projected into the new tangent plane
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
     style = Style(colour="#d62728", marker="v", linestyle="-.")
-    hand_command = "liggghts -in"
 
     def executables(self) -> tuple[str, ...]:
         return ("liggghts",)
