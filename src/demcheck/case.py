@@ -798,8 +798,8 @@ def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=N
                           ("run.steps_per_contact", case.run.steps_per_contact))
             why = f"{t_contact:.3g} s of contact"
         raise ConfigError(key, value, f"the run would take {steps:.3g} steps ({why} at dt = {step:.3g} s), more "
-                                      f"than the {MAX_STEPS:,} a time-stepped run (the verlet method, an engine: "
-                                      "every step recorded) is allowed")
+                                      f"than the {MAX_STEPS:,} an engine run (every step dumped; the "
+                                      "verlet method is bounded by its record's memory) is allowed")
     return step, t_end, int(math.ceil(steps))
 
 
