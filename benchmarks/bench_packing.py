@@ -25,7 +25,7 @@ def main():
     case = C.load(CASE)
     n = len(case.particles)
     dt = P.packing_dt(case)
-    duration = case.raw["packing"]["duration"]
+    duration = case.packing.duration
     steps = duration / dt
     P.simulate(case, duration=10 * dt)  # compile once
     rows = []
@@ -33,14 +33,14 @@ def main():
     st = P.simulate(case, rest=0.0)
     ref_time = time.perf_counter() - t
     nc = min(st.n_contacts, len(st.contacts))
-    rows.append(("reference", ref_time, PM.compute(st.x, st.rad, box=tuple(case.raw["packing"]["box"]), margin=1.0,
+    rows.append(("reference", ref_time, PM.compute(st.x, st.rad, box=case.packing.box, margin=1.0,
                                                    forces=st.contacts[:nc, 3])))
     for engine in ("lammps", "liggghts"):
         t = time.perf_counter()
         run = run_engine(case, engine)
         rows.append((f"{engine} ({run.version})", time.perf_counter() - t,
                      PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(),
-                                box=tuple(case.raw["packing"]["box"]), margin=1.0,
+                                box=case.packing.box, margin=1.0,
                                 forces=run.contacts["fn"].to_numpy())))
     print(f"poured packing: {n} spheres, {steps:.0f} steps of {dt:.3g} s, one core each")
     print(f"{'source':36s} {'wall s':>8s} {'particle-steps/s':>17s} {'vs LAMMPS':>9s} {'solid frac':>10s} {'coord':>6s}")

@@ -338,7 +338,7 @@ def test_engine_contact_dumps_match_the_engine_positions(engine):
     case = C.load(CASES / "optin" / "poured-small-poly.toml", ["packing.duration=0.08"])
     run = run_engine(case, engine)
     x, rad = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy()
-    box = case.raw["packing"]["box"]
+    box = case.packing.box
     pairs = PM.contacts(x, rad, box=tuple(box), tol=0.0)
     c = run.contacts
     assert len(c) > 50
@@ -487,7 +487,7 @@ def _packing_files():
 def test_the_suite_s_and_the_opt_in_packings_run_within_the_bound(path):
     case = C.load(path)
     dt, duration, steps = C.packing_run(case)
-    assert dt == P.packing_dt(case) and duration == case.raw["packing"]["duration"]
+    assert dt == P.packing_dt(case) and duration == case.packing.duration
     assert steps == math.ceil(duration / dt)
     assert steps * 5 <= C.MAX_PACKING_STEPS and len(case.particles) * steps * 20 <= C.MAX_PARTICLE_STEPS
 
@@ -531,7 +531,7 @@ def _refused(p, needle):
     (["pack", "column-lsd", "--duration", "1e6"], "--duration = 1000000.0: the run would take 1.24e+12 steps"),
     (["pack", "column-lsd", "--engine", "lammps", "--duration", "1e6"], "--duration = 1000000.0: the run would take"),
     (["pack", "optin/poured-large", "--set", "packing.duration=10"],
-     "packing.duration = 10: the run would take 1.24e+06 steps of 10,000 particles (1.24e+10 particle-steps; 10 s at "
+     "packing.duration = 10.0: the run would take 1.24e+06 steps of 10,000 particles (1.24e+10 particle-steps; 10 s at "
      "dt = 8.04e-06 s), more than the 1e+10 particle-steps a packing run is allowed"),
 ])
 def test_a_packing_run_too_long_is_refused_before_any_work(args, needle, tmp_path):

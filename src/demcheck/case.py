@@ -78,6 +78,19 @@ class Run:
 
 
 @dataclass(frozen=True)
+class Packing:
+    """A packing case's [packing] table, validated: how its particles were laid out and how long it settles."""
+
+    layout: str  # column | layer | poured
+    count: int
+    material: str
+    radii: tuple[float, ...]
+    box: tuple[float, float] | None  # the periodic box in x and y (m); None for a column
+    seed: int
+    duration: float | None  # s
+
+
+@dataclass(frozen=True)
 class Case:
     name: str
     kind: str
@@ -86,6 +99,7 @@ class Case:
     walls: tuple[Wall, ...]
     contact: Contact
     run: Run
+    packing: Packing | None = None
     raw: dict = field(repr=False, compare=False, default_factory=dict)
 
     @property
@@ -372,9 +386,12 @@ def from_dict(raw: dict) -> Case:
 
     raw = copy.deepcopy(raw)
     impact = raw.get("impact")
+    packing = None
     if kind == "packing":
+        if "particles" not in raw or "packing" in raw:
+            packing = packing_spec(raw.get("packing"), materials)
         if "particles" not in raw:
-            raw["particles"] = generate_packing(raw.get("packing"), materials)
+            raw["particles"] = generate_packing(packing)
     elif "packing" in raw:
         raise ConfigError("packing", raw["packing"], "a [packing] table needs kind = \"packing\"")
     parts_raw = raw.get("particles")
@@ -469,7 +486,7 @@ def from_dict(raw: dict) -> Case:
              "velocity": list(p.velocity), "angular_velocity": list(p.angular_velocity)} for p in parts
         ]
         return Case(name=name, kind=kind, materials=materials, particles=parts, walls=tuple(walls),
-                    contact=contact, run=run, raw=resolved_raw)
+                    contact=contact, run=run, packing=packing, raw=resolved_raw)
 
     case = build(parts)
     # Model ids and parameters are checked here too, so that nothing runs on a bad case.
@@ -487,7 +504,7 @@ def from_dict(raw: dict) -> Case:
             else:
                 flight = ("impact.gap", impact["gap"]) if "gap" in impact else ("impact.speed", impact.get("speed"))
             run_length(case, model=model, flight=flight)
-    elif (raw.get("packing") or {}).get("duration") is not None:
+    elif packing is not None and packing.duration is not None:
         packing_run(case)  # a packing too long to run is refused here too, before any work
     return case
 
@@ -619,7 +636,7 @@ def _apply_impact(impact: dict, particles: list[dict], walls: list[Wall], materi
         raise ConfigError("impact", impact, "applies to a collision of two particles or of a particle and a wall")
 
 
-def packing_spec(p: dict | None, materials) -> dict:
+def packing_spec(p: dict | None, materials) -> Packing:
     """The validated [packing] table: layout, count, material, radii, periodic box (x, y), seed, duration."""
     if not isinstance(p, dict):
         raise ConfigError("packing", p, "a packing case needs a [packing] table (layout, count, material, radius)")
@@ -663,8 +680,8 @@ def packing_spec(p: dict | None, materials) -> dict:
         raise ConfigError("packing.seed", seed, "must be an integer")
     duration = _number(p, "duration", "packing", required=False, default=None, rule="must be > 0 (s)",
                        check=_positive)
-    return {"layout": layout, "count": count, "material": mat, "radii": radii, "box": box, "seed": seed,
-            "duration": duration}
+    return Packing(layout=layout, count=count, material=mat, radii=tuple(radii),
+                   box=tuple(float(b) for b in box) if box is not None else None, seed=seed, duration=duration)
 
 
 # What a packing costs in memory per particle, measured: building the case (~2.5 KiB at the peak, tracemalloc, for
@@ -696,14 +713,13 @@ def _bytes(n: float) -> str:
         n /= 1024
 
 
-def generate_packing(p: dict | None, materials) -> list[dict]:
+def generate_packing(spec: Packing) -> list[dict]:
     """The initial positions of a packing (seeded): a vertical column of spheres just apart, a square layer
     on the floor, or spheres on a loose jittered lattice above the floor to be poured. The floor is z = 0."""
-    spec = packing_spec(p, materials)
-    radii, n, mat = spec["radii"], spec["count"], spec["material"]
+    radii, n, mat = spec.radii, spec.count, spec.material
     gap = 1e-3
     out = []
-    if spec["layout"] == "column":
+    if spec.layout == "column":
         z = 0.0
         for k in range(n):
             r = radii[k % len(radii)]
@@ -711,8 +727,8 @@ def generate_packing(p: dict | None, materials) -> list[dict]:
             out.append({"material": mat, "radius": r, "position": [0.0, 0.0, z]})
             z += r * (1.0 + gap)
         return out
-    lx, ly = spec["box"]
-    if spec["layout"] == "layer":
+    lx, ly = spec.box
+    if spec.layout == "layer":
         side = int(math.ceil(math.sqrt(n)))
         a = lx / side
         for k in range(n):
@@ -721,13 +737,13 @@ def generate_packing(p: dict | None, materials) -> list[dict]:
                         "position": [(k % side + 0.5) * a, (k // side + 0.5) * ly / side, r * (1.0 + gap)]})
         return out
     # poured: a loose lattice of cells 2.2 r_max wide, each sphere jittered inside its cell
-    rng = np.random.default_rng(spec["seed"])
+    rng = np.random.default_rng(spec.seed)
     rmax = max(radii)
     a = 2.2 * rmax
     nx, ny = max(1, int(lx / a)), max(1, int(ly / a))
     ax, ay = lx / nx, ly / ny
     if ax < 2.0 * rmax * 1.05 or ay < 2.0 * rmax * 1.05:
-        raise ConfigError("packing.box", spec["box"], "is too small for a layer of the particles")
+        raise ConfigError("packing.box", spec.box, "is too small for a layer of the particles")
     slack_x, slack_y, slack_z = ax - 2.0 * rmax, ay - 2.0 * rmax, 0.2 * rmax
     for k in range(n):
         layer, cell = divmod(k, nx * ny)
@@ -838,7 +854,7 @@ def packing_run(case: Case, duration: float | None = None, dt: float | None = No
     --dt; run.dt; the auto dt's run.steps_per_contact) when the run would fit at the default auto step, else the
     duration (``duration`` given here: --duration; packing.duration)."""
     given = duration
-    duration = duration or (case.raw.get("packing") or {}).get("duration")
+    duration = duration or (case.packing.duration if case.packing else None)
     if not duration:
         raise ConfigError("packing.duration", None, "missing: how long to let the packing settle (s)")
     step = dt or packing_step(case)

@@ -479,7 +479,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
     if mpi > 1 and engine == "reference":
         raise ConfigError("--mpi", mpi, f"applies to an engine (--engine {'|'.join(ENGINE_NAMES)}); the reference runs on one "
                           "core")
-    box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
+    box = case.packing.box if case.packing else None
     import pandas as pd
 
     from .inputs.packing_decks import CONTACT_COLUMNS

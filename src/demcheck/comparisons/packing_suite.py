@@ -31,7 +31,7 @@ def static_overlaps(case, x) -> list[tuple[float, float]] | None:
     from ..reference.normal import NormalLaw
     from ..reference.packing import resolve_laws
 
-    layout = (case.raw.get("packing") or {}).get("layout")
+    layout = case.packing.layout if case.packing else None
     if layout not in ("column", "layer") or not case.walls:
         return None
     sp, laws_n, _, wall_n, _ = resolve_laws(case)
@@ -120,7 +120,7 @@ def run_packing(case, opts, found, file=None) -> dict:
 
     normal, tangential = models_of(case)
     entry["model"] = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
-    box = tuple((case.raw.get("packing") or {}).get("box") or ()) or None
+    box = case.packing.box if case.packing else None
     comps = []
     x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
     states = {"reference": (x, rad)}
@@ -177,7 +177,7 @@ def run_packing(case, opts, found, file=None) -> dict:
                                       V.AGREE if worst <= CLOSED_FORM_RTOL else V.UNEXPECTED,
                                       "" if worst <= CLOSED_FORM_RTOL else
                                       "the settled overlaps miss the static closed form (not settled?)"))
-        elif (case.raw.get("packing") or {}).get("layout") == "poured":
+        elif case.packing is not None and case.packing.layout == "poured":
             m = entry["sources"][src]["metrics"]
             ke = m.get("kinetic_energy", math.nan)
             lift = sum(case.mass(i) for i in range(len(case.particles))) * float(np.linalg.norm(case.run.gravity)) \

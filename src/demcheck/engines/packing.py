@@ -71,7 +71,7 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     table = table.sort_values("id").reset_index(drop=True)
     # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
     contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
-                             table[["x", "y", "z"]].to_numpy(), (case.raw.get("packing") or {}).get("box"))
+                             table[["x", "y", "z"]].to_numpy(), case.packing.box if case.packing else None)
     from ..errors import EngineFailed
 
     bad = dumps.non_finite(table) or dumps.non_finite(contacts)

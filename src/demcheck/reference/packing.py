@@ -558,14 +558,12 @@ class PackState:
 
 def box_of(case, x, rad):
     """(lo, hi, periodic): the packing's periodic box in x and y, and a z range that holds the particles."""
-    from ..case import packing_spec
-
-    spec = packing_spec(case.raw.get("packing"), case.materials) if case.raw.get("packing") else None
+    spec = case.packing
     rmax = float(rad.max())
     zlo = min(0.0, float((x[:, 2] - rad).min())) - rmax
     zhi = float((x[:, 2] + rad).max()) + 4 * rmax
-    if spec and spec["box"] is not None:
-        lx, ly = spec["box"]
+    if spec is not None and spec.box is not None:
+        lx, ly = spec.box
         return np.array([0.0, 0.0, zlo]), np.array([lx, ly, zhi]), np.array([True, True])
     lo = (x - rad[:, None]).min(axis=0) - 4 * rmax
     hi = (x + rad[:, None]).max(axis=0) + 4 * rmax
