@@ -301,7 +301,7 @@ def test_report_html_renders_its_plots_in_a_headless_browser(tmp_path):
 
 def test_the_plot_cache_lives_under_the_cache_and_a_damaged_entry_is_drawn_again(tmp_path, caplog):
     files = [CASES / "glass-pair.toml"]
-    first = _run(tmp_path, files)
+    _run(tmp_path, files)
     plots = sorted((tmp_path / "cache" / "plots").glob("*.b64"))
     assert len(plots) >= 2 and not (tmp_path / "plots").exists()  # under $DEMCHECK_CACHE, not beside it
     good = {p: p.read_text() for p in plots}
