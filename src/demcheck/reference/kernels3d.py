@@ -791,6 +791,19 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
 # ----------------------------------------------------------------------------- velocity Verlet (engines)
 
 
+ROTATION_THRESHOLD = 1e-10  # of μ|Fn|: a history whose normal part is below it is left as it is
+
+
+@njit(cache=True, inline="always")
+def rotates(mode, normal_part, scale, mu, fabs):
+    """Whether a history is turned into the new tangent plane (keeping its length) this step: always
+    (ROT_RESCALE), or only when its normal part matters, |ξ·n| scale > ROTATION_THRESHOLD μ|Fn|
+    (ROT_RESCALE_SIGNIFICANT, LAMMPS's rule; ``scale`` turns the history into a force: Kt, or 1). The one rule of
+    the two-body verlet kernel and the packing loop."""
+    return mode == ROT_RESCALE or (mode == ROT_RESCALE_SIGNIFICANT
+                                   and abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs)
+
+
 @njit(cache=True)
 def _rotate_history(h, n, mode):
     if mode == ROT_NONE:
@@ -876,14 +889,10 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 if a_now < a_prev:
                     hist = hist * (a_now / a_prev)
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
-                if rules[R_ROTATION] == ROT_RESCALE:
+                # (a force history's normal part is a force already: its scale is 1)
+                if rotates(rules[R_ROTATION], _dot(hist, n), 1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K],
+                           fabs):
                     hist = _rotate_history(hist, n, ROT_RESCALE)
-                elif rules[R_ROTATION] == ROT_RESCALE_SIGNIFICANT:
-                    # turned only when its normal part matters (LAMMPS's rule): |ξ·n| Kt > 1e-10 μ|Fn|
-                    # (|F·n| > 1e-10 μ|Fn| for a force history)
-                    scale = 1.0 if force_hist else kt_of(tl, delta)
-                    if abs(_dot(hist, n)) * scale > 1e-10 * tl[T_MU_K] * fabs:
-                        hist = _rotate_history(hist, n, ROT_RESCALE)
             if force_hist:
                 # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the
                 # history keeps the elastic part of the capped force
