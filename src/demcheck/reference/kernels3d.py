@@ -795,13 +795,12 @@ ROTATION_THRESHOLD = 1e-10  # of μ|Fn|: a history whose normal part is below it
 
 
 @njit(cache=True, inline="always")
-def rotates(mode, normal_part, scale, mu, fabs):
-    """Whether a history is turned into the new tangent plane (keeping its length) this step: always
-    (ROT_RESCALE), or only when its normal part matters, |ξ·n| scale > ROTATION_THRESHOLD μ|Fn|
-    (ROT_RESCALE_SIGNIFICANT, LAMMPS's rule; ``scale`` turns the history into a force: Kt, or 1). The one rule of
-    the two-body verlet kernel and the packing loop."""
-    return mode == ROT_RESCALE or (mode == ROT_RESCALE_SIGNIFICANT
-                                   and abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs)
+def normal_part_matters(normal_part, scale, mu, fabs):
+    """The rescale_significant rule (LAMMPS's): a history is turned into the new tangent plane only when its
+    normal part matters, |ξ·n| scale > ROTATION_THRESHOLD μ|Fn| (``scale`` turns the history into a force: Kt,
+    or 1). The one rule of the two-body verlet kernel and the packing loop; the callers test the mode first, so
+    that nothing is computed for the other modes."""
+    return abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs
 
 
 @njit(cache=True)
@@ -889,9 +888,10 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 if a_now < a_prev:
                     hist = hist * (a_now / a_prev)
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
+                rot = rules[R_ROTATION]
                 # (a force history's normal part is a force already: its scale is 1)
-                if rotates(rules[R_ROTATION], _dot(hist, n), 1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K],
-                           fabs):
+                if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and normal_part_matters(
+                        _dot(hist, n), 1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)):
                     hist = _rotate_history(hist, n, ROT_RESCALE)
             if force_hist:
                 # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the

@@ -24,8 +24,9 @@ import numpy as np
 from numba import njit
 
 from .kernels import normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT, eta_of,
-                        kt_of, return_map, rotates, slip_surface, tangential_force, walton_stiffness)
+from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT, ROT_RESCALE,
+                        ROT_RESCALE_SIGNIFICANT, eta_of, kt_of, normal_part_matters, return_map, slip_surface,
+                        tangential_force, walton_stiffness)
 from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
                          TRUNC_SPRING, WALTON, ZZY)
 
@@ -185,7 +186,8 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
         # in verlet_3d's order
         hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-        if rotates(rot, hn, kt_of(tl, delta), tl[T_MU_K], fabs):
+        if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT
+                                  and normal_part_matters(hn, kt_of(tl, delta), tl[T_MU_K], fabs)):
             old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
             for k in range(3):
                 hist[k] -= hn * n[k]
@@ -236,7 +238,7 @@ def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
     h0, h1, h2 = hist[row, 0], hist[row, 1], hist[row, 2]
     kt = kt_of(tl, delta)
     hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-    if rotates(rot, hn, kt, tl[T_MU_K], fabs):
+    if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and normal_part_matters(hn, kt, tl[T_MU_K], fabs)):
         old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
         h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
         new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
