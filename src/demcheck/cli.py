@@ -15,7 +15,7 @@ import click
 
 from . import __version__
 from .errors import ConfigError, DemcheckError
-from .io import plain
+from .io import number as as_text, plain
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
@@ -36,8 +36,6 @@ ENGINE_NAMES = _engine_names()  # the registered engines (built-ins, then plug-i
 
 def show(v) -> str:
     """A value in a CLI table: the reports' formatter, ten significant digits."""
-    from .io import number as as_text
-
     return as_text(v, ".10g")
 
 
@@ -170,14 +168,19 @@ def models(model_id, as_json):
                  "params": {p.name: p.meaning for p in m.params}} for m in registry.values()]
 
     table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
-    if model_id is not None:
-        key = model_id.strip().lower()
-        table = [r for r in table if key == r["id"] or key in (a.lower() for a in r["aliases"])]
+    if model_id is not None:  # an id or alias, in either slot (tti names a normal and a tangential model)
+        found = set()
+        for slot, reg in (("normal", normal.REGISTRY), ("tangential", tangential.REGISTRY)):
+            try:
+                found.add((slot, reg.lookup(model_id).id))
+            except KeyError:
+                pass
+        table = [r for r in table if (r["slot"], r["id"]) in found]
         if not table:
             import difflib
 
-            known = [m.id for m in (*normal.REGISTRY.values(), *tangential.REGISTRY.values())]
-            near = difflib.get_close_matches(key, known, n=1)
+            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names()]
+            near = difflib.get_close_matches(model_id.strip().lower(), known, n=1)
             raise ConfigError("ID", model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
                                                                              else f"; known: {', '.join(known)}"))
     engines = mapping.by_model()
