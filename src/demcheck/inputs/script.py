@@ -1,0 +1,439 @@
+"""A reader of the LAMMPS-family input language (LIGGGHTS shares it), for auditing a user's own deck.
+
+Nothing read here is ever executed: the reader turns a deck into a list of :class:`Command` (words after
+quoting and substitution, with the file and line they came from). What it implements, as LAMMPS's input
+reader does:
+
+* a line ending in ``&`` continues onto the next; triple quotes (``\"\"\"``) span lines;
+* ``#`` outside quotes starts a comment;
+* ``variable NAME equal EXPR`` (evaluated when referenced), ``string TEXT``, ``index V1 V2 …`` (the first
+  value; an index variable is not redefined), ``delete``; other variable styles are listed as not audited and
+  their references make a command unreadable;
+* ``$x``, ``${NAME}`` and ``$(EXPR)`` substitution outside quotes, with a small evaluator of arithmetic (numbers,
+  ``+ - * / ^``, parentheses, ``PI``, ``v_NAME`` and a few functions) — never Python's ``eval``;
+* ``include FILE`` relative to the deck's directory (a path that leaves it is refused);
+* ``label``, ``jump``, ``next``, ``if`` and ``loop`` are refused: control flow decides which lines run.
+
+:class:`ScriptError` (exit 2) names the file, line and command it cannot read.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import DemcheckError
+
+CONTROL_FLOW = frozenset({"label", "jump", "next", "if", "loop"})
+MAX_INCLUDE_DEPTH = 8
+MAX_LINES = 200_000
+
+
+class ScriptError(DemcheckError):
+    """A deck the reader cannot read: names the file, the line and the command (exit 2)."""
+
+    exit_code = 2
+
+
+@dataclass
+class Command:
+    words: list[str]
+    file: str
+    line: int
+    text: str  # the command as written (continuations joined), for messages
+    problem: str = ""  # why its words could not be read exactly (an unknown variable): "" when read
+
+    @property
+    def name(self) -> str:
+        return self.words[0] if self.words else ""
+
+    def where(self) -> str:
+        return f"{self.file}:{self.line}"
+
+
+@dataclass
+class Script:
+    commands: list[Command] = field(default_factory=list)
+    variables: dict = field(default_factory=dict)  # name → (style, value or expression)
+    unread: list[tuple[Command, str]] = field(default_factory=list)  # variables the reader could not define
+
+
+# ----------------------------------------------------------------------------- the safe evaluator
+
+_TOKEN = re.compile(r"\s*(?:(\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?)|(v_[A-Za-z0-9_]+)|"
+                    r"([A-Za-z_][A-Za-z0-9_]*)|(\*\*|[-+*/^(),]))")
+_FUNCTIONS = {"sqrt": math.sqrt, "exp": math.exp, "ln": math.log, "log": math.log10, "abs": abs, "sin": math.sin,
+              "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
+              "atan2": math.atan2, "floor": math.floor, "ceil": math.ceil, "round": round, "min": min, "max": max}
+_CONSTANTS = {"PI": math.pi}
+
+
+class _Unevaluable(Exception):
+    pass
+
+
+def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
+    """The value of an equal-style formula made of numbers, + - * / ^, parentheses, PI, v_NAME of other
+    evaluable variables and the functions in _FUNCTIONS. Anything else (thermo keywords, atom values,
+    comparisons) raises _Unevaluable: the reader never guesses a value."""
+    if depth > 20:
+        raise _Unevaluable("variables refer to each other too deeply")
+    tokens, pos = [], 0
+    expr = expr.strip()
+    while pos < len(expr):
+        m = _TOKEN.match(expr, pos)
+        if not m or m.end() == pos:
+            raise _Unevaluable(f"cannot read {expr[pos:pos + 20]!r}")
+        num, var, name, op = m.groups()
+        tokens.append(("num", float(num)) if num else ("var", var[2:]) if var else ("name", name) if name
+                      else ("op", "^" if op == "**" else op))
+        pos = m.end()
+        while pos < len(expr) and expr[pos].isspace():
+            pos += 1
+    k = 0
+
+    def peek():
+        return tokens[k] if k < len(tokens) else ("end", None)
+
+    def take(kind=None, value=None):
+        nonlocal k
+        t = peek()
+        if (kind and t[0] != kind) or (value and t[1] != value):
+            raise _Unevaluable(f"expected {value or kind} in {expr!r}")
+        k += 1
+        return t
+
+    def add():
+        x = mul()
+        while peek() in (("op", "+"), ("op", "-")):
+            op = take()[1]
+            y = mul()
+            x = x + y if op == "+" else x - y
+        return x
+
+    def mul():
+        x = unary()
+        while peek() in (("op", "*"), ("op", "/")):
+            op = take()[1]
+            y = unary()
+            if op == "/" and y == 0:
+                raise _Unevaluable("division by zero")
+            x = x * y if op == "*" else x / y
+        return x
+
+    def unary():
+        if peek() in (("op", "-"), ("op", "+")):
+            sign = -1.0 if take()[1] == "-" else 1.0
+            return sign * unary()
+        return power()
+
+    def power():
+        x = atom()
+        if peek() == ("op", "^"):
+            take()
+            y = unary()  # right-associative
+            try:
+                x = float(x) ** y
+            except (OverflowError, ZeroDivisionError) as exc:
+                raise _Unevaluable(str(exc)) from None
+            if isinstance(x, complex):
+                raise _Unevaluable("a negative number to a fractional power")
+        return x
+
+    def atom():
+        kind, value = peek()
+        if kind == "num":
+            take()
+            return value
+        if kind == "op" and value == "(":
+            take()
+            x = add()
+            take("op", ")")
+            return x
+        if kind == "var":
+            take()
+            return lookup(value, variables, depth + 1)
+        if kind == "name":
+            take()
+            if value in _CONSTANTS:
+                return _CONSTANTS[value]
+            if value in _FUNCTIONS and peek() == ("op", "("):
+                take()
+                args = [add()]
+                while peek() == ("op", ","):
+                    take()
+                    args.append(add())
+                take("op", ")")
+                try:
+                    return float(_FUNCTIONS[value](*args))
+                except (TypeError, ValueError, OverflowError) as exc:
+                    raise _Unevaluable(f"{value}{tuple(args)}: {exc}") from None
+            raise _Unevaluable(f"'{value}' is not a number the reader can know before a run")
+        raise _Unevaluable(f"unexpected {value!r} in {expr!r}")
+
+    x = add()
+    if k != len(tokens):
+        raise _Unevaluable(f"unexpected {tokens[k][1]!r} in {expr!r}")
+    if not math.isfinite(x):
+        raise _Unevaluable(f"{expr!r} is not finite")
+    return x
+
+
+def lookup(name: str, variables: dict, depth: int = 0) -> float:
+    if name not in variables:
+        raise _Unevaluable(f"variable '{name}' is not defined (before this line)")
+    style, value = variables[name]
+    if style == "equal":
+        return evaluate(value, variables, depth)
+    try:
+        return float(value)
+    except ValueError:
+        raise _Unevaluable(f"variable '{name}' = {value!r} is not a number") from None
+
+
+def number_text(x: float) -> str:
+    return repr(int(x)) if float(x).is_integer() and abs(x) < 1e15 else f"{x:.15g}"
+
+
+# ----------------------------------------------------------------------------- lines, quotes, substitution
+
+
+def _logical_lines(text: str, name: str):
+    """(line number, text) of each command: continuations joined, triple-quoted text kept whole."""
+    lines = text.split("\n")
+    if len(lines) > MAX_LINES:
+        raise ScriptError(f"{name}: {len(lines)} lines: more than the {MAX_LINES} a deck may have")
+    i = 0
+    while i < len(lines):
+        start, buf = i + 1, lines[i].rstrip("\r")
+        i += 1
+        while True:
+            if buf.count('"""') % 2 == 1:  # inside a triple-quoted string: take the next line whole
+                if i >= len(lines):
+                    raise ScriptError(f"{name}:{start}: a triple quote is not closed: {buf[:60]!r}")
+                buf += "\n" + lines[i].rstrip("\r")
+                i += 1
+                continue
+            stripped = buf.rstrip()
+            if stripped.endswith("&") and not _in_comment(stripped):
+                if i >= len(lines):
+                    raise ScriptError(f"{name}:{start}: the last line continues ('&') onto nothing")
+                buf = stripped[:-1] + " " + lines[i].rstrip("\r")
+                i += 1
+                continue
+            break
+        yield start, buf
+
+
+def _in_comment(text: str) -> bool:
+    return _strip_comment(text) != text
+
+
+def _strip_comment(text: str) -> str:
+    """The text before the first '#' outside single, double or triple quotes."""
+    i, quote = 0, ""
+    while i < len(text):
+        if quote:
+            if text.startswith(quote, i):
+                i += len(quote)
+                quote = ""
+                continue
+        elif text.startswith('"""', i):
+            quote = '"""'
+            i += 3
+            continue
+        elif text[i] in "'\"":
+            quote = text[i]
+        elif text[i] == "#":
+            return text[:i]
+        i += 1
+    return text
+
+
+def _substitute(text: str, variables: dict) -> tuple[str, str]:
+    """(text with $x, ${NAME} and $(EXPR) replaced outside quotes, the problem or "")."""
+    out, i, quote, problem = [], 0, "", ""
+    while i < len(text):
+        ch = text[i]
+        if quote:
+            if text.startswith(quote, i):
+                out.append(quote)
+                i += len(quote)
+                quote = ""
+                continue
+            out.append(ch)
+            i += 1
+            continue
+        if text.startswith('"""', i):
+            quote = '"""'
+            out.append(quote)
+            i += 3
+            continue
+        if ch in "'\"":
+            quote = ch
+            out.append(ch)
+            i += 1
+            continue
+        if ch != "$" or i + 1 >= len(text):
+            out.append(ch)
+            i += 1
+            continue
+        nxt = text[i + 1]
+        try:
+            if nxt == "{":
+                end = text.find("}", i + 2)
+                if end < 0:
+                    raise _Unevaluable("'${' is not closed")
+                value = _value_text(text[i + 2:end], variables)
+                i = end + 1
+            elif nxt == "(":
+                depth, j = 0, i + 1
+                while j < len(text):
+                    depth += text[j] == "("
+                    depth -= text[j] == ")"
+                    if depth == 0:
+                        break
+                    j += 1
+                if depth:
+                    raise _Unevaluable("'$(' is not closed")
+                expr = text[i + 2:j]
+                fmt = ""
+                if ":" in expr:
+                    expr, fmt = expr.rsplit(":", 1)
+                x = evaluate(expr, variables)
+                value = _format(x, fmt)
+                i = j + 1
+            else:
+                value = _value_text(nxt, variables)
+                i += 2
+        except _Unevaluable as exc:
+            problem = problem or str(exc)
+            value = "?"
+            i += 2 if nxt not in "{(" else 0
+            if nxt in "{(":
+                close = "}" if nxt == "{" else ")"
+                end = text.find(close, i + 2)
+                i = end + 1 if end >= 0 else len(text)
+        out.append(value)
+    return "".join(out), problem
+
+
+def _format(x: float, fmt: str) -> str:
+    m = re.fullmatch(r"%(\d*)(?:\.(\d+))?([fgeFGE])", fmt.strip()) if fmt else None
+    if fmt and not m:
+        raise _Unevaluable(f"format {fmt!r} is not %f, %g or %e")
+    if m:
+        return f"{x:{m.group(1) or ''}{'.' + m.group(2) if m.group(2) else ''}{m.group(3)}}"
+    return f"{x:.15g}"
+
+
+def _value_text(name: str, variables: dict) -> str:
+    if name not in variables:
+        raise _Unevaluable(f"variable '{name}' is not defined (before this line)")
+    style, value = variables[name]
+    if style == "equal":
+        return f"{evaluate(value, variables):.15g}"
+    return value
+
+
+def split_words(text: str, where: str) -> list[str]:
+    """Words separated by whitespace; single, double and triple quotes group words (and are removed)."""
+    words, i = [], 0
+    while i < len(text):
+        if text[i].isspace():
+            i += 1
+            continue
+        for q in ('"""', '"', "'"):
+            if text.startswith(q, i):
+                end = text.find(q, i + len(q))
+                if end < 0:
+                    raise ScriptError(f"{where}: a quote {q} is not closed: {text.strip()[:80]!r}")
+                words.append(text[i + len(q):end])
+                i = end + len(q)
+                break
+        else:
+            j = i
+            while j < len(text) and not text[j].isspace():
+                j += 1
+            words.append(text[i:j])
+            i = j
+    return words
+
+
+# ----------------------------------------------------------------------------- the reader
+
+
+def read(path: str | Path) -> Script:
+    """Read a deck (and what it includes) into commands, defining variables as it goes."""
+    path = Path(path)
+    if not path.is_file():
+        raise ScriptError(f"DECK = {str(path)!r}: no such file")
+    root = path.resolve().parent
+    script = Script()
+    _read_file(path.resolve(), root, script, 0)
+    return script
+
+
+def _read_file(path: Path, root: Path, script: Script, depth: int) -> None:
+    name = path.name if path.parent == root else str(path.relative_to(root))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ScriptError(f"{name}: not a text file (UTF-8)") from None
+    for line_no, raw in _logical_lines(text, name):
+        body = _strip_comment(raw).strip()
+        if not body:
+            continue
+        where = f"{name}:{line_no}"
+        head = body.split(None, 1)[0]
+        if head in CONTROL_FLOW:
+            raise ScriptError(f"{where}: {body[:60]!r}: not audited: control flow ('{head}' decides which lines "
+                              "run; unroll it, or audit each branch as its own deck)")
+        substituted, problem = _substitute(body, script.variables)
+        words = split_words(substituted, where)
+        if not words:
+            continue
+        cmd = Command(words, name, line_no, body, problem)
+        if cmd.name == "quit":
+            script.commands.append(cmd)
+            return
+        if cmd.name == "variable" and not problem:
+            _define(cmd, script)
+        if cmd.name == "include":
+            if problem or len(words) != 2:
+                raise ScriptError(f"{where}: {body[:60]!r}: include takes one file name"
+                                  + (f" ({problem})" if problem else ""))
+            target = (path.parent / words[1]).resolve()
+            if not target.is_relative_to(root):
+                raise ScriptError(f"{where}: include {words[1]!r}: the file lies outside the deck's directory "
+                                  f"{str(root)!r} (refused)")
+            if not target.is_file():
+                raise ScriptError(f"{where}: include {words[1]!r}: no such file")
+            if depth >= MAX_INCLUDE_DEPTH:
+                raise ScriptError(f"{where}: include {words[1]!r}: more than {MAX_INCLUDE_DEPTH} nested includes")
+            script.commands.append(cmd)
+            _read_file(target, root, script, depth + 1)
+            continue
+        script.commands.append(cmd)
+
+
+def _define(cmd: Command, script: Script) -> None:
+    w = cmd.words
+    if len(w) < 3:
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:60]!r}: variable needs a name and a style")
+    name, style, rest = w[1], w[2], w[3:]
+    if style == "delete":
+        script.variables.pop(name, None)
+    elif style == "equal":
+        script.variables[name] = ("equal", " ".join(rest))
+    elif style == "string":
+        script.variables[name] = ("string", " ".join(rest))
+    elif style == "index":
+        if not rest:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:60]!r}: an index variable needs a value")
+        script.variables.setdefault(name, ("index", rest[0]))
+    else:  # loop, world, universe, atom, vector, python, file, getenv, format, internal, …
+        script.variables.pop(name, None)
+        script.unread.append((cmd, f"variable style '{style}' is not read (its value is known only in a run)"))

@@ -1,0 +1,96 @@
+"""The input-language reader of `demcheck audit` (inputs/script.py): comments, continuations, quotes, variables
+and substitution, include, control flow refused; nothing it reads is executed."""
+
+import math
+
+import pytest
+
+from demcheck.inputs import script as S
+
+
+def _read(tmp_path, text, name="in.deck"):
+    p = tmp_path / name
+    p.write_text(text)
+    return S.read(p)
+
+
+def test_comments_continuations_and_quotes(tmp_path):
+    sc = _read(tmp_path, "# a comment\nunits si   # trailing\npair_style granular &\n  # not a comment here? &\n"
+                         "timestep 1e-7\nprint 'a # b' \"c d\"\nprint \"\"\"x\n# y\n\"\"\"\n")
+    words = [c.words for c in sc.commands]
+    assert words[0] == ["units", "si"]
+    # the '&' joins the next line; a '#' there starts a comment that runs to the end of the joined line
+    assert words[1] == ["pair_style", "granular"]
+    assert words[2] == ["timestep", "1e-7"]
+    assert words[3] == ["print", "a # b", "c d"]
+    assert words[4] == ["print", "x\n# y\n"]
+    assert [c.line for c in sc.commands] == [2, 3, 5, 6, 7]
+
+
+def test_variables_and_substitution(tmp_path):
+    sc = _read(tmp_path, "variable E equal 63e9\nvariable nu equal 0.24\nvariable r index 1e-3 2e-3\n"
+                         "variable r index 5\nvariable s string hertz/material\n"
+                         "variable k equal 4/3*v_E/(2*(1-v_nu^2))\n"
+                         "pair_coeff * * ${s} $E 0.6 ${nu} $(2*v_r) ${k} $(sqrt(4):%.3f)\n"
+                         "print '${E}'\n")
+    w = sc.commands[-2].words
+    assert w[:4] == ["pair_coeff", "*", "*", "hertz/material"]
+    assert float(w[4]) == 63e9 and float(w[6]) == 0.24
+    assert float(w[7]) == 2e-3  # an index variable keeps its first definition
+    # closed form: (4/3)·63e9/(2(1 − 0.24²)), to the 15 digits substitution writes
+    assert float(w[8]) == pytest.approx(4 / 3 * 63e9 / (2 * (1 - 0.24**2)), rel=1e-14)
+    assert w[9] == "2.000"
+    assert sc.commands[-1].words == ["print", "${E}"]  # no substitution inside quotes
+
+
+def test_unknown_variables_are_a_problem_not_a_guess(tmp_path):
+    sc = _read(tmp_path, "variable t equal step*dt\nvariable a atom x\nfix 1 all print ${t}\nfix 2 all print $a\n")
+    assert "not a number" in sc.commands[2].problem and "?" in sc.commands[2].words
+    assert "not defined" in sc.commands[3].problem
+    assert sc.unread and "atom" in sc.unread[0][1]
+
+
+@pytest.mark.parametrize("expr,value", [("2^3^2", 512.0), ("-2^2", -4.0), ("(1+2)*3-4/8", 8.5),
+                                        ("PI", math.pi), ("atan2(1,1)*4", math.pi), ("min(3,max(1,2))", 2.0),
+                                        ("1e-3*2", 2e-3), (".5", 0.5)])
+def test_evaluator(expr, value):
+    assert S.evaluate(expr, {}) == pytest.approx(value, rel=1e-15)
+
+
+@pytest.mark.parametrize("expr", ["__import__('os')", "1/0", "x", "step", "2 > 1", "(1", "1 2", "(-8)^(1/3)",
+                                  "10^400"])
+def test_evaluator_refuses(expr):
+    with pytest.raises(S._Unevaluable):
+        S.evaluate(expr, {})
+
+
+def test_include_relative_and_confined(tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "mat.in").write_text("variable E equal 7e10\n")
+    sc = _read(tmp_path, "include sub/mat.in\ntimestep $E\n")
+    assert sc.commands[-1].words[0] == "timestep" and float(sc.commands[-1].words[1]) == 7e10
+    assert sc.commands[-1].file == "in.deck"
+    (tmp_path / "outside.in").write_text("units si\n")
+    inner = tmp_path / "sub" / "in.deck"
+    inner.write_text("include ../outside.in\n")
+    with pytest.raises(S.ScriptError, match="outside the deck's directory"):
+        S.read(inner)
+
+
+@pytest.mark.parametrize("line", ["label loop", "jump SELF loop", "next a", "if \"${a} > 1\" then quit"])
+def test_control_flow_is_refused(tmp_path, line):
+    with pytest.raises(S.ScriptError, match="not audited: control flow") as exc:
+        _read(tmp_path, f"units si\n{line}\n")
+    assert "in.deck:2" in str(exc.value) and exc.value.exit_code == 2
+
+
+def test_unclosed_quote_names_the_line(tmp_path):
+    with pytest.raises(S.ScriptError, match=r"in.deck:2: a quote"):
+        _read(tmp_path, "units si\nprint 'abc\n")
+
+
+def test_shell_and_python_lines_are_read_not_run(tmp_path):
+    marker = tmp_path / "touched"
+    sc = _read(tmp_path, f"shell touch {marker}\npython f input 0 format f here \"\"\"\nopen('{marker}','w')\n\"\"\"\n")
+    assert [c.name for c in sc.commands] == ["shell", "python"]
+    assert not marker.exists()
