@@ -437,3 +437,203 @@ def _define(cmd: Command, script: Script) -> None:
     else:  # loop, world, universe, atom, vector, python, file, getenv, format, internal, …
         script.variables.pop(name, None)
         script.unread.append((cmd, f"variable style '{style}' is not read (its value is known only in a run)"))
+
+
+# ----------------------------------------------------------------------------- what an engine's reader makes of a deck
+
+
+@dataclass
+class Finding:
+    """A trap the deck falls into (``trap``: exit 1) or a remark (``note``), with its measured size."""
+
+    kind: str  # "trap" | "note"
+    code: str  # tsuji, limit, mixing, wall-moduli, hard-particles, dt-unstable, dt-coarse, attraction, …
+    text: str
+    where: str = ""
+    size: dict = field(default_factory=dict)
+
+
+@dataclass
+class Body:
+    """One atom type's particles as the deck makes them (None where the deck does not say)."""
+
+    type: int
+    radius: float | None = None
+    density: float | None = None
+    mass: float | None = None
+    youngs_modulus: float | None = None  # what the engine's contact settings give the type (for the seed model)
+    poisson_ratio: float | None = None
+
+
+@dataclass
+class PairSetting:
+    """One type pair (``j`` None: a wall with type ``i``) as the engine computes it."""
+
+    label: str
+    i: int
+    j: int | None
+    native: object  # the engine's Native: exactly what it computes for this pair (an explicit equivalent)
+    where: str
+    asked: dict = field(default_factory=dict)  # what the deck asks for: restitution, friction
+    intended: object = None  # what the deck most likely means, where the engine reads it otherwise
+    findings: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    wall: dict = field(default_factory=dict)  # a wall's own properties (youngs_modulus, poisson_ratio)
+    probe: bool = True  # False: listed, not run (no twin for its law)
+
+
+@dataclass
+class Setup:
+    engine: str
+    bodies: dict = field(default_factory=dict)  # type → Body
+    pairs: list = field(default_factory=list)  # PairSetting
+    dt: float | None = None
+    dt_where: str = ""
+    speeds: list = field(default_factory=list)  # (speed, where) the deck gives its bodies
+    not_audited: list = field(default_factory=list)  # (where, text, why)
+    findings: list = field(default_factory=list)
+    ntypes: int = 0
+
+
+# ----------------------------------------------------------------------------- what both engines' decks share
+
+# commands that set nothing a two-body contact depends on (output, neighbour lists, bookkeeping)
+NO_CONTACT_EFFECT = frozenset({
+    "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "region", "neighbor",
+    "neigh_modify", "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "compute",
+    "compute_modify", "run", "print", "log", "echo", "processors", "variable", "include", "quit", "write_restart",
+    "write_data", "write_dump", "reset_timestep", "group", "lattice", "restart", "info", "clear", "suffix",
+    "package", "partition", "plugin", "units", "create_box", "create_atoms", "set", "read_data", "velocity",
+    "timestep", "pair_style", "pair_coeff", "fix", "unfix", "hard_particles", "soft_particles", "delete_atoms",
+    "run_style", "min_style", "minimize", "displace_atoms", "mass", "atom_modify"})
+NEVER_RUN = frozenset({"shell", "python", "plugin", "labelmap", "read_restart", "read_dump", "rerun", "kim",
+                       "mdi", "fitpod", "message", "server", "quit"})
+
+
+def _num(cmd: Command, k: int, what: str) -> float:
+    if cmd.problem:
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {cmd.problem}")
+    try:
+        x = float(cmd.words[k])
+    except (IndexError, ValueError):
+        got = cmd.words[k] if k < len(cmd.words) else "(missing)"
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {what} = {got!r} is not a number") from None
+    if not math.isfinite(x):
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {what} = {cmd.words[k]!r} is not finite")
+    return x
+
+
+def type_range(word: str, n: int, cmd: Command) -> list[int]:
+    """The types of ``*``, ``i``, ``i*``, ``*j``, ``i*j`` (1-based, up to n types)."""
+    m = re.fullmatch(r"(\d*)\*(\d*)|(\d+)", word)
+    if not m:
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {word!r} is not a type or a type range")
+    if m.group(3):
+        lo = hi = int(m.group(3))
+    else:
+        lo, hi = int(m.group(1) or 1), int(m.group(2) or n)
+    if n and (lo < 1 or hi > n or lo > hi):
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: types {word} lie outside 1..{n}")
+    return list(range(lo, hi + 1))
+
+
+def body(setup: Setup, t: int) -> Body:
+    return setup.bodies.setdefault(t, Body(t))
+
+
+def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
+    """The commands both engines share that define bodies, their speeds and the step; True when read."""
+    w, name = cmd.words, cmd.name
+    if name == "units":
+        if len(w) < 2 or w[1] != "si":
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: audit reads decks in units si "
+                              f"(got {w[1] if len(w) > 1 else 'none'})")
+        return True
+    if name == "timestep":
+        dt = _num(cmd, 1, "timestep")
+        if not dt > 0:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: the time step must be > 0 s")
+        setup.dt, setup.dt_where = dt, cmd.where()
+        return True
+    if name == "create_box":
+        setup.ntypes = int(_num(cmd, 1, "number of atom types"))
+        for t in range(1, setup.ntypes + 1):
+            body(setup, t)
+        return True
+    if name == "create_atoms":
+        t = int(_num(cmd, 1, "atom type"))
+        body(setup, t)
+        return True
+    if name == "set" and len(w) >= 5 and w[1] in ("type", "group"):
+        if w[1] == "group" and w[2] != "all":
+            setup.not_audited.append((cmd.where(), cmd.text, "set group other than all: the audit reads "
+                                                              "properties per type"))
+            return True
+        types = (type_range(w[2], setup.ntypes, cmd) if w[1] == "type"
+                 else list(range(1, setup.ntypes + 1)) or list(setup.bodies))
+        k = 3
+        while k + 1 < len(w):
+            key = w[k]
+            if key in ("diameter", "density", "mass"):
+                x = _num(cmd, k + 1, key)
+                if not x > 0:
+                    raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {key} must be > 0")
+                for t in types:
+                    b = body(setup, t)
+                    if key == "diameter":
+                        b.radius = x / 2
+                    elif key == "density":
+                        b.density = x
+                    else:
+                        b.mass = x
+            elif key in ("vx", "vy", "vz"):
+                setup.speeds.append((abs(_num(cmd, k + 1, key)), cmd.where()))
+            k += 2
+        return True
+    if name == "velocity" and len(w) >= 6 and w[2] == "set":
+        v = [0.0 if x == "NULL" else _num(cmd, 3 + i, "velocity") for i, x in enumerate(w[3:6])]
+        setup.speeds.append((math.sqrt(sum(x * x for x in v)), cmd.where()))
+        return True
+    if name == "read_data":
+        _read_data(cmd, setup, root)
+        return True
+    return False
+
+
+def _read_data(cmd: Command, setup: Setup, root: Path) -> None:
+    if len(cmd.words) < 2 or cmd.problem:
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: read_data needs a file name")
+    path = (root / cmd.words[1]).resolve()
+    if not path.is_relative_to(root):
+        raise ScriptError(f"{cmd.where()}: read_data {cmd.words[1]!r}: the file lies outside the deck's directory "
+                          "(refused)")
+    if not path.is_file():
+        raise ScriptError(f"{cmd.where()}: read_data {cmd.words[1]!r}: no such file")
+    section = ""
+    for n, raw in enumerate(path.read_text(encoding="utf-8", errors="replace").split("\n")[1:], 2):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        words = line.split()
+        where = f"{path.name}:{n}"
+        if words[0] in ("Atoms", "Velocities", "Masses") or (words[0][0].isalpha() and len(words) <= 2
+                                                              and not words[-1].replace(".", "").isdigit()):
+            section = words[0]
+            continue
+        try:
+            nums = [float(x) for x in words if not x.isalpha()]
+        except ValueError:
+            raise ScriptError(f"{where}: {line[:60]!r}: not a number") from None
+        if not section:
+            if words[-2:] == ["atom", "types"]:
+                setup.ntypes = int(nums[0])
+                for t in range(1, setup.ntypes + 1):
+                    body(setup, t)
+            continue
+        if section == "Masses" and len(nums) >= 2:
+            body(setup, int(nums[0])).mass = nums[1]
+        elif section == "Atoms" and len(nums) >= 7:  # atom_style sphere/granular: id type diameter density x y z
+            b = body(setup, int(nums[1]))
+            b.radius, b.density = nums[2] / 2, nums[3]
+        elif section == "Velocities" and len(nums) >= 4:
+            setup.speeds.append((math.sqrt(sum(x * x for x in nums[1:4])), where))

@@ -1,0 +1,348 @@
+"""LAMMPS's contact vocabulary read back from a user's deck (``demcheck audit``): ``pair_style granular`` with
+``pair_coeff`` per type pair and LAMMPS's own mixing, the classic ``gran/hooke``, ``gran/hooke/history`` and
+``gran/hertz/history`` styles, and ``fix wall/gran`` (``/region``). Every type pair and wall × type becomes a
+Native that computes what LAMMPS 22Jul2025 computes for it (an auto-mixed pair as its explicit equivalent),
+with the static traps of its settings."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from ...inputs.script import (NEVER_RUN, NO_CONTACT_EFFECT, Command, Finding, PairSetting, ScriptError, Setup,
+                              _num, read_common, type_range)
+from ..base import Native
+
+NORMAL_ARGS = {"hooke": 2, "hertz": 2, "hertz/material": 3, "dmt": 4, "jkr": 4, "mdr": 6}
+DAMPING = ("velocity", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution", "mdr")
+TANGENTIAL_ARGS = {"linear_nohistory": 2, "linear_history": 3, "mindlin": 3, "mindlin/force": 3,
+                   "mindlin_rescale": 3, "mindlin_rescale/force": 3}
+ROLLING_ARGS = {"none": 0, "sds": 3}
+TWISTING_ARGS = {"none": 0, "marshall": 0, "sds": 3}
+HEAT_ARGS = {"none": 0, "radius": 1, "area": 1}
+CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
+PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
+
+
+def _bad(cmd: Command, why: str):
+    return ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {why}")
+
+
+def parse_granular(cmd: Command, words: list[str], k: int) -> dict:
+    """The sub-models of a ``granular`` argument list from words[k]: {normal, normal_coeffs, damping,
+    tangential, tangential_coeffs (None for NULL), rolling, twisting, limit_damping, extras}."""
+    out = {"damping": "viscoelastic", "rolling": "none", "twisting": "none", "limit_damping": False, "extras": []}
+    if k >= len(words) or words[k] not in NORMAL_ARGS:
+        raise _bad(cmd, f"{words[k] if k < len(words) else '(missing)'} is not a normal model of pair granular "
+                        f"({', '.join(NORMAL_ARGS)})")
+    out["normal"] = words[k]
+    n = NORMAL_ARGS[words[k]]
+    out["normal_coeffs"] = tuple(_num(cmd, k + 1 + i, f"{words[k]} coefficient {i + 1}") for i in range(n))
+    k += 1 + n
+    while k < len(words):
+        key = words[k]
+        if key == "damping":
+            if k + 1 >= len(words) or words[k + 1] not in DAMPING:
+                raise _bad(cmd, f"damping takes one of {', '.join(DAMPING)}")
+            out["damping"] = words[k + 1]
+            k += 2
+        elif key in ("tangential", "rolling", "twisting", "heat"):
+            table = {"tangential": TANGENTIAL_ARGS, "rolling": ROLLING_ARGS, "twisting": TWISTING_ARGS,
+                     "heat": HEAT_ARGS}[key]
+            model = words[k + 1] if k + 1 < len(words) else "(missing)"
+            if model not in table:
+                raise _bad(cmd, f"{key} {model}: not a {key} model of pair granular ({', '.join(table)})")
+            m = table[model]
+            coeffs = tuple(None if words[k + 2 + i] == "NULL" else _num(cmd, k + 2 + i, f"{key} coefficient")
+                           for i in range(m) if k + 2 + i < len(words))
+            if len(coeffs) != m:
+                raise _bad(cmd, f"{key} {model} takes {m} coefficients")
+            out[key] = model
+            out[f"{key}_coeffs"] = coeffs
+            k += 2 + m
+        elif key == "limit_damping":
+            out["limit_damping"] = True
+            k += 1
+        elif key == "synchronized_verlet":
+            out["extras"].append(key)
+            k += 1
+        elif key == "cutoff":
+            _num(cmd, k + 1, "cutoff")
+            out["extras"].append(f"cutoff {words[k + 1]}")
+            k += 2
+        else:
+            return {**out, "rest": k}
+    if "tangential" not in out:
+        raise _bad(cmd, "pair granular needs a tangential model")
+    return {**out, "rest": k}
+
+
+def native_of(spec: dict) -> Native:
+    """A parsed granular specification as a Native (the deck writer's and the twin's vocabulary)."""
+    c = spec["normal_coeffs"]
+    if spec["normal"] == "hertz/material":
+        normal_args, damp = (c[0], c[2]), c[1]
+    else:
+        normal_args, damp = (c[0],), c[1]
+    tc = spec["tangential_coeffs"]
+    return Native("lammps", spec["normal"], normal_args, damping=spec["damping"], damping_coeff=damp,
+                  tangential=spec["tangential"], tangential_args=tuple(tc), limit=spec["limit_damping"])
+
+
+def classic(cmd: Command, style: str, words: list[str], k: int) -> tuple[dict, list[str]]:
+    """``Kn Kt γn γt μ dampflag [limit_damping]`` of a classic style as its pair granular equivalent."""
+    kn = _num(cmd, k, "Kn")
+    kt = 2.0 / 7.0 * kn if words[k + 1:k + 2] == ["NULL"] else _num(cmd, k + 1, "Kt")
+    gn = _num(cmd, k + 2, "gamma_n")
+    gt = 0.5 * gn if words[k + 3:k + 4] == ["NULL"] else _num(cmd, k + 3, "gamma_t")
+    mu = _num(cmd, k + 4, "xmu")
+    flag = _num(cmd, k + 5, "dampflag")
+    if flag == 0:
+        gt = 0.0
+    xt = gt / gn if gn > 0 else (0.0 if gt == 0 else math.inf)
+    limit = "limit_damping" in words[k + 6:]
+    notes = [f"{style}: Kt = {kt:.6g}, γt = {gt:.6g} (NULL: Kt = 2/7 Kn, γt = γn/2; dampflag 0: γt = 0), run as "
+             "its pair granular equivalent"]
+    if style == "gran/hooke":
+        spec = {"normal": "hooke", "normal_coeffs": (kn, gn), "damping": "mass_velocity",
+                "tangential": "linear_nohistory", "tangential_coeffs": (xt, mu)}
+    elif style == "gran/hooke/history":
+        spec = {"normal": "hooke", "normal_coeffs": (kn, gn), "damping": "mass_velocity",
+                "tangential": "linear_history", "tangential_coeffs": (kt, xt, mu)}
+        notes.append("the classic style projects the tangential history without rescaling it (pair granular "
+                     "rescales): about 1% in oblique impacts")
+    else:
+        spec = {"normal": "hertz", "normal_coeffs": (kn, gn), "damping": "viscoelastic",
+                "tangential": "mindlin", "tangential_coeffs": (kt, xt, mu)}
+        notes.append("the classic style projects the tangential history without rescaling it: about 1% in "
+                     "oblique impacts")
+    spec.update(limit_damping=limit, rolling="none", twisting="none", extras=[])
+    return spec, notes
+
+
+def _mix_e(e1, nu1, e2, nu2):
+    return 1.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2)
+
+
+def _mix_g(e1, nu1, e2, nu2):
+    return 1.0 / (2.0 * (2.0 - nu1) * (1.0 + nu1) / e1 + 2.0 * (2.0 - nu2) * (1.0 + nu2) / e2)
+
+
+def mixed(a: dict, b: dict, cmd_where: str) -> tuple[Native, Native | None, list[str]]:
+    """LAMMPS's auto-mixing of two types' granular settings (granular_model.cpp mix_coeffs and each sub-model's):
+    hertz/material's E* mixed as Hertz does, every other coefficient by its geometric mean; ``mindlin NULL``
+    then computes k_t = 8·E*/(4(2−ν)(1+ν)) from the mixed E* as if it were a modulus. Returns (the explicit
+    equivalent of what LAMMPS computes, what the deck most likely means when that differs, notes)."""
+    def geo(x, y):
+        return math.sqrt(x * y)
+
+    na, nb = a["normal_coeffs"], b["normal_coeffs"]
+    notes = []
+    if a["normal"] == "hertz/material":
+        e_star = _mix_e(na[0], na[2], nb[0], nb[2])
+        nu = geo(na[2], nb[2])
+        normal, args = "hertz", (4.0 / 3.0 * e_star,)
+        damp = geo(na[1], nb[1])
+    else:
+        normal, args, damp = a["normal"], (geo(na[0], nb[0]),), geo(na[1], nb[1])
+    ta, tb = a["tangential_coeffs"], b["tangential_coeffs"]
+    intended_t = None
+    if a["tangential"] == "linear_nohistory":
+        targs = (geo(ta[0], tb[0]), geo(ta[1], tb[1]))
+    else:
+        if ta[0] is None or tb[0] is None:
+            if a["normal"] != "hertz/material":
+                raise ScriptError(f"{cmd_where}: mindlin NULL needs hertz/material")
+            kt = 8.0 * e_star / (4.0 * (2.0 - nu) * (1.0 + nu))
+            right = 8.0 * _mix_g(na[0], na[2], nb[0], nb[2])
+            intended_t = (right, geo(ta[1], tb[1]), geo(ta[2], tb[2]))
+            notes.append(f"auto-mixed mindlin NULL: LAMMPS computes k_t = 8E*/(4(2−ν)(1+ν)) = {kt:.6g} Pa from the "
+                         f"mixed E* = {e_star:.6g} Pa; 8G* = {right:.6g} Pa ({kt / right:.4f}×)")
+        else:
+            kt = geo(ta[0], tb[0])
+        targs = (kt, geo(ta[1], tb[1]), geo(ta[2], tb[2]))
+    limit = a["limit_damping"] or b["limit_damping"]
+    nat = Native("lammps", normal, args, damping=a["damping"], damping_coeff=damp, tangential=a["tangential"],
+                 tangential_args=targs, limit=limit)
+    intended = None
+    if intended_t is not None:
+        intended = Native("lammps", normal, args, damping=a["damping"], damping_coeff=damp,
+                          tangential=a["tangential"], tangential_args=intended_t, limit=limit)
+    return nat, intended, notes
+
+
+def read(script, root: Path) -> Setup:
+    """A read deck (inputs.script.Script) → Setup: bodies, every type pair and wall × type, dt, speeds."""
+    setup = Setup("lammps")
+    explicit: dict = {}  # (i, j) i ≤ j → (spec, where)
+    style_cmd = None
+    classic_spec = None
+    walls = []  # (spec, where, notes)
+    for cmd in script.commands:
+        w, name = cmd.words, cmd.name
+        if name in NEVER_RUN and name != "quit":
+            setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
+            continue
+        if cmd.problem and name in ("pair_style", "pair_coeff", "fix", "set", "timestep", "create_box"):
+            raise _bad(cmd, cmd.problem)
+        if read_common(cmd, setup, root):
+            continue
+        if name == "pair_style":
+            style_cmd = cmd
+            if len(w) < 2:
+                raise _bad(cmd, "pair_style needs a style")
+            if w[1] == "granular":
+                classic_spec = None
+            elif w[1] in CLASSIC:
+                classic_spec = classic(cmd, w[1], w, 2)
+            else:
+                raise _bad(cmd, f"pair_style {w[1]}: audit reads granular, {', '.join(CLASSIC)}")
+            continue
+        if name == "pair_coeff":
+            if style_cmd is None:
+                raise _bad(cmd, "pair_coeff before pair_style")
+            if len(w) < 3:
+                raise _bad(cmd, "pair_coeff needs two types")
+            ti, tj = type_range(w[1], setup.ntypes, cmd), type_range(w[2], setup.ntypes, cmd)
+            if classic_spec is not None:
+                spec, notes = classic_spec
+                if len(w) > 3:
+                    raise _bad(cmd, f"pair_coeff of {style_cmd.words[1]} takes no coefficients")
+            else:
+                spec, notes = parse_granular(cmd, w, 3), []
+                if spec["rest"] != len(w):
+                    raise _bad(cmd, f"{w[spec['rest']]!r} is not a keyword of pair granular")
+            for i in ti:
+                for j in tj:
+                    if j >= i or w[1] == w[2]:
+                        explicit[(min(i, j), max(i, j))] = (spec, cmd.where(), notes, cmd)
+            continue
+        if name == "fix" and len(w) >= 4 and w[3] in ("wall/gran", "wall/gran/region"):
+            if w[4:5] == ["granular"]:
+                spec = parse_granular(cmd, w, 5)
+                notes = []
+            elif len(w) > 4 and w[4] in ("hooke", "hooke/history", "hertz/history"):
+                spec, notes = classic(cmd, "gran/" + w[4], w, 5)
+                spec["rest"] = 11 + (1 if spec["limit_damping"] else 0)
+                notes.append(f"classic fix wall/gran {w[4]}: LAMMPS 22Jul2025's classic wall styles mishandle "
+                             "sliding and give NaN with γn = 0; use fix wall/gran granular")
+            else:
+                raise _bad(cmd, "fix wall/gran: audit reads granular and the classic hooke, hooke/history, "
+                                "hertz/history styles")
+            rest = w[spec["rest"]:] if "rest" in spec else []
+            if w[3] == "wall/gran" and rest[:1] and rest[0] not in ("xplane", "yplane", "zplane"):
+                notes.append(f"wall {rest[0]}: probed as a flat wall (the contact law is the same; curvature "
+                             "is not)")
+            if w[2] != "all":
+                notes.append(f"fix group '{w[2]}': probed with every type")
+            walls.append((spec, cmd.where(), notes, cmd, w[1]))
+            continue
+        if name == "fix":
+            if len(w) >= 4 and (w[3].startswith("python") or w[3] in ("shell",)):
+                setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
+            elif len(w) >= 4 and w[3] in ("nve/sphere", "gravity", "print", "ave/time", "ave/atom"):
+                pass
+            else:
+                setup.not_audited.append((cmd.where(), cmd.text, f"fix {w[3] if len(w) > 3 else ''}: not read by "
+                                                                 "the audit"))
+            continue
+        if name in NO_CONTACT_EFFECT:
+            continue
+        setup.not_audited.append((cmd.where(), cmd.text, "not audited: not a command the audit reads"))
+    if style_cmd is None:
+        raise ScriptError("the deck has no pair_style: nothing defines its contacts")
+    if setup.dt is None:
+        setup.dt, setup.dt_where = 1e-8, "LAMMPS's default for units si (no timestep command)"
+    types = sorted(setup.bodies) or sorted({t for k in explicit for t in k})
+    _pairs(setup, types, explicit)
+    _walls(setup, types, explicit, walls)
+    return setup
+
+
+def _asked(spec: dict) -> dict:
+    out = {}
+    if spec["damping"] in ("tsuji", "coeff_restitution"):
+        out["restitution"] = spec["normal_coeffs"][1]
+    tc = spec.get("tangential_coeffs") or ()
+    if tc:
+        out["friction"] = tc[-1]
+    return out
+
+
+def _static(ps: PairSetting, spec: dict, where: str) -> None:
+    if spec["normal"] not in PROBED_NORMALS:
+        ps.probe = False
+        ps.notes.append(f"normal {spec['normal']}: listed, not probed (no twin of this law in demcheck)")
+    if spec.get("rolling", "none") != "none" or spec.get("twisting", "none") != "none":
+        ps.notes.append("rolling/twisting resistance: not part of the probes (the twin has none); the probes run "
+                        "without it")
+    for extra in spec.get("extras", []):
+        ps.notes.append(f"{extra}: not part of the probes")
+    if spec["damping"] == "tsuji":
+        ps.findings.append(Finding("trap", "tsuji", "damping tsuji: LAMMPS's α(e) misses the input restitution "
+                                   "(use damping coeff_restitution)", where))
+    if spec["limit_damping"] and spec["damping"] in ("tsuji", "coeff_restitution"):
+        ps.findings.append(Finding("trap", "limit", "limit_damping: the normal force is held ≥ 0, which raises the "
+                                   "restitution above the input", where))
+    if spec["damping"] == "viscoelastic" and spec["normal"] in PROBED_NORMALS:
+        ps.notes.append("damping viscoelastic (the default when no damping is given): the 2nd coefficient is η0 "
+                        "in 1/(s·m), not a restitution; e then depends on the speed")
+
+
+def _pairs(setup: Setup, types: list[int], explicit: dict) -> None:
+    for a in types:
+        for b in types:
+            if b < a:
+                continue
+            if (a, b) in explicit:
+                spec, where, notes, _ = explicit[(a, b)]
+                ps = PairSetting(f"{a}-{b}", a, b, native_of(spec), where, _asked(spec), notes=list(notes))
+                _static(ps, spec, where)
+                setup.pairs.append(ps)
+                continue
+            if (a, a) not in explicit or (b, b) not in explicit:
+                raise ScriptError(f"type pair {a} {b}: no pair_coeff sets it, or {a} {a} and {b} {b} to mix from "
+                                  "(LAMMPS would stop: 'All pair coeffs are not set')")
+            sa, wa, _, _ = explicit[(a, a)]
+            sb, wb, _, _ = explicit[(b, b)]
+            for slot in ("normal", "damping", "tangential"):
+                if sa[slot] != sb[slot]:
+                    raise ScriptError(f"type pair {a} {b}: auto-mixing {sa[slot]} ({wa}) with {sb[slot]} ({wb}): "
+                                      "LAMMPS cannot mix different sub-models; write pair_coeff for the pair")
+            where = f"mixed from {wa} and {wb}"
+            nat, intended, notes = mixed(sa, sb, where)
+            asked = _asked(sa)
+            ps = PairSetting(f"{a}-{b}", a, b, nat, where, asked, intended=intended, notes=notes)
+            _static(ps, sa, where)
+            if sa["normal_coeffs"] != sb["normal_coeffs"] or sa["tangential_coeffs"] != sb["tangential_coeffs"]:
+                ps.notes.append("auto-mixed coefficients: E* as Hertz mixes it, every other one by its geometric "
+                                "mean (write pair_coeff for the pair to choose them)")
+            if intended is not None:
+                ps.findings.append(Finding("trap", "mixing", f"type pair {a} {b} auto-mixed with mindlin NULL: "
+                                           "LAMMPS's tangential stiffness is wrong (write pair_coeff "
+                                           f"{a} {b} explicitly)", where,
+                                           {"kt_ratio": nat.tangential_args[0] / intended.tangential_args[0]}))
+            setup.pairs.append(ps)
+
+
+def _walls(setup: Setup, types: list[int], explicit: dict, walls: list) -> None:
+    for spec, where, notes, cmd, fix_id in walls:
+        for t in types:
+            nat = native_of(spec)
+            ps = PairSetting(f"wall {fix_id} × {t}", t, None, nat, where, _asked(spec), notes=list(notes))
+            _static(ps, spec, where)
+            own = explicit.get((t, t))
+            if spec["normal"] == "hertz/material" and own and own[0]["normal"] == "hertz/material":
+                e_pair, nu_pair = own[0]["normal_coeffs"][0], own[0]["normal_coeffs"][2]
+                e_wall, nu = spec["normal_coeffs"][0], spec["normal_coeffs"][2]
+                if math.isclose(e_wall, e_pair, rel_tol=1e-12) and math.isclose(nu, nu_pair, rel_tol=1e-12):
+                    intended = Native("lammps", "hertz/material", (2.0 * e_wall, nu), damping=nat.damping,
+                                      damping_coeff=nat.damping_coeff, tangential=nat.tangential,
+                                      tangential_args=nat.tangential_args, limit=nat.limit)
+                    ps.intended = intended
+                    ps.findings.append(Finding(
+                        "trap", "wall-moduli", f"fix {fix_id} wall/gran hertz/material E = {e_wall:g} is type {t}'s "
+                        "own modulus, but LAMMPS reads a wall's E and ν as pair values: E* = E/(2(1−ν²)), half a "
+                        f"rigid wall's E/(1−ν²); for a rigid wall pass E = {2 * e_wall:g}", where,
+                        {"e_star_ratio": 0.5}))
+            setup.pairs.append(ps)
