@@ -1,0 +1,75 @@
+"""Yade 2023.02a (Debian's ``yade``): a Python script run headless by ``yade -x -n``.
+
+A collision deck is a Python script generated from a fixed template with only numbers substituted
+(:mod:`.deck`), checked before every run by :func:`.deck.check_script` (parsed with ``ast``: only the
+template's names, attributes, calls and numeric constants). It steps Yade's leap-frog NewtonIntegrator one
+step at a time and writes the bodies' states as a LAMMPS-style ``dump custom`` (float64, %.17g), so the rest
+of demcheck reads Yade as it reads the other engines.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import re
+import shlex
+import shutil
+import tempfile
+from pathlib import Path
+
+from .. import registry
+from ..base import Native, PackageEngine, Style
+
+LAUNCHER = Path(__file__).with_name("launch.py")
+
+
+@functools.lru_cache(maxsize=None)
+def _versioned(executable: str) -> str:
+    """A wrapper of ``executable`` that answers ``-h`` with Yade's version (Yade's own ``-h`` does not name it;
+    demcheck's discovery reads the version from ``<exe> -h``) and passes anything else on. Written once per
+    process into a private temporary directory (mode 0700)."""
+    where = Path(tempfile.mkdtemp(prefix="demcheck-yade-"))
+    path = where / "yade"
+    exe = shlex.quote(executable)
+    path.write_text("#!/bin/sh\n# demcheck: Yade with its version for -h\n"
+                    f'if [ "$#" = 1 ] && [ "$1" = -h ]; then exec {exe} --version; fi\n'
+                    f'exec {exe} "$@"\n')
+    path.chmod(0o700)
+    return str(path)
+
+
+class Yade(PackageEngine):
+    name = "yade"
+    title = "Yade"
+    release = "Yade 2023.02a"
+    how_to_install = "apt-get install yade (Debian), or scripts/install-engines.sh as root"
+    banner = re.compile(r"^Yade version: *(\S+)", re.M)
+    # slip velocity and torques at the contact point (R − δ/2 for a pair); the history's rotation is Yade's
+    # first-order ScGeom::rotate, which the twin's "project" matches where the normal does not turn (walls,
+    # head-on pairs); on a wall Yade's slip arm is R − δ (see mapping.py)
+    rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
+    style = Style(colour="#2ca02c", marker="D", linestyle=":")
+
+    def executables(self) -> tuple[str, ...]:
+        return ("yade",)
+
+    def candidates(self) -> list[str]:
+        env = os.environ.get("DEMCHECK_YADE")
+        if env and not Path(env).exists():
+            return [env]  # discovery names it: it does not start
+        found = [env] if env else [shutil.which(e) for e in self.executables()]
+        return [_versioned(str(Path(e).resolve())) for e in found if e]
+
+    def argv(self, executable: str, deck: str) -> list[str]:
+        return [executable, "-x", "-n", str(LAUNCHER), deck]
+
+    def check_deck(self, text: str, files: dict | None = None) -> None:
+        from .deck import check_script
+
+        check_script(text, files)
+
+    def summary(self, native: Native) -> str:
+        return f"{native.normal} + {native.tangential}"
+
+
+registry.register(Yade())

@@ -1,0 +1,196 @@
+"""Yade collision scripts: a fixed template with only numbers substituted (written with repr(), so they
+round-trip), and the guard that proves a script is one of them (:func:`check_script`).
+
+The script builds the two bodies (spheres, or a sphere and an axis-aligned ``Wall``), one material per body,
+the engines (``NewtonIntegrator(damping=0, gravity=…)``: Yade's default Cundall damping is 0.2 in many
+examples), then steps one step at a time. Yade's NewtonIntegrator is a leap-frog: a step computes the forces
+F_k at the positions x_k with the velocities v_{k−½}, then v_{k+½} = v_{k−½} + dt F_k/m and x_{k+1} = x_k +
+dt v_{k+½}. The dump's row of step k holds x_k, F_k (plus the weight, as the LAMMPS-family engines write a
+body's force) and the full-step velocity v_k = v_{k−½} + ½dt F_k/m: exactly the rows velocity Verlet writes,
+whose force at step k reads the same x_k and v_{k−½}.
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+
+from ...case import Case
+from ...errors import DemcheckError, UnsupportedByEngine
+from ...inputs import common
+from ..mapping import contact_mapping
+from .mapping import MINDLIN, VISCEL
+
+VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
+HEAD = "ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS ff ff ff\n-1 1\n-1 1\n-1 1\nITEM: ATOMS " \
+       + " ".join(common.DUMP_COLUMNS) + "\n"
+ROW = "%d %d" + " %.17g" * (len(common.DUMP_COLUMNS) - 2) + "\n"
+STRINGS = frozenset({HEAD, ROW, common.DUMP_FILE, "w"})
+NAMES = frozenset({
+    "O", "Vector3", "utils", "FrictMat", "ViscElMat", "ForceResetter", "InsertionSortCollider", "Bo1_Sphere_Aabb",
+    "Bo1_Wall_Aabb", "InteractionLoop", "Ig2_Sphere_Sphere_ScGeom", "Ig2_Wall_Sphere_ScGeom",
+    "Ip2_FrictMat_FrictMat_MindlinPhys", "Law2_ScGeom_MindlinPhys_Mindlin", "Ip2_ViscElMat_ViscElMat_ViscElPhys",
+    "Law2_ScGeom_ViscElPhys_Basic", "NewtonIntegrator", "open", "range", "len",
+    # the template's own variables
+    "DT", "STEPS", "G", "ids", "mass", "inertia", "radius", "out", "k", "n", "i", "s", "x", "v", "w", "f", "t", "a",
+    "b", "b0", "b1"})
+ATTRIBUTES = frozenset({"materials", "bodies", "append", "sphere", "wall", "state", "mass", "inertia", "pos", "vel",
+                        "angVel", "engines", "dt", "step", "forces", "f", "t", "write", "close"})
+NODES = (ast.Module, ast.Expr, ast.Assign, ast.Call, ast.Name, ast.Load, ast.Store, ast.Attribute, ast.Constant,
+         ast.Tuple, ast.List, ast.keyword, ast.For, ast.BinOp, ast.Add, ast.Sub, ast.Mult, ast.Div, ast.Mod,
+         ast.UnaryOp, ast.USub, ast.Subscript, ast.ImportFrom, ast.alias, ast.ListComp, ast.comprehension)
+COOKIE = "coding"
+
+
+def check_script(text: str, files: dict | None = None) -> None:
+    """The final guard before Yade runs a script: it parses, and holds only the template's names, attributes,
+    calls and constants (numbers, and the template's own strings); its first two lines name no encoding; it
+    reads no other file. Raises DemcheckError otherwise."""
+    def refuse(why: str):
+        raise DemcheckError(f"refusing to run a Yade script: {why}")
+
+    if files:
+        refuse(f"it comes with files ({', '.join(files)}); demcheck's Yade scripts read none")
+    if not text.isascii():
+        refuse("it has a character that is not ASCII")
+    for n, line in enumerate(text.split("\n")[:2], 1):
+        if COOKIE in line:
+            refuse(f"line {n} could declare the source encoding: {line[:80]!r}")
+    if any(not line.isprintable() for line in text.split("\n")):
+        refuse("a line has a character that is not printable")
+    try:
+        tree = ast.parse(text)
+    except SyntaxError as exc:
+        refuse(f"it does not parse (line {exc.lineno}: {exc.msg})")
+    for node in ast.walk(tree):
+        if not isinstance(node, NODES):
+            refuse(f"line {getattr(node, 'lineno', '?')}: {type(node).__name__} is not in the template")
+        if isinstance(node, ast.Name) and node.id not in NAMES:
+            refuse(f"line {node.lineno}: name {node.id!r} is not in the template")
+        if isinstance(node, ast.Attribute) and node.attr not in ATTRIBUTES:
+            refuse(f"line {node.lineno}: attribute {node.attr!r} is not in the template")
+        if isinstance(node, ast.keyword) and node.arg is None:
+            refuse(f"line {node.lineno}: ** arguments are not in the template")
+        if isinstance(node, ast.ImportFrom) and (node.module != "yade" or [a.name for a in node.names] != ["utils"]
+                                                 or node.names[0].asname):
+            refuse(f"line {node.lineno}: only 'from yade import utils' is imported")
+        if isinstance(node, ast.Constant):
+            v = node.value
+            if isinstance(v, str):
+                if v not in STRINGS:
+                    refuse(f"line {node.lineno}: string {v[:40]!r} is not one of the template's")
+            elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                refuse(f"line {node.lineno}: constant {v!r} is not a finite number")
+
+
+def ascii_comment(line: str) -> str:
+    """A comment line (inputs.common.comment's) with every character outside ASCII escaped: Yade reads a
+    script in the locale's encoding when it is run by hand."""
+    return line.encode("ascii", "backslashreplace").decode("ascii")
+
+
+def _num(x: float) -> str:
+    x = float(x)
+    if not math.isfinite(x):
+        raise DemcheckError(f"refusing to write a Yade script with the number {x!r}")
+    return repr(x)
+
+
+def _vec(xs) -> str:
+    return f"Vector3({', '.join(_num(x) for x in xs)})"
+
+
+def materials(nat, case: Case, sc) -> tuple[str, str]:
+    """(particle material, wall material) as Yade constructor calls, from the native configuration."""
+    p = nat.props
+    phi = math.atan(p.get("mu", 0.0))
+    if nat.normal == VISCEL:
+        # in series: 1/(1/a + 1/b) = a/2 for equal values; a wall's material takes the same values
+        body = (f"ViscElMat(kn={_num(2.0 * p['kn'])}, cn={_num(2.0 * p['cn'])}, ks={_num(2.0 * p['ks'])}, "
+                f"cs={_num(2.0 * p['cs'])}, frictionAngle={_num(phi)}, density=1.0)")
+        return body, body
+    if nat.normal == MINDLIN:
+        r_y = (case.particles[0].radius / 2.0) if case.walls else p["r_eff"]  # Yade's R̄ (a wall: R/2)
+        nu = 0.0
+        if p["kso"] > 0.0:  # kso/kno = 3(1 − ν)/(2 − ν) for two equal materials
+            rho = p["kso"] / p["kno"]
+            nu = (3.0 - 2.0 * rho) / (3.0 - rho)
+            if not -1.0 < nu < 0.5:
+                raise UnsupportedByEngine(f"Yade Mindlin: kso/kno = {rho:.4g} needs Poisson's ratio {nu:.4g}, "
+                                          "outside (−1, 0.5)")
+        e_star = p["kno"] / (4.0 / 3.0 * math.sqrt(r_y))
+        young = 2.0 * (1.0 - nu * nu) * e_star  # two equal materials: E* = E/(2(1 − ν²))
+        body = f"FrictMat(young={_num(young)}, poisson={_num(nu)}, frictionAngle={_num(phi)}, density=1.0)"
+        return body, body
+    raise UnsupportedByEngine(f"no Yade deck for {nat.normal}")
+
+
+def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
+    """The script of a collision case (``native``: a configuration used instead of the case's mapped model)."""
+    if options.get("copies", 1) != 1:
+        raise UnsupportedByEngine("Yade scripts are written for one copy of a collision")
+    sc = common.scene(case, dt, length)
+    mp = contact_mapping(case, "yade", native)
+    nat = mp.require()
+    body_mat, wall_mat = materials(nat, case, sc)
+    p = nat.props
+    g = [float(x) for x in case.run.gravity]
+    if nat.normal == VISCEL:
+        phys, law = "Ip2_ViscElMat_ViscElMat_ViscElPhys()", "Law2_ScGeom_ViscElPhys_Basic()"
+    else:
+        phys = (f"Ip2_FrictMat_FrictMat_MindlinPhys(betan={_num(p['betan'])}, betas={_num(p['betas'])})"
+                if p["betan"] > 0.0 or p["betas"] > 0.0 else "Ip2_FrictMat_FrictMat_MindlinPhys()")
+        law = "Law2_ScGeom_MindlinPhys_Mindlin()"
+    head = common.header("yade", sc, mp, VERSION_NOTE, "yade -x -n")
+    notes = [ascii_comment(c) for c in head[1:] + common.notes(nat.comments)]
+    lines = ["# demcheck: a Yade script (Python), generated from a fixed template",
+             "# every value below is a number written by demcheck"] + notes
+    lines += ["from yade import utils", "", f"DT = {_num(sc.dt)}", f"STEPS = {int(sc.steps)}", f"G = {_vec(g)}",
+              f"O.materials.append({body_mat})"]
+    if case.walls:
+        lines.append(f"O.materials.append({wall_mat})")
+    ids = []
+    for i, part in enumerate(case.particles):
+        lines.append(f"b{i} = O.bodies.append(utils.sphere({_vec(part.position)}, {_num(part.radius)}, material=0))")
+        ids.append(f"b{i}")
+    if case.walls:
+        sense = 1 if sc.wall_side == "lo" else -1
+        lines.append(f"O.bodies.append(utils.wall({_num(sc.wall_position)}, axis={int(sc.wall_axis)}, "
+                     f"sense={sense}, material=1))")
+    lines.append(f"ids = [{', '.join(ids)}]")
+    masses, inertias = [], []
+    for i, part in enumerate(case.particles):
+        m = case.mass(i)
+        inertia = 0.4 * m * part.radius * part.radius
+        masses.append(_num(m))
+        inertias.append(_num(inertia))
+        lines += [f"O.bodies[b{i}].state.mass = {_num(m)}",
+                  f"O.bodies[b{i}].state.inertia = {_vec([inertia] * 3)}",
+                  f"O.bodies[b{i}].state.vel = {_vec(part.velocity)}",
+                  f"O.bodies[b{i}].state.angVel = {_vec(part.angular_velocity)}"]
+    lines += [f"mass = [{', '.join(masses)}]", f"radius = [{', '.join(_num(q.radius) for q in case.particles)}]", f"inertia = [{', '.join(inertias)}]",
+              "O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),",
+              "              InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],",
+              f"                              [{phys}],",
+              f"                              [{law}]),",
+              "              NewtonIntegrator(damping=0.0, gravity=G)]",
+              "O.dt = DT",
+              f"out = open({common.DUMP_FILE!r}, 'w')",
+              "n = len(ids)",
+              # step k: F_k at x_k with v_{k-1/2}; the row holds x_k, v_k = v_{k-1/2} + dt F_k/(2m), F_k + m g
+              "for k in range(STEPS + 1):",
+              "    x = [Vector3(O.bodies[i].state.pos) for i in ids]",
+              "    v = [Vector3(O.bodies[i].state.vel) for i in ids]",
+              "    w = [Vector3(O.bodies[i].state.angVel) for i in ids]",
+              "    O.step()",
+              f"    out.write({HEAD!r} % (k, n))",
+              "    for s in range(n):",
+              "        f = O.forces.f(ids[s])",
+              "        t = O.forces.t(ids[s])",
+              "        a = v[s] + f * (0.5 * DT / mass[s])",
+              "        b = w[s] + t * (0.5 * DT / inertia[s])",
+              "        f = f + G * mass[s]",
+              f"        out.write({ROW!r} % (s + 1, s + 1, radius[s], mass[s], x[s][0], x[s][1], "
+              "x[s][2], a[0], a[1], a[2], b[0], b[1], b[2], f[0], f[1], f[2], t[0], t[1], t[2]))",
+              "out.close()", ""]
+    return common.Deck("yade", "\n".join(lines), {}, dt=sc.dt, check=check_script)

@@ -1,0 +1,132 @@
+"""Yade 2023.02a's vocabulary: a seed model → Yade's interaction physics and law with their fidelity
+(:func:`map_model`), and those settings → the reference laws that compute what Yade computes (:func:`twin`).
+
+Two of Yade's laws are used, as read in Yade's sources (pkg/dem/ViscoelasticPM.cpp, HertzMindlin.cpp,
+ScGeom.cpp, Ig2_Facet_Sphere_ScGeom.cpp, NewtonIntegrator.cpp):
+
+* ``ViscElPhys`` (``Ip2_ViscElMat_ViscElMat_ViscElPhys`` + ``Law2_ScGeom_ViscElPhys_Basic``), given kn, cn,
+  ks, cs directly: Fn = kn δ + cn δ̇, **held at ≥ 0** (the law drops any attraction); Ft: an incremental
+  elastic force ks·v_t·dt capped at μ|Fn| (the spring only), plus cs·v_t while it sticks. Each material's
+  value is combined in series (1/(1/a + 1/b)), so both bodies (and a wall) carry twice the pair's value.
+* ``MindlinPhys`` (``Ip2_FrictMat_FrictMat_MindlinPhys`` + ``Law2_ScGeom_MindlinPhys_Mindlin``): Fn =
+  kno δ^{3/2} with kno = (4/3)E*√R̄_Y; with betan > 0 a dashpot cn = 2 betan √(m̄ · 3/2 kno δ^½) and the total
+  held at ≥ 0; Ft incremental with ks = kso √δ, kso = 2√(4R̄_Y) G/(2 − ν̄) (G, ν̄ the materials' means),
+  capped at μ|Fn| (spring only), plus cs v_t while sticking (cs = 2 betas √(m̄ ks)).
+  R̄_Y is Yade's radius: R1R2/(R1+R2) for a pair, but **R/2 on a wall** (Ig2_Wall_Sphere_ScGeom gives the
+  wall the sphere's radius); the deck sets Young's modulus so that kno is the seed's K_HZ with the true R̄.
+
+Friction: μ = tan(min(φ1, φ2)) with φ in radians (frictionAngle = atan μ is written).
+"""
+
+from __future__ import annotations
+
+import math
+
+from ...reference import twins
+from ...reference.model import ResolvedModel
+from ...reference.normal import HYSTERETIC, NormalLaw
+from ...reference.tangential import NONE, SPRING, TRUNC_SPRING, VISCOUS, TangentialLaw
+from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from ..mapping import mu_of
+
+VISCEL = "ViscElPhys"
+MINDLIN = "MindlinPhys"
+CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashpot's attraction at the end of "
+         "the contact); the case has limit_force = false")
+
+
+def map_model(model: ResolvedModel, cp: dict) -> Mapping:
+    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    m, r = pair.m_eff, pair.r_eff
+    reasons: list[str] = []
+    comments: list[str] = []
+    fid = EXACT
+    if nl.kind == HYSTERETIC:
+        return refused("yade", "no linear hysteretic law is mapped for Yade (its nearest, "
+                               "Law2_ScGeom6D_NormalInelasticityPhys_NormalInelasticity, is unverified here)")
+    if nl.a == 1.0 and (nl.eta == 0.0 or nl.b == 0.0):
+        nat = Native("yade", normal=VISCEL, limit=True)
+        nat.props.update(kn=nl.k, cn=nl.eta, ks=0.0, cs=0.0, mu=0.0)
+        comments.append(f"ViscElMat kn, cn given directly: the pair's kn = {nl.k:.10g} N/m, cn = {nl.eta:.10g} "
+                        "kg/s (each material carries twice: Yade combines them in series)")
+    elif nl.a == 1.5 and (nl.eta == 0.0 or nl.b == 0.25):
+        nat = Native("yade", normal=MINDLIN, limit=nl.eta > 0.0 or model.limit_force)
+        # cn = 2 betan √(m̄ · 3/2 kno) δ^¼ = η δ^¼
+        betan = nl.eta / (2.0 * math.sqrt(1.5 * m * nl.k)) if nl.eta > 0.0 else 0.0
+        nat.props.update(kno=nl.k, betan=betan, betas=0.0, kso=0.0, mu=0.0, r_eff=r)
+        comments.append(f"MindlinPhys kno = (4/3)E*√R̄ = {nl.k:.10g} N/m^1.5 (Young's modulus set for Yade's "
+                        f"R̄_Y), betan = {betan:.17g}")
+    elif nl.a == 1.5:
+        return refused("yade", f"Yade's Hertz–Mindlin dashpots grow as δ^¼ (alpha from en, or betan); the "
+                               f"normal law '{model.normal.id}' damps as δ^{nl.b:g}")
+    else:
+        return refused("yade", f"no Yade law for normal '{model.normal.id}'")
+    if nat.limit and nl.eta > 0.0 and not model.limit_force:
+        fid = APPROXIMATE
+        reasons.append(CLAMP.format(law=nat.normal))
+    p = nat.props
+    kind = tl.kind
+    if kind == NONE:
+        nat.tangential = "none"
+    else:
+        mu, f_mu = mu_of(model, reasons)
+        fid = worst(fid, f_mu)
+        p["mu"] = mu
+        if nat.normal == VISCEL and kind == VISCOUS:
+            # ks = 0: the elastic part stays 0, never above μ|Fn|, so cs v_t is added uncapped
+            nat.tangential = "viscous"
+            p["cs"] = tl.eta
+            comments.append(f"ViscElMat ks = 0, cs = {tl.eta:.10g} kg/s: Ft = cs v_t, never capped")
+        elif nat.normal == VISCEL and kind == SPRING and not tl.kt_sqrt and not tl.eta_normal:
+            nat.tangential = "spring"
+            p["ks"], p["cs"] = tl.kt, tl.eta
+            comments.append(f"ViscElMat ks = {tl.kt:.10g} N/m, cs = {tl.eta:.10g} kg/s, frictionAngle = atan μ")
+            if tl.eta > 0.0 and tl.truncation != TRUNC_SPRING:
+                fid = worst(fid, APPROXIMATE)
+                reasons.append("Yade caps the spring only (the dashpot is added uncapped while sticking, dropped "
+                               "while slipping); the case asks for another truncation")
+            fid = worst(fid, APPROXIMATE)
+            reasons.append("oblique impacts: Yade's slip velocity on a wall uses the arm R − δ (the contact point "
+                           "on the wall), and it turns the history with ScGeom's first-order rotation")
+        elif nat.normal == MINDLIN and kind == SPRING and tl.kt_sqrt:
+            nat.tangential = "mindlin"
+            # ks = kso √δ = Kt √(R̄δ): kso = Kt √R̄ (Kt here: tl.kt, the coefficient of √(R̄δ))
+            p["kso"] = tl.kt * math.sqrt(r)
+            if tl.eta > 0.0 or tl.eta_normal:
+                if not tl.eta_normal or nl.eta == 0.0:
+                    return refused("yade", "Yade's Mindlin shear dashpot is 2 betas √(m̄ ks): a δ^¼ law like "
+                                           "the normal one, not a constant ηt")
+                # cs = 2 betas √(m̄ kso) δ^¼ = factor · η δ^¼
+                p["betas"] = tl.eta * nl.eta / (2.0 * math.sqrt(m * p["kso"]))
+            fid = worst(fid, APPROXIMATE)
+            reasons.append("Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t dt), not Kt(δ)·ξ; it caps "
+                           "the spring only, and on a wall its slip arm is R − δ")
+            comments.append(f"MindlinPhys kso = {p['kso']:.10g} (ks = kso √δ), betas = {p['betas']:.17g}")
+        else:
+            return refused("yade", f"no Yade law pairs tangential '{model.tangential.id}' with the normal law "
+                                   f"mapped here ({nat.normal})")
+    nat.comments = comments
+    return Mapping("yade", fid, reasons, nat)
+
+
+def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
+    p = nat.props
+    mu = p.get("mu", 0.0)
+    if nat.normal == VISCEL:
+        nl = twins.normal_law(p["kn"], 1.0, p["cn"], 0.0, True)
+        if nat.tangential == "viscous":
+            return nl, TangentialLaw(VISCOUS, eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m)
+        if nat.tangential == "spring":
+            return nl, TangentialLaw(SPRING, kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
+                                     r_eff=r, m_eff=m)
+        return nl, twins.no_friction()
+    if nat.normal == MINDLIN:
+        c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
+        nl = twins.normal_law(p["kno"], 1.5, c, 0.25, nat.limit)
+        if nat.tangential == "mindlin":
+            factor = (2.0 * p["betas"] * math.sqrt(m * p["kso"]) / c) if c > 0.0 else 0.0
+            return nl, TangentialLaw(SPRING, kt=p["kso"] / math.sqrt(r), kt_sqrt=True, eta=factor, eta_normal=True,
+                                     mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING, force_history=True, r_eff=r,
+                                     m_eff=m)
+        return nl, twins.no_friction()
+    raise ValueError(f"no twin for Yade physics {nat.normal!r}")
