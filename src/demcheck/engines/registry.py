@@ -13,7 +13,7 @@ import os
 
 from .base import Engine
 
-BUILTIN = ("demcheck.engines.lammps", "demcheck.engines.liggghts")
+BUILTIN = ("demcheck.engines.lammps", "demcheck.engines.liggghts", "demcheck.engines.kratos")
 _ENGINES: dict[str, Engine] = {}
 _loaded = False
 
