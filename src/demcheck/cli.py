@@ -657,6 +657,37 @@ def dt(case_path, target, overrides, as_json):
                f"{', '.join(rec['metrics'])})")
 
 
+@cli.command()
+@click.argument("deck_path", metavar="DECK")
+@click.option("--engine", "engine", type=click.Choice(["lammps", "liggghts"]), default=None,
+              help="the deck's engine (default: read from its vocabulary)")
+@click.option("--speed", type=Number(lo=0, lo_open=True, hi=1e4, unit="m/s"), default=None,
+              help="characteristic impact speed (default: the deck's largest speed, or characteristicVelocity)")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--report", "report_dir", type=OutputPath(directory=True, files=("audit.json", "audit.txt")),
+              default=None, help="write audit.json and audit.txt into this directory")
+def audit(deck_path, engine, speed, as_json, report_dir):
+    """Audit a user's own LAMMPS or LIGGGHTS input deck: each type pair's and wall's contact law, probed in the
+    engine, its twin and the nearest seed model; the traps it falls into. The deck is read, never run as written.
+    Exit 0: nothing found; 1: a trap; 2: a line it cannot read."""
+    from .comparisons import audit as A
+    from .io import write_text
+
+    result = A.audit(deck_path, engine, speed)
+    text = A.text_report(result)
+    if report_dir:
+        out = Path(report_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        write_text(out / "audit.json", json.dumps(plain(result), indent=2) + "\n")
+        write_text(out / "audit.txt", text + "\n")
+    if as_json:
+        emit_json(result)
+    else:
+        click.echo(text)
+    if result["traps"]:
+        sys.exit(1)
+
+
 def _case_files(paths) -> list[Path]:
     if not paths:
         paths = [str(CASES_DIR)]

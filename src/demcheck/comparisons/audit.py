@@ -1,0 +1,429 @@
+"""``demcheck audit DECK``: does a user's own LAMMPS or LIGGGHTS deck do what it asks for?
+
+The deck is read (inputs/script.py), never run as written; the engine's package reads its contact commands
+into one Native per type pair and wall × type (engines/<name>/audit.py). For each, the standard probes — a
+head-on impact and oblique ones at 30° and 60° — with the deck's radii, densities and time step at a
+characteristic speed run in three places: the engine itself (a deck written by the engine's deck writer from
+the user's own Native), its twin (the reference computing the engine's formulas, at the deck's dt and
+converged), and the nearest seed model with what the deck asks for. The report lists the realised
+restitution, tangential restitution, rebound spin and contact time against the asked values, the steps per
+contact with the time-step error and the stability margin, and every trap with its measured size.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .. import case as C
+from ..errors import ConfigError, DemcheckError
+from ..inputs import script as S
+from ..reference import collision3d
+from ..reference.model import resolve
+from ..reference.normal import HYSTERETIC
+from ..reference.tangential import NONE, SPRING, VISCOUS_SLIDING
+from ..engines import registry
+from ..engines.collide import collide, twin_states
+from ..engines.mapping import native_summary, twin_model
+from .verdicts import Tolerances, scaled
+
+ANGLES = (0.0, 30.0, 60.0)
+AUDITED = ("lammps", "liggghts")
+# |realised − asked| restitution above which the deck does not get what it asks for (restitutions are
+# dimensionless; 0.01 is what a calibration to two digits can tell apart)
+ASKED_TOL = 0.01
+# an attractive normal force (the dashpot pulling the bodies together at the end of the contact) with no limit
+# on it: a note above 1% of the peak force (every damped law without a limit has some: so does the seed's), a
+# trap above 10% (a strongly damped contact that ends pulling)
+ATTRACTION_NOTE, ATTRACTION_TRAP = 0.01, 0.10
+MIN_STEPS_PER_CONTACT = 20  # fewer: the contact is resolved too coarsely whatever the error measured
+METRICS = ("restitution", "tangential_restitution", "rebound_angular_velocity", "contact_time", "peak_force")
+
+
+def detect(script: S.Script) -> str:
+    """The deck's engine from its vocabulary: LIGGGHTS's ``pair_style gran model``, ``fix property/global``
+    or ``communicate``; LAMMPS otherwise."""
+    for cmd in script.commands:
+        w = cmd.words
+        if (cmd.name == "pair_style" and w[1:3] == ["gran", "model"]) or cmd.name in ("communicate",
+                                                                                     "hard_particles") \
+                or (cmd.name == "fix" and len(w) > 3 and w[3] == "property/global"):
+            return "liggghts"
+    return "lammps"
+
+
+def read(path: str | Path, engine: str | None = None):
+    script = S.read(path)
+    engine = engine or detect(script)
+    if engine not in AUDITED:
+        raise ConfigError("--engine", engine, f"audit reads {' and '.join(AUDITED)} decks")
+    reader = importlib.import_module(f"demcheck.engines.{engine}.audit")
+    setup = reader.read(script, Path(path).resolve().parent)
+    for cmd, why in script.unread:
+        setup.not_audited.append((cmd.where(), cmd.text, why))
+    return setup
+
+
+def characteristic_speed(setup: S.Setup, speed: float | None) -> tuple[float, str]:
+    if speed is not None:
+        return speed, "--speed"
+    moving = [(v, w) for v, w in setup.speeds if v > 0]
+    if moving:
+        v, w = max(moving)
+        return v, f"the deck's largest speed ({w})"
+    raise ConfigError("--speed", None, "the deck gives its bodies no speed (no velocity, Velocities or "
+                                       "characteristicVelocity): give the characteristic impact speed (m/s)")
+
+
+def _body(setup: S.Setup, t: int):
+    b = setup.bodies.get(t)
+    if b is None or b.radius is None:
+        raise S.ScriptError(f"type {t}: the deck gives it no diameter (set type {t} diameter, read_data Atoms, or "
+                            "a particle template)")
+    if b.density is None:
+        if b.mass is None:
+            raise S.ScriptError(f"type {t}: the deck gives it no density or mass")
+        return b.radius, b.mass / (4.0 / 3.0 * math.pi * b.radius ** 3)
+    return b.radius, b.density
+
+
+def _effective(setup, ps):
+    r1, rho1 = _body(setup, ps.i)
+    m1 = rho1 * 4.0 / 3.0 * math.pi * r1 ** 3
+    if ps.j is None:
+        return m1, r1
+    r2, rho2 = _body(setup, ps.j)
+    m2 = rho2 * 4.0 / 3.0 * math.pi * r2 ** 3
+    return m1 * m2 / (m1 + m2), r1 * r2 / (r1 + r2)
+
+
+def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
+    """The nearest seed model of a twin's laws, with what the deck asks for: (normal, tangential, params,
+    reasons why it is only near)."""
+    reasons, params = [], {}
+    if nl.kind == HYSTERETIC:
+        normal = "hls"
+        params["kl"] = nl.kl
+    elif nl.a == 1.0:
+        normal = "lsd"
+        params["kn"] = nl.k
+        if "restitution" in asked:
+            params["restitution"] = asked["restitution"]
+        else:
+            params["eta_n"] = nl.eta
+            if nl.b != 0.0:
+                reasons.append(f"the engine's dashpot grows as δ^{nl.b:g}; LSD's is constant")
+    elif nl.eta == 0.0:
+        normal = "hertz"
+    elif nl.b == 0.5:
+        normal = "kk"
+        params["eta_n"] = nl.eta
+    else:
+        normal = "tti"
+        if "restitution" in asked:
+            params["restitution"] = asked["restitution"]
+        else:
+            params["eta_n"] = nl.eta
+        if nl.b != 0.25:
+            reasons.append(f"the engine's dashpot grows as δ^{nl.b:g}; TTIn's as δ^¼")
+    if nl.limit:
+        params["limit_force"] = True
+    mu = tl.mu_s
+    if tl.kind == NONE or mu == 0.0:
+        tangential = "none"
+    elif tl.kind == SPRING and tl.kt_sqrt:
+        tangential = "tti" if normal == "tti" else "ddt"
+        params["truncation"] = "overlap"
+    elif tl.kind == SPRING:
+        tangential = "spring_sliding"
+        params["kt"] = tl.kt
+    elif tl.kind == VISCOUS_SLIDING:
+        tangential = "sliding"
+        reasons.append("the engine's tangential dashpot regularises sliding friction")
+    else:
+        tangential = "none"
+        reasons.append("no seed tangential law near the engine's")
+    if tangential != "none":
+        params["friction"] = mu
+    return normal, tangential, params, reasons
+
+
+def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> C.Case:
+    normal, tangential, params, _ = seed
+    r1, rho1 = _body(setup, ps.i)
+    e_star = nl.k / (4.0 / 3.0 * math.sqrt(_effective(setup, ps)[1])) if nl.a == 1.5 else 1e9
+    nu = 0.3
+    if getattr(ps.native, "normal", "") == "hertz/material":
+        nu = ps.native.normal_args[1]
+    b1 = setup.bodies[ps.i]
+    restitution = params.pop("restitution", 0.9)
+    friction = params.pop("friction", 0.0)
+
+    def material(rho, body=None, own=False):
+        if own and body is not None and body.youngs_modulus is not None:
+            e, n = body.youngs_modulus, body.poisson_ratio
+        else:  # E such that the seed's E* is the engine's: like materials E/(2(1−ν²)), a rigid wall E/(1−ν²)
+            n = nu
+            e = (1.0 - nu * nu) * e_star * (1.0 if ps.j is None else 2.0)
+        return {"density": rho, "youngs_modulus": e, "poisson_ratio": n, "restitution": restitution,
+                "friction": friction}
+
+    own = setup.engine == "liggghts"  # LIGGGHTS's deck writer writes each type's own modulus
+    mats = {"a": material(rho1, b1, own)}
+    parts = [{"material": "a", "radius": r1}]
+    raw = {"name": f"audit-{ps.label.replace(' ', '-').replace('×', 'x')}-{angle:g}", "materials": mats,
+           "particles": parts, "impact": {"speed": speed, "angle": angle},
+           "contact": {"normal": normal, "tangential": tangential, **params}, "run": {"dt": setup.dt}}
+    if ps.j is None:
+        wall = {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}
+        if own and ps.wall:
+            mats["w"] = {"density": 1000.0, "youngs_modulus": ps.wall["youngs_modulus"],
+                         "poisson_ratio": ps.wall["poisson_ratio"], "restitution": restitution, "friction": friction}
+            wall.update(rigid=False, material="w")
+        raw["walls"] = [wall]
+    else:
+        r2, rho2 = _body(setup, ps.j)
+        mats["b"] = material(rho2, setup.bodies[ps.j], own)
+        parts.append({"material": "b", "radius": r2})
+    return C.from_dict(raw)
+
+
+def _metrics(res) -> dict:
+    m = res.metrics()
+    return {k: m.get(k, math.nan) for k in METRICS}
+
+
+def _stability(nl, m_eff: float, max_overlap: float, dt: float) -> float:
+    """dt_crit/dt: velocity Verlet is stable for ω dt < 2, ω² = (dF/dδ)/m̄ at the largest overlap."""
+    if nl.kind == HYSTERETIC:
+        k = max(nl.kl, nl.ku)
+    else:
+        k = nl.a * nl.k * max(max_overlap, 0.0) ** (nl.a - 1.0)
+    if not k > 0:
+        return math.inf
+    return 2.0 / math.sqrt(k / m_eff) / dt
+
+
+def probe(setup, ps, speed: float, angle: float, run_engine: bool = True) -> dict:
+    """One probe of one type pair: the engine, its twin at the deck's dt and converged, and the seed model."""
+    m_eff, r_eff = _effective(setup, ps)
+    eng = registry.get(setup.engine)
+    nl, tl = eng.twin(ps.native, m_eff, r_eff)
+    seed = seed_of(nl, tl, ps.asked)
+    case = probe_case(setup, ps, speed, angle, nl, tl, seed)
+    out = {"angle": angle, "speed": speed, "seed": {"normal": seed[0], "tangential": seed[1], "reasons": seed[3]}}
+    scales = {"impact_energy": 0.5 * m_eff * speed ** 2, "spin": speed / case.particles[0].radius}
+    twin = twin_states(case, setup.engine, setup.dt, native=ps.native)
+    out["twin"] = {"status": twin.status, "message": twin.message, **_metrics(twin)}
+    try:
+        conv = collision3d.collide(case, twin_model(resolve(case), ps.native), "adaptive")
+        out["converged"] = {"status": conv.status, **_metrics(conv)}
+    except ConfigError as exc:
+        conv = None
+        out["converged"] = {"status": "not run", "message": str(exc)}
+    ref = collision3d.collide(case, resolve(case), "adaptive")
+    out["seed"].update(status=ref.status, **_metrics(ref))
+    if run_engine:
+        res = collide(case, setup.engine, dt=setup.dt, native=ps.native)
+        out["engine"] = {"status": res.status, "message": res.message, "version": res.engine_version,
+                         **_metrics(res)}
+        fn = res.contact["fn"].to_numpy() if res.contact is not None and len(res.contact) else np.array([0.0])
+        d = res.contact["delta"].to_numpy() if res.contact is not None and len(res.contact) else np.array([0.0])
+        inside = d > 0
+        out["engine"]["min_force"] = float(fn[inside].min()) if inside.any() else math.nan
+        out["engine_vs_twin"] = max((scaled(out["engine"][k], out["twin"][k], k, scales) for k in METRICS),
+                                    default=0.0)
+    main = out.get("engine", out["twin"])
+    if conv is not None and conv.ok and twin.ok:
+        out["dt_error"] = max((scaled(out["twin"][k], out["converged"][k], k, scales) for k in METRICS
+                               if k != "peak_force"), default=0.0)
+    else:
+        out["dt_error"] = math.nan
+    t_c = main["contact_time"]
+    out["steps_per_contact"] = t_c / setup.dt if math.isfinite(t_c) else math.nan
+    mo = twin.metrics().get("max_overlap", math.nan)
+    out["stability_margin"] = _stability(nl, m_eff, mo, setup.dt) if math.isfinite(mo) else math.nan
+    out["seed_gap"] = max((scaled(main[k], out["seed"][k], k, scales) for k in METRICS if k != "peak_force"),
+                          default=0.0)
+    return out
+
+
+def _fidelity(gap: float, reasons: list) -> str:
+    if not math.isfinite(gap):
+        return "none"
+    return "exact" if gap <= 1e-6 and not reasons else "approximate"
+
+
+def audit(path: str | Path, engine: str | None = None, speed: float | None = None, run_engine: bool = True,
+          tol: Tolerances | None = None) -> dict:
+    """The audit of a deck as a plain dict (the CLI prints it, --json dumps it)."""
+    from ..engines import discovery
+
+    tol = tol or Tolerances.load()
+    setup = read(path, engine)
+    v, v_from = characteristic_speed(setup, speed)
+    info = discovery.find(setup.engine) if run_engine else None
+    if run_engine and info is None:
+        from ..errors import EngineNotFound
+
+        raise EngineNotFound(discovery.missing(setup.engine))
+    for ps in setup.pairs:  # every body the probes need, before any run
+        if ps.probe:
+            _effective(setup, ps)
+    pairs = []
+    findings = list(setup.findings)
+    for ps in setup.pairs:
+        entry = {"pair": ps.label, "where": ps.where, "native": native_summary(ps.native), "asked": ps.asked,
+                 "notes": list(ps.notes), "probes": [], "findings": []}
+        found = list(ps.findings)
+        if ps.probe:
+            angles = ANGLES if ps.asked.get("friction", 0.0) > 0 else ANGLES[:1]
+            for angle in angles:
+                try:
+                    entry["probes"].append(probe(setup, ps, v, angle, run_engine))
+                except DemcheckError as exc:
+                    entry["probes"].append({"angle": angle, "error": str(exc)})
+                    found.append(S.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
+                                           ps.where))
+            _judge(setup, ps, entry, found, tol)
+        entry["findings"] = [_finding(f) for f in found]
+        findings += found
+        pairs.append(entry)
+    traps = [f for f in findings if f.kind == "trap"]
+    return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
+            "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
+            "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass} for t, b in
+                       sorted(setup.bodies.items())},
+            "pairs": pairs, "not_audited": [{"where": w, "text": t, "why": y} for w, t, y in setup.not_audited],
+            "traps": len(traps), "status": "traps" if traps else "clean"}
+
+
+def _finding(f: S.Finding) -> dict:
+    return {"kind": f.kind, "code": f.code, "text": f.text, "where": f.where, "size": f.size}
+
+
+def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
+    probes = [p for p in entry["probes"] if "error" not in p]
+    if not probes:
+        return
+    head = probes[0]
+    main = head.get("engine", head["twin"])
+    gap = max(p["seed_gap"] for p in probes)
+    reasons = sorted({r for p in probes for r in p["seed"]["reasons"]})
+    entry["seed"] = {"normal": head["seed"]["normal"], "tangential": head["seed"]["tangential"],
+                     "fidelity": _fidelity(gap, reasons), "gap": gap, "reasons": reasons}
+    for p in probes:
+        eng = p.get("engine")
+        if eng is None:
+            continue
+        if eng["status"] != "ok":
+            found.append(S.Finding("trap", "engine-failed", f"{p['angle']:g}° probe: the engine run is "
+                                   f"{eng['status']}: {eng['message']}", ps.where))
+        elif not p["engine_vs_twin"] <= 1e-9:
+            found.append(S.Finding("trap", "engine-vs-twin", f"{p['angle']:g}° probe: the engine differs from the "
+                                   f"formulas the audit read from the deck by {p['engine_vs_twin']:.3g}", ps.where,
+                                   {"difference": p["engine_vs_twin"]}))
+    e_asked = ps.asked.get("restitution")
+    e_real = main["restitution"]
+    codes = {f.code for f in found}
+    if e_asked is not None and math.isfinite(e_real):
+        size = {"asked": e_asked, "realised": e_real, "difference": e_real - e_asked}
+        for f in found:
+            if f.code in ("tsuji", "limit"):
+                f.size.update(size)
+                f.text += f": e = {e_asked:g} asked, {e_real:.4f} realised"
+        if abs(e_real - e_asked) > ASKED_TOL and not codes & {"tsuji", "limit"}:
+            found.append(S.Finding("trap", "restitution", f"restitution {e_real:.4f} realised, {e_asked:g} asked",
+                                   ps.where, size))
+    elif e_asked is None and "restitution" in main:
+        entry["notes"].append(f"realised restitution {e_real:.4f} (the deck sets a damping coefficient, not e)")
+    if ps.intended is not None:  # the measured size of a mixing or wall-moduli trap: the run it meant
+        intended = PairLike(ps, ps.intended)
+        sizes = [_intended_probe(setup, intended, p) for p in probes]
+        for f in found:
+            if f.code in ("mixing", "wall-moduli"):
+                f.size.update({"probes": sizes})
+                worst = max(sizes, key=lambda s: max(abs(v) for v in s["difference"].values()))
+                key = max(worst["difference"], key=lambda k: abs(worst["difference"][k]))
+                f.text += (f"; measured at {worst['angle']:g}°: {key} {worst['deck'][key]:.4g} in the engine, "
+                           f"{worst['intended'][key]:.4g} as meant ({worst['difference'][key] * 100:+.1f}%)")
+    # time step
+    spc = min(p["steps_per_contact"] for p in probes)
+    margin = min(p["stability_margin"] for p in probes)
+    dt_err = max((p["dt_error"] for p in probes if math.isfinite(p["dt_error"])), default=math.nan)
+    entry["time_step"] = {"dt": setup.dt, "steps_per_contact": spc, "dt_error": dt_err, "stability_margin": margin}
+    if margin < 1.0:
+        found.append(S.Finding("trap", "dt-unstable", f"dt = {setup.dt:g} s is above velocity Verlet's stability "
+                               f"limit {margin * setup.dt:.3g} s for this contact", setup.dt_where,
+                               {"stability_margin": margin}))
+    elif spc < MIN_STEPS_PER_CONTACT or (math.isfinite(dt_err) and dt_err > tol.verlet_rtol):
+        found.append(S.Finding("trap", "dt-coarse", f"dt = {setup.dt:g} s: {spc:.1f} steps per contact, "
+                               f"time-step error {dt_err:.3g} against the converged contact", setup.dt_where,
+                               {"steps_per_contact": spc, "dt_error": dt_err}))
+    if not ps.native.limit and "engine" in head:
+        peak, low = head["engine"]["peak_force"], head["engine"]["min_force"]
+        if math.isfinite(low) and low < -ATTRACTION_NOTE * peak:
+            kind = "trap" if low < -ATTRACTION_TRAP * peak else "note"
+            found.append(S.Finding(kind, "attraction", f"the normal force pulls the bodies together "
+                                   f"({low:.4g} N, {-low / peak * 100:.1f}% of the peak) and no limit holds it at 0",
+                                   ps.where, {"min_force": low, "peak_force": peak}))
+
+
+class PairLike:
+    """A pair setting with another Native (what the deck meant): probed like the deck's own."""
+
+    def __init__(self, ps, native):
+        self.__dict__.update(vars(ps))
+        self.native = native
+
+
+def _intended_probe(setup, intended, p: dict) -> dict:
+    q = probe(setup, intended, p["speed"], p["angle"], run_engine="engine" in p)
+    deck = p.get("engine", p["twin"])
+    meant = q.get("engine", q["twin"])
+    keys = [k for k in METRICS if math.isfinite(deck[k]) and math.isfinite(meant[k]) and meant[k] != 0]
+    return {"angle": p["angle"], "deck": {k: deck[k] for k in keys}, "intended": {k: meant[k] for k in keys},
+            "difference": {k: deck[k] / meant[k] - 1.0 for k in keys}}
+
+
+def text_report(r: dict) -> str:
+    """The audit as text for people."""
+    lines = [f"audit of {r['deck']} ({r['engine']} {r['engine_version'] or ''}".rstrip() + ")",
+             f"  dt = {r['dt']:g} s ({r['dt_from']}); characteristic speed {r['speed']:g} m/s ({r['speed_from']})"]
+    for p in r["pairs"]:
+        lines.append(f"\n{p['pair']}: {p['native']}  [{p['where']}]")
+        if "seed" in p:
+            s = p["seed"]
+            lines.append(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — {s['fidelity']}"
+                         f" (largest gap {s['gap']:.3g})" + (f"; {'; '.join(s['reasons'])}" if s["reasons"] else ""))
+        asked = ", ".join(f"{k} {v:g}" for k, v in p["asked"].items())
+        if asked:
+            lines.append(f"  asks for: {asked}")
+        for q in p["probes"]:
+            if "error" in q:
+                lines.append(f"  {q['angle']:>3g}°: not run: {q['error']}")
+                continue
+            m = q.get("engine", q["twin"])
+            lines.append(f"  {q['angle']:>3g}°: e {m['restitution']:.4f} (seed {q['seed']['restitution']:.4f}), "
+                         f"et {_f(m['tangential_restitution'])}, spin {_f(m['rebound_angular_velocity'])} rad/s, "
+                         f"tc {m['contact_time']:.4g} s; engine − twin {_f(q.get('engine_vs_twin', math.nan))}")
+        if "time_step" in p:
+            t = p["time_step"]
+            lines.append(f"  time step: {t['steps_per_contact']:.1f} steps per contact, error {_f(t['dt_error'])}, "
+                         f"stability margin {t['stability_margin']:.3g}×")
+        for n in p["notes"]:
+            lines.append(f"  note: {n}")
+        for f in p["findings"]:
+            lines.append(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
+    if r["not_audited"]:
+        lines.append("\nnot audited (read, never run):")
+        lines += [f"  {n['where']}: {n['text'][:70]} — {n['why']}" for n in r["not_audited"]]
+    lines.append(f"\n{r['traps']} trap(s)" if r["traps"] else "\nno trap found")
+    return "\n".join(lines)
+
+
+def _f(x) -> str:
+    return "—" if x is None or not math.isfinite(x) else f"{x:.4g}"
