@@ -21,7 +21,7 @@ class _Banner:
     """Discovery reads ``<executable> -h``; the executable is a Python, whose help names itself
     (``usage: /path/python [option] ...``) but not Kratos. This pattern asks that Python for the versions of
     its KratosMultiphysics and KratosDEMApplication distributions; a match's group 1 is
-    "KratosMultiphysics 10.4.4 (DEMApplication 10.4.4)". No match when they are not installed there."""
+    "10.4.4 (DEMApplication 10.4.4)" (KratosMultiphysics first). No match when they are not installed there."""
 
     def __init__(self, timeout: float = 20.0):
         self.timeout = timeout
@@ -38,7 +38,7 @@ class _Banner:
         m = VERSION.search(out)
         if not m:
             return None
-        return re.match(r"(.+)", f"KratosMultiphysics {m.group(1)} (DEMApplication {m.group(2)})")
+        return re.match(r"(.+)", f"{m.group(1)} (DEMApplication {m.group(2)})")
 
 
 class Kratos(PackageEngine):
@@ -50,7 +50,7 @@ class Kratos(PackageEngine):
     # only frictionless contacts are mapped (no tangential law maps): the arms never act; recorded as Kratos'
     # SphericParticle computes them, the slip velocity and the torque at the contact point
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
-    style = Style(colour="#2ca02c", marker="D", linestyle=":")
+    style = Style(colour="#ff7f0e", marker="s", linestyle=":")
 
     def executables(self) -> tuple[str, ...]:
         return ("python",)
