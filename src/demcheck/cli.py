@@ -457,6 +457,54 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
 
 
 @cli.command()
+@click.argument("name", required=False, metavar="[NAME]")
+@click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
+              help=f"comma-separated engines ({', '.join(ENGINE_NAMES)}), or 'none' for the reference alone")
+@click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
+              help="cases run in parallel")
+@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True,
+              help="where reports/<run-id> and reports/latest go")
+@click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+@click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again")
+@click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="per engine run (s)")
+def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
+    """Run the published benchmarks (cases/benchmarks/: Chung & Ooi's eight tests, Thornton's oblique
+    impacts; NAME one of them, e.g. chung-ooi-4) in the reference and every engine, and judge each source
+    against the exact limits and the papers' curves (docs/benchmarks.md). Exit 1 when the reference misses an
+    exact limit or a run fails, 2 on bad input."""
+    from .comparisons.suite import Options
+    from .comparisons.validate import by_name, run
+    from .engines import run as runner
+    from .engines.cache import Cache, default_dir
+
+    by_name(name)  # an unknown NAME: one line, exit 2, before any work
+    names = _engine_list(engines)
+    check_output("DEMCHECK_CACHE", default_dir(), directory=True)
+    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout)
+    try:
+        summary = run(name, CASES_DIR / "benchmarks", Path(report_dir), opts, quiet=as_json,
+                      junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]])
+    except KeyboardInterrupt as exc:
+        click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
+                   f"report {Path(report_dir) / 'latest'}", err=True)
+        sys.exit(runner.interrupt_exit_code(exc))
+    val = summary["validation"]
+    if as_json:
+        emit_json({"report": summary["report"], "engines": summary["engines"], "failed": summary["failed"],
+                   "validation": {k: v for k, v in val.items() if k != "series"}})
+    else:
+        counts: dict = {}
+        for c in val["checks"]:
+            counts[(c["kind"], c["verdict"])] = counts.get((c["kind"], c["verdict"]), 0) + 1
+        click.echo("validation: " + ", ".join(f"{k} {v}: {n}" for (k, v), n in sorted(counts.items())), err=True)
+        for c in val["failed"]:
+            click.echo(f"reference misses {c['expected']} in {c['file']}: {c['deviation']:.3g} > {c['tolerance']:.3g}",
+                       err=True)
+    sys.exit(0 if summary["failed"] == 0 else 1)
+
+
+@cli.command()
 @click.argument("case_path", metavar="CASE")
 @click.option("--engine", type=click.Choice(["reference", *ENGINE_NAMES]), default="reference",
               show_default=True)
