@@ -173,7 +173,56 @@ def render_markdown(summary: dict) -> str:
         srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
         worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
         lines.append(f"| {c['case']} | {_model(c)} | {c['status']} | {srcs} | {number(worst_curve, '.3g')} |")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + validation_markdown(summary)) + "\n"
+
+
+# ----------------------------------------------------------------------------- validation (demcheck validate)
+
+
+def validation_markdown(summary: dict) -> list[str]:
+    """The published-benchmark verdicts (comparisons/validate.py): each source against each exact limit and
+    each paper's curve, largest deviation, tolerance and what it stands for."""
+    val = summary.get("validation")
+    if not val:
+        return []
+    lines = ["", "## Validation against published benchmarks", "",
+             "| case file | source | quantity | expected | largest deviation | at | tolerance | verdict |",
+             "|---|---|---|---|---|---|---|---|"]
+    for c in val["checks"]:
+        lines.append(f"| {c['file']} | {c['source']} | {c['quantity']} | {c['kind']}: {c['expected']} | "
+                     f"{number(c['deviation'], '.3g')} | {number(c['at'], '.3g')} | {number(c['tolerance'], '.3g')} | "
+                     f"{c['verdict']} |")
+    lines += ["", "Tolerances:", ""] + sorted({f"* {c['quantity']} ({c['kind']}): {c['why']}" for c in val["checks"]})
+    return lines
+
+
+def validation_plots(summary: dict) -> list[tuple[str, str]]:
+    """One panel per case file and quantity, drawn like the papers' figures: each source a line over the
+    benchmark's axis, the paper's points over them."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = []
+    for line in (summary.get("validation") or {}).get("series", []):
+        if not line["x_label"]:
+            continue
+        fig, ax = plt.subplots(figsize=(5.2, 3.4))
+        for src, xy in line["sources"].items():
+            pts = sorted((x, y) for x, y in zip(xy["x"], xy["y"]) if y is not None)
+            if pts:
+                st = style(src)
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], color=st.colour, linestyle=st.linestyle,
+                        marker=st.marker, ms=3, label=src)
+        if line["paper"]:
+            ax.plot([p[0] for p in line["paper"]], [p[1] for p in line["paper"]], "k*", ms=7, label="paper")
+        ax.set(xlabel=line["x_label"], ylabel=line["label"], title=f"{line['file']}: {line['quantity']}")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        out.append((f"{line['file']} {line['quantity']}", _png(fig)))
+    return out
 
 
 # ----------------------------------------------------------------------------- junit
@@ -463,6 +512,10 @@ def render_html(summary: dict) -> str:
     for c in summary["cases"]:
         if c.get("kind") == "packing" and c.get("packing"):
             parts.append(f"<h3>packing {esc(c['case'])}</h3>" + _img(packing_plots(c), f"packing {c['case']}"))
+    if summary.get("validation"):
+        val_md = "\n".join(validation_markdown(summary)[3:])
+        parts.append("<h2>Validation against published benchmarks</h2>" + _md_table_to_html(val_md.split("\n\nTolerances:")[0]))
+        parts += [f"<h3>{esc(title)}</h3>{_img(b64, title)}" for title, b64 in validation_plots(summary)]
     parts.append("<h2>Disagreements</h2>" + "".join(
         f"<p>{esc(line.strip('* '))}</p>" for line in md[mat_end:md.index('## Cases')].splitlines()[2:] if line.strip()))
     parts.append("<h2>Cases</h2>")
