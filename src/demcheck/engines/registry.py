@@ -13,7 +13,7 @@ import os
 
 from .base import Engine
 
-BUILTIN = ("demcheck.engines.lammps", "demcheck.engines.liggghts", "demcheck.engines.kratos")
+BUILTIN = ("demcheck.engines.lammps", "demcheck.engines.liggghts", "demcheck.engines.kratos", "demcheck.engines.yade")
 _ENGINES: dict[str, Engine] = {}
 _loaded = False
 
