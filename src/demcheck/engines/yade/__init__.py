@@ -48,7 +48,7 @@ class Yade(PackageEngine):
     # first-order ScGeom::rotate, which the twin's "project" matches where the normal does not turn (walls,
     # head-on pairs); on a wall Yade's slip arm is R − δ (see mapping.py)
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
-    style = Style(colour="#2ca02c", marker="D", linestyle=":")
+    style = Style(colour="#e377c2", marker="X", linestyle=":")
 
     def executables(self) -> tuple[str, ...]:
         return ("yade",)

@@ -89,19 +89,11 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             reasons.append("oblique impacts: Yade's slip velocity on a wall uses the arm R − δ (the contact point "
                            "on the wall), and it turns the history with ScGeom's first-order rotation")
         elif nat.normal == MINDLIN and kind == SPRING and tl.kt_sqrt:
-            nat.tangential = "mindlin"
-            # ks = kso √δ = Kt √(R̄δ): kso = Kt √R̄ (Kt here: tl.kt, the coefficient of √(R̄δ))
-            p["kso"] = tl.kt * math.sqrt(r)
-            if tl.eta > 0.0 or tl.eta_normal:
-                if not tl.eta_normal or nl.eta == 0.0:
-                    return refused("yade", "Yade's Mindlin shear dashpot is 2 betas √(m̄ ks): a δ^¼ law like "
-                                           "the normal one, not a constant ηt")
-                # cs = 2 betas √(m̄ kso) δ^¼ = factor · η δ^¼
-                p["betas"] = tl.eta * nl.eta / (2.0 * math.sqrt(m * p["kso"]))
-            fid = worst(fid, APPROXIMATE)
-            reasons.append("Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t dt), not Kt(δ)·ξ; it caps "
-                           "the spring only, and on a wall its slip arm is R − δ")
-            comments.append(f"MindlinPhys kso = {p['kso']:.10g} (ks = kso √δ), betas = {p['betas']:.17g}")
+            # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
+            # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
+            return refused("yade", "not mapped yet: Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t "
+                                   "dt, not Kt(δ)·ξ) and its slip arm on a wall is R − δ; the reference's "
+                                   "adaptive solver has no incremental-force history to hold it against")
         else:
             return refused("yade", f"no Yade law pairs tangential '{model.tangential.id}' with the normal law "
                                    f"mapped here ({nat.normal})")
