@@ -1,0 +1,88 @@
+"""Yade 2023.02a: its runs against its twin at equal dt (the engine tests carry the engine marker and run
+for real where Yade is installed), and the guard on its scripts (no engine needed)."""
+
+from __future__ import annotations
+
+import pytest
+
+from demcheck import case as C
+from demcheck.engines import collide as CO
+from demcheck.engines.yade.deck import check_script
+from demcheck.errors import DemcheckError
+
+from .conftest import CASES
+
+METRICS = ("peak_force", "restitution", "contact_time", "max_overlap")
+
+
+def _twin_agreement(case):
+    run = CO.collide(case, "yade")
+    assert run.ok, run.message
+    assert run.engine_version == "2023.02a"
+    twin = CO.twin_states(case, "yade", run.dt)
+    a, b = run.metrics(), twin.metrics()
+    return {k: abs(a[k] - b[k]) / abs(b[k]) for k in METRICS}, run
+
+
+@pytest.mark.engine("yade")
+@pytest.mark.parametrize("path,overrides", [
+    # MindlinPhys, elastic, on a wall: kno set through Young's modulus for Yade's wall radius R/2
+    ("hertz-wall.toml", []),
+    # MindlinPhys with betan: a velocity-dependent dashpot; Yade's leap-frog reads v_{k-1/2} at x_k, as
+    # velocity Verlet's force does, so the twin holds to round-off
+    ("glass-pair.toml", ["contact.normal=tti", "contact.limit_force=true"]),
+    # ViscElPhys with kn, cn given directly (each material carries twice the pair's value), on a wall
+    ("hertz-wall.toml", ["contact.normal=lsd", "contact.limit_force=true", "contact.stiffness_method=duration"]),
+])
+def test_yade_runs_as_its_twin(path, overrides):
+    """An exact twin: equal dt, the same scheme, so round-off only (≤ 1e-9; measured ≤ 1.3e-15)."""
+    diffs, run = _twin_agreement(C.load(CASES / path, overrides))
+    assert max(diffs.values()) <= 1e-9, diffs
+
+
+@pytest.mark.engine("yade")
+def test_yade_clamp_is_the_only_difference_from_an_unlimited_lsd():
+    """ViscElPhys holds Fn ≥ 0: with limit_force = false the mapping is approximate, and the run still equals
+    its twin (which carries the clamp) to round-off."""
+    case = C.load(CASES / "glass-pair.toml", ["contact.normal=lsd", "contact.stiffness_method=duration"])
+    diffs, run = _twin_agreement(case)
+    assert run.meta["fidelity"] == "approximate" and "≥ 0" in run.message
+    assert max(diffs.values()) <= 1e-9, diffs
+
+
+def _script() -> str:
+    case = C.load(CASES / "hertz-wall.toml")
+    return CO.deck(case, "yade").text
+
+
+def test_generated_script_passes_its_guard_and_numbers_round_trip():
+    case = C.load(CASES / "hertz-wall.toml")
+    dk = CO.deck(case, "yade")
+    check_script(dk.text)
+    assert f"DT = {float(dk.dt)!r}" in dk.text
+    assert "NewtonIntegrator(damping=0.0, gravity=G)" in dk.text
+
+
+@pytest.mark.parametrize("bad,why", [
+    ("import os", "Import"),
+    ("__import__('os')", "name '__import__'"),
+    ("O.bodies.append(utils.sphere((0, 0, 0), 1.0)).__class__", "attribute '__class__'"),
+    ("out = open('/etc/passwd', 'w')", "string"),
+    ("O.run(1, True)", "attribute 'run'"),
+    ("x = 1e400", "finite"),
+    ("exec('1')", "name 'exec'"),
+])
+def test_guard_refuses_what_the_template_does_not_write(bad, why):
+    with pytest.raises(DemcheckError, match=why):
+        check_script(_script() + bad + "\n")
+
+
+def test_guard_refuses_an_encoding_declaration_and_other_files():
+    text = _script()
+    lines = text.split("\n")
+    with pytest.raises(DemcheckError, match="encoding"):
+        check_script("\n".join(["# -*- coding: utf-7 -*-"] + lines[1:]))
+    with pytest.raises(DemcheckError, match="files"):
+        check_script(text, {"data.lmp": "x"})
+    with pytest.raises(DemcheckError, match="ASCII"):
+        check_script(text + "# \u00e9\n")
