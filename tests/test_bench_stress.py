@@ -91,7 +91,7 @@ def test_verlet_stability_limit_of_an_undamped_linear_spring():
 @pytest.mark.engine("liggghts")
 def test_engines_and_reference_agree_about_stability(tmp_path):
     s = S.stress_file(CASES / "suite" / "normal-lsd-wall.toml", only=["restitution"]).summary()
-    assert {l["source"] for l in s["limits"]} == {"reference-verlet", "lammps", "liggghts"}
+    assert {"reference-verlet", "lammps", "liggghts"} <= {l["source"] for l in s["limits"]}  # and the other engines
     assert s["disagreements"] == []
     assert all(l["dt_max_over_tc"] for l in s["limits"])
 

@@ -104,7 +104,7 @@ def test_collide_all_sources_side_by_side_in_json():
     p = demcheck("collide", CASES / "oblique-viscous-sliding-pair.toml", "--engine", "all", "--json")
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
-    assert set(out) == {"reference", "lammps", "liggghts"}
+    assert {"reference", "lammps", "liggghts"} <= set(out)  # and every other registered engine (kratos, …)
     assert "22 Jul 2025" in out["lammps"]["engine_version"]
     assert out["liggghts"]["engine_version"].startswith("LIGGGHTS-PUBLIC 3.8.0")
     assert out["lammps"]["params"]["mapping"] == "exact"
