@@ -165,7 +165,7 @@ def _hertz(metric: str):
 
 def _sliding(c: Impact) -> bool:
     """Gross sliding throughout with margin: the rigid-body threshold is v_t = 3.5 μ (1 + e) v_n."""
-    return c.vt > 1.5 * 3.5 * c.mu * (1 + c.e) * c.vn
+    return c.vt > 1.2 * 3.5 * c.mu * (1 + c.e) * c.vn
 
 
 # gross sliding: the tangential impulse is μ (1 + e') m v_n, e' the source's own restitution
