@@ -707,8 +707,8 @@ def dt(case_path, target, overrides, as_json):
 
 @cli.command()
 @click.argument("deck_path", metavar="DECK")
-@click.option("--engine", "engine", type=click.Choice(["lammps", "liggghts"]), default=None,
-              help="the deck's engine (default: read from its vocabulary)")
+@click.option("--engine", "engine", default=None,
+              help="the deck's engine (default: read from its vocabulary; lammps or liggghts)")
 @click.option("--speed", type=Number(lo=0, lo_open=True, hi=1e4, unit="m/s"), default=None,
               help="characteristic impact speed (default: the deck's largest speed, or characteristicVelocity)")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")

@@ -12,7 +12,6 @@ contact with the time-step error and the stability margin, and every trap with i
 
 from __future__ import annotations
 
-import importlib
 import math
 from pathlib import Path
 
@@ -31,7 +30,6 @@ from ..engines.mapping import native_summary, twin_model
 from .verdicts import Tolerances, scaled
 
 ANGLES = (0.0, 30.0, 60.0)
-AUDITED = ("lammps", "liggghts")
 # |realised − asked| restitution above which the deck does not get what it asks for (restitutions are
 # dimensionless; 0.01 is what a calibration to two digits can tell apart)
 ASKED_TOL = 0.01
@@ -43,25 +41,34 @@ MIN_STEPS_PER_CONTACT = 20  # fewer: the contact is resolved too coarsely whatev
 METRICS = ("restitution", "tangential_restitution", "rebound_angular_velocity", "contact_time", "peak_force")
 
 
-def detect(script: S.Script) -> str:
-    """The deck's engine from its vocabulary: LIGGGHTS's ``pair_style gran model``, ``fix property/global``
-    or ``communicate``; LAMMPS otherwise."""
-    for cmd in script.commands:
-        w = cmd.words
-        if (cmd.name == "pair_style" and w[1:3] == ["gran", "model"]) or cmd.name in ("communicate",
-                                                                                     "hard_particles") \
-                or (cmd.name == "fix" and len(w) > 3 and w[3] == "property/global"):
-            return "liggghts"
-    return "lammps"
+def readers() -> dict:
+    """{engine name: its package's deck reader} for every registered engine whose package has an ``audit``
+    module (``read(script, root) → Setup``, ``claims(script)``: the deck uses its own vocabulary)."""
+    import importlib.util
+
+    out = {}
+    for e in registry.all_engines():
+        module = f"{type(e).__module__}.audit"
+        if importlib.util.find_spec(module) is not None:
+            out[e.name] = importlib.import_module(module)
+    return out
+
+
+def detect(script: S.Script, found: dict) -> str:
+    """The deck's engine: the first whose reader claims its vocabulary, else the one that reads by default."""
+    for name, reader in found.items():
+        if reader.claims(script):
+            return name
+    return next(name for name, reader in found.items() if getattr(reader, "DEFAULT", False))
 
 
 def read(path: str | Path, engine: str | None = None):
     script = S.read(path)
-    engine = engine or detect(script)
-    if engine not in AUDITED:
-        raise ConfigError("--engine", engine, f"audit reads {' and '.join(AUDITED)} decks")
-    reader = importlib.import_module(f"demcheck.engines.{engine}.audit")
-    setup = reader.read(script, Path(path).resolve().parent)
+    found = readers()
+    engine = engine or detect(script, found)
+    if engine not in found:
+        raise ConfigError("--engine", engine, f"audit reads {', '.join(found)} decks")
+    setup = found[engine].read(script, Path(path).resolve().parent)
     for cmd, why in script.unread:
         setup.not_audited.append((cmd.where(), cmd.text, why))
     return setup
@@ -171,7 +178,7 @@ def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> C.Case:
         return {"density": rho, "youngs_modulus": e, "poisson_ratio": n, "restitution": restitution,
                 "friction": friction}
 
-    own = setup.engine == "liggghts"  # LIGGGHTS's deck writer writes each type's own modulus
+    own = getattr(readers()[setup.engine], "OWN_MODULI", False)  # its deck writer writes each type's modulus
     mats = {"a": material(rho1, b1, own)}
     parts = [{"material": "a", "radius": r1}]
     raw = {"name": f"audit-{ps.label.replace(' ', '-').replace('×', 'x')}-{angle:g}", "materials": mats,

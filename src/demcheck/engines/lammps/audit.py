@@ -22,6 +22,13 @@ TWISTING_ARGS = {"none": 0, "marshall": 0, "sds": 3}
 HEAT_ARGS = {"none": 0, "radius": 1, "area": 1}
 CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
 PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
+DEFAULT = True  # a LAMMPS-family deck that no other reader claims is read as LAMMPS's
+
+
+def claims(script) -> bool:
+    """LAMMPS's own vocabulary: pair_style granular or a classic gran/* style."""
+    return any(c.name == "pair_style" and c.words[1:2] and (c.words[1] == "granular" or c.words[1] in CLASSIC)
+               for c in script.commands)
 
 
 def _bad(cmd: Command, why: str):

@@ -15,6 +15,19 @@ from ..base import Native
 MODELS = ("hertz", "hooke", "hooke/stiffness", "hertz/stiffness")  # the probed ones (they have a twin)
 OTHER_MODELS = ("luding", "edinburgh", "thornton_ning", "hooke/hysteresis", "hertz/stiffness/ttt")
 TANGENTIAL = ("off", "no_history", "history")
+OWN_MODULI = True  # the deck writer writes each type's own Young's modulus and Poisson's ratio
+
+
+def claims(script) -> bool:
+    """LIGGGHTS's own vocabulary: pair_style gran model …, fix property/global, communicate, hard_particles."""
+    for c in script.commands:
+        w = c.words
+        if ((c.name == "pair_style" and w[1:3] == ["gran", "model"]) or c.name in ("communicate", "hard_particles")
+                or (c.name == "fix" and len(w) > 3 and w[3] == "property/global")):
+            return True
+    return False
+
+
 PER_PAIR = {"coefficientRestitution": "restitution", "coefficientFriction": "friction", "kn": "kn", "kt": "kt",
             "gamman": "gamman", "gammat": "gammat"}
 
