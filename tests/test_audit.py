@@ -156,3 +156,17 @@ def test_no_speed_is_bad_input(tmp_path):
     out = demcheck("audit", str(deck))
     assert out.returncode == 2 and "--speed" in out.stderr
     assert math.isfinite(A.characteristic_speed(A.read(deck), 2.0)[0])
+
+
+def test_models_reverse_lookup():
+    """The issue's LAMMPS line: TTIn/TTIt, E* = E/(2(1−ν²)) and k_t = 8G* = 8E/(4(2−ν)(1+ν)) (closed forms), tsuji."""
+    out = demcheck("models", "--engine", "lammps", "--json",
+                   "hertz/material 63e9 0.6 0.24 damping tsuji tangential mindlin NULL 1.0 0.5")
+    assert out.returncode == 0, out.stderr
+    r = json.loads(out.stdout)
+    assert (r["seed"]["normal"], r["seed"]["tangential"]) == ("tti", "tti")
+    assert r["implied"]["E*"] == pytest.approx(63e9 / (2 * (1 - 0.24**2)), rel=1e-12)
+    assert float(r["implied"]["kt"].split()[0]) == pytest.approx(8 * 63e9 / (4 * 1.76 * 1.24), rel=1e-5)
+    assert [f["code"] for f in r["findings"]] == ["tsuji"]
+    bad = demcheck("models", "--engine", "lammps", "hertz/material 63e9 0.6 damping")
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1

@@ -156,9 +156,33 @@ def cli():
 @cli.command()
 @click.argument("model_id", metavar="[ID]", required=False)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def models(model_id, as_json):
+@click.option("--engine", "engine", default=None,
+              help="reverse lookup: ID is an engine's native setting, e.g. --engine lammps \"hertz/material …\"")
+def models(model_id, as_json, engine):
     """Registered models: one line each (id, seed name, each engine's fidelity); `demcheck models ID` shows one
-    model in full (formula, source, parameters, each engine's configuration and reason)."""
+    model in full (formula, source, parameters, each engine's configuration and reason); `demcheck models
+    --engine E "SETTING"` looks a native setting up (seed model, fidelity, implied parameters, traps)."""
+    if engine is not None:
+        from .comparisons.audit import reverse
+
+        if model_id is None:
+            raise ConfigError("SETTING", None, "--engine needs the native setting to look up")
+        r = reverse(engine, model_id)
+        if as_json:
+            emit_json(r)
+            return
+        s = r["seed"]
+        click.echo(f"{engine}: {r['native']}")
+        click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']}"
+                   + (f" ({'; '.join(s['reasons'])})" if s["reasons"] else ""))
+        click.echo("  implied (like pair, R = 1 mm, ρ = 2500): "
+                   + ", ".join(f"{k} {v:.6g}" if isinstance(v, float) else f"{k} {v}" for k, v in r["implied"].items()))
+        for n in r["notes"]:
+            click.echo(f"  note: {n}")
+        for f in r["findings"]:
+            click.echo(f"  TRAP [{f['code']}]: {f['text']}")
+        click.echo("  `demcheck audit DECK` measures each trap in the engine (docs/audit.md)")
+        return
     from .engines import mapping, registry as engine_registry
     from .reference import normal, tangential
 

@@ -434,3 +434,27 @@ def text_report(r: dict) -> str:
 
 def _f(x) -> str:
     return "—" if x is None or not math.isfinite(x) else f"{x:.4g}"
+
+
+def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.0) -> dict:
+    """The reverse lookup of one native setting (``demcheck models --engine E "…"``): its nearest seed model,
+    fidelity and implied parameters for a like pair (``radius``, ``density``), and its static traps."""
+    found = readers()
+    reader = found.get(engine)
+    if reader is None or not hasattr(reader, "reverse"):
+        raise ConfigError("--engine", engine, "the reverse lookup reads " + ", ".join(
+            n for n, r in found.items() if hasattr(r, "reverse")) + " settings")
+    ps = reader.reverse(line)
+    m = density * 4.0 / 3.0 * math.pi * radius ** 3
+    nl, tl = registry.get(engine).twin(ps.native, m / 2.0, radius / 2.0)
+    normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)
+    implied = {"normal_force": f"{nl.k:.6g} δ^{nl.a:g}", "damping": f"{nl.eta:.6g} δ^{nl.b:g} (N·s/m at δ^b)",
+               "limit": nl.limit}
+    if nl.a == 1.5:
+        implied["E*"] = nl.k / (4.0 / 3.0 * math.sqrt(radius / 2.0))
+    if tl.kind == SPRING:
+        implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if tl.kt_sqrt else "")
+    return {"engine": engine, "setting": line, "native": native_summary(ps.native), "seed": {
+        "normal": normal, "tangential": tangential, "params": params, "reasons": reasons},
+        "asked": ps.asked, "implied": implied, "pair": {"radius": radius, "density": density},
+        "findings": [_finding(f) for f in ps.findings], "notes": ps.notes}

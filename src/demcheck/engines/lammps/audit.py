@@ -353,3 +353,16 @@ def _walls(setup: Setup, types: list[int], explicit: dict, walls: list) -> None:
                         f"rigid wall's E/(1−ν²); for a rigid wall pass E = {2 * e_wall:g}", where,
                         {"e_star_ratio": 0.5}))
             setup.pairs.append(ps)
+
+
+def reverse(line: str) -> PairSetting:
+    """One ``pair_coeff`` argument list (after the types) as the pair setting it defines, with its static traps
+    (``demcheck models --engine lammps "…"``)."""
+    words = line.split()
+    cmd = Command(["pair_coeff", "1", "1", *words], "models", 1, line)
+    spec = parse_granular(cmd, cmd.words, 3)
+    if spec["rest"] != len(cmd.words):
+        raise _bad(cmd, f"{cmd.words[spec['rest']]!r} is not a keyword of pair granular")
+    ps = PairSetting("1-1", 1, 1, native_of(spec), "models", _asked(spec))
+    _static(ps, spec, "models")
+    return ps
