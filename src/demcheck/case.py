@@ -75,6 +75,10 @@ class Run:
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rtol: float = 1e-13
     method: str = "adaptive"
+    # how far the verlet method at this case's step may lie from the converged answer (units of each metric's
+    # scale); None: the suite's [verlet] rtol. A case run at many steps per contact sets it tight, so that the
+    # verlet method checks the adaptive one
+    verlet_rtol: float | None = None
 
 
 @dataclass(frozen=True)
@@ -101,6 +105,9 @@ class Case:
     run: Run
     packing: Packing | None = None
     raw: dict = field(repr=False, compare=False, default_factory=dict)
+    # the case prepared once: reference.model.resolve keeps each pair's resolved model here (a Case is frozen,
+    # so what is resolved from it never changes)
+    prepared: dict = field(repr=False, compare=False, default_factory=dict, init=False)
 
     @property
     def hash(self) -> str:
@@ -320,7 +327,7 @@ MATERIAL_KEYS = {
 }
 PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity"}
 WALL_KEYS = {"point", "normal", "rigid", "material"}
-RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method"}
+RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method", "verlet_rtol"}
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
 TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants",
             "packing"}
@@ -453,6 +460,9 @@ def from_dict(raw: dict) -> Case:
         rtol=_number(run_raw, "rtol", "run", required=False, default=1e-13,
                      rule="must be in [1e-14, 1e-2]", check=lambda v: 1e-14 <= v <= 1e-2),
         method=method,
+        verlet_rtol=_number(run_raw, "verlet_rtol", "run", required=False, default=None,
+                            rule="must be in (0, 1] (a difference in units of each metric's scale)",
+                            check=lambda v: 0 < v <= 1),
     )
 
     contact_raw = dict(raw.get("contact", {}) or {})

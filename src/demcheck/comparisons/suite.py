@@ -21,7 +21,7 @@ import math
 import os
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from rich.console import Console
@@ -120,8 +120,9 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         # the engines do at that step
         comps.append(V.status_comparison("reference-verlet", V.FAILED, f"{verlet.status}: {verlet.message}"))
     else:
+        tol_v = replace(tol, verlet_rtol=case.run.verlet_rtol) if case.run.verlet_rtol else tol
         for metric in ref:
-            comps.append(V.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol))
+            comps.append(V.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
 
     seed_cache: dict = {}
     for engine in opts.engines:

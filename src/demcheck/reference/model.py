@@ -51,9 +51,19 @@ def models_of(case: Case):
 
 
 def resolve(case: Case, i: int = 0, j: int | None = 1) -> ResolvedModel:
-    normal, tangential = models_of(case)
+    """The case's model resolved for the pair (i, j) (j None: particle i on a wall), once per case and pair: the
+    reference, each engine's mapping, decks, twins and verdicts all read the same object."""
     if len(case.particles) == 1:
         j = None
+    key = ("model", i, j)
+    model = case.prepared.get(key)
+    if model is None:
+        model = case.prepared[key] = _resolve(case, i, j)
+    return model
+
+
+def _resolve(case: Case, i: int, j: int | None) -> ResolvedModel:
+    normal, tangential = models_of(case)
     pair = pair_of(case, i, j)
     params = case.contact.params
     normal_law, normal_out = normal.resolve(pair, params, case.contact.limit_force)
