@@ -481,6 +481,47 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
 
 
 @cli.command()
+@click.argument("old", metavar="OLD")
+@click.argument("new", metavar="NEW")
+@click.option("--tolerance", type=Number(lo=0), default=None,
+              help="scaled move allowed for every quantity (default: the baseline's per-quantity tolerances, "
+                   "else the implementation bar, 1e-9)")
+@click.option("--source", "renames", multiple=True, metavar="OLD_NAME=NEW_NAME",
+              help="compare OLD's source under NEW's name (e.g. lammps@2024=lammps); repeatable")
+@click.option("--report", "report_dir", type=OutputPath(directory=True, files=("diff.md", "diff.json", "junit.xml")),
+              default=None, help="write diff.md, diff.json and junit.xml into this directory")
+@click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def diff(old, new, tolerance, renames, report_dir, junit, as_json):
+    """What moved between two verification runs (results.json, a report directory, or a baseline file): per
+    case, source and metric, the move in units of the metric's scale and every verdict that changed. Exit 1
+    when a verdict got worse, a value moved beyond its tolerance or a source is gone; 2 on bad input."""
+    from .comparisons import diff as D
+    from .io import write_json, write_text
+
+    rename = {}
+    for r in renames:
+        a, eq, b = r.partition("=")
+        if not (eq and a.strip() and b.strip()):
+            raise ConfigError("--source", r, "must be OLD_NAME=NEW_NAME")
+        rename[a.strip()] = b.strip()
+    d = D.compare(D.load(old, "OLD"), D.load(new, "NEW"), tolerance, rename)
+    md = D.render_markdown(d)
+    if report_dir:
+        out = Path(report_dir)
+        write_text(out / "diff.md", md + "\n")
+        write_json(out / "diff.json", plain(d))
+        write_text(out / "junit.xml", D.render_junit(d))
+    if junit:
+        write_text(junit, D.render_junit(d))
+    if as_json:
+        emit_json(d)
+    else:
+        click.echo(md)
+    sys.exit(1 if d["regressions"] else 0)
+
+
+@cli.command()
 @click.argument("name", required=False, metavar="[NAME]")
 @click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
               help=f"comma-separated engines ({', '.join(ENGINE_NAMES)}), or 'none' for the reference alone")
