@@ -455,7 +455,12 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
 @click.option("--no-cache", "no_cache", is_flag=True,
               help="run every engine deck again (read no cached run; the fresh runs replace the cached ones)")
 @click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="per engine run (s)")
-def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
+@click.option("--baseline", "baseline", default=None, metavar="PATH",
+              help="also judge every source against a stored earlier run (a baseline file, results.json or report "
+                   "directory): a worse verdict or a value moved beyond its tolerance differs unexpectedly")
+@click.option("--write-baseline", "write_baseline", type=OUT_FILE, default=None, metavar="PATH",
+              help="store this run as a baseline (metrics, verdicts, engine versions, per-quantity tolerances)")
+def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, baseline, write_baseline):
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
@@ -466,7 +471,10 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
     names = _engine_list(engines)
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)
-    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout)
+    from .comparisons import diff as D
+
+    base = D.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
+    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout, baseline=base)
     try:
         summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
                             argv=["demcheck", "verify", *sys.argv[2:]])
@@ -474,6 +482,11 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
                    f"report {Path(report_dir) / 'latest'}", err=True)
         sys.exit(runner.interrupt_exit_code(exc))
+    if write_baseline:
+        from .io import write_json
+
+        write_json(write_baseline, D.baseline(summary))
+        click.echo(f"baseline: {write_baseline}", err=True)
     if as_json:
         emit_json(({k: v for k, v in summary.items() if k != "cases"}
                         | {"cases": [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]}))

@@ -103,6 +103,10 @@ def render_markdown(summary: dict) -> str:
     lines += ["| verdict | comparisons |", "|---|---|"]
     lines += [f"| {v} | {counts[v]} |" for v in V.VERDICTS if counts[v]]
     lines += ["", f"**{summary['failed']} case(s) with an unexpected difference or a failure.**", ""]
+    if "baseline" in summary:
+        from .diff import baseline_markdown
+
+        lines += baseline_markdown(summary["baseline"])
 
     # the agreement matrix: models × sources × metrics
     mat = matrix(summary)

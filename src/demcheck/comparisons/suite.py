@@ -48,6 +48,7 @@ class Options:
     timeout: float = 600.0
     tolerances: V.Tolerances = field(default_factory=V.Tolerances.load)
     expected: list = field(default_factory=V.load_expected)
+    baseline: dict | None = None  # a stored earlier run (comparisons/diff.load): every source judged against it too
 
 
 def discover(engines) -> dict:
@@ -255,6 +256,10 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
         summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
         if opts.cache is not None:
             summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
+        if opts.baseline is not None:
+            from .diff import apply_baseline
+
+            apply_baseline(summary, opts.baseline)
         report.write_all(summary, out_dir, report_root, junit=junit)
     _print(console, summary)
     if interrupted is not None:
