@@ -19,6 +19,7 @@ LAYERS = [
     ("deck helpers", r"inputs(\..*)?"),
     ("engines", r"engines(\..*)?"),
     ("comparisons", r"comparisons(\..*)?"),
+    ("api", r"api"),
     ("front ends", r"cli|__main__"),
 ]
 

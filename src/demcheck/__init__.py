@@ -34,3 +34,19 @@ def _numba_cache_dir() -> None:
 
 
 _numba_cache_dir()
+
+
+# the Python API (docs/api.md), looked up on first use: ``import demcheck`` loads no solver, engine or pandas
+_API = ("load", "collide", "sweep", "verify", "audit", "calibrate", "sources")
+
+
+def __getattr__(name: str):
+    if name in _API:
+        import importlib
+
+        return getattr(importlib.import_module(f"{__name__}.api"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted([*globals(), *_API])

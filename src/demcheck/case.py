@@ -105,6 +105,9 @@ class Case:
     run: Run
     packing: Packing | None = None
     raw: dict = field(repr=False, compare=False, default_factory=dict)
+    # [engine.NAME] tables: an engine's own settings for the contact ({name: {key: text}}), parsed by that
+    # engine's package (engines.base.Engine.native_from_case); here only their shape is checked
+    natives: dict = field(compare=False, default_factory=dict)
     # the case prepared once: reference.model.resolve keeps each pair's resolved model here (a Case is frozen,
     # so what is resolved from it never changes)
     prepared: dict = field(repr=False, compare=False, default_factory=dict, init=False)
@@ -330,7 +333,7 @@ WALL_KEYS = {"point", "normal", "rigid", "material"}
 RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method", "verlet_rtol"}
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
 TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants",
-            "packing"}
+            "packing", "engine"}
 PACKING_KEYS = {"layout", "count", "material", "radius", "radii", "box", "seed", "duration"}
 LAYOUTS = ("column", "layer", "poured")
 
@@ -362,6 +365,39 @@ def _material(name: str, d: dict) -> Material:
         tangential_restitution=_number(d, "tangential_restitution", where, required=False,
                                        rule="must be in [0, 1]", check=lambda v: 0 <= v <= 1),
     )
+
+
+NATIVE_RULE = ("an [engine.NAME] table holds that engine's own settings as text (pair_coeff = \"hertz/material "
+               "…\"; docs/api.md, docs/lammps-users.md, docs/liggghts-users.md)")
+
+
+def _natives(table, kind: str) -> dict:
+    """The [engine.NAME] tables' shape: tables of keys to text (or numbers, kept as text); which engines and
+    which keys is the engines' to say (engines.base.case_natives)."""
+    if table is None:
+        return {}
+    if not isinstance(table, dict):
+        raise ConfigError("engine", table, f"must be a table of [engine.NAME] tables: {NATIVE_RULE}")
+    if table and kind != "collision":
+        raise ConfigError("engine", sorted(table), "native engine settings are read for collisions only")
+    out = {}
+    for name, settings in table.items():
+        where = f"engine.{_key_text(name)}"
+        if not isinstance(settings, dict) or not settings:
+            raise ConfigError(where, settings, f"must be a non-empty table: {NATIVE_RULE}")
+        values = {}
+        for key, value in settings.items():
+            k = f"{where}.{_key_text(key)}"
+            if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+                raise ConfigError(k, value, f"must be text (or a number): {NATIVE_RULE}")
+            if isinstance(value, float) and not math.isfinite(value):
+                raise ConfigError(k, value, "must be finite")
+            text = value if isinstance(value, str) else repr(value)
+            if not text.strip() or len(text) > 1000 or any(ch in text for ch in "\n\r\0"):
+                raise ConfigError(k, value, "must be one non-empty line of at most 1000 characters")
+            values[str(key)] = text
+        out[str(name)] = values
+    return out
 
 
 def _unit(v, key):
@@ -465,6 +501,7 @@ def from_dict(raw: dict) -> Case:
                             check=lambda v: 0 < v <= 1),
     )
 
+    natives = _natives(raw.get("engine"), kind)
     contact_raw = dict(raw.get("contact", {}) or {})
     if "normal" not in contact_raw:
         raise ConfigError("contact.normal", None, "missing: a normal model id is required (see `demcheck models`)")
@@ -496,7 +533,7 @@ def from_dict(raw: dict) -> Case:
              "velocity": list(p.velocity), "angular_velocity": list(p.angular_velocity)} for p in parts
         ]
         return Case(name=name, kind=kind, materials=materials, particles=parts, walls=tuple(walls),
-                    contact=contact, run=run, packing=packing, raw=resolved_raw)
+                    contact=contact, run=run, packing=packing, raw=resolved_raw, natives=natives)
 
     case = build(parts)
     # Model ids and parameters are checked here too, so that nothing runs on a bad case.

@@ -140,8 +140,12 @@ PACK_CSV_DIR = OutputPath(directory=True, files=("particles.csv", "contacts.csv"
 
 def _load(case_path: str, overrides) -> "object":
     from . import case as case_mod
+    from .engines import registry
+    from .engines.base import case_natives
 
-    return case_mod.load(case_path, list(overrides))
+    case = case_mod.load(case_path, list(overrides))
+    case_natives(case, registry.all_engines())  # [engine.NAME] settings read by their engines before any work
+    return case
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -274,7 +278,10 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         from .engines.collide import collide as run_engine
 
         try:
-            results[src] = run_engine(case, src, dt=dt, timeout=timeout)
+            from .engines import registry
+
+            results[src] = run_engine(case, src, dt=dt, timeout=timeout,
+                                      native=registry.get(src).case_native(case))
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
                 raise

@@ -30,6 +30,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from .. import __version__
 from ..case import Case, expand, naming_file
 from ..engines import registry
+from ..engines.base import case_natives
 from ..errors import DemcheckError, EngineInterrupted
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
@@ -127,11 +128,12 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
 
     seed_cache: dict = {}
     for engine in opts.engines:
-        mp = contact_mapping(case, engine)
+        native = registry.get(engine).case_native(case)  # the case's [engine.NAME] setting, if any
+        mp = contact_mapping(case, engine, native)
         if V.unavailable(entry, comps, engine, mp, found):
             continue
         try:
-            res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout)
+            res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout, native=native)
         except EngineInterrupted:
             raise  # the case did not finish: it is left out of the (partial) report
         except DemcheckError as exc:
@@ -144,7 +146,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
             comps.append(V.status_comparison(engine, V.FAILED, f"{res.status}: {res.message}"))
             continue
         me = res.metrics()
-        twin = twin_states(case, engine, res.dt).metrics()
+        twin = twin_states(case, engine, res.dt, native=native).metrics()
         if res.dt not in seed_cache:
             seed_cache[res.dt] = states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
         seed_v = seed_cache[res.dt]
@@ -197,7 +199,9 @@ def collect(paths) -> list[tuple[Path, Case]]:
     cases = []
     for path in paths:
         with naming_file(path):
-            cases.extend((Path(path), case) for case in expand(path))
+            for case in expand(path):
+                case_natives(case, registry.all_engines())  # [engine.NAME] settings read before any work
+                cases.append((Path(path), case))
     return cases
 
 

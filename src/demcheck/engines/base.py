@@ -154,6 +154,25 @@ class Engine(ABC):
     def summary(self, native: Native) -> str:
         """A native configuration in one line of the engine's own words."""
 
+    def native_from_case(self, table: dict, case) -> Native:
+        """A case's ``[engine.<name>]`` table (keys to text, shape checked by case.py) as the Native it sets
+        for the case's contact, read with the engine's own deck reader (never pasted into a deck). Raises a
+        ConfigError naming the key for a key or a setting it cannot read. The default reads none."""
+        from ..errors import ConfigError
+
+        raise ConfigError(f"engine.{self.name}", sorted(table), f"{self.title} takes no native settings in case "
+                                                                 "files")
+
+    def case_native(self, case) -> Native | None:
+        """The Native of the case's ``[engine.<name>]`` table (read once per case), or None without one."""
+        table = getattr(case, "natives", {}).get(self.name)
+        if table is None:
+            return None
+        key = ("native", self.name)
+        if key not in case.prepared:
+            case.prepared[key] = self.native_from_case(table, case)
+        return case.prepared[key]
+
     # ------------------------------------------------------------------ decks and output
 
     @abstractmethod
@@ -196,3 +215,18 @@ class PackageEngine(Engine):
 
     def packing_deck(self, case, duration=None, dt=None):
         return self._part("packing").deck(case, duration, dt)
+
+
+def case_natives(case, engines) -> dict:
+    """Every ``[engine.NAME]`` table of a case read by its engine (``engines``: the registered ones), before any
+    work: a ConfigError names an unknown engine, or the key its engine cannot read."""
+    from ..errors import ConfigError
+
+    known = {e.name: e for e in engines}
+    out = {}
+    for name in getattr(case, "natives", {}):
+        if name not in known:
+            raise ConfigError(f"engine.{name}", sorted(case.natives[name]), "is not a registered engine ("
+                              + ", ".join(known) + ")")
+        out[name] = known[name].case_native(case)
+    return out

@@ -42,6 +42,10 @@ class Lammps(PackageEngine):
             parts.append("limit_damping")
         return " ".join(parts)
 
+    def native_from_case(self, table: dict, case) -> Native:
+        """``[engine.lammps]`` of a case file, read by the deck reader (audit.native_from_case)."""
+        return self._part("audit").native_from_case(table, case)
+
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/local dist force p4`` after the two ids: centre distance, Fn (repulsive > 0), |Ft|."""
         return radius[i] + radius[j] - v[:, 2], v[:, 3], v[:, 4]

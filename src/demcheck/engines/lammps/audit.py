@@ -366,3 +366,74 @@ def reverse(line: str) -> PairSetting:
     ps = PairSetting("1-1", 1, 1, native_of(spec), "models", _asked(spec))
     _static(ps, spec, "models")
     return ps
+
+
+# ----------------------------------------------------------------------------- native settings in case files
+
+CASE_KEYS = ("pair_style", "pair_coeff")
+
+
+def native_from_case(table: dict, case) -> Native:
+    """A case's ``[engine.lammps]`` table as the Native of its contact (pair or wall: LAMMPS reads a wall's
+    coefficients as a pair's): ``pair_coeff`` = a ``pair_style granular`` argument list (``hertz/material E e ν
+    damping tsuji tangential mindlin NULL 1.0 0.5``; leading types ``* *`` are read and dropped), or
+    ``pair_style`` = a classic ``gran/hooke``, ``gran/hooke/history`` or ``gran/hertz/history`` line with its
+    coefficients. Read by the deck reader's own parsers; the deck is written from the parsed numbers."""
+    from ...errors import ConfigError
+
+    for key in table:
+        if key not in CASE_KEYS:
+            raise ConfigError(f"engine.lammps.{key}", table[key], f"is not a setting read here ({', '.join(CASE_KEYS)})")
+    style = table.get("pair_style", "granular").split()
+    where = "engine.lammps.pair_style"
+    try:
+        if style[:1] == ["granular"] and len(style) == 1:
+            if "pair_coeff" not in table:
+                raise ConfigError("engine.lammps.pair_coeff", None, "missing: pair_style granular needs its "
+                                  "pair_coeff arguments (\"hertz/material E e ν damping … tangential …\")")
+            text, where = table["pair_coeff"], "engine.lammps.pair_coeff"
+            words = text.split()
+            if len(words) > 2 and all(_is_type(w) for w in words[:2]):
+                words = words[2:]
+            cmd = Command(["pair_coeff", "1", "1", *words], where, 1, text)
+            spec = parse_granular(cmd, cmd.words, 3)
+            if spec["rest"] != len(cmd.words):
+                raise _bad(cmd, f"{cmd.words[spec['rest']]!r} is not a keyword of pair granular")
+        elif style[:1] and style[0] in CLASSIC:
+            if "pair_coeff" in table:
+                raise ConfigError("engine.lammps.pair_coeff", table["pair_coeff"], f"pair_style {style[0]} takes "
+                                  "its coefficients on the pair_style line, not in pair_coeff")
+            cmd = Command(["pair_style", *style], where, 1, table["pair_style"])
+            spec, _ = classic(cmd, style[0], cmd.words, 2)
+            if len(cmd.words) not in (8, 9) or cmd.words[8:] not in ([], ["limit_damping"]):
+                raise _bad(cmd, f"{style[0]} takes Kn Kt γn γt μ dampflag [limit_damping]")
+        else:
+            raise ConfigError(where, table.get("pair_style"), f"must be granular (with pair_coeff) or one of "
+                                                              f"{', '.join(CLASSIC)} with its coefficients")
+    except ScriptError as exc:
+        raise ConfigError(where, table.get(where.rsplit(".", 1)[1]), str(exc).split(": ", 2)[-1]) from None
+    if spec["normal"] not in PROBED_NORMALS:
+        raise ConfigError(where, table.get(where.rsplit(".", 1)[1]), f"normal {spec['normal']}: demcheck has no "
+                          f"twin of it (it runs {', '.join(PROBED_NORMALS)})")
+    for extra in ("rolling", "twisting"):
+        if spec.get(extra, "none") != "none":
+            raise ConfigError(where, table.get(where.rsplit(".", 1)[1]), f"{extra} {spec[extra]}: demcheck's twin "
+                              "has no rolling or twisting resistance (leave it out)")
+    if spec.get("extras") or spec.get("heat", "none") != "none":
+        raise ConfigError(where, table.get(where.rsplit(".", 1)[1]), f"{', '.join(spec.get('extras') or ['heat'])}: "
+                          "not part of a two-body run (leave it out)")
+    nat = native_of(spec)
+    from .mapping import twin
+
+    try:
+        twin(nat, 1.0, 1.0)
+    except (ValueError, KeyError) as exc:
+        raise ConfigError(where, table.get(where.rsplit(".", 1)[1]), f"no twin: {exc}") from None
+    nat.comments.append("the case's own native setting ([engine.lammps])")
+    return nat
+
+
+def _is_type(word: str) -> bool:
+    import re
+
+    return re.fullmatch(r"\d*\*\d*|\d+", word) is not None

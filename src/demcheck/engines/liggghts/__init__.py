@@ -48,6 +48,10 @@ class Liggghts(PackageEngine):
             parts.append("limitForce on")
         return " ".join(parts)
 
+    def native_from_case(self, table: dict, case) -> Native:
+        """``[engine.liggghts]`` of a case file, read by the deck reader (audit.native_from_case)."""
+        return self._part("audit").native_from_case(table, case)
+
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/gran/local id force force_normal delta``: id1 id2 periodic-flag, the force on the
         first (3), its normal part (3), the overlap. Fn is signed from the positions ``x`` (minimum image in

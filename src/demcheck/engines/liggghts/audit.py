@@ -251,3 +251,93 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         findings.append(Finding("trap", "limit", "limitForce on: the normal force is held ≥ 0, which raises the "
                                 "restitution above coefficientRestitution", where))
     return ps
+
+
+# ----------------------------------------------------------------------------- native settings in case files
+
+CASE_PROPERTIES = ("coefficientRestitution", "coefficientFriction", "characteristicVelocity", "kn", "kt", "gamman",
+                   "gammat")
+CASE_FLAGS = ("limitForce", "tangential_damping")
+RIGID_WALL_MODULUS = 1e30  # the deck writer's rigid wall type (deck.RIGID_WALL_MODULUS)
+
+
+def native_from_case(table: dict, case) -> Native:
+    """A case's ``[engine.liggghts]`` table as the Native of its contact: ``pair_style`` = ``gran model M
+    tangential T [limitForce on|off] [tangential_damping on|off]`` (the leading ``gran`` optional) and the
+    scalar properties of ``fix property/global`` (coefficientRestitution, coefficientFriction,
+    characteristicVelocity, kn, kt, gamman, gammat) as text; youngsModulus and poissonsRatio are the case's
+    materials' (a rigid wall: LIGGGHTS's 1e30 Pa wall type), and restitution and friction default to the
+    materials' when the bodies share them. Read by the deck reader's own parsers; the deck is written from the
+    parsed numbers."""
+    from ...errors import ConfigError
+
+    for key in table:
+        if key != "pair_style" and key not in CASE_PROPERTIES:
+            raise ConfigError(f"engine.liggghts.{key}", table[key], "is not a setting read here (pair_style, "
+                              + ", ".join(CASE_PROPERTIES) + "; youngsModulus and poissonsRatio come from [materials])")
+    if "pair_style" not in table:
+        raise ConfigError("engine.liggghts.pair_style", None, "missing: \"gran model M tangential T\"")
+    text = table["pair_style"]
+    words = text.split()
+    words = words[1:] if words[:1] == ["gran"] else words
+    cmd = Command(["pair_style", "gran", *words], "engine.liggghts.pair_style", 1, text)
+    try:
+        spec, k = parse_style(cmd, cmd.words, 2)
+        if k != len(cmd.words):
+            raise _bad(cmd, f"{cmd.words[k]!r} is not a keyword of pair_style gran")
+    except ScriptError as exc:
+        raise ConfigError("engine.liggghts.pair_style", text, str(exc).split(": ", 2)[-1]) from None
+    for key in spec["flags"]:
+        if key not in CASE_FLAGS:
+            raise ConfigError("engine.liggghts.pair_style", text, f"flag {key}: demcheck's deck writes "
+                              f"{', '.join(CASE_FLAGS)} only")
+    for key in ("rolling", "cohesion"):
+        if spec[key] != "off":
+            raise ConfigError("engine.liggghts.pair_style", text, f"{key} {spec[key]}: demcheck's twin has none "
+                                                                  "(leave it out)")
+    if spec.get("surface", "off") not in ("off", "default"):
+        raise ConfigError("engine.liggghts.pair_style", text, f"surface {spec['surface']}: not read here")
+    props: dict = {}
+    for name in CASE_PROPERTIES:
+        if name in table:
+            c = Command(["fix", "p", "all", "property/global", name, "scalar", *table[name].split()],
+                        f"engine.liggghts.{name}", 1, table[name])
+            try:
+                if len(c.words) != 7:
+                    raise _bad(c, "one number")
+                props[name] = ("scalar", [_num(c, 6, name)], c.file)
+            except ScriptError as exc:
+                raise ConfigError(f"engine.liggghts.{name}", table[name], str(exc).split(": ", 2)[-1]) from None
+    mats = [case.materials[p.material] for p in case.particles]
+    walls = list(case.walls)
+    for name, attr in (("coefficientRestitution", "restitution"), ("coefficientFriction", "friction")):
+        if name in props:
+            continue
+        own = {getattr(m, attr) for m in mats} | ({getattr(case.materials[w.material], attr) for w in walls
+                                                   if w.material} - {None})
+        if len(own) == 1 and None not in own:
+            props[name] = ("scalar", [next(iter(own))], f"materials' {attr}")
+        elif len(own) > 1:
+            raise ConfigError(f"engine.liggghts.{name}", None, f"the bodies' materials differ in {attr}: give it "
+                                                                 "here")
+    moduli = [m.youngs_modulus for m in mats]
+    ratios = [m.poisson_ratio for m in mats]
+    if walls:
+        w = walls[0]
+        if w.rigid:
+            moduli.append(RIGID_WALL_MODULUS)
+            ratios.append(ratios[0])
+        else:
+            moduli.append(case.materials[w.material].youngs_modulus)
+            ratios.append(case.materials[w.material].poisson_ratio)
+    props["youngsModulus"] = ("peratomtype", moduli, "materials")
+    props["poissonsRatio"] = ("peratomtype", ratios, "materials")
+    try:
+        ps = _pair(Setup("liggghts"), spec, "engine.liggghts", props, 1, 2, "contact")
+    except ScriptError as exc:
+        raise ConfigError("engine.liggghts", sorted(table), str(exc).split(": ", 1)[-1]) from None
+    if not ps.probe:
+        raise ConfigError("engine.liggghts.pair_style", text, f"model {spec['model']} / tangential "
+                          f"{spec['tangential']}: demcheck has no twin of it (it runs {', '.join(MODELS)})")
+    ps.native.comments.append("the case's own native setting ([engine.liggghts])")
+    return ps.native

@@ -1,0 +1,275 @@
+"""demcheck's Python API: what the command line does, as functions that return Python objects.
+
+``import demcheck`` stays cheap: these functions are looked up here on first use (``demcheck.__getattr__``).
+
+* :func:`load` — a case file, or a dict shaped like one, with overrides → a :class:`~demcheck.case.Case`;
+* :func:`collide` — one collision from one source (the reference, an engine, an engine's twin) → a Result with
+  ``.metrics()`` and ``.to_frame()``;
+* :func:`sweep` — metrics over a grid of case keys → a pandas DataFrame;
+* :func:`verify` — the verification suite over case files → its results dict (what ``results.json`` holds);
+* :func:`audit` — a user's own LAMMPS or LIGGGHTS deck → the audit as a dict;
+* :func:`calibrate` — the native input that realises a target metric in an engine at a time step.
+
+Bad input raises :class:`~demcheck.errors.ConfigError` (key, value, rule) before any work; docs/api.md has
+examples.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+from pathlib import Path
+from typing import Any, Iterable, Mapping
+
+from . import case as _case
+from .errors import ConfigError, DemcheckError
+from .result import Result as _Result
+
+__all__ = ["load", "collide", "sweep", "verify", "audit", "calibrate", "Result", "ConfigError"]
+
+MAX_POINTS = 10_000  # a sweep's grid, as the command line's
+
+
+class Result(_Result):
+    """A source's answer for a case (demcheck.result.Result) with :meth:`to_frame`."""
+
+    __slots__ = ()
+
+    def to_frame(self):
+        """The contact's time series as a pandas DataFrame (t, delta, delta_dot, fn, and the tangential
+        columns of a 3-D run), one row per output time; a copy."""
+        import pandas as pd
+
+        return pd.DataFrame(self.contact).copy()
+
+
+def _framed(result: _Result) -> Result:
+    result.__class__ = Result
+    return result
+
+
+def _overrides(overrides: Iterable[str] | Mapping[str, Any] | None, keyword: Mapping[str, Any]) -> list:
+    """[(dotted key, value)]: ``overrides`` as ``key=value`` texts (--set's form) or a mapping of dotted keys to
+    Python values; keywords with ``__`` for the dots (``contact__normal="tti"``)."""
+    out = []
+    if isinstance(overrides, Mapping):
+        out += [(str(k), v) for k, v in overrides.items()]
+    elif overrides:
+        if isinstance(overrides, str):
+            raise ConfigError("overrides", overrides, "must be a list of KEY=VALUE texts or a dict, not one text")
+        for item in overrides:
+            if not isinstance(item, str) or "=" not in item:
+                raise ConfigError("overrides", item, "must be KEY=VALUE with a dotted key, e.g. contact.normal=hertz")
+            key, _, text = item.partition("=")
+            out.append((key.strip(), _case.parse_value(text.strip())))
+    out += [(k.replace("__", "."), v) for k, v in keyword.items()]
+    return out
+
+
+def _raw(source) -> dict:
+    """A case's raw table: from a file, a dict (copied), or a Case (its resolved table)."""
+    if isinstance(source, _case.Case):
+        return copy.deepcopy(source.raw)
+    if isinstance(source, Mapping):
+        return copy.deepcopy(dict(source))
+    if isinstance(source, (str, Path)):
+        return _case._read(source)
+    raise ConfigError("case", type(source).__name__, "must be a case file's path, a dict shaped like a case file, "
+                                                     "or a Case")
+
+
+def _check_natives(case: _case.Case) -> _case.Case:
+    """Every [engine.NAME] table is parsed by its engine now, so that a bad native setting stops before any
+    work (a ConfigError naming the key)."""
+    if getattr(case, "natives", None):
+        from .engines import registry
+        from .engines.base import case_natives
+
+        case_natives(case, registry.all_engines())
+    return case
+
+
+def _build(case, pairs: list) -> _case.Case:
+    raw = _raw(case)
+    for key, value in pairs:
+        _case.set_path(raw, key, value)
+    if "variants" in raw:
+        raise ConfigError("variants", sorted(raw["variants"]), "a file with [variants] is several cases: "
+                                                               "use verify, or load one with its keys overridden")
+    return _check_natives(_case.from_dict(raw))
+
+
+def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword) -> _case.Case:
+    """A validated Case from a case file's path, a dict shaped like one, or a Case, with overrides applied:
+    ``key=value`` texts as ``--set`` takes them, a dict of dotted keys to values, or keywords with ``__`` for
+    the dots. A Case passed with no override is returned as it is."""
+    if isinstance(case, _case.Case) and not overrides and not keyword:
+        return case
+    return _build(case, _overrides(overrides, keyword))
+
+
+def sources() -> tuple[str, ...]:
+    """The names :func:`collide` takes as ``source``: reference, each registered engine, and its twin."""
+    from .engines import registry
+
+    names = registry.names()
+    return ("reference", *names, *(f"{n}-twin" for n in names))
+
+
+def collide(case, source: str = "reference", method: str | None = None, dt: float | None = None,
+            overrides: Iterable[str] | Mapping[str, Any] | None = (), timeout: float = 600.0, **keyword) -> Result:
+    """One collision from one source → a Result (``.metrics()``, ``.to_frame()``, ``.status``, ``.ok``).
+
+    ``source``: ``"reference"`` (``method`` adaptive — converged — or verlet at ``dt``), an engine's name (its
+    deck run for real at ``dt``, default the case's), or ``"NAME-twin"`` (the reference computing that
+    engine's formulas with its scheme at ``dt``). A case's ``[engine.NAME]`` native settings are used by that
+    engine and its twin. Overrides as :func:`load` takes them."""
+    c = load(case, overrides, **keyword)
+    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        raise ConfigError("dt", dt, "must be a number > 0 (s)")
+    known = sources()
+    if source not in known:
+        raise ConfigError("source", source, f"must be one of {', '.join(known)}")
+    if source == "reference":
+        from .reference.collision import collide as run
+
+        return _framed(run(c, method=method, dt=dt))
+    if method is not None:
+        raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
+                                            "velocity Verlet at dt")
+    from .engines import registry
+
+    engine = source.removesuffix("-twin")
+    native = registry.get(engine).case_native(c)
+    if source.endswith("-twin"):
+        from .engines.collide import twin_states
+
+        step = dt or _case.run_length(c)[0]
+        return _framed(twin_states(c, engine, step, native=native))
+    from .engines.collide import collide as run_engine
+
+    return _framed(run_engine(c, engine, dt=dt, native=native, timeout=timeout))
+
+
+def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method: str | None = None,
+          dt: float | None = None, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword):
+    """Metrics over a grid of case keys → a DataFrame: one row per point (its values, every metric, and its
+    status). ``vary`` maps dotted keys to their values (``{"impact.angle": [0, 30, 60]}``); several keys make a
+    grid. Every point is validated before any is solved; a point whose solve fails keeps its row with the
+    error as its status."""
+    import pandas as pd
+
+    if not isinstance(vary, Mapping) or not vary:
+        raise ConfigError("vary", vary, "must be a dict of dotted case keys to lists of values")
+    axes = []
+    for key, values in vary.items():
+        values = [values] if isinstance(values, (str, bytes)) else list(values)
+        if not values:
+            raise ConfigError(f"vary.{key}", values, "must be a non-empty list of values")
+        axes.append((str(key), values))
+    total = math.prod(len(v) for _, v in axes)
+    if total > MAX_POINTS:
+        raise ConfigError("vary", {k: len(v) for k, v in axes}, f"makes a grid of {total} points; at most "
+                                                                 f"{MAX_POINTS}")
+    pairs = _overrides(overrides, keyword)
+    _build(case, pairs)  # the base case must be valid on its own
+    points = []
+    for combo in itertools.product(*(v for _, v in axes)):
+        values = {k: (v.item() if hasattr(v, "item") else v) for (k, _), v in zip(axes, combo)}
+        points.append((values, _build(case, [*pairs, *values.items()])))
+    rows = []
+    for values, c in points:
+        row = dict(values)
+        try:
+            res = collide(c, source=source, method=method, dt=dt)
+            row.update(res.metrics())
+            row["status"] = res.status
+        except ConfigError:
+            raise
+        except DemcheckError as exc:
+            row["status"] = f"error: {exc}"
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path | None = None, jobs: int = 1,
+           cache: bool = True, timeout: float = 600.0) -> dict:
+    """The verification suite over case files (paths of files or directories) → its results dict (the
+    ``results.json`` of a report: ``cases``, each with its ``sources``, ``comparisons`` and ``status``, and
+    ``failed``, the count of failing cases). ``engines``: names, or None for every registered one, or ``()`` /
+    ``"none"`` for the reference alone. ``report``: a directory for the report (``<report>/<run-id>/``), or None
+    to write none."""
+    import shutil
+    import tempfile
+
+    from .comparisons.suite import Options, run_suite
+    from .engines import registry
+
+    names = _engines(engines, registry.names())
+    files = _case_files(paths)
+    opts = Options(engines=names, jobs=int(jobs), timeout=timeout)
+    if cache:
+        from .engines.cache import Cache
+
+        opts.cache = Cache()
+    if report is not None:
+        return run_suite(files, Path(report), opts, quiet=True, argv=["demcheck.verify"])
+    tmp = Path(tempfile.mkdtemp(prefix="demcheck-verify-"))
+    try:
+        out = run_suite(files, tmp, opts, quiet=True, argv=["demcheck.verify"])
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    out["report"] = None
+    return out
+
+
+def _engines(engines, registered) -> tuple[str, ...]:
+    if engines is None:
+        return tuple(registered)
+    if isinstance(engines, str):
+        engines = [] if engines == "none" else [e.strip() for e in engines.split(",") if e.strip()]
+    out = tuple(engines)
+    for e in out:
+        if e not in registered:
+            raise ConfigError("engines", e, f"is not a registered engine ({', '.join(registered)})")
+    return out
+
+
+def _case_files(paths) -> list[Path]:
+    if isinstance(paths, (str, Path)):
+        paths = [paths]
+    files = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            files += sorted(p.rglob("*.toml"))
+        elif p.is_file():
+            files.append(p)
+        else:
+            raise ConfigError("paths", str(p), "no such case file or directory")
+    if not files:
+        raise ConfigError("paths", [str(p) for p in paths], "holds no case file (*.toml)")
+    return files
+
+
+def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:
+    """The audit of a user's own LAMMPS or LIGGGHTS deck (``demcheck audit``) as a dict: per type pair and
+    wall × type the native law, the nearest seed model, the probes (engine, twin, seed model) and the traps
+    with their measured sizes; ``status`` is "clean" or "traps". ``run_engine=False``: the twin only."""
+    from .comparisons.audit import audit as run
+
+    if speed is not None and not (isinstance(speed, (int, float)) and math.isfinite(speed) and speed > 0):
+        raise ConfigError("speed", speed, "must be a number > 0 (m/s)")
+    return run(path, engine=engine, speed=speed, run_engine=run_engine)
+
+
+def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None = None,
+              confirm: bool = True, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword) -> dict:
+    """The native input of ``engine`` that realises ``targets`` (``{"restitution": 0.6}``; also
+    ``tangential_restitution``) for the case's contact at ``dt``: root finding on the engine's twin, confirmed
+    by one engine run (``confirm``). Returns a dict with the input, the line to paste, and the realised
+    values (twin and engine)."""
+    from .comparisons.calibrate import calibrate as run
+
+    c = load(case, overrides, **keyword)
+    return run(c, engine, dict(targets), dt=dt, confirm=confirm)
