@@ -280,8 +280,8 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         try:
             from .engines import registry
 
-            results[src] = run_engine(case, src, dt=dt, timeout=timeout,
-                                      native=registry.get(src).case_native(case))
+            native = registry.get(src).case_native(case) if src in ENGINE_NAMES else None  # [engine.NAME]
+            results[src] = run_engine(case, src, dt=dt, timeout=timeout, native=native)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
                 raise
@@ -818,6 +818,39 @@ def audit(deck_path, engine, speed, as_json, report_dir):
     else:
         click.echo(text)
     if result["traps"]:
+        sys.exit(1)
+
+
+@cli.command()
+@click.argument("case_path", metavar="CASE")
+@click.option("--engine", "engine", type=click.Choice(ENGINE_NAMES), required=True,
+              help="the engine whose native input is calibrated")
+@click.option("--target", "targets", multiple=True, required=True, metavar="METRIC=VALUE",
+              help="a metric to realise: restitution=0.6, tangential_restitution=0.4 (repeatable)")
+@click.option("--dt", type=DT, default=None, help="the engine's time step (s); default: the case's")
+@_set_option
+@click.option("--no-confirm", "no_confirm", is_flag=True, help="the twin only: no confirming engine run")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json):
+    """The native input (the coefficient of restitution or damping an engine reads, k_t, …) that realises a
+    target metric in ENGINE at the run's dt: root finding on the engine's twin, confirmed by one engine run;
+    prints the line to paste. Exit 0: confirmed; 1: the engine run misses the target; 2: bad input."""
+    from .comparisons import calibrate as K
+
+    wanted = {}
+    for item in targets:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ConfigError("--target", item, "must be METRIC=VALUE, e.g. restitution=0.6")
+        wanted[key.strip()] = number(f"--target {key.strip()}", value)
+    K.check_targets(wanted)  # bad input: one line, before any work
+    case = _load(case_path, overrides)
+    result = K.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm)
+    if as_json:
+        emit_json(result)
+    else:
+        click.echo(K.text_report(result))
+    if result["confirmed"] is False:
         sys.exit(1)
 
 

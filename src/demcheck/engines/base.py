@@ -80,6 +80,18 @@ class Mapping:
         return self.native
 
 
+@dataclass
+class Knob:
+    """One native input that ``demcheck calibrate`` turns: its name in the engine's words, the bracket
+    [lo, hi] (hi None: doubled from ``start`` until it brackets), and ``set(x)`` → the Native with that value."""
+
+    name: str
+    lo: float
+    hi: float | None
+    start: float
+    set: object  # Callable[[float], Native]
+
+
 def refused(engine: str, reason: str) -> Mapping:
     """The mapping of a model the engine cannot express, with the one reason why."""
     return Mapping(engine, NONE_, [reason], None)
@@ -162,6 +174,15 @@ class Engine(ABC):
 
         raise ConfigError(f"engine.{self.name}", sorted(table), f"{self.title} takes no native settings in case "
                                                                  "files")
+
+    def knob(self, native: Native, metric: str):
+        """The native input that sets ``metric`` (restitution, tangential_restitution) for ``demcheck
+        calibrate``: a :class:`Knob`, or None when the configuration has none."""
+        return None
+
+    def native_lines(self, native: Native) -> list[str]:
+        """The native configuration as the lines a user pastes into a deck (for a like pair)."""
+        return [self.summary(native)]
 
     def case_native(self, case) -> Native | None:
         """The Native of the case's ``[engine.<name>]`` table (read once per case), or None without one."""

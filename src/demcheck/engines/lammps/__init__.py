@@ -46,6 +46,34 @@ class Lammps(PackageEngine):
         """``[engine.lammps]`` of a case file, read by the deck reader (audit.native_from_case)."""
         return self._part("audit").native_from_case(table, case)
 
+    def knob(self, native: Native, metric: str):
+        """restitution: the damping coefficient (the input e of tsuji and coeff_restitution, in (0, 1]; η0 of
+        velocity, mass_velocity, viscoelastic, from 0); tangential_restitution: k_t of a history model."""
+        from dataclasses import replace
+
+        from ..base import Knob
+
+        if metric == "restitution":
+            if native.damping in ("tsuji", "coeff_restitution"):
+                return Knob(f"damping {native.damping} e", 1e-3, 1.0, native.damping_coeff,
+                            lambda x: replace(native, damping_coeff=x))
+            if native.damping in ("velocity", "mass_velocity", "viscoelastic"):
+                return Knob(f"damping {native.damping} coefficient", 0.0, None, native.damping_coeff or 1.0,
+                            lambda x: replace(native, damping_coeff=x))
+        if metric == "tangential_restitution" and native.tangential != "linear_nohistory":
+            kt = native.tangential_args[0]
+            if kt is None:  # mindlin NULL: 8G* of hertz/material's E and ν
+                e_mod, nu = native.normal_args
+                kt = 8.0 * e_mod / (4.0 * (2.0 - nu) * (1.0 + nu))
+            return Knob(f"tangential {native.tangential} k_t", kt * 1e-3, kt * 1e3, kt,
+                        lambda x: replace(native, tangential_args=(x, *native.tangential_args[1:])))
+        return None
+
+    def native_lines(self, native: Native) -> list[str]:
+        from .deck import coeff_args
+
+        return [f"pair_coeff * * {coeff_args(native)}"]
+
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/local dist force p4`` after the two ids: centre distance, Fn (repulsive > 0), |Ft|."""
         return radius[i] + radius[j] - v[:, 2], v[:, 3], v[:, 4]

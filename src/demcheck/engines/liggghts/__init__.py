@@ -52,6 +52,32 @@ class Liggghts(PackageEngine):
         """``[engine.liggghts]`` of a case file, read by the deck reader (audit.native_from_case)."""
         return self._part("audit").native_from_case(table, case)
 
+    def knob(self, native: Native, metric: str):
+        """restitution: coefficientRestitution (hertz, hooke; in (0, 1]) or gamman (the stiffness models)."""
+        from dataclasses import replace
+
+        from ..base import Knob
+
+        if metric != "restitution":
+            return None
+        if native.normal in ("hertz", "hooke"):
+            return Knob("coefficientRestitution", 1e-3, 1.0, native.props.get("restitution", 0.5),
+                        lambda x: replace(native, props={**native.props, "restitution": x}))
+        if native.normal in ("hooke/stiffness", "hertz/stiffness"):
+            return Knob("gamman", 0.0, None, native.props.get("gamman") or 1.0,
+                        lambda x: replace(native, props={**native.props, "gamman": x}))
+        return None
+
+    def native_lines(self, native: Native) -> list[str]:
+        from .deck import NAMES, fmt
+
+        lines = [f"pair_style gran {self.summary(native)}"]
+        for key in ("restitution", "friction", "kn", "kt", "gamman", "gammat"):
+            if key in native.props and (native.props[key] or key in ("restitution", "friction")):
+                lines.append(f"fix m_{key} all property/global {NAMES[key]} peratomtypepair 1 "
+                             f"{fmt(native.props[key])}")
+        return lines
+
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """``compute pair/gran/local id force force_normal delta``: id1 id2 periodic-flag, the force on the
         first (3), its normal part (3), the overlap. Fn is signed from the positions ``x`` (minimum image in

@@ -1,0 +1,82 @@
+"""demcheck calibrate: the native input that realises a target in an engine at its dt (Brent's method on the
+twin, confirmed by one engine run)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import demcheck
+from demcheck.comparisons.calibrate import ROOT_TOL
+from demcheck.errors import ConfigError
+
+from .test_native import TSUJI, _case, to_toml, tsuji_restitution
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_tsuji_twin_calibration_inverts_the_law():
+    # the twin's root: an input e below 0.6 (tsuji realises more than it is given), realising 0.6 to the root
+    # tolerance; independently, the input's converged realised e lies near 0.6 too (the time step's error apart)
+    r = demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), "lammps", {"restitution": 0.6}, confirm=False)
+    e = r["inputs"]["restitution"]
+    assert e["from"] == 0.6 and e["to"] < 0.6 and abs(e["twin"] - 0.6) <= ROOT_TOL
+    assert abs(tsuji_restitution(e["to"]) - 0.6) < 5e-4
+    assert "damping tsuji" in r["lines"][0] and r["lines"][0].startswith("pair_coeff * * hertz/material")
+    assert r["confirmed"] is None
+
+
+@pytest.mark.engine("lammps")
+def test_lammps_tsuji_calibration_is_confirmed_by_the_engine(tmp_path):
+    f = tmp_path / "tsuji.toml"
+    f.write_text(to_toml(_case({"lammps": {"pair_coeff": TSUJI}})))
+    p = subprocess.run([sys.executable, "-m", "demcheck", "calibrate", str(f), "--engine", "lammps", "--target",
+                        "restitution=0.6", "--json"], capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 0, p.stderr
+    import json
+
+    r = json.loads(p.stdout)
+    e = r["inputs"]["restitution"]
+    assert e["to"] < 0.6 and abs(e["engine"] - 0.6) <= ROOT_TOL and r["confirmed"] is True
+    # the pasted line, read back as a case's native setting, realises the target in the engine
+    line = r["lines"][0].removeprefix("pair_coeff * * ")
+    again = demcheck.collide(_case({"lammps": {"pair_coeff": line}}), source="lammps", dt=r["dt"])
+    assert abs(again.metrics()["restitution"] - 0.6) <= ROOT_TOL
+
+
+def test_liggghts_limitforce_calibration_lowers_the_input():
+    case = _case({"liggghts": {"pair_style": "gran model hertz tangential history limitForce on"}})
+    r = demcheck.calibrate(case, "liggghts", {"restitution": 0.6}, confirm=False)
+    e = r["inputs"]["restitution"]
+    assert e["to"] < 0.6 and abs(e["twin"] - 0.6) <= ROOT_TOL
+    assert any(x.startswith("fix m_restitution all property/global coefficientRestitution") for x in r["lines"])
+
+
+@pytest.mark.parametrize("engine, targets, key", [
+    ("lammps", {"restitution": 1.5}, "--target restitution"),
+    ("lammps", {"restitution": "0.6"}, "--target restitution"),
+    ("lammps", {"restitutio": 0.6}, "--target"),
+    ("lammps", {}, "--target"),
+    ("lammpz", {"restitution": 0.6}, "--engine"),
+    ("lammps", {"tangential_restitution": 0.3}, "--target tangential_restitution"),
+])
+def test_bad_calibration_input_is_one_config_error(engine, targets, key):
+    with pytest.raises(ConfigError) as err:
+        demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), engine, targets, confirm=False)
+    assert err.value.key == key, str(err.value)
+
+
+def test_an_unreachable_target_says_so():
+    # an input e in [0.001, 1] of tsuji realises at least about 0.4 at a wall: 0.05 is out of reach
+    with pytest.raises(ConfigError) as err:
+        demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), "lammps", {"restitution": 0.05}, confirm=False)
+    assert "out of reach" in err.value.rule
+
+
+def test_cli_bad_target_exits_2_before_any_work(tmp_path):
+    p = subprocess.run([sys.executable, "-m", "demcheck", "calibrate", "cases/glass-pair.toml", "--engine", "lammps",
+                        "--target", "restitution"], capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 2 and "--target" in p.stderr and p.stderr.strip().count("\n") == 0
