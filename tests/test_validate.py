@@ -2,11 +2,11 @@
 ability to fail (a planted wrong paper value), and one benchmark end to end (engines by their markers)."""
 
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
 
-import os
 import pytest
 
 from demcheck.case import expand
@@ -90,6 +90,23 @@ def test_a_nan_is_never_a_match():
                                        "restitution": 0.98}})]}
     checks, _ = VA.judge(b, rows)
     assert all(c["verdict"] != VA.MEETS for c in checks if c["quantity"] == "et")
+
+
+def test_an_engine_that_cannot_express_the_model_is_no_source_but_a_failed_run_misses():
+    """Kratos without the law (not expressible) and a missing Yade are left out; a failed LAMMPS run misses every
+    limit (a failed run is never agreement, nor 'no data')."""
+    b = VA.by_name("chung-ooi-1")[0]
+    path = ROOT / "chung-ooi-1-glass.toml"
+    (case,) = expand(path)
+    ok = {"status": "ok", "metrics": collide(case, "adaptive").metrics()}
+    summary = {"cases": [{"case": case.name, "sources": {
+        "reference": ok, "lammps": {"status": "failed", "message": "boom"},
+        "kratos": {"status": "not expressible", "message": "no such law"},
+        "yade": {"status": "engine missing", "message": "not installed"}}}]}
+    val = VA.validate(summary, [b], {b.name: [path]}, opts=None)
+    assert {c["source"] for c in val["checks"]} == {"reference", "lammps"}
+    assert {(c["verdict"], c["deviation"]) for c in val["checks"] if c["source"] == "lammps"} == {(VA.MISSES, math.inf)}
+    assert {c["verdict"] for c in val["checks"] if c["source"] == "reference"} == {VA.MEETS}
 
 
 def test_every_data_file_names_its_source_and_reads():

@@ -349,6 +349,9 @@ def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float] | None:
     return worst
 
 
+_NOT_A_SOURCE = ("not expressible", "engine missing")  # comparisons/verdicts.py's statuses of a source left out
+
+
 def _source_metrics(entry: dict, source: str) -> dict | None:
     s = entry["sources"].get(source) or {}
     if s.get("status") != "ok" or "metrics" not in s:
@@ -403,12 +406,12 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     tol = lim.tol_reference if src == "reference" else lim.tol_engine
     worst, at, n, tol_at = None, None, 0, tol
     for imp, ms in rows:
-        m = ms.get(src)
-        if m is None or not lim.applies(imp):
+        if src not in ms or not lim.applies(imp):
             continue
+        m = ms[src]  # None: the run failed, which never meets a limit
         y = _value(fn, m, imp)
         try:
-            exact = lim.value(imp, m)
+            exact = lim.value(imp, m) if m is not None else None
         except (KeyError, ZeroDivisionError, TypeError):
             exact = None
         n += 1
@@ -416,7 +419,7 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
             worst, at = math.inf, X_AXES[bench.x][1](imp)  # a NaN is never an agreement
             break
         d = abs(y - exact) / max(lim.scale(imp, exact), 1e-300)
-        allowed = tol + (m.get("max_overlap", 0.0) / imp.radius if lim.arm else 0.0)
+        allowed = tol + (m.get("max_overlap", 0.0) / imp.radius if lim.arm else 0.0)  # m: not None here
         if worst is None or d / allowed > worst / tol_at:
             worst, at, tol_at = d, X_AXES[bench.x][1](imp), allowed
     verdict = NO_DATA if n == 0 else (MEETS if worst <= tol_at else MISSES)
@@ -482,9 +485,9 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
                     continue
                 imp = impact_of(case)
                 ms = {}
-                for src in entry.get("sources", {}):
-                    if src == "reference-verlet":
-                        continue
+                for src, got in entry.get("sources", {}).items():
+                    if src == "reference-verlet" or got.get("status") in _NOT_A_SOURCE:
+                        continue  # an engine that cannot express the model is no source here (a failed run is)
                     m = _source_metrics(entry, src)
                     if m is not None:
                         m["_pair"] = resolve(case).pair
