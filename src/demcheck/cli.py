@@ -251,9 +251,9 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
 
 @cli.command()
 @click.argument("case_path", metavar="CASE")
-@click.option("--engine", "engine", type=click.Choice(["reference", *ENGINE_NAMES, "all"]),
-              default="reference", show_default=True,
-              help="the source(s): the reference, an engine (its deck run for real), or all side by side")
+@click.option("--engine", "engine", default="reference", show_default=True, metavar="SOURCE[,SOURCE…]",
+              help=f"the source(s): reference, an engine ({', '.join(ENGINE_NAMES)}: its deck run for real), a build "
+                   "of one (ENGINE=PATH, or ENGINE@LABEL=PATH beside it), a comma-separated list side by side, or all")
 @click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
               help="reference method (default: the case's run.method, adaptive)")
 @click.option("--dt", type=DT, default=None, help="time step of the verlet method and of the engines (s)")
@@ -268,8 +268,20 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
     from .errors import EngineNotFound, UnsupportedByEngine
     from .reference.collision import collide as run
 
+    if engine == "all":
+        sources = ["reference", *ENGINE_NAMES]
+    else:  # the reference and engines or builds (engines/builds.py), each checked before any work
+        from .engines import discovery
+
+        specs = [s.strip() for s in engine.split(",") if s.strip()]
+        if not specs:
+            raise ConfigError("--engine", engine, "must name a source: reference, an engine, a build or all")
+        rest = [s for s in specs if s != "reference"]
+        labels = iter(discovery.resolve(",".join(rest), "--engine") if rest else [])
+        sources = ["reference" if s == "reference" else next(labels) for s in specs]
+        if len(sources) == 1:
+            engine = sources[0]
     case = _load(case_path, overrides)
-    sources = ["reference", *ENGINE_NAMES] if engine == "all" else [engine]
     results, skipped = {}, {}
     for src in sources:
         if src == "reference":
@@ -451,8 +463,9 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
 @cli.command()
 @click.argument("paths", nargs=-1, metavar="[CASE|DIR]...")
 @click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
-              help=f"comma-separated engines to compare ({', '.join(ENGINE_NAMES)}), or 'none' for the reference "
-                   "alone")
+              help=f"comma-separated engines to compare ({', '.join(ENGINE_NAMES)}), builds of one beside it "
+                   "(ENGINE@LABEL=PATH, e.g. lammps@2024=/opt/lammps-2024/bin/lmp; ENGINE=PATH replaces its "
+                   "executable), or 'none' for the reference alone")
 @click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
               help="cases run in parallel")
 @click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True,
@@ -475,13 +488,15 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, 
     from .engines import run as runner
     from .engines.cache import Cache, default_dir
 
-    names = _engine_list(engines)
+    from .comparisons import diff as D, verdicts as V
+    from .engines import builds, discovery
+
+    names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)
-    from .comparisons import diff as D
-
     base = D.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
-    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout, baseline=base)
+    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout, baseline=base,
+                   expected=builds.expected_for(V.load_expected(), names))
     try:
         summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
                             argv=["demcheck", "verify", *sys.argv[2:]])

@@ -182,8 +182,10 @@ def compare(old: dict, new: dict, tolerance: float | None = None, rename: dict |
         if o["hash"] and n["hash"] and o["hash"] != n["hash"]:
             changed_cases.append(case)
         scales = n["scales"] or o["scales"]
-        o_sources = {rename.get(s, s): (s, v) for s, v in o["sources"].items()}
-        o_verdicts = {rename.get(s, s): v for s, v in o["verdicts"].items()}
+        # a renamed source takes the place of OLD's own source of that name
+        targets = set(rename.values())
+        o_sources = {rename.get(s, s): (s, v) for s, v in o["sources"].items() if s in rename or s not in targets}
+        o_verdicts = {rename.get(s, s): v for s, v in o["verdicts"].items() if s in rename or s not in targets}
         for src in sorted(set(o_sources) | set(n["sources"]) | set(o_verdicts) | set(n["verdicts"])):
             old_name, os_ = o_sources.get(src, (src, None))
             ns = n["sources"].get(src)
@@ -231,7 +233,8 @@ def _about(run: dict) -> dict:
 
 
 def _engines(old: dict, new: dict, rename: dict) -> dict:
-    o = {rename.get(k, k): v for k, v in old["engines"].items()}
+    targets = set(rename.values())
+    o = {rename.get(k, k): v for k, v in old["engines"].items() if k in rename or k not in targets}
     return {k: {"old": o.get(k), "new": new["engines"].get(k)} for k in [*o, *(k for k in new["engines"] if k not in o)]}
 
 

@@ -1,6 +1,7 @@
 """The engine-run cache: an engine never runs the same deck twice.
 
-Key: SHA-256 of the engine's name and version, the deck and the files it reads. Value: the parsed dump
+Key: SHA-256 of the source's name (an engine, or a build's label) and version (a build with its own
+executable also its binary's identity, engines/builds.py), the deck and the files it reads. Value: the parsed dump
 (every column, float64) and the run's metadata, in one ``.npz`` written atomically, so an interrupted run
 never leaves a half-written entry. Location: ``$DEMCHECK_CACHE``, else ``~/.cache/demcheck/engine-runs``.
 
@@ -36,8 +37,15 @@ def default_dir() -> Path:
 
 
 def key(engine: str, version: str, deck: str, files: dict[str, str]) -> str:
+    """The entry of a deck run by ``engine`` (a source's name: an engine, or a build's label) at ``version``;
+    a build with its own executable (engines/builds.py) adds its binary's path, size and modification time,
+    so a rebuilt binary that prints the same version never reads the old build's runs."""
+    from .builds import identity
+
     h = hashlib.sha256()
-    for part in (engine, version, deck, *(f"{n}\0{t}" for n, t in sorted(files.items()))):
+    build = identity(engine)
+    for part in (engine, version, *((build,) if build else ()), deck,
+                 *(f"{n}\0{t}" for n, t in sorted(files.items()))):
         h.update(part.encode())
         h.update(b"\0\0")
     return h.hexdigest()

@@ -92,6 +92,32 @@ def find(name: str) -> EngineInfo | None:
     return None
 
 
+def resolve(text: str, key: str = "--engines") -> list[str]:
+    """The sources of an ``--engines`` list: engines and builds (``lammps,lammps@2024=/opt/lmp-2024/lmp``,
+    engines/builds.py), each build registered under its label and its version read from its own binary
+    before any work; a build whose executable prints no banner of its engine is a ConfigError naming
+    ``key``. Returns the labels, in order."""
+    from ..errors import ConfigError
+    from . import builds
+
+    labels = []
+    for b in builds.parse_list(text, key):
+        labels.append(builds.register(b))
+        find.cache_clear()  # the label may have named another executable before
+        if b.executable is not None and find(b.label) is None:
+            drop(b.label)
+            raise ConfigError(key, f"{b.label}={b.executable}", f"is not a usable {b.engine} build: {_WHY.get(b.label, '')}")
+    return labels
+
+
+def drop(label: str) -> None:
+    """Remove a build registered by ``resolve`` and forget the versions found."""
+    from . import builds
+
+    builds.unregister(label)
+    find.cache_clear()
+
+
 def missing(name: str) -> str:
     """Why ``name`` cannot run: not installed (and how to install it), or the candidates that failed."""
     why = _WHY.get(name)
