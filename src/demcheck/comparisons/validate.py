@@ -149,7 +149,9 @@ class Limit:
     tol_reference: float
     tol_engine: float
     why: str
-    arm: bool = False  # a spin: the seed's torque arm R − δ/2 departs from the rigid body's R by δ_max/(2R)
+    # the size of the limit's spin part in its scale's units (0: no spin in it): the seed's torque arm R − δ/2
+    # departs from the rigid body's R, which moves a spin by up to δ_max/(2R) of it (0.39 δ_max/R measured)
+    arm: Callable[[Impact, dict], float] | None = None
 
 
 def _hertz(metric: str):
@@ -172,6 +174,10 @@ def _sliding(c: Impact) -> bool:
 
 
 # gross sliding: the tangential impulse is μ (1 + e') m v_n, e' the source's own restitution
+def _WHOLE(c, m) -> float:
+    return 1.0
+
+
 _SLIDE_WHY = ("rigid-body gross sliding (tangential impulse μ(1+e')m v_n): where the law slides throughout, "
               "met to 1e-4 by the reference (the laws' uncapped attractive normal force at the end of contact "
               "moves it by ~1e-5) and 1e-2 by the engines (their time step); spins also by δ_max/R (torque arm "
@@ -181,17 +187,21 @@ SLIDE_ET = Limit("et", "gross sliding e_t = 1 − μ(1+e')/tanθ",
                  1e-4, 1e-2, _SLIDE_WHY)
 SLIDE_SPIN = Limit("spin_paper", "gross sliding ω' = −2.5 μ(1+e') v_n/R",
                    lambda c, m: -2.5 * c.mu * (1 + m["restitution"]) * c.vn / c.radius, _sliding,
-                   lambda c, v: abs(v), 1e-4, 1e-2, _SLIDE_WHY, arm=True)
+                   lambda c, v: abs(v), 1e-4, 1e-2, _SLIDE_WHY, arm=_WHOLE)
 T5_ANGLE = Limit("t5_angle", "gross sliding v'_c/(μ v'_n) = (ψ − 3.5(1+e'))/e'",
                  lambda c, m: (c.vt / (c.mu * c.vn) - 3.5 * (1 + m["restitution"])) / m["restitution"], _sliding,
-                 lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY)
+                 lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; the contact point's velocity carries R ω'",
+                 arm=lambda c, m: 2.5 * (1 + m["restitution"]) / m["restitution"])
 T5_SPIN = Limit("t5_spin", "gross sliding R ω'/(μ v_n) = −2.5(1+e')", lambda c, m: -2.5 * (1 + m["restitution"]),
-                _sliding, lambda c, v: 2.5 * (1 + c.e), 1e-4, 1e-2, _SLIDE_WHY, arm=True)
+                _sliding, lambda c, v: 2.5 * (1 + c.e), 1e-4, 1e-2, _SLIDE_WHY,
+                arm=lambda c, m: (1 + m["restitution"]) / (1 + c.e))
 PSI2 = Limit("psi2", "Ψ2 = Ψ1 − 3.5(1+e')·2/(1+e)",
              lambda c, m: 2 * c.vt / (c.mu * (1 + c.e) * c.vn) - 7 * (1 + m["restitution"]) / (1 + c.e),
-             _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; Ψ2 = Ψ1 − 7 when e' = e")
+             _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; Ψ2 = Ψ1 − 7 when e' = e; Ψ2 carries Ω",
+             arm=lambda c, m: 5 * (1 + m["restitution"]) / (1 + c.e))
 OMEGA = Limit("omega", "Ω = −5(1+e')/(1+e)", lambda c, m: -5 * (1 + m["restitution"]) / (1 + c.e), _sliding,
-              lambda c, v: 5.0, 1e-4, 1e-2, _SLIDE_WHY + "; |Ω| = 5 when e' = e", arm=True)
+              lambda c, v: 5.0, 1e-4, 1e-2, _SLIDE_WHY + "; |Ω| = 5 when e' = e",
+              arm=lambda c, m: (1 + m["restitution"]) / (1 + c.e))
 
 
 def _spin_slide(c: Impact) -> bool:
@@ -201,7 +211,8 @@ def _spin_slide(c: Impact) -> bool:
 
 BETA = Limit("beta", "gross sliding β = 3.5μ(1+e')v_n/(Rω0) − 1",
              lambda c, m: 3.5 * c.mu * (1 + m["restitution"]) * c.vn / (c.radius * c.spin) - 1, _spin_slide,
-             lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY)
+             lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; β carries 1.4 ω'/ω0",
+             arm=lambda c, m: 1.4 * abs(m["rebound_angular_velocity"]) / c.spin)
 GIVEN_E = Limit("restitution", "e' = the given e", lambda c, m: c.e, lambda c: c.normal != "tti", lambda c, v: 1.0,
                 1e-6, 1e-2, "a law calibrated to the restitution it is given returns it: exact for LSDn and HLS "
                 "(reference 1e-6: its events); engines 1e-2 (their time step)")
@@ -419,7 +430,7 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
             worst, at = math.inf, X_AXES[bench.x][1](imp)  # a NaN is never an agreement
             break
         d = abs(y - exact) / max(lim.scale(imp, exact), 1e-300)
-        allowed = tol + (m.get("max_overlap", 0.0) / imp.radius if lim.arm else 0.0)  # m: not None here
+        allowed = tol + (lim.arm(imp, m) * m.get("max_overlap", 0.0) / imp.radius if lim.arm else 0.0)
         if worst is None or d / allowed > worst / tol_at:
             worst, at, tol_at = d, X_AXES[bench.x][1](imp), allowed
     verdict = NO_DATA if n == 0 else (MEETS if worst <= tol_at else MISSES)
