@@ -135,6 +135,17 @@ def test_unknown_benchmark_is_one_line_exit_2():
     assert r.returncode == 2 and "NAME = 'nope'" in r.stderr and len(r.stderr.strip().splitlines()) == 1
 
 
+def test_validate_summary_and_report_are_titled_validate(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "demcheck", "validate", "chung-ooi-1", "--engines", "none", "--report",
+                        str(tmp_path)], capture_output=True, text=True, timeout=600,
+                       env={**os.environ, "DEMCHECK_CACHE": str(tmp_path / "cache"), "COLUMNS": "200"})
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "demcheck validate: 2 of 2" in r.stderr and "demcheck verify" not in r.stderr  # the title wraps
+    assert "validation: limit meets: 6" in r.stderr
+    html = (tmp_path / "latest" / "report.html").read_text()
+    assert "<title>demcheck validate " in html and "<title>demcheck verify" not in html
+
+
 def test_validate_test7_reads_the_final_spin(tmp_path):
     """demcheck validate chung-ooi-7 in the reference (the engines' end-to-end run is the test below): Test 7's
     ω' = ω0 is read from each source's final spin (not a metric), for every file."""

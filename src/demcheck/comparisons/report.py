@@ -498,7 +498,8 @@ def _panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_
 def render_html(summary: dict) -> str:
     esc = html.escape
     parts = ["<!doctype html><html><head><meta charset='utf-8'>",
-             f"<title>demcheck verify {esc(summary['run_id'])}</title><style>{_STYLE}</style>{_SCRIPT}</head><body>",
+             f"<title>demcheck {'validate' if summary.get('validation') else 'verify'} {esc(summary['run_id'])}</title>"
+             f"<style>{_STYLE}</style>{_SCRIPT}</head><body>",
              f"<h1>demcheck verification {esc(summary['run_id'])}</h1>"]
     if summary["partial"]:
         parts.append(f"<p class='partial'>PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of "

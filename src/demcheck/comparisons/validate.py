@@ -21,6 +21,7 @@ reference missing an exact limit, or a run that failed, fails the command (exit 
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 from dataclasses import dataclass
@@ -515,6 +516,37 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
     return out
 
 
+class _Retitled:
+    """A console whose tables titled "demcheck verify…" print as ``title``…; everything else passes through."""
+
+    def __init__(self, console, title: str):
+        self._console, self._title = console, title
+
+    def print(self, *objects, **kwargs):
+        from rich.table import Table
+
+        for o in objects:
+            if isinstance(o, Table) and isinstance(o.title, str) and o.title.startswith("demcheck verify"):
+                o.title = self._title + o.title[len("demcheck verify"):]
+        self._console.print(*objects, **kwargs)
+
+    def __getattr__(self, name):
+        return getattr(self._console, name)
+
+
+@contextlib.contextmanager
+def _titled(title: str):
+    """The suite's closing summary table titled for this command (suite.run_suite prints it as verify's)."""
+    from . import suite
+
+    printer = suite._print
+    suite._print = lambda console, summary: printer(_Retitled(console, title), summary)
+    try:
+        yield
+    finally:
+        suite._print = printer
+
+
 def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, junit=None, argv=None) -> dict:
     """Run the benchmarks' case files through the suite, judge them, and rewrite the run's report with the
     validation section."""
@@ -528,7 +560,8 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
         from ..errors import ConfigError
 
         raise ConfigError("NAME", names or "(all)", f"no benchmark case files in {root}")
-    summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv)
+    with _titled("demcheck validate"):
+        summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv)
     summary["validation"] = validate(summary, benches, files, opts)
     summary["failed"] += len(summary["validation"]["failed"])
     report.write_all(summary, Path(summary["report"]), report_root, junit=junit)
