@@ -292,7 +292,10 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         try:
             from .engines import registry
 
-            native = registry.get(src).case_native(case) if src in ENGINE_NAMES else None  # [engine.NAME]
+            from .engines.builds import engine_of
+
+            # [engine.NAME] (a build reads its engine's table)
+            native = registry.get(src).case_native(case) if engine_of(src) in ENGINE_NAMES else None
             results[src] = run_engine(case, src, dt=dt, timeout=timeout, native=native)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
