@@ -1,4 +1,4 @@
-"""Metrics: pure functions of a Result, named as in DESIGN.md.
+"""Metrics: pure functions of a Result's series (its arrays: ``Result.table``), named as in DESIGN.md.
 
 Where the Result has exact events (adaptive method) they are used; otherwise the metrics are read off the
 time series the same way for every time-stepped source (the reference's verlet method and the engines):
@@ -18,10 +18,11 @@ TANGENTIAL_METRICS = ("tangential_restitution", "rebound_angle", "rebound_angula
 
 
 def _event(events, name):
-    if events is None or events.empty:
+    """The first event called ``name`` as {column: value}, or None."""
+    if not events or not len(events["event"]):
         return None
-    rows = events[events["event"] == name]
-    return None if rows.empty else rows.iloc[0]
+    rows = np.flatnonzero(np.asarray(events["event"]) == name)
+    return None if not rows.size else {k: v[rows[0]] for k, v in events.items()}
 
 
 def _crossing(t, y, k):
@@ -33,16 +34,16 @@ def _crossing(t, y, k):
 
 
 def compute(result) -> dict:
-    c = result.contact
+    c = result.table("contact")
     nan = math.nan
     out = {name: nan for name in NORMAL_METRICS}
-    if c is None or c.empty:
+    if not c or not len(c["t"]):
         return out
-    t = c["t"].to_numpy()
-    d = c["delta"].to_numpy()
-    r = c["delta_dot"].to_numpy()
-    f = c["fn"].to_numpy()
-    ev = result.events
+    t = np.asarray(c["t"], dtype=float)
+    d = np.asarray(c["delta"], dtype=float)
+    r = np.asarray(c["delta_dot"], dtype=float)
+    f = np.asarray(c["fn"], dtype=float)
+    ev = result.table("events")
     start, end = _event(ev, "contact_start"), _event(ev, "contact_end")
 
     inside = np.flatnonzero(d > 0)
@@ -73,7 +74,7 @@ def compute(result) -> dict:
     fe = _event(ev, "force_end")
     if fe is not None:
         out["force_contact_time"] = float(fe["t"]) - t_s
-    elif ev is not None and not ev.empty:
+    elif ev and len(ev["event"]):
         out["force_contact_time"] = out["contact_time"]
     else:
         # the force ends where it first drops to ≤ 0 while the bodies still overlap; else with the overlap
@@ -90,14 +91,14 @@ def compute(result) -> dict:
     out["peak_force"] = float(np.max(f[window]))
     k_in = _row_at(t, t_s, k_s, start is not None, before=True)
     k_out = _row_at(t, t_e, k_e, end is not None, before=False)
-    if "energy" in c.columns and k_out is not None:
-        e = c["energy"].to_numpy()
+    if "energy" in c and k_out is not None:
+        e = c["energy"]
         out["energy_dissipated"] = float(e[k_in] - e[k_out])
     else:
         m_eff = result.params.get("m_eff")
         if m_eff is not None:
             out["energy_dissipated"] = 0.5 * m_eff * (v_in * v_in - v_out * v_out)
-    if "vrx" in c.columns:
+    if "vrx" in c:
         out.update(tangential(c, k_in, k_out))
     return out
 
@@ -112,8 +113,12 @@ def _row_at(t, t_x, k, exact: bool, before: bool):
     return max(k - 1, 0) if before else k
 
 
+def _vectors(c, prefix: str, k: int) -> np.ndarray:
+    return np.array([c[prefix + "x"][k], c[prefix + "y"][k], c[prefix + "z"][k]], dtype=float)
+
+
 def tangential(c, k_in: int, k_out: int | None) -> dict:
-    """Tangential metrics from the relative velocity of the centres (v0 − v1, or v0 at a wall) and the spin
+    """Tangential metrics (``c``: the contact table's arrays, or a DataFrame) from the relative velocity of the centres (v0 − v1, or v0 at a wall) and the spin
     of body 0, decomposed on the contact normal n at impact:
 
     * tangential_restitution = (v_out·t̂)/(v_in·t̂), t̂ the direction of v_in's tangential part (1 when the
@@ -125,9 +130,10 @@ def tangential(c, k_in: int, k_out: int | None) -> dict:
     out = {k: nan for k in TANGENTIAL_METRICS}
     if k_out is None:
         return out
-    n = c[["nx", "ny", "nz"]].to_numpy()[k_in]
-    vr = c[["vrx", "vry", "vrz"]].to_numpy()
-    v_in, v_out = vr[k_in], vr[k_out]
+    if not isinstance(c, dict):
+        c = {k: c[k].to_numpy() for k in c.columns}
+    n = _vectors(c, "n", k_in)
+    v_in, v_out = _vectors(c, "vr", k_in), _vectors(c, "vr", k_out)
     vt_in = v_in - (v_in @ n) * n
     vt_out = v_out - (v_out @ n) * n
     out["rebound_angle"] = math.degrees(math.atan2(float(np.linalg.norm(vt_out)), float(-(v_out @ n))))
@@ -136,13 +142,13 @@ def tangential(c, k_in: int, k_out: int | None) -> dict:
     if speed_t > 1e-12 * scale:
         t_hat = vt_in / speed_t
         out["tangential_restitution"] = float(vt_out @ t_hat) / speed_t
-    elif {"vtx", "vty", "vtz"} <= set(c.columns):
-        slip = c[["vtx", "vty", "vtz"]].to_numpy()[k_in]
+    elif {"vtx", "vty", "vtz"} <= c.keys():
+        slip = _vectors(c, "vt", k_in)
         s = float(np.linalg.norm(slip))
         t_hat = slip / s if s > 1e-12 * max(scale, 1e-300) else None
     else:
         t_hat = None
-    if t_hat is not None and {"w0x", "w0y", "w0z"} <= set(c.columns):
-        w_out = c[["w0x", "w0y", "w0z"]].to_numpy()[k_out]
+    if t_hat is not None and {"w0x", "w0y", "w0z"} <= c.keys():
+        w_out = _vectors(c, "w0", k_out)
         out["rebound_angular_velocity"] = float(w_out @ np.cross(t_hat, n))
     return out

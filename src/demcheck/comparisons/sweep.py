@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..case import load, parse_value
+from ..case import _read, apply_overrides, from_dict, parse_value
 from ..errors import ConfigError, DemcheckError
 from ..reference.collision import collide
 
@@ -52,11 +52,12 @@ def sweep_points(case_path, overrides, varies: list[str]) -> list[tuple[dict, ob
     total = math.prod(len(vals) for _, vals in axes)
     if total > MAX_POINTS:
         raise ConfigError("--vary", " ".join(varies), f"makes a grid of {total} points; at most {MAX_POINTS}")
-    load(case_path, list(overrides))  # the base case must be valid on its own
+    raw = _read(case_path)  # the file is read once
+    from_dict(apply_overrides(raw, list(overrides)))  # the base case must be valid on its own
     points = []
     for point in itertools.product(*[vals for _, vals in axes]):
         sets = list(overrides) + [f"{k}={_text(v)}" for k, v in zip(keys, point)]
-        points.append((dict(zip(keys, point)), load(case_path, sets)))
+        points.append((dict(zip(keys, point)), from_dict(apply_overrides(raw, sets))))
     return points
 
 

@@ -17,7 +17,6 @@ import math
 import time
 
 import numpy as np
-import pandas as pd
 
 from ..case import Case
 from ..errors import ConfigError
@@ -90,10 +89,10 @@ def collide(case: Case, method: str | None = None, dt: float | None = None,
         out = kernels.adaptive_normal(law, m, geo.an, geo.delta0, geo.rate0, rtol, t_c, v * t_c, v, t_max,
                                       1_000_000)
         status, n, T, D, R, F, ne, ET, EC, ED, ER, EF = out
-        events = pd.DataFrame({
-            "t": ET, "event": [kernels.EVENT_NAMES.get(abs(int(c)), "?") if c > 0 else "force_end_again"
-                               for c in EC],
-            "delta": ED, "delta_dot": ER, "fn": EF})
+        events = {
+            "t": ET, "event": np.array([kernels.EVENT_NAMES.get(abs(int(c)), "?") if c > 0 else "force_end_again"
+                                        for c in EC], dtype=object),
+            "delta": ED, "delta_dot": ER, "fn": EF}
         used_dt = None
     else:
         dt_given = bool(dt)
@@ -105,27 +104,28 @@ def collide(case: Case, method: str | None = None, dt: float | None = None,
         events = None
         used_dt, rtol = dt, None
     wall_time = time.perf_counter() - started
-    contact = pd.DataFrame({"t": T, "delta": D, "delta_dot": R, "fn": F})
+    contact = {"t": T, "delta": D, "delta_dot": R, "fn": F}
+    particles = _particles_1d(case, geo, contact)
+    _add_frame_columns(contact, particles, case, geo)
     status_name = STATUS[status]
     result = Result(
         source="reference", method=method, case_name=case.name, case_hash=case.hash,
-        model=model.describe(), params=dict(model.params), contact=contact, events=events,
+        model=model.describe(), params=dict(model.params), contact=contact, particles=particles, events=events,
         dt=used_dt, rtol=rtol, wall_time=wall_time, status=status_name,
         message=MESSAGES.get(status_name, ""),
         meta={"solver": "1d-normal", "steps": int(n), "radius0": radius},
     )
-    result.particles = _particles_1d(case, geo, contact)
-    _add_frame_columns(result, case, geo)
     return judge(result, case, model)
 
 
-def _particles_1d(case: Case, geo: Geometry1D, contact: pd.DataFrame) -> pd.DataFrame:
+def _particles_1d(case: Case, geo: Geometry1D, contact: dict) -> dict:
     """Rebuild both bodies' centres and velocities from the 1-D solution (the centre of mass of a pair
-    moves uniformly; a particle keeps its velocity along a wall)."""
-    t = contact["t"].to_numpy()
-    d = contact["delta"].to_numpy()
-    r = contact["delta_dot"].to_numpy()
-    frames = []
+    moves uniformly; a particle keeps its velocity along a wall): the particles table's arrays, body 0's
+    rows first."""
+    t = contact["t"]
+    d = contact["delta"]
+    r = contact["delta_dot"]
+    bodies = []
     p0 = case.particles[0]
     x0, v0 = np.asarray(p0.position), np.asarray(p0.velocity)
     g = np.asarray(case.run.gravity)
@@ -134,7 +134,7 @@ def _particles_1d(case: Case, geo: Geometry1D, contact: pd.DataFrame) -> pd.Data
         gt = g - (g @ geo.n) * geo.n
         pos = x0 + np.outer(t, vt) + 0.5 * np.outer(t * t, gt) + np.outer(d - geo.delta0, geo.n)
         vel = vt + np.outer(t, gt) + np.outer(r, geo.n)
-        frames.append(_frame(t, 0, pos, vel, p0.angular_velocity))
+        bodies.append((pos, vel, p0.angular_velocity))
     else:
         p1 = case.particles[1]
         m0, m1 = case.mass(0), case.mass(1)
@@ -145,26 +145,27 @@ def _particles_1d(case: Case, geo: Geometry1D, contact: pd.DataFrame) -> pd.Data
         com = xc + np.outer(t, vc) + 0.5 * np.outer(t * t, g)
         vcom = vc + np.outer(t, g)
         sep = p0.radius + p1.radius - d  # distance between centres
-        frames.append(_frame(t, 0, com - np.outer(sep * m1 / mt, geo.n), vcom + np.outer(r * m1 / mt, geo.n),
-                             p0.angular_velocity))
-        frames.append(_frame(t, 1, com + np.outer(sep * m0 / mt, geo.n), vcom - np.outer(r * m0 / mt, geo.n),
-                             p1.angular_velocity))
-    return pd.concat(frames, ignore_index=True)
+        bodies.append((com - np.outer(sep * m1 / mt, geo.n), vcom + np.outer(r * m1 / mt, geo.n),
+                       p0.angular_velocity))
+        bodies.append((com + np.outer(sep * m0 / mt, geo.n), vcom - np.outer(r * m0 / mt, geo.n),
+                       p1.angular_velocity))
+    n, k = len(t), len(bodies)
+    pos = np.concatenate([b[0] for b in bodies]) if k > 1 else bodies[0][0]
+    vel = np.concatenate([b[1] for b in bodies]) if k > 1 else bodies[0][1]
+    omega = np.repeat(np.array([b[2] for b in bodies], dtype=float), n, axis=0)
+    return {"t": np.tile(t, k), "id": np.repeat(np.arange(k, dtype=np.int64), n),
+            "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2], "vx": vel[:, 0], "vy": vel[:, 1], "vz": vel[:, 2],
+            "wx": omega[:, 0], "wy": omega[:, 1], "wz": omega[:, 2]}
 
 
-def _add_frame_columns(result: Result, case: Case, geo: Geometry1D) -> None:
-    """The relative centre velocity, the (fixed) normal and body 0's spin, for the tangential metrics."""
-    p = result.particles
-    c = result.contact
-    v0 = p[p["id"] == 0][["vx", "vy", "vz"]].to_numpy()
-    vr = v0 - p[p["id"] == 1][["vx", "vy", "vz"]].to_numpy() if not geo.wall else v0
+def _add_frame_columns(contact: dict, particles: dict, case: Case, geo: Geometry1D) -> None:
+    """The relative centre velocity, the (fixed) normal and body 0's spin, for the tangential metrics (added
+    to the contact table's arrays)."""
+    n = len(contact["t"])
+    vr = np.column_stack([particles[c][:n] for c in ("vx", "vy", "vz")])
+    if not geo.wall:
+        vr = vr - np.column_stack([particles[c][n:] for c in ("vx", "vy", "vz")])
     for i, axis in enumerate("xyz"):
-        c[f"vr{axis}"] = vr[:, i]
-        c[f"n{axis}"] = geo.n[i]
-        c[f"w0{axis}"] = case.particles[0].angular_velocity[i]
-
-
-def _frame(t, pid, pos, vel, omega):
-    return pd.DataFrame({"t": t, "id": pid, "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
-                         "vx": vel[:, 0], "vy": vel[:, 1], "vz": vel[:, 2],
-                         "wx": omega[0], "wy": omega[1], "wz": omega[2]})
+        contact[f"vr{axis}"] = vr[:, i]
+        contact[f"n{axis}"] = np.full(n, geo.n[i], dtype=float)
+        contact[f"w0{axis}"] = np.full(n, float(case.particles[0].angular_velocity[i]))

@@ -6,7 +6,6 @@ import math
 import time
 
 import numpy as np
-import pandas as pd
 
 from ..case import Case
 from ..errors import ConfigError
@@ -89,9 +88,9 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
         names = {**kernels.EVENT_NAMES, **k3.EVENT_NAMES_3D}
         idx = np.searchsorted(rec[:, k3.C_T], ev_t)
-        events = pd.DataFrame({"t": ev_t, "event": [names.get(int(c), "force_end_again") if c > 0
-                                                      else "force_end_again" for c in ev_c],
-                               "delta": rec[idx, k3.C_D], "delta_dot": rec[idx, k3.C_R], "fn": rec[idx, k3.C_FN]})
+        events = {"t": ev_t, "event": np.array([names.get(int(c), "force_end_again") if c > 0
+                                                else "force_end_again" for c in ev_c], dtype=object),
+                  "delta": rec[idx, k3.C_D], "delta_dot": rec[idx, k3.C_R], "fn": rec[idx, k3.C_FN]}
         used_dt = None
     elif method == "verlet":
         dt_given = bool(dt)
@@ -130,8 +129,8 @@ def _points_message(result: Result, rtol: float, l_scale: float) -> str:
     7 000 at 1e-11, 700 at 1e-10)."""
     from .outcome import MESSAGES
 
-    p = result.particles
-    x = float(np.max(np.abs(p[["x", "y", "z"]].to_numpy()))) if len(p) else 0.0
+    p = result.table("particles")
+    x = float(max(np.max(np.abs(p[c])) for c in ("x", "y", "z"))) if len(p["t"]) else 0.0
     if l_scale > 0 and np.spacing(x) / l_scale > rtol:
         return (f"the adaptive method needed more than {result.meta['steps']} points: the contact's overlap scale "
                 f"({l_scale:.3g} m) is {l_scale / x:.2g} of the bodies' positions (~{x:.3g} m), and the tolerance "
@@ -140,11 +139,13 @@ def _points_message(result: Result, rtol: float, l_scale: float) -> str:
     return MESSAGES["too-many-steps"]
 
 
-def tables(rec: np.ndarray, wall: bool) -> tuple[pd.DataFrame, pd.DataFrame]:
+def tables(rec: np.ndarray, wall: bool) -> tuple[dict, dict]:
+    """The contact and particles tables of a 3-D run's record, as arrays (Result.table): views of ``rec`` where
+    a column is one of its own."""
     t = rec[:, k3.C_T]
     v0, v1 = rec[:, k3.C_V0:k3.C_V0 + 3], rec[:, k3.C_V1:k3.C_V1 + 3]
     vr = v0 - v1 if not wall else v0
-    contact = pd.DataFrame({
+    contact = {
         "t": t, "delta": rec[:, k3.C_D], "delta_dot": rec[:, k3.C_R], "fn": rec[:, k3.C_FN],
         "ftx": rec[:, k3.C_FT], "fty": rec[:, k3.C_FT + 1], "ftz": rec[:, k3.C_FT + 2],
         "vtx": rec[:, k3.C_VT], "vty": rec[:, k3.C_VT + 1], "vtz": rec[:, k3.C_VT + 2],
@@ -152,13 +153,15 @@ def tables(rec: np.ndarray, wall: bool) -> tuple[pd.DataFrame, pd.DataFrame]:
         "vrx": vr[:, 0], "vry": vr[:, 1], "vrz": vr[:, 2],
         "w0x": rec[:, k3.C_W0], "w0y": rec[:, k3.C_W0 + 1], "w0z": rec[:, k3.C_W0 + 2],
         "energy": rec[:, k3.C_E], "slipping": rec[:, k3.C_SLIP].astype(bool),
-    })
-    frames = []
-    for pid, (cx, cv, cw) in enumerate([(k3.C_X0, k3.C_V0, k3.C_W0), (k3.C_X1, k3.C_V1, k3.C_W1)]):
-        if pid == 1 and wall:
-            break
-        frames.append(pd.DataFrame({"t": t, "id": pid,
-                                    "x": rec[:, cx], "y": rec[:, cx + 1], "z": rec[:, cx + 2],
-                                    "vx": rec[:, cv], "vy": rec[:, cv + 1], "vz": rec[:, cv + 2],
-                                    "wx": rec[:, cw], "wy": rec[:, cw + 1], "wz": rec[:, cw + 2]}))
-    return contact, pd.concat(frames, ignore_index=True)
+    }
+    bodies = [(k3.C_X0, k3.C_V0, k3.C_W0)] + ([] if wall else [(k3.C_X1, k3.C_V1, k3.C_W1)])
+
+    def column(which: int, j: int) -> np.ndarray:  # body 0's rows, then body 1's
+        parts = [rec[:, b[which] + j] for b in bodies]
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    particles = {"t": np.tile(t, len(bodies)), "id": np.repeat(np.arange(len(bodies), dtype=np.int64), len(t))}
+    for which, names in enumerate((("x", "y", "z"), ("vx", "vy", "vz"), ("wx", "wy", "wz"))):
+        for j, name in enumerate(names):
+            particles[name] = column(which, j)
+    return contact, particles
