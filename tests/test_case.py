@@ -95,6 +95,8 @@ BAD = [
     (["contact.kn=1e6"], "contact.kn", "not a parameter"),
     (["particles.0.materal=glass"], "particles.0.materal", "did you mean 'material'"),
     (["run.dt=-1"], "run.dt", "> 0"),
+    (["run.verlet_rtol=0"], "run.verlet_rtol", "in (0, 1]"),
+    (["run.verlet_rtol=\"tight\""], "run.verlet_rtol", "finite number"),
     (["particles.0.velocity=[1, 0]"], "particles.0.velocity", "3 finite numbers"),
 ]
 

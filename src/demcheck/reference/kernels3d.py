@@ -163,7 +163,10 @@ def slip_surface(tl, nl, h, vt, fn_abs, delta, mu):
         return sn - cap, (s / sn if sn > 0.0 else w), kt
     if kind == LTH or kind == ZZY:
         return hn - tl[T_XI] * max(delta, 0.0), w, 1.0
-    # WALTON saturates by itself (Kt → 0 at μ|Fn|) and has no slip state: its force is capped instead
+    if kind == WALTON:
+        # the load saturates by itself on a rising limit (Kt → 0 at μ|Fn|); a falling limit μk|Fn| below |L|
+        # carries the stored load down with it (seed 000 §4.8: the force is the state and obeys Coulomb's law)
+        return hn - tl[T_MU_K] * fn_abs, w, 1.0
     return -1.0, w, 1.0
 
 
@@ -249,6 +252,16 @@ def walton_margin(tl, h, vt, fn_abs, lstar):
 
 
 WALTON_NEAR_LIMIT = 1e-6
+WALTON_RIDE = 1e-9  # below a rising limit, the band in which the load rides it (rhs)
+
+
+@njit(cache=True, inline="always")
+def walton_reverses(vt, previous):
+    """Whether the slip reverses its direction (seed 000 §4.8, Walton & Braun 1986): v_t turns against the last
+    nonzero slip velocity. Only then is the load at the reversal stored (L* := L); the load passing through
+    zero while the slip keeps its direction is no reversal. The verlet method and the packing loop test this
+    each step; the adaptive method locates the zero of v_t·t̂ (t̂ the slip direction before it) as an event."""
+    return vt[0] * previous[0] + vt[1] * previous[1] + vt[2] * previous[2] < 0.0
 
 
 @njit(cache=True)
@@ -371,6 +384,12 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
             b = _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s)
             ft = -b / amob
             req_margin = _norm(ft) - tl[T_MU_S] * fabs
+        elif slipping and (kind == LTH or kind == ZZY):
+            # a slipping history lies on its surface |ξ| = ξm by definition: the force reads it there, not the
+            # integrated value, which is not error-controlled while slipping (below) and would drift off it —
+            # a drift the viscous term's (1 − |ξ|/ξm)^{1/4} magnifies a thousandfold
+            ft = tangential_force(tl, nl, return_map(tl, nl, h, vt, fabs, delta, tl[T_MU_K]), vt, fabs, delta,
+                                  slipping, aux[A_TREF:A_TREF + 3])
         else:
             ft = tangential_force(tl, nl, h, vt, fabs, delta, slipping, aux[A_TREF:A_TREF + 3])
     fvec0 = -fn * n + ft
@@ -381,7 +400,25 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     if contact and (kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON):
         rot = _dot(h, ndot) * n
         if kind == WALTON:
-            dy[18:21] = walton_stiffness(tl, h, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+            dh = walton_stiffness(tl, h, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+            hn = _norm(h)
+            cap = tl[T_MU_K] * fabs
+            if hn > 0.0 and cap > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
+                # at the Coulomb limit the load rides it, |L|/μ|Fn| held — within WALTON_NEAR_LIMIT of a falling
+                # limit, which carries the load down with it (the verlet method truncates it after each
+                # increment, slip_surface; a load above the limit is put back on it after each step,
+                # _walton_truncate), and within WALTON_RIDE of a rising one: there Kt ∝ x^{1/3} makes the
+                # approach infinitely stiff, while farther below the lag x of the load behind a rising limit
+                # is physics (the verlet plateau test) and is integrated as it is. The limit's rate by a
+                # one-sided difference along the flow, on the branch of |Fn| of the base point
+                capdot = _limit_rate(y, aux, nl, tl, geo, rules, fn, dy)
+                if capdot < 0.0 or hn >= (1.0 - WALTON_RIDE) * cap:
+                    most = (hn / cap) * capdot
+                    u = h / hn
+                    radial = _dot(u, dh)
+                    if radial > most:
+                        dh = dh - (radial - most) * u
+            dy[18:21] = dh
         else:
             dy[18:21] = vt - rot
         if slipping and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
@@ -431,6 +468,58 @@ def _dp5_3(y, aux, nl, tl, geo, rules, h):
 
 
 NSLOT = 8
+# LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
+# of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
+# the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
+# whose force, μ|Fn|, is the slip state's). A slip of these laws therefore ends only when sticking would
+# unload the history by more than this fraction of |v_t| (λ < −UNLOAD_MARGIN |v_t|); below it the contact
+# stays on the surface, where stick and slip give the same force, instead of chattering between the two.
+UNLOAD_MARGIN = 1e-4
+
+
+@njit(cache=True, inline="always")
+def _margin(tl, vt):
+    kind = tl[T_KIND]
+    return UNLOAD_MARGIN * _norm(vt) if (kind == LTH or kind == ZZY) else 0.0
+
+
+@njit(cache=True, inline="always")
+def _unloads(tl, lam, vt):
+    """Whether a slip whose stick flow has multiplier λ sticks again (λ < 0, past the margin above)."""
+    return lam < -_margin(tl, vt)
+
+
+@njit(cache=True)
+def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
+    """d(μk|Fn|)/dt by a one-sided (forward, second-order) difference along the flow ``dy``, on the branch of
+    |Fn| of the base point."""
+    s = 1e-7 * geo[G_TS]
+    fsign = 1.0 if fn >= 0.0 else -1.0
+    fa = fsign * _fn_at(y + s * dy, aux, nl, geo, rules)
+    fb = fsign * _fn_at(y + 2.0 * s * dy, aux, nl, geo, rules)
+    return tl[T_MU_K] * (-3.0 * fsign * fn + 4.0 * fa - fb) / (2.0 * s)
+
+
+@njit(cache=True)
+def _walton_truncate(y, aux, nl, tl, geo, rules):
+    """Walton's stored load back onto the Coulomb limit where it lies above it (the verlet method's truncation),
+    and onto it where it rides within WALTON_NEAR_LIMIT below a falling limit (rhs): a load that close to a
+    falling limit meets it at once, and snapping it there keeps the answer from depending on where a step
+    happened to enter the band."""
+    if aux[A_NMODE] == M_PRE:
+        return
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    h = _tangent_history(y, n)
+    hn = _norm(h)
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    cap = tl[T_MU_K] * abs(fn)
+    if hn > cap:
+        y[18:21] = h * (cap / hn)
+    elif hn > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
+        dy = np.empty(y.shape[0])
+        rhs(y, aux, nl, tl, geo, rules, dy)
+        if _limit_rate(y, aux, nl, tl, geo, rules, fn, dy) < 0.0:
+            y[18:21] = h * (cap / hn)
 
 
 @njit(cache=True)
@@ -441,7 +530,10 @@ def _settle(y, aux, nl, tl, geo, rules):
     kind = tl[T_KIND]
     if aux[A_NMODE] == M_PRE or kind == NONE:
         return
-    if not (kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON or kind == SLIDING):
+    if kind == WALTON:  # no slip state: its load rides the limit (rhs), and is truncated to it
+        _walton_truncate(y, aux, nl, tl, geo, rules)
+        return
+    if not (kind == SPRING or kind == LTH or kind == ZZY or kind == SLIDING):
         return
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     dy = np.empty(y.shape[0])
@@ -452,7 +544,7 @@ def _settle(y, aux, nl, tl, geo, rules):
             # would unload the history (λ < 0) sticks from there
             y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-            if lam < 0.0 and fn != 0.0:
+            if _unloads(tl, lam, vt) and fn != 0.0:
                 aux[A_TMODE] = STICK
         return
     if kind == SLIDING:
@@ -469,7 +561,7 @@ def _settle(y, aux, nl, tl, geo, rules):
         if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
             # as at a stick→slip event: from the surface, a slip that would unload the history sticks
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-            if lam < 0.0 and fn != 0.0:
+            if _unloads(tl, lam, vt) and fn != 0.0:
                 aux[A_TMODE] = STICK
 
 
@@ -541,10 +633,10 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
             return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
         if fn == 0.0:  # a zero cap (limit_force, force ended) admits only the slip state's zero force
             return 1.0
-        return lam
+        return lam + _margin(tl, vt)  # falls through 0 where the slip ends (_unloads)
     if slot == 7:
-        if kind == WALTON:
-            return _dot(vt, _tangent_history(y, n))
+        if kind == WALTON:  # a reversal of the slip (walton_reverses)
+            return _dot(vt, aux[A_TREF:A_TREF + 3])
         return eta_of(tl, nl, delta) * _norm(vt) - tl[T_MU_K] * abs(fn)
     return 1.0
 
@@ -683,7 +775,10 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             y = yn
             if aux[A_NMODE] == M_LOAD:
                 aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
-            if tl[T_KIND] == SLIDING and aux[A_TMODE] == SLIP:
+            if tl[T_KIND] == WALTON:
+                _walton_truncate(y, aux, nl, tl, geo, rules)
+            if (tl[T_KIND] == SLIDING and aux[A_TMODE] == SLIP) or tl[T_KIND] == WALTON:
+                # the slip direction: SLIDING's force direction, Walton's reference for a reversal
                 vt = kinematics(y, geo, rules)[4]
                 vn = _norm(vt)
                 if vn > 0.0:
@@ -707,9 +802,11 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             aux[A_LSTAR:A_LSTAR + 3] = 0.0
             aux[A_TMODE] = STICK
             vn = _norm(vt)
+            aux[A_TREF:A_TREF + 3] = 0.0
+            if (kind == SLIDING or kind == WALTON) and vn > 0.0:
+                aux[A_TREF:A_TREF + 3] = vt / vn
             if kind == SLIDING and vn > 0.0:
                 aux[A_TMODE] = SLIP
-                aux[A_TREF:A_TREF + 3] = vt / vn
         elif best_slot == 0:
             code = EV_END
             terminal = True
@@ -749,7 +846,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                     # contradicts the step it predicts (near contact end |Fn| ∝ δ^{1/4} has an unbounded
                     # rate), sticking would re-cross at θ = 0 for ever, and the contact slips
                     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-                    if lam < 0.0 and t != graze_t:
+                    if _unloads(tl, lam, vt) and t != graze_t:
                         aux[A_TMODE] = STICK
                         graze_t = t
         elif best_slot == 6:
@@ -763,6 +860,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             if kind == WALTON:
                 code = EV_REVERSAL
                 aux[A_LSTAR:A_LSTAR + 3] = _tangent_history(y, nvec)
+                aux[A_TREF:A_TREF + 3] = -aux[A_TREF:A_TREF + 3]  # the slip now runs the other way
             else:
                 code = EV_KINK
         if not terminal and code != EV_STICK_SLIP and code != EV_SLIP_STICK:
@@ -829,7 +927,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     aux[A_NMODE] = M_VE
     hist = np.zeros(3)
     lstar = np.zeros(3)
-    prev_vl = 0.0
+    prev_vt = np.zeros(3)
     a_prev = 0.0
     dmax = 0.0
     sliding = False
@@ -912,11 +1010,10 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                         ft = np.zeros(3)
             elif kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
                 if kind == WALTON:
-                    vl = _dot(vt, hist)
-                    if (vl < 0.0 and prev_vl > 0.0) or (vl > 0.0 and prev_vl < 0.0):
+                    if walton_reverses(vt, prev_vt):
                         lstar = hist.copy()
-                    if vl != 0.0:
-                        prev_vl = vl
+                    if _norm(vt) != 0.0:
+                        prev_vt = vt.copy()
                     hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
                 else:
                     hist = hist + vt * dt
@@ -938,7 +1035,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
             hist[:] = 0.0
             lstar[:] = 0.0
             a_prev = 0.0
-            prev_vl = 0.0
+            prev_vt = np.zeros(3)
             dmax = 0.0
             sliding = False
         fvec0 = -fn * n + ft

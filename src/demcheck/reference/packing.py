@@ -26,13 +26,13 @@ from numba import njit
 from .kernels import normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT, ROT_RESCALE,
                         ROT_RESCALE_SIGNIFICANT, eta_of, kt_of, normal_part_matters, return_map, slip_surface,
-                        tangential_force, walton_stiffness)
+                        tangential_force, walton_reverses, walton_stiffness)
 from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
                          TRUNC_SPRING, WALTON, ZZY)
 
 # per contact slot: the tangential history (3); Walton's also the load at the last reversal (3) and the last
 # nonzero v_t·L (1), so its slots are wider (only when a Walton law is in the packing: memory and bandwidth)
-HIST_WIDTH, WALTON_HIST_WIDTH = 3, 7
+HIST_WIDTH, WALTON_HIST_WIDTH = 3, 9
 
 
 @njit(cache=True)
@@ -183,7 +183,7 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
     kind = tl[T_KIND]
     if (kind == LTH or kind == ZZY or kind == WALTON) and update:
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
-        # the last reversal L* in hist[3:6] and the last nonzero v_t·L in hist[6]), by kernels3d's functions
+        # the last reversal L* in hist[3:6] and the last nonzero slip velocity in hist[6:9]), by kernels3d's functions
         # in verlet_3d's order
         hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
         if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT
@@ -196,11 +196,10 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
                 for k in range(3):
                     hist[k] *= old / new
         if kind == WALTON:
-            vl = vt[0] * hist[0] + vt[1] * hist[1] + vt[2] * hist[2]
-            if (vl < 0.0 and hist[6] > 0.0) or (vl > 0.0 and hist[6] < 0.0):  # a reversal: L* = L
+            if walton_reverses(vt, hist[6:9]):  # L* = L
                 hist[3], hist[4], hist[5] = hist[0], hist[1], hist[2]
-            if vl != 0.0:
-                hist[6] = vl
+            if vt[0] != 0.0 or vt[1] != 0.0 or vt[2] != 0.0:
+                hist[6], hist[7], hist[8] = vt[0], vt[1], vt[2]
             kw = walton_stiffness(tl, hist[0:3], vt, fabs, hist[3:6])
             for k in range(3):
                 hist[k] += kw * vt[k] * dt
