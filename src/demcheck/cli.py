@@ -222,11 +222,16 @@ def models(model_id, as_json, engine):
         def cut(text, width):
             return text if len(text) < width else text[:width - 2] + "… "
 
-        click.echo(f"{'slot':<11}{'id':<16}{'seed':<15}" + "".join(f"{n:<12}" for n in names).rstrip())
+        short = {"approximate": "approx"}
+        widths = {n: max(len(n) + 1, 7) for n in names}  # "approx" and a space, or the engine's name
+        seed_w = max(8, min(15, 80 - 27 - sum(widths.values())))  # the seed name gives way to engine columns
+        click.echo(f"{'slot':<11}{'id':<16}{'seed':<{seed_w}}" + "".join(f"{n:<{widths[n]}}" for n in names).rstrip())
         for row in table:
-            click.echo((f"{row['slot']:<11}{row['id']:<16}{cut(row['seed_name'], 15):<15}"
-                        + "".join(f"{row['engines'][n]['fidelity']:<12}" for n in names)).rstrip())
-        click.echo("\n`demcheck models ID` shows a model in full; --json gives everything.")
+            click.echo((f"{row['slot']:<11}{row['id']:<16}{cut(row['seed_name'], seed_w):<{seed_w}}"
+                        + "".join(f"{short.get(f := row['engines'][n]['fidelity'], f):<{widths[n]}}"
+                                  for n in names)).rstrip())
+        click.echo("\napprox = approximate. `demcheck models ID` shows a model in full, with each\n"
+                   "engine's reasons; --json gives everything.")
         return
     for row in table:
         click.echo(f"{row['id']} ({row['slot']}; seed name {row['seed_name']}"
