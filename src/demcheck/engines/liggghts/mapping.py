@@ -102,7 +102,8 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                                    else ""))
         elif kind == SPRING:
             nat.tangential = "history"
-            if tl.eta_normal:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot outside the cap
+            if tl.eta_normal and nl.eta > 0.0:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot
+                # outside the cap (undamped, ηt = ηn = 0, it is DDt's case below on hertz/stiffness)
                 if not (nl.a == 1.5 and nl.b == 0.25):
                     return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
                 fid = worst(fid, APPROXIMATE)
@@ -113,10 +114,15 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 if nat.normal != "hertz/stiffness":
                     return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
                                                 f"Hertz-type; normal '{nid}' is not")
-                if tl.eta > 0.0:
+                if tl.eta > 0.0 and not tl.eta_normal:
                     return refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
                 p["kt"] = tl.kt
                 nat.tangential_damping = False
+                if tl.truncation == TRUNC_CAP:
+                    fid = worst(fid, APPROXIMATE)
+                    reasons.append("LIGGGHTS truncates the spring at μ|Fn|; the case's truncation = force is the "
+                                   "seed's min() cap, which keeps the spring's extension (they part after a slip "
+                                   "that reverses)")
                 comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
             else:
                 if not stiff:
@@ -223,7 +229,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     elif nat.normal in ("hooke/stiffness", "hooke"):
         factor, const = None, eta_t
     elif nat.normal == "hertz/stiffness":
-        factor = p["gammat"] / p["gamman"] if p["gamman"] > 0 else math.nan
+        # (an undamped normal law — TTIn at e = 1 — maps here with gamman = gammat = 0: no dashpot at all)
+        factor = p["gammat"] / p["gamman"] if p["gamman"] > 0 else (0.0 if p["gammat"] == 0.0 else math.nan)
         const = None
     else:  # hertz: γt = γn √(4G*/E*)
         factor, const = math.sqrt(4.0 * p["shear_eff"] / p["youngs_eff"]), None
