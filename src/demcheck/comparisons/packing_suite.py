@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ..errors import EngineInterrupted
+from ..errors import EngineInterrupted, UnsupportedByEngine
 from . import packing_metrics as PM, verdicts as V
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
@@ -138,6 +138,10 @@ def run_packing(case, opts, found, file=None) -> dict:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
         except EngineInterrupted:
             raise  # the case did not finish: it is left out of the (partial) report
+        except UnsupportedByEngine as exc:  # an engine whose package writes no packing decks
+            entry["sources"][engine] = {"status": "not expressible", "message": str(exc)}
+            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, str(exc)))
+            continue
         except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
             comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))

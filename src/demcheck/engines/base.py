@@ -235,6 +235,10 @@ class PackageEngine(Engine):
         return self._part("deck").deck(case, dt, length, native=native, **options)
 
     def packing_deck(self, case, duration=None, dt=None):
+        import importlib.util
+
+        if importlib.util.find_spec(f"{type(self).__module__}.packing") is None:  # a package without packings
+            return super().packing_deck(case, duration, dt)
         return self._part("packing").deck(case, duration, dt)
 
 
