@@ -465,6 +465,22 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
         sys.exit(1)
 
 
+# ----------------------------------------------------------------------------- warmup
+
+
+@cli.command()
+def warmup():
+    """Compile every reference kernel the suite uses into the on-disk cache (numba), so that the first
+    verify starts warm; the Makefile's setup runs it. Each scene's time is printed (compiled or loaded)."""
+    import os
+
+    from .comparisons.warmup import warm
+
+    click.echo(f"demcheck warmup: numba cache {os.environ.get('NUMBA_CACHE_DIR', '(numba default)')}")
+    total = sum(s for _, s in warm(lambda label, s: click.echo(f"  {label:32s} {s:8.2f} s")))
+    click.echo(f"  {'total':32s} {total:8.2f} s")
+
+
 # ----------------------------------------------------------------------------- verify
 
 
