@@ -1,0 +1,77 @@
+"""Cold start (issue 16, item 3): how much of a cold `demcheck verify --engines none` (the default suite, the
+reference alone) is numba compilation, and what `demcheck warmup` buys. Target: compilation ≤ 25 % of the
+cold suite once setup has run the warm-up.
+
+Each run is a fresh process with its own NUMBA_CACHE_DIR (empty = cold). Compilation time is the union of the
+top-level ``numba:compile`` events (numba's event API) inside the process; the runs, in one go:
+
+1. the suite on an empty cache (what a fresh clone without the warm-up paid);
+2. `demcheck warmup` on another empty cache (what setup pays once), then the suite on that cache.
+
+Run: .venv/bin/python benchmarks/bench_coldstart.py > benchmarks/results/bench_coldstart.txt
+"""
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TIMED = r"""
+import json, sys, time
+from numba.core import event
+rec = event.RecordingListener()
+event.register("numba:compile", rec)
+t0 = time.perf_counter()
+from demcheck import cli
+code = 0
+try:
+    cli.main(sys.argv[1:])
+except SystemExit as e:
+    code = e.code
+wall = time.perf_counter() - t0
+depth, start, total = 0, 0.0, 0.0
+for ts, ev in rec.buffer:
+    if ev.is_start:
+        start = ts if depth == 0 else start
+        depth += 1
+    else:
+        depth -= 1
+        total += (ts - start) if depth == 0 else 0.0
+print("BENCH " + json.dumps({"wall": wall, "compile": total, "exit": code}), file=sys.stderr)
+"""
+
+
+def timed(args, cache: Path) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT / "src"))
+    t = time.perf_counter()
+    p = subprocess.run([sys.executable, "-c", TIMED, *args], cwd=ROOT, env=env, capture_output=True, text=True)
+    line = [x for x in p.stderr.splitlines() if x.startswith("BENCH ")][-1]
+    return {**json.loads(line[6:]), "process": time.perf_counter() - t}
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        suite = ["verify", "--engines", "none", "--report", str(tmp / "reports"), "--json"]
+        cold = timed(suite, tmp / "cold")
+        warm_up = timed(["warmup"], tmp / "warm")
+        warm = timed(suite, tmp / "warm")
+    print("demcheck verify --engines none (the default suite, the reference alone), fresh processes, one run each")
+    print(f"{'run':44s} {'process s':>10s} {'compile s':>10s} {'compile %':>10s} exit")
+    for label, r in (("suite, empty kernel cache (cold)", cold), ("demcheck warmup, empty kernel cache", warm_up),
+                     ("suite after the warm-up", warm)):
+        print(f"{label:44s} {r['process']:10.1f} {r['compile']:10.1f} {100 * r['compile'] / r['process']:9.1f}% "
+              f"{r['exit']}")
+    share = warm["compile"] / warm["process"]
+    print(f"\ncold suite: compilation {100 * cold['compile'] / cold['process']:.0f} % of it; after the warm-up "
+          f"{100 * share:.0f} % (target ≤ 25 %: {'met' if share <= 0.25 else 'MISSED'}); the warm-up itself "
+          f"{warm_up['process']:.0f} s; cold / warmed suite = {cold['process'] / warm['process']:.2f}")
+
+
+if __name__ == "__main__":
+    main()
