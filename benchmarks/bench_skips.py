@@ -1,4 +1,4 @@
-"""What each skip saves (DESIGN.md "Skip what a scene does not need"), measured side by side in one run.
+"""What each skip saves (docs/performance.md), measured side by side in one run.
 
 Ratios of best-of-N wall times on this shared, noisy machine; absolute seconds are printed for context only.
 

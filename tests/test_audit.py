@@ -47,7 +47,7 @@ def _codes(result, pair):
 
 @pytest.mark.engine("lammps")
 def test_tsuji_turns_06_into_070(tmp_path):
-    """ENGINES.md §1.2: LAMMPS 22Jul2025's tsuji gives e = 0.700 for an input of 0.6 (Marshall's α(e) without
+    """docs/lammps-users.md: LAMMPS 22Jul2025's tsuji gives e = 0.700 for an input of 0.6 (Marshall's α(e) without
     √2); the engine run matches its twin to round-off."""
     deck = _deck(tmp_path, HEAD.format(n=1) + "pair_style granular\npair_coeff * * hertz/material 63e9 0.6 0.24 "
                  "damping tsuji tangential linear_nohistory 0 0\n")
@@ -63,7 +63,7 @@ def test_tsuji_turns_06_into_070(tmp_path):
 
 @pytest.mark.engine("liggghts")
 def test_limit_force_raises_the_restitution(tmp_path):
-    """ENGINES.md §1.2: LIGGGHTS hertz with limitForce on gives 0.550 for an input of 0.5."""
+    """docs/liggghts-users.md: LIGGGHTS hertz with limitForce on gives 0.550 for an input of 0.5."""
     deck = _deck(tmp_path, HEAD.format(n=1).replace("atom_style sphere", "atom_style granular\ncommunicate single "
                  "vel yes") + "fix m1 all property/global youngsModulus peratomtype 5e8\n"
                  "fix m2 all property/global poissonsRatio peratomtype 0.25\n"

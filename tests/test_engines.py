@@ -109,7 +109,7 @@ def test_every_expressible_case_is_covered():
 
 @pytest.mark.engine("lammps")
 def test_lammps_tsuji_misses_the_input_restitution():
-    """ENGINES.md pitfall 2: damping tsuji (Marshall's α(e), no √2) gives e = 0.616 for an input of 0.5
+    """docs/lammps-users.md (trap tsuji): damping tsuji (Marshall's α(e), no √2) gives e = 0.616 for an input of 0.5
     in a head-on Hertz collision; coeff_restitution gives back 0.5 (to the scheme's O(dt))."""
     case = glass_case("hertz", {}, restitution=0.5)
     k = 4.0 / 3.0 * 71e9 / (2.0 * (1.0 - 0.22**2))
@@ -125,7 +125,7 @@ def test_lammps_tsuji_misses_the_input_restitution():
 
 @pytest.mark.engine("liggghts")
 def test_liggghts_limit_force_raises_the_restitution():
-    """ENGINES.md pitfall 1: LIGGGHTS hertz gives its input e with limitForce off, 0.550 for 0.5 with it on
+    """docs/liggghts-users.md: LIGGGHTS hertz gives its input e with limitForce off, 0.550 for 0.5 with it on
     (a rigid wall: E* = E/(1−ν²), G* = E/(2(1+ν)(2−ν)))."""
     case = glass_case("hertz", {}, wall=True, restitution=0.5)
     for limit, expected in ((False, 0.5), (True, 0.550)):
@@ -139,7 +139,7 @@ def test_liggghts_limit_force_raises_the_restitution():
 
 @pytest.mark.engine("lammps")
 def test_lammps_auto_mixed_mindlin_null_is_wrong_between_types():
-    """ENGINES.md §1.4: with only I I coefficients, LAMMPS mixes mindlin NULL wrongly for I ≠ J; the explicit
+    """docs/lammps-users.md, Mixing: with only I I coefficients, LAMMPS mixes mindlin NULL wrongly for I ≠ J; the explicit
     pair_coeff demcheck writes is right (it matches the twin with k_t = 8G*)."""
     case = oblique_case("ddt", {}, normal="hertz", normal_params={}, wall=False, angle=30.0)
     nat = Native("lammps", "hertz/material", (71e9, 0.22), damping="velocity", damping_coeff=0.0,
@@ -152,7 +152,7 @@ def test_lammps_auto_mixed_mindlin_null_is_wrong_between_types():
 
 @pytest.mark.engine("lammps")
 def test_lammps_wall_moduli_are_pair_values():
-    """ENGINES.md §1.5: fix wall/gran granular hertz/material E ν uses E* = E/(2(1−ν²)), the pair value, not
+    """docs/lammps-users.md, Walls: fix wall/gran granular hertz/material E ν uses E* = E/(2(1−ν²)), the pair value, not
     the rigid wall's E/(1−ν²): the peak force is (1/2)^{2/5} of the rigid wall's."""
     case = glass_case("hertz", {}, wall=True)
     nat = Native("lammps", "hertz/material", (71e9, 0.22), damping="velocity", damping_coeff=0.0,

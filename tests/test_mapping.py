@@ -112,7 +112,7 @@ def test_static_and_kinetic_friction_is_approximate_in_both_engines():
 
 
 def test_tti_transform_carries_ttin_damping_exactly():
-    """ENGINES.md §3: coeff_restitution with e′ = exp(−cπ/√(1−c²)), c = α_TTI/√5, carries TTIn's ηn."""
+    """docs/models.md, Engine twins: coeff_restitution with e′ = exp(−cπ/√(1−c²)), c = α_TTI/√5, carries TTIn's ηn."""
     from demcheck.reference import twins
 
     for e in (0.1, 0.5, 0.9):
@@ -122,7 +122,7 @@ def test_tti_transform_carries_ttin_damping_exactly():
         nl, _ = registry.get(mp.native.engine).twin(mp.native, model.pair.m_eff, model.pair.r_eff)
         assert nl.eta == pytest.approx(model.normal_law.eta, rel=1e-13)
         assert nl.b == 0.25
-    # the transform's fixed points from ENGINES.md: ε = 0.1 → 0.0983, 0.5 → 0.4997, 0.9 → 0.9000
+    # the transform's fixed points (docs/models.md): ε = 0.1 → 0.0983, 0.5 → 0.4997, 0.9 → 0.9000
     for eps, e_prime in ((0.1, 0.0983), (0.5, 0.4997), (0.9, 0.9000)):
         model = resolve(glass_case("tti", {}, restitution=eps))
         c = model.normal_law.eta / math.sqrt(model.pair.m_eff * model.normal_law.k)

@@ -1,4 +1,4 @@
-"""Command line: ``demcheck models | collide | deck | sweep | verify`` (DESIGN.md "Command line").
+"""Command line: ``demcheck models | collide | deck | sweep | verify`` (the README lists every command).
 
 Exit codes: 0 success, 1 an unexpected disagreement or a failed run, 2 bad input or usage.
 ``--json`` prints one JSON object on stdout and nothing else there.

@@ -1,4 +1,4 @@
-"""Metrics: pure functions of a Result's series (its arrays: ``Result.table``), named as in DESIGN.md.
+"""Metrics: pure functions of a Result's series (its arrays: ``Result.table``), named as in docs/verify.md.
 
 Where the Result has exact events (adaptive method) they are used; otherwise the metrics are read off the
 time series the same way for every time-stepped source (the reference's verlet method and the engines):

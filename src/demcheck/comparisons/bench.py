@@ -226,7 +226,7 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
 
 
 def rayleigh_time(case: Case) -> float:
-    """Rayleigh wave time πR√(ρ/G)/(0.1631ν + 0.8766) of the smallest particle (ENGINES.md pitfall 11)."""
+    """Rayleigh wave time πR√(ρ/G)/(0.1631ν + 0.8766) of the smallest particle (the usual DEM time-step bound)."""
     out = math.inf
     for p in case.particles:
         m = case.materials[p.material]

@@ -1,4 +1,4 @@
-"""Packing metrics (DESIGN.md names), computed from positions and radii — independent of the solver that
+"""Packing metrics (named as in docs/packing.md), computed from positions and radii — independent of the solver that
 produced them, so the reference and the engines' dumps are measured the same way.
 
 * solid_fraction: sphere volume inside a horizontal slab of the bulk (away from the floor and the free

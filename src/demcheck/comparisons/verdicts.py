@@ -3,7 +3,7 @@
 The reference's adaptive method is the seed model's converged answer. A time-stepped source at step dt is
 compared with it in units of each metric's scale (:func:`scale`), against a tolerance that includes the
 time step's own error, measured in the same run (the reference's verlet method, seed law, same dt). For
-an engine the difference is split in two, as DESIGN.md asks:
+an engine the difference is split in two (docs/verify.md):
 
 * implementation: the engine against its twin at equal dt (what the engine should compute) — must be
   within ``tolerances.engine.implementation``;

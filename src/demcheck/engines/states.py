@@ -2,7 +2,7 @@
 
 An engine's dump gives, per step, the end-of-step positions, velocities, angular velocities and the forces
 of that step; a two-body contact is read off them (per-contact output would be re-evaluated at output
-time, ENGINES.md §1.6 and §2.4). A body's force in the dump is the whole force on it: the contact's plus its
+time, docs/models.md, Reading the engines' output). A body's force in the dump is the whole force on it: the contact's plus its
 weight m·g (``fix gravity``), so the contact's is the body's force less its weight (the case's run.gravity).
 The reference's verlet twin writes its bodies' forces the same way (``body_forces``: contact + weight) and is
 read off its states through the same function (``restate``), so engine and twin are compared quantity by

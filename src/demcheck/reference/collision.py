@@ -1,6 +1,6 @@
 """Two-body collision solver: a particle–particle or particle–wall impact.
 
-Methods (DESIGN.md "The reference solver"):
+Methods (docs/models.md):
 
 * ``adaptive`` integrates to a relative tolerance with embedded Dormand–Prince 5(4), locating contact
   start, contact end, the force end, the maximum overlap, the peak force and every loading/unloading

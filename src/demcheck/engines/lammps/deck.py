@@ -1,9 +1,9 @@
 """LAMMPS decks (`pair_style granular`, `fix wall/gran granular`), for LAMMPS 22Jul2025.
 
 One atom type per particle and an explicit ``pair_coeff`` for every type pair (auto-mixing gets
-``mindlin NULL`` wrong between types, ENGINES.md §1.4). Masses are set exactly (``set atom … mass``), so the
+``mindlin NULL`` wrong between types, docs/lammps-users.md, Mixing). Masses are set exactly (``set atom … mass``), so the
 engine and the reference share m to the last bit. Walls are ``fix wall/gran granular`` with the contact's own
-coefficients computed for the particle (m̄ = m, R̄ = R): its E and ν are pair values (ENGINES.md §1.5), and
+coefficients computed for the particle (m̄ = m, R̄ = R): its E and ν are pair values (docs/lammps-users.md, Walls), and
 demcheck passes the Hertz stiffness directly (``hertz k``), which sidesteps that trap.
 """
 

@@ -57,7 +57,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                                           "can express (e′ would be ≤ 0)")
             nat.damping, nat.damping_coeff = "coeff_restitution", e_prime
             comments.append(f"damping coeff_restitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} "
-                            "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of ENGINES.md §3)")
+                            "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of docs/models.md, Engine twins)")
         else:
             return refused("lammps", f"no LAMMPS damping style has the δ^{nl.b:g} law")
     if model.limit_force:

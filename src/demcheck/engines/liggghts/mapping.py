@@ -63,7 +63,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         # to round-off)
         p.update(restitution=e_prime, youngs_eff=pair.e_eff, shear_eff=pair.g_eff)
         comments.append(f"hertz coefficientRestitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} through "
-                        "√5 β(e′)√(m̄K_HZ) (ENGINES.md §3)")
+                        "√5 β(e′)√(m̄K_HZ) (docs/models.md, Engine twins)")
     else:
         return refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
     if model.limit_force:
