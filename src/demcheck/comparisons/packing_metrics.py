@@ -72,7 +72,10 @@ def surface_height(x, rad, box=None) -> float:
     return float(highest[np.isfinite(highest)].mean())
 
 
-def compute(x, rad, box=None, floor=0.0, margin=2.0, forces=None, overlaps=None, ke=None) -> dict:
+BULK_MARGIN = 1.0  # diameters between the bulk slab and the floor / the free surface (pack and verify alike)
+
+
+def compute(x, rad, box=None, floor=0.0, margin=BULK_MARGIN, forces=None, overlaps=None, ke=None) -> dict:
     x = np.asarray(x, float)
     rad = np.asarray(rad, float)
     d = 2.0 * float(rad.mean())

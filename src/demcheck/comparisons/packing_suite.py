@@ -125,7 +125,7 @@ def run_packing(case, opts, found, file=None) -> dict:
     x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
     states = {"reference": (x, rad)}
     ref_forces = contacts[:, 3]
-    ref_m = PM.compute(x, rad, box=box, margin=1.0, forces=ref_forces, overlaps=contacts[:, 2],
+    ref_m = PM.compute(x, rad, box=box, forces=ref_forces, overlaps=contacts[:, 2],
                        ke=[e for _, e in ke])
     entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": t_end, "wall_time": seconds}
     entry["packing"]["reference"] = {"ke": ke, "forces": PM.force_distribution(ref_forces),
@@ -150,7 +150,7 @@ def run_packing(case, opts, found, file=None) -> dict:
         rad = run.table["radius"].to_numpy()
         states[engine] = (x, rad)
         fn = run.contacts["fn"].to_numpy()
-        m = PM.compute(x, rad, box=box, margin=1.0, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
+        m = PM.compute(x, rad, box=box, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
         entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": run.version}
         dt = P.packing_dt(case)

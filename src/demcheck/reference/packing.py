@@ -589,10 +589,11 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
     return ke, nc, flags
 
 
-def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 1e-14,
+def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 0.0,
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
-    """Run the packing until ``duration`` (s; default the case's packing.duration) or until the kinetic
-    energy falls below ``rest`` × N m g R (settled); dt and the number of steps are case.packing_run's (a run
+    """Run the packing for ``duration`` (s; default the case's packing.duration) — `pack` and `verify` alike, as
+    the engines do: an early stop where the kinetic energy dips (``rest`` × N m g R, off by default) can fall on a
+    turning point of a layer bouncing in phase, not on a settled state; dt and the number of steps are case.packing_run's (a run
     past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin."""
     from ..case import packing_run
