@@ -35,7 +35,7 @@ browser:
 run: engines warmup
 	$(BIN)/demcheck verify
 
-test: engines browser
+test: engines engines-versions browser
 	bash scripts/run-tests.sh $(VENV)
 
 bench: engines
