@@ -512,15 +512,15 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, 
     from .engines import run as runner
     from .engines.cache import Cache, default_dir
 
-    from .comparisons import diff as D, verdicts as V
+    from .comparisons import diff, verdicts
     from .engines import builds, discovery
 
     names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)
-    base = D.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
+    base = diff.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
     opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout, baseline=base,
-                   expected=builds.expected_for(V.load_expected(), names))
+                   expected=builds.expected_for(verdicts.load_expected(), names))
     try:
         summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
                             argv=["demcheck", "verify", *sys.argv[2:]])
@@ -531,7 +531,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, 
     if write_baseline:
         from .io import write_json
 
-        write_json(write_baseline, D.baseline(summary))
+        write_json(write_baseline, diff.baseline(summary))
         click.echo(f"baseline: {write_baseline}", err=True)
     if as_json:
         emit_json(({k: v for k, v in summary.items() if k != "cases"}
@@ -555,7 +555,7 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
     """What moved between two verification runs (results.json, a report directory, or a baseline file): per
     case, source and metric, the move in units of the metric's scale and every verdict that changed. Exit 1
     when a verdict got worse, a value moved beyond its tolerance or a source is gone; 2 on bad input."""
-    from .comparisons import diff as D
+    from .comparisons import diff
     from .io import write_json, write_text
 
     rename = {}
@@ -564,15 +564,15 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
         if not (eq and a.strip() and b.strip()):
             raise ConfigError("--source", r, "must be OLD_NAME=NEW_NAME")
         rename[a.strip()] = b.strip()
-    d = D.compare(D.load(old, "OLD"), D.load(new, "NEW"), tolerance, rename)
-    md = D.render_markdown(d)
+    d = diff.compare(diff.load(old, "OLD"), diff.load(new, "NEW"), tolerance, rename)
+    md = diff.render_markdown(d)
     if report_dir:
         out = Path(report_dir)
         write_text(out / "diff.md", md + "\n")
         write_json(out / "diff.json", plain(d))
-        write_text(out / "junit.xml", D.render_junit(d))
+        write_text(out / "junit.xml", diff.render_junit(d))
     if junit:
-        write_text(junit, D.render_junit(d))
+        write_text(junit, diff.render_junit(d))
     if as_json:
         emit_json(d)
     else:
@@ -645,8 +645,8 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout)
 def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json):
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics."""
-    from .comparisons import packing_metrics as PM
-    from .reference import packing as P
+    from .comparisons import packing_metrics
+    from .reference import packing
 
     case = _load(case_path, overrides)
     if case.kind != "packing":
@@ -660,23 +660,23 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
     from .inputs.packing_decks import CONTACT_COLUMNS
 
     if engine == "reference":
-        st = P.simulate(case, duration=duration)
+        st = packing.simulate(case, duration=duration)
         nc = min(st.n_contacts, len(st.contacts))
-        m = PM.compute(st.x, st.rad, box=box, forces=st.contacts[:nc, 3], overlaps=st.contacts[:nc, 2],
+        m = packing_metrics.compute(st.x, st.rad, box=box, forces=st.contacts[:nc, 3], overlaps=st.contacts[:nc, 2],
                        ke=[e for _, e in st.ke])
         out = {"case": case.name, "source": "reference", "particles": len(case.particles), "time": st.time,
-               "dt": P.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
+               "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
         x, rad = st.x, st.rad
         contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
     else:
         from .engines.packing import run_engine
 
         run = run_engine(case, engine, duration=duration, mpi=mpi, timeout=timeout)
-        m = PM.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
+        m = packing_metrics.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
                        forces=run.contacts["fn"].to_numpy(), overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
         out = {"case": case.name, "source": engine, "engine_version": run.version, "particles": len(run.table),
-               "dt": P.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
+               "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
         x, rad, contacts = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), run.contacts
     if csv_dir:
         from .io import write_text
@@ -737,11 +737,11 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     from rich.progress import Progress
 
     from .case import load, naming_file
-    from .comparisons import bench as B
+    from .comparisons import bench
     from .comparisons.perf_report import new_run_dir, write_bench
 
     names = _engine_list(engines)
-    grid = B.STEPS_PER_CONTACT
+    grid = bench.STEPS_PER_CONTACT
     if steps:
         grid = tuple(number("--steps", x, lo=1, hi=1e6, unit="steps per contact") for x in steps.split(","))
     cases = []
@@ -751,15 +751,15 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
-    per_case = len(B.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
+    per_case = len(bench.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
     with Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("bench", total=per_case * len(cases))
         for case in cases:
-            results.append(B.bench_case(case, names, grid, batch=batch,
+            results.append(bench.bench_case(case, names, grid, batch=batch,
                                         progress=lambda: progress.advance(task)).summary())
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names), "batch": batch,
             "command": ["demcheck", "bench", *sys.argv[2:]], "cases": results,
-            "speed_goal": B.speed_goal_text(results)}
+            "speed_goal": bench.speed_goal_text(results)}
     write_bench(data, root)
     _show_report(data, out_dir, as_json)
 
@@ -842,11 +842,11 @@ def audit(deck_path, engine, speed, as_json, report_dir):
     """Audit a user's own LAMMPS or LIGGGHTS input deck: each type pair's and wall's contact law, probed in the
     engine, its twin and the nearest seed model; the traps it falls into. The deck is read, never run as written.
     Exit 0: nothing found; 1: a trap; 2: a line it cannot read."""
-    from .comparisons import audit as A
+    from .comparisons import audit
     from .io import write_text
 
-    result = A.audit(deck_path, engine, speed)
-    text = A.text_report(result)
+    result = audit.audit(deck_path, engine, speed)
+    text = audit.text_report(result)
     if report_dir:
         out = Path(report_dir)
         out.mkdir(parents=True, exist_ok=True)
@@ -874,7 +874,7 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json):
     """The native input (the coefficient of restitution or damping an engine reads, k_t, …) that realises a
     target metric in ENGINE at the run's dt: root finding on the engine's twin, confirmed by one engine run;
     prints the line to paste. Exit 0: confirmed; 1: the engine run misses the target; 2: bad input."""
-    from .comparisons import calibrate as K
+    from .comparisons import calibrate
 
     wanted = {}
     for item in targets:
@@ -882,13 +882,13 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json):
         if not sep:
             raise ConfigError("--target", item, "must be METRIC=VALUE, e.g. restitution=0.6")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
-    K.check_targets(wanted)  # bad input: one line, before any work
+    calibrate.check_targets(wanted)  # bad input: one line, before any work
     case = _load(case_path, overrides)
-    result = K.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm)
+    result = calibrate.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm)
     if as_json:
         emit_json(result)
     else:
-        click.echo(K.text_report(result))
+        click.echo(calibrate.text_report(result))
     if result["confirmed"] is False:
         sys.exit(1)
 

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import case as C
+from ..case import Case, from_dict
 from ..errors import ConfigError, DemcheckError
-from ..inputs import script as S
+from ..inputs import script as deck_script
 from ..reference import collision3d
 from ..reference.model import resolve
 from ..reference.normal import HYSTERETIC
@@ -54,7 +54,7 @@ def readers() -> dict:
     return out
 
 
-def detect(script: S.Script, found: dict) -> str:
+def detect(script: deck_script.Script, found: dict) -> str:
     """The deck's engine: the first whose reader claims its vocabulary, else the one that reads by default."""
     for name, reader in found.items():
         if reader.claims(script):
@@ -63,7 +63,7 @@ def detect(script: S.Script, found: dict) -> str:
 
 
 def read(path: str | Path, engine: str | None = None):
-    script = S.read(path)
+    script = deck_script.read(path)
     found = readers()
     engine = engine or detect(script, found)
     if engine not in found:
@@ -74,7 +74,7 @@ def read(path: str | Path, engine: str | None = None):
     return setup
 
 
-def characteristic_speed(setup: S.Setup, speed: float | None) -> tuple[float, str]:
+def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple[float, str]:
     if speed is not None:
         return speed, "--speed"
     moving = [(v, w) for v, w in setup.speeds if v > 0]
@@ -85,14 +85,14 @@ def characteristic_speed(setup: S.Setup, speed: float | None) -> tuple[float, st
                                        "characteristicVelocity): give the characteristic impact speed (m/s)")
 
 
-def _body(setup: S.Setup, t: int):
+def _body(setup: deck_script.Setup, t: int):
     b = setup.bodies.get(t)
     if b is None or b.radius is None:
-        raise S.ScriptError(f"type {t}: the deck gives it no diameter (set type {t} diameter, read_data Atoms, or "
+        raise deck_script.ScriptError(f"type {t}: the deck gives it no diameter (set type {t} diameter, read_data Atoms, or "
                             "a particle template)")
     if b.density is None:
         if b.mass is None:
-            raise S.ScriptError(f"type {t}: the deck gives it no density or mass")
+            raise deck_script.ScriptError(f"type {t}: the deck gives it no density or mass")
         return b.radius, b.mass / (4.0 / 3.0 * math.pi * b.radius ** 3)
     return b.radius, b.density
 
@@ -158,7 +158,7 @@ def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
     return normal, tangential, params, reasons
 
 
-def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> C.Case:
+def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> Case:
     normal, tangential, params, _ = seed
     r1, rho1 = _body(setup, ps.i)
     e_star = nl.k / (4.0 / 3.0 * math.sqrt(_effective(setup, ps)[1])) if nl.a == 1.5 else 1e9
@@ -195,7 +195,7 @@ def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> C.Case:
         r2, rho2 = _body(setup, ps.j)
         mats["b"] = material(rho2, setup.bodies[ps.j], own)
         parts.append({"material": "b", "radius": r2})
-    return C.from_dict(raw)
+    return from_dict(raw)
 
 
 def _metrics(res) -> dict:
@@ -293,7 +293,7 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
                     entry["probes"].append(probe(setup, ps, v, angle, run_engine))
                 except DemcheckError as exc:
                     entry["probes"].append({"angle": angle, "error": str(exc)})
-                    found.append(S.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
+                    found.append(deck_script.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
                                            ps.where))
             _judge(setup, ps, entry, found, tol)
         entry["findings"] = [_finding(f) for f in found]
@@ -308,7 +308,7 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             "traps": len(traps), "status": "traps" if traps else "clean"}
 
 
-def _finding(f: S.Finding) -> dict:
+def _finding(f: deck_script.Finding) -> dict:
     return {"kind": f.kind, "code": f.code, "text": f.text, "where": f.where, "size": f.size}
 
 
@@ -327,10 +327,10 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
         if eng is None:
             continue
         if eng["status"] != "ok":
-            found.append(S.Finding("trap", "engine-failed", f"{p['angle']:g}° probe: the engine run is "
+            found.append(deck_script.Finding("trap", "engine-failed", f"{p['angle']:g}° probe: the engine run is "
                                    f"{eng['status']}: {eng['message']}", ps.where))
         elif not p["engine_vs_twin"] <= 1e-9:
-            found.append(S.Finding("trap", "engine-vs-twin", f"{p['angle']:g}° probe: the engine differs from the "
+            found.append(deck_script.Finding("trap", "engine-vs-twin", f"{p['angle']:g}° probe: the engine differs from the "
                                    f"formulas the audit read from the deck by {p['engine_vs_twin']:.3g}", ps.where,
                                    {"difference": p["engine_vs_twin"]}))
     e_asked = ps.asked.get("restitution")
@@ -343,7 +343,7 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
                 f.size.update(size)
                 f.text += f": e = {e_asked:g} asked, {e_real:.4f} realised"
         if abs(e_real - e_asked) > ASKED_TOL and not codes & {"tsuji", "limit"}:
-            found.append(S.Finding("trap", "restitution", f"restitution {e_real:.4f} realised, {e_asked:g} asked",
+            found.append(deck_script.Finding("trap", "restitution", f"restitution {e_real:.4f} realised, {e_asked:g} asked",
                                    ps.where, size))
     elif e_asked is None and "restitution" in main:
         entry["notes"].append(f"realised restitution {e_real:.4f} (the deck sets a damping coefficient, not e)")
@@ -363,18 +363,18 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
     dt_err = max((p["dt_error"] for p in probes if math.isfinite(p["dt_error"])), default=math.nan)
     entry["time_step"] = {"dt": setup.dt, "steps_per_contact": spc, "dt_error": dt_err, "stability_margin": margin}
     if margin < 1.0:
-        found.append(S.Finding("trap", "dt-unstable", f"dt = {setup.dt:g} s is above velocity Verlet's stability "
+        found.append(deck_script.Finding("trap", "dt-unstable", f"dt = {setup.dt:g} s is above velocity Verlet's stability "
                                f"limit {margin * setup.dt:.3g} s for this contact", setup.dt_where,
                                {"stability_margin": margin}))
     elif spc < MIN_STEPS_PER_CONTACT or (math.isfinite(dt_err) and dt_err > tol.verlet_rtol):
-        found.append(S.Finding("trap", "dt-coarse", f"dt = {setup.dt:g} s: {spc:.1f} steps per contact, "
+        found.append(deck_script.Finding("trap", "dt-coarse", f"dt = {setup.dt:g} s: {spc:.1f} steps per contact, "
                                f"time-step error {dt_err:.3g} against the converged contact", setup.dt_where,
                                {"steps_per_contact": spc, "dt_error": dt_err}))
     if not ps.native.limit and "engine" in head:
         peak, low = head["engine"]["peak_force"], head["engine"]["min_force"]
         if math.isfinite(low) and low < -ATTRACTION_NOTE * peak:
             kind = "trap" if low < -ATTRACTION_TRAP * peak else "note"
-            found.append(S.Finding(kind, "attraction", f"the normal force pulls the bodies together "
+            found.append(deck_script.Finding(kind, "attraction", f"the normal force pulls the bodies together "
                                    f"({low:.4g} N, {-low / peak * 100:.1f}% of the peak) and no limit holds it at 0",
                                    ps.where, {"min_force": low, "peak_force": peak}))
 

@@ -26,16 +26,16 @@ from pathlib import Path
 
 from ..errors import ConfigError
 from ..io import number, plain
-from . import verdicts as V
+from . import verdicts
 
 FORMAT = "demcheck-baseline"
 FORMAT_VERSION = 1
-RANK = {V.AGREE: 0, V.NOT_EXPRESSIBLE: 1, V.MISSING: 2, V.EXPECTED: 3, V.UNEXPECTED: 4, V.FAILED: 5}
+RANK = {verdicts.AGREE: 0, verdicts.NOT_EXPRESSIBLE: 1, verdicts.MISSING: 2, verdicts.EXPECTED: 3, verdicts.UNEXPECTED: 4, verdicts.FAILED: 5}
 
 
 def default_tolerance() -> float:
     """The scaled move a value may make between two runs: the implementation bar of data/tolerances.toml."""
-    return V.Tolerances.load().implementation
+    return verdicts.Tolerances.load().implementation
 
 
 # ----------------------------------------------------------------------------- reading runs
@@ -59,7 +59,7 @@ def from_summary(summary: dict, path: str = "") -> dict:
         for k in c.get("comparisons", []):
             src, metric = k["source"], k["metric"]
             old = verdicts[src].get(metric)
-            verdicts[src][metric] = k["verdict"] if old is None else V.worst([old, k["verdict"]])
+            verdicts[src][metric] = k["verdict"] if old is None else verdicts.worst([old, k["verdict"]])
         sources = {}
         for src, s in (c.get("sources") or {}).items():
             sources[src] = {"status": s.get("status"), "version": s.get("engine_version"),
@@ -144,9 +144,9 @@ def _scaled(new: float, old: float, metric: str, scales: dict) -> float:
     """|new − old| in the metric's scale (verdicts.scaled, OLD as the reference; relative where the case
     carries no scale for it); 0 when neither exists, NaN when only one does."""
     try:
-        return V.scaled(new, old, metric, scales)
+        return verdicts.scaled(new, old, metric, scales)
     except KeyError:  # a packing's or an old report's case without the scale: relative to OLD
-        return V.scaled(new, old, "", {})
+        return verdicts.scaled(new, old, "", {})
 
 
 def _tolerance(old_run: dict, case: str, source: str, metric: str, default: float) -> float:
@@ -269,11 +269,11 @@ def render_markdown(d: dict) -> str:
               f"metric's scale ({tol}).", ""]
     if d["changed_cases"]:
         lines += ["Case files changed between the runs (their hash differs): " + ", ".join(d["changed_cases"]), ""]
-    verdicts = [r for r in d["rows"] if r["old_verdict"] != r["new_verdict"]]
-    if verdicts:
+    changed = [r for r in d["rows"] if r["old_verdict"] != r["new_verdict"]]
+    if changed:
         lines += ["## Verdicts that changed", "", "| case | source | metric | OLD | NEW | |", "|---|---|---|---|---|---|"]
         lines += [f"| {r['case']} | {r['source']} | {r['metric']} | {_v(r['old_verdict'])} | {_v(r['new_verdict'])} | "
-                  f"{'**worse**' if r['change'] == 'worse' else r['change']} |" for r in verdicts]
+                  f"{'**worse**' if r['change'] == 'worse' else r['change']} |" for r in changed]
         lines.append("")
     moved = [r for r in d["rows"] if r["beyond"]]
     if moved:
@@ -357,7 +357,7 @@ def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) ->
     for c in summary["cases"]:
         for r in by_case.get(c["case"], []):
             if "metric" not in r:
-                comp = V.status_comparison(r["source"], V.UNEXPECTED, f"baseline: {r['source']} {r['what']} "
+                comp = verdicts.status_comparison(r["source"], verdicts.UNEXPECTED, f"baseline: {r['source']} {r['what']} "
                                            f"(it ran in the baseline {base['path']})")
             else:
                 why = [] if not r["beyond"] else [f"moved {_moved(r['moved'])} from the baseline's "
@@ -367,12 +367,12 @@ def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) ->
                 if r["old_version"] != r["new_version"]:
                     why.append(f"version {_v(r['old_version'])} → {_v(r['new_version'])}")
                 absd = abs(r["new"] - r["old"]) if math.isfinite(r["new"]) and math.isfinite(r["old"]) else math.nan
-                comp = V.Comparison(r["source"], r["metric"], r["new"], r["old"], absd, r["moved"], r["tolerance"],
-                                    V.UNEXPECTED, "baseline: " + "; ".join(why))
+                comp = verdicts.Comparison(r["source"], r["metric"], r["new"], r["old"], absd, r["moved"], r["tolerance"],
+                                    verdicts.UNEXPECTED, "baseline: " + "; ".join(why))
             c.setdefault("comparisons", []).append(comp.as_dict())
         if c["case"] in by_case:
-            c["verdict"] = V.worst(k["verdict"] for k in c["comparisons"])
-            c["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(c["verdict"], "ok")
+            c["verdict"] = verdicts.worst(k["verdict"] for k in c["comparisons"])
+            c["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(c["verdict"], "ok")
     summary["failed"] = sum(c["status"] in ("failed", "unexpected") for c in summary["cases"])
     summary["baseline"] = {k: v for k, v in d.items() if k != "new"} | {"path": base["path"]}
     return summary["baseline"]

@@ -18,7 +18,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from ..io import number, plain, write_json, write_text
-from . import verdicts as V
+from . import verdicts
 from .styles import engine_sources, style
 
 def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None) -> None:
@@ -76,11 +76,11 @@ def matrix(summary: dict) -> dict:
     for c in summary["cases"]:
         for k in c.get("comparisons", []):
             out[(_model(c), k["source"], k["metric"])].append(k["verdict"])
-    return {key: V.worst(vs) for key, vs in out.items()}
+    return {key: verdicts.worst(vs) for key, vs in out.items()}
 
 
-_SHORT = {V.AGREE: "✓", V.EXPECTED: "≈", V.UNEXPECTED: "✗", V.NOT_EXPRESSIBLE: "n/e", V.MISSING: "missing",
-          V.FAILED: "FAIL"}
+_SHORT = {verdicts.AGREE: "✓", verdicts.EXPECTED: "≈", verdicts.UNEXPECTED: "✗", verdicts.NOT_EXPRESSIBLE: "n/e", verdicts.MISSING: "missing",
+          verdicts.FAILED: "FAIL"}
 
 
 # ----------------------------------------------------------------------------- markdown
@@ -101,7 +101,7 @@ def render_markdown(summary: dict) -> str:
         for k in c.get("comparisons", []):
             counts[k["verdict"]] += 1
     lines += ["| verdict | comparisons |", "|---|---|"]
-    lines += [f"| {v} | {counts[v]} |" for v in V.VERDICTS if counts[v]]
+    lines += [f"| {v} | {counts[v]} |" for v in verdicts.VERDICTS if counts[v]]
     lines += ["", f"**{summary['failed']} case(s) with an unexpected difference or a failure.**", ""]
     if "baseline" in summary:
         from .diff import baseline_markdown
@@ -136,7 +136,7 @@ def render_markdown(summary: dict) -> str:
     reasons: dict = defaultdict(list)
     for c in summary["cases"]:
         for k in c.get("comparisons", []):
-            if k["verdict"] in (V.EXPECTED, V.UNEXPECTED, V.FAILED, V.NOT_EXPRESSIBLE, V.MISSING):
+            if k["verdict"] in (verdicts.EXPECTED, verdicts.UNEXPECTED, verdicts.FAILED, verdicts.NOT_EXPRESSIBLE, verdicts.MISSING):
                 reasons[(k["verdict"], k["source"], k["reason"])].append((c["case"], k["metric"], k["rel_diff"]))
     if not reasons:
         lines.append("None: every source agrees with the seed model on every metric.")
@@ -246,9 +246,9 @@ def render_junit(summary: dict) -> str:
         for src, comps in by_source.items():
             n += 1
             tc = ET.SubElement(suite, "testcase", classname=f"{c['case']}", name=f"{_model(c)} · {src}")
-            bad = [k for k in comps if k["verdict"] == V.UNEXPECTED]
-            failed = [k for k in comps if k["verdict"] == V.FAILED]
-            skipped = [k for k in comps if k["verdict"] in (V.NOT_EXPRESSIBLE, V.MISSING)]
+            bad = [k for k in comps if k["verdict"] == verdicts.UNEXPECTED]
+            failed = [k for k in comps if k["verdict"] == verdicts.FAILED]
+            skipped = [k for k in comps if k["verdict"] in (verdicts.NOT_EXPRESSIBLE, verdicts.MISSING)]
             if failed:
                 errors += 1
                 ET.SubElement(tc, "error", message=failed[0]["reason"][:500]).text = "\n".join(
@@ -261,7 +261,7 @@ def render_junit(summary: dict) -> str:
             elif skipped:
                 skips += 1
                 ET.SubElement(tc, "skipped", message=skipped[0]["reason"][:500])
-            expected = [k for k in comps if k["verdict"] == V.EXPECTED]
+            expected = [k for k in comps if k["verdict"] == verdicts.EXPECTED]
             if expected:
                 ET.SubElement(tc, "system-out").text = "\n".join(
                     f"differs as expected: {k['metric']} ({number(k['rel_diff'], '.3g')}): {k['reason']}" for k in expected)
@@ -539,7 +539,7 @@ def render_html(summary: dict) -> str:
         parts.append("<table><tr><th>source</th><th>metric</th><th>value</th><th>reference</th><th>scaled diff"
                      "</th><th>tolerance</th><th>verdict</th><th>reason</th></tr>")
         for k in rows:
-            vcls = {V.AGREE: "agree", V.EXPECTED: "expected", V.UNEXPECTED: "unexpected", V.FAILED: "failed"}.get(
+            vcls = {verdicts.AGREE: "agree", verdicts.EXPECTED: "expected", verdicts.UNEXPECTED: "unexpected", verdicts.FAILED: "failed"}.get(
                 k["verdict"], "")
             parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{number(k['value'])}</td>"
                          f"<td>{number(k['reference'])}</td><td>{number(k['rel_diff'], '.3g')}</td>"

@@ -156,13 +156,13 @@ class Limit:
 
 
 def _hertz(metric: str):
-    from ..reference import analytic as A
+    from ..reference import analytic
 
     def value(c: Impact, m: dict) -> float:
         p = m["_pair"]
         args = (p.m_eff, p.r_eff, p.e_eff, p.impact_speed)
-        return {"contact_time": A.hertz_duration, "max_overlap": A.hertz_max_overlap,
-                "peak_force": A.hertz_peak_force}[metric](*args)
+        return {"contact_time": analytic.hertz_duration, "max_overlap": analytic.hertz_max_overlap,
+                "peak_force": analytic.hertz_peak_force}[metric](*args)
 
     return Limit(metric, "Hertz closed form", value, lambda c: True, lambda c, v: abs(v), 1e-6, 2e-3,
                  "elastic Hertz: exact (reference 1e-6: the adaptive solver's events; engines 2e-3: their time "

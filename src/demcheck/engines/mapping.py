@@ -90,8 +90,8 @@ def twin_model(model: ResolvedModel, native: Native) -> ResolvedModel:
 def table(examples: list[tuple[str, str]] | None = None) -> list[dict]:
     """The mapping of every registered model for ``demcheck models`` and docs/models.md: each normal model
     with tangential none, each tangential model with its natural normal partner, on the glass pair."""
-    from .. import case as C
-    from ..reference import normal as N, tangential as T
+    from ..case import apply_overrides, from_dict
+    from ..reference import normal, tangential
     from ..reference.model import resolve
 
     import copy
@@ -99,17 +99,17 @@ def table(examples: list[tuple[str, str]] | None = None) -> list[dict]:
 
     base = tomllib.loads(_TABLE_CASE)
     rows = []
-    combos = examples or ([(n, "none", {}) for n in N.REGISTRY] + [
-        (_PARTNER.get(t, "lsd"), t, {}) for t in T.REGISTRY if t != "none"] + _VARIANTS)
+    combos = examples or ([(n, "none", {}) for n in normal.REGISTRY] + [
+        (_PARTNER.get(t, "lsd"), t, {}) for t in tangential.REGISTRY if t != "none"] + _VARIANTS)
     for combo in combos:
-        normal, tangential, extra = combo if len(combo) == 3 else (*combo, {})
-        params = {**N.REGISTRY[normal].example, **T.REGISTRY[tangential].example, **extra}
+        nid, tid, extra = combo if len(combo) == 3 else (*combo, {})
+        params = {**normal.REGISTRY[nid].example, **tangential.REGISTRY[tid].example, **extra}
         params.pop("friction", None)
-        sets = [f"contact.normal={normal}", f"contact.tangential={tangential}"]
+        sets = [f"contact.normal={nid}", f"contact.tangential={tid}"]
         sets += [f"contact.{k}={_toml(v)}" for k, v in params.items()]
-        case = C.from_dict(C.apply_overrides(copy.deepcopy(base), sets))
+        case = from_dict(apply_overrides(copy.deepcopy(base), sets))
         model = resolve(case)
-        row = {"normal": normal, "tangential": tangential,
+        row = {"normal": nid, "tangential": tid,
                "variant": ", ".join(f"{k} = {_toml(v)}" for k, v in extra.items())}
         for engine in registry.names():
             mp = map_model(model, engine, case.contact.params)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..case import Case, packing_run
 from ..errors import UnsupportedByEngine
-from ..reference import packing as P
+from ..reference import packing
 from . import common
 from .common import fmt
 
@@ -60,10 +60,10 @@ def layout(case: Case, duration, dt):
     if case.kind != "packing":
         raise UnsupportedByEngine(f"case '{case.name}' is not a packing")
     dt, _, steps = packing_run(case, duration, dt)
-    species, rep = P.species_of(case)
+    species, rep = packing.species_of(case)
     x = np.array([p.position for p in case.particles], float)
     rad = np.array([p.radius for p in case.particles], float)
-    lo, hi, periodic = P.box_of(case, x, rad)
+    lo, hi, periodic = packing.box_of(case, x, rad)
     return species, rep, rad, lo, hi, periodic, dt, steps
 
 

@@ -6,17 +6,17 @@ import numpy as np
 
 from ...case import Case
 from ...errors import UnsupportedByEngine
-from ...inputs import common, packing_decks as PD
+from ...inputs import common, packing_decks
 from ...inputs.common import fmt
 from ..mapping import pair_mapping
 from .deck import VERSION_NOTE, coeff_args
 
 
 def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
-    species, rep, rad, lo, hi, periodic, dt, steps = PD.layout(case, duration, dt)
+    species, rep, rad, lo, hi, periodic, dt, steps = packing_decks.layout(case, duration, dt)
     g = np.asarray(case.run.gravity, float)
     gn = float(np.linalg.norm(g))
-    lines = PD.head(case, "lammps", VERSION_NOTE, len(rep), dt, steps, periodic,
+    lines = packing_decks.head(case, "lammps", VERSION_NOTE, len(rep), dt, steps, periodic,
                   ["atom_style sphere", "atom_modify map array", "BOUNDS", "newton off", "comm_modify vel yes"])
     rmax = float(rad.max())
     lines += ["", f"neighbor {fmt(0.5 * rmax)} bin", "neigh_modify delay 0 every 1 check yes", "pair_style granular"]
@@ -43,7 +43,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
               "# every pair within the cutoff: the two ids, centre distance, normal force (repulsive > 0) and the",
               "# tangential force's magnitude (pair granular's 4th single() quantity), re-evaluated at the final state",
               "compute pairs all pair/local dist force p4", "compute ids all property/local patom1 patom2",
-              f"dump contacts all local 1 {PD.CONTACT_DUMP} c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3]",
+              f"dump contacts all local 1 {packing_decks.CONTACT_DUMP} c_ids[1] c_ids[2] c_pairs[1] c_pairs[2] c_pairs[3]",
               "dump_modify contacts format float %.17g", "run 0", "undump contacts",
-              f"write_dump all custom {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)} modify format float %.17g sort id", ""]
-    return common.Deck("lammps", "\n".join(lines), {"data.lmp": PD.data_file(case, species, lo, hi)}, dt=dt)
+              f"write_dump all custom {packing_decks.FINAL_DUMP} {' '.join(packing_decks.FINAL_COLUMNS)} modify format float %.17g sort id", ""]
+    return common.Deck("lammps", "\n".join(lines), {"data.lmp": packing_decks.data_file(case, species, lo, hi)}, dt=dt)

@@ -6,14 +6,14 @@ import numpy as np
 
 from ...case import Case
 from ...errors import UnsupportedByEngine
-from ...inputs import common, packing_decks as PD
+from ...inputs import common, packing_decks
 from ...inputs.common import fmt
 from ..mapping import pair_mapping
 from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
 
 
 def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
-    species, rep, rad, lo, hi, periodic, dt, steps = PD.layout(case, duration, dt)
+    species, rep, rad, lo, hi, periodic, dt, steps = packing_decks.layout(case, duration, dt)
     ns = len(rep)
     natives = {}
     for a in range(ns):
@@ -50,7 +50,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
             moduli.append(RIGID_WALL_MODULUS)
             ratios.append(ratios[0])
     model_lines, style, flags = model_setup(nat, matrices, moduli, ratios)
-    lines = PD.head(case, "liggghts", VERSION_NOTE, ns, dt, steps, periodic,
+    lines = packing_decks.head(case, "liggghts", VERSION_NOTE, ns, dt, steps, periodic,
                   ["atom_style granular", "atom_modify map array", "BOUNDS", "newton off",
                    "communicate single vel yes"])
     lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
@@ -64,15 +64,15 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
     if gn > 0:
         lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
     every = max(1, steps // 50)
-    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(PD.FINAL_COLUMNS) - 2))
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(packing_decks.FINAL_COLUMNS) - 2))
     local_fmt = " ".join(["%.17g"] * 10)  # compute values are doubles, the ids too
     lines += ["# per contact: the two ids, a periodic flag, the force on the first and its normal part, the overlap",
               "# (defined before the first run, as LIGGGHTS requires; dumped at the final state only)",
               "compute pairs all pair/gran/local id force force_normal delta",
               "fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
               "thermo_modify norm no", f"thermo {every}", f"run {steps}",
-              f"dump final all custom 1 {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)}",
+              f"dump final all custom 1 {packing_decks.FINAL_DUMP} {' '.join(packing_decks.FINAL_COLUMNS)}",
               f'dump_modify final format "{fmt_line}" sort id',
-              f"dump contacts all local 1 {PD.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
+              f"dump contacts all local 1 {packing_decks.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
               f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
-    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": PD.data_file(case, species, lo, hi, ntypes)}, dt=dt)
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": packing_decks.data_file(case, species, lo, hi, ntypes)}, dt=dt)
