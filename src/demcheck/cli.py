@@ -138,6 +138,14 @@ REPORT_DIR = OutputPath(directory=True, link="latest")  # <report>/<run-id>/… 
 PACK_CSV_DIR = OutputPath(directory=True, files=("particles.csv", "contacts.csv"))
 
 
+def _seed_only(case, command: str) -> None:
+    """Commands that run the seed model's mapping refuse a case with native settings, in one line, rather than
+    run something else than the case asks for."""
+    for name in getattr(case, "natives", {}) or {}:
+        raise ConfigError(f"engine.{name}", "(native settings)", f"are run by collide, verify, deck and calibrate; "
+                          f"`demcheck {command}` runs the seed model's mapping in every engine: drop the table")
+
+
 def _load(case_path: str, overrides) -> "object":
     from . import case as case_mod
     from .engines import registry
@@ -439,6 +447,8 @@ def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
     from .comparisons.sweep import parse_vary, plot_sweep, run_sweep, sweep_points
 
     points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
+    for _, point in points[:1]:
+        _seed_only(point, "sweep")
     with Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("sweep", total=len(points))
         table = run_sweep(points, method, dt, lambda: progress.advance(task))
@@ -748,6 +758,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     for f in _case_files(paths):  # every file read and checked before any work; an error names the file
         with naming_file(f):
             cases.append(load(f, list(overrides)))
+            _seed_only(cases[-1], "bench")
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
@@ -783,6 +794,8 @@ def stress(paths, engines, only, report_dir, as_json):
 
     names = _engine_list(engines)
     cases = [read_stress(f) for f in _case_files(paths)]  # every file read and checked before any work
+    for _, case in cases:
+        _seed_only(case, "stress")
     root = Path(report_dir)
     out_dir = new_run_dir(root, "stress")
     results = []
@@ -811,6 +824,7 @@ def dt(case_path, target, overrides, as_json):
     from .comparisons.bench import recommend
 
     case = _load(case_path, overrides)
+    _seed_only(case, "dt")
     rec = recommend(case, target)
     if as_json:
         emit_json(rec)
