@@ -14,6 +14,7 @@ import os
 import re
 import shlex
 import shutil
+import subprocess
 import tempfile
 from pathlib import Path
 
@@ -38,12 +39,41 @@ def _versioned(executable: str) -> str:
     return str(path)
 
 
+class _Banner:
+    """Discovery reads ``<executable> -h``. Through demcheck's launcher (:func:`_versioned`) that prints
+    ``Yade version: 2023.02a``; a build named directly (``--engine yade@f128=/usr/bin/yade-float128``, whose
+    executable discovery runs as it is) prints only Yade's usage line, ``usage: yade-float128 [options] [
+    simulation.xml[.bz2] | script.py ...``, which names the program but not its version. Then the program it names
+    is found on PATH and asked ``--version``. A match's group 1 is the version ("2023.02a")."""
+
+    VERSION = re.compile(r"^Yade version: *(\S+)", re.M)
+    USAGE = re.compile(r"^usage: (yade[A-Za-z0-9._-]*) \[options\] \[ simulation\.xml", re.M)
+
+    def __init__(self, timeout: float = 20.0):
+        self.timeout = timeout
+
+    def search(self, text: str):
+        found = self.VERSION.search(text or "")
+        if found:
+            return found
+        usage = self.USAGE.search(text or "")
+        exe = shutil.which(usage.group(1)) if usage else None
+        if not exe:
+            return None
+        try:
+            out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=self.timeout,
+                                 stdin=subprocess.DEVNULL).stdout
+        except (OSError, subprocess.SubprocessError):
+            return None
+        return self.VERSION.search(out)
+
+
 class Yade(PackageEngine):
     name = "yade"
     title = "Yade"
     release = "Yade 2023.02a"
     how_to_install = "apt-get install yade (Debian), or scripts/install-engines.sh as root"
-    banner = re.compile(r"^Yade version: *(\S+)", re.M)
+    banner = _Banner()
     # slip velocity and torques at the contact point (R − δ/2 for a pair); the history's rotation is Yade's
     # first-order ScGeom::rotate, which the twin's "project" matches where the normal does not turn (walls,
     # head-on pairs); on a wall Yade's slip arm is R − δ (see mapping.py)
