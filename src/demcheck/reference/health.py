@@ -47,14 +47,14 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
     """(status, why) of a time-stepped result (module docstring); ("ok", "") when every rule holds.
     ``radius``: the smaller radius (default: ``result.meta["radius0"]``); ``impact_energy``: the energy
     the energy rule is measured in (default ½ m̄ v² of the normal impact)."""
-    c = result.contact
+    c = result.table("contact")  # the arrays: no DataFrame is built for the check
     dt = result.dt
-    state = c[list(STATE_COLUMNS)].to_numpy(dtype=float)
+    state = np.column_stack([np.asarray(c[k], dtype=float) for k in STATE_COLUMNS])
     bad = ~np.isfinite(state).all(axis=1)
     if bad.any():
-        t_bad = float(c["t"].to_numpy()[int(np.argmax(bad))])
+        t_bad = float(np.asarray(c["t"])[int(np.argmax(bad))])
         return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
-    d = c["delta"].to_numpy()
+    d = np.asarray(c["delta"], dtype=float)
     inside = int((d > 0).sum())
     if inside < min_steps and (inside > 0 or t_c / dt < min_steps):
         return "unresolved", (f"only {inside} steps inside the contact ({_steps(dt, t_c)}): the time step does not "
@@ -72,7 +72,7 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
     if out is not None:
         return out
     if d[-1] > 0:
-        return "no-separation", f"the contact had not ended by the end of the run (t = {c['t'].iloc[-1]:.3g} s)"
+        return "no-separation", f"the contact had not ended by the end of the run (t = {float(np.asarray(c['t'])[-1]):.3g} s)"
     return "ok", ""
 
 

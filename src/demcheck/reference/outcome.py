@@ -83,7 +83,7 @@ def judge(result: Result, case: Case, model: ResolvedModel) -> Result:
         if result.status != "too-many-steps":
             health.apply(result, case, model)
     elif result.status in ("ok", "no-separation"):
-        out = health.overlap_rule(float(result.contact["delta"].max()), health.smallest_radius(case))
+        out = health.overlap_rule(float(np.max(result.table("contact")["delta"])), health.smallest_radius(case))
         if out is not None:
             result.status, result.message = out
     return result
