@@ -140,6 +140,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     else:
         phys = (f"Ip2_FrictMat_FrictMat_MindlinPhys(betan={_num(p['betan'])}, betas={_num(p['betas'])})"
                 if p["betan"] > 0.0 or p["betas"] > 0.0 else "Ip2_FrictMat_FrictMat_MindlinPhys()")
+        if p.get("en") is not None:  # Yade's own restitution input (never mapped: docs/findings.md's trap)
+            phys = f"Ip2_FrictMat_FrictMat_MindlinPhys(en={_num(p['en'])})"
         law = "Law2_ScGeom_MindlinPhys_Mindlin()"
     head = common.header("yade", sc, mp, VERSION_NOTE, "yade -x -n")
     notes = [ascii_comment(c) for c in head[1:] + common.notes(nat.comments)]
