@@ -23,8 +23,7 @@ from numba import njit
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
                       L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
-                      normal_force, spow, viscoelastic_force)
-from .integrator import make_core, simultaneous_end
+                      illinois_trial, illinois_update, normal_force, spow, viscoelastic_force)
 from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_KIND, T_KT,
                          T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
@@ -444,12 +443,28 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
 
 
 @njit(cache=True)
-def _deriv(y, args):
-    """ẏ (the integrator's right-hand side); args = (aux, nl, tl, geo, rules)."""
-    aux, nl, tl, geo, rules = args
-    dy = np.empty(y.shape[0])
-    rhs(y, aux, nl, tl, geo, rules, dy)
-    return dy
+def _dp5_3(y, aux, nl, tl, geo, rules, h):
+    n = y.shape[0]
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    rhs(y, aux, nl, tl, geo, rules, k1)
+    rhs(y + h * (k1 / 5), aux, nl, tl, geo, rules, k2)
+    rhs(y + h * (3 / 40 * k1 + 9 / 40 * k2), aux, nl, tl, geo, rules, k3)
+    rhs(y + h * (44 / 45 * k1 - 56 / 15 * k2 + 32 / 9 * k3), aux, nl, tl, geo, rules, k4)
+    rhs(y + h * (19372 / 6561 * k1 - 25360 / 2187 * k2 + 64448 / 6561 * k3 - 212 / 729 * k4),
+        aux, nl, tl, geo, rules, k5)
+    rhs(y + h * (9017 / 3168 * k1 - 355 / 33 * k2 + 46732 / 5247 * k3 + 49 / 176 * k4 - 5103 / 18656 * k5),
+        aux, nl, tl, geo, rules, k6)
+    yn = y + h * (35 / 384 * k1 + 500 / 1113 * k3 + 125 / 192 * k4 - 2187 / 6784 * k5 + 11 / 84 * k6)
+    rhs(yn, aux, nl, tl, geo, rules, k7)
+    err = h * (71 / 57600 * k1 - 71 / 16695 * k3 + 71 / 1920 * k4 - 17253 / 339200 * k5 + 22 / 525 * k6
+               - 1 / 40 * k7)
+    return yn, err
 
 
 NSLOT = 8
@@ -626,19 +641,29 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
     return 1.0
 
 
-@njit(cache=True, inline="always")
-def _event(y, args, slot):
-    aux, nl, tl, geo, rules = args
-    return _event_value(y, aux, nl, tl, geo, rules, slot)
+@njit(cache=True)
+def _crossed(g0, g1, direction):
+    if direction == 2:
+        return (g0 > 0.0 and g1 <= 0.0) or (g0 < 0.0 and g1 >= 0.0)
+    if direction < 0:
+        return g0 > 0.0 and g1 <= 0.0
+    # rising from exactly 0 counts: at contact start the slip function of a fresh history is 0
+    return (g0 < 0.0 and g1 >= 0.0) or (g0 == 0.0 and g1 > 0.0)
 
 
-@njit(cache=True, inline="always")
-def _direction(args, slot):
-    aux, nl, tl, geo, rules = args
-    return _slot_direction(nl, tl, aux, slot)
-
-
-_dp5, _locate, _earliest, _graze = make_core(_deriv, _event, _direction, NSLOT)
+@njit(cache=True)
+def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
+    lo, hi, glo, ghi = 0.0, 1.0, g0, g1
+    side = 0
+    for _ in range(200):
+        if hi - lo <= 1e-15:
+            break
+        theta = illinois_trial(lo, hi, glo, ghi)
+        yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
+        g = _event_value(yt, aux, nl, tl, geo, rules, slot)
+        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, theta, g,
+                                                 _crossed(glo, g, direction) or g == 0.0)
+    return hi
 
 
 @njit(cache=True)
@@ -696,8 +721,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             status = ST_STEPS
             break
         hstep = min(hstep, t_max - t)
-        args = (aux, nl, tl, geo, rules)
-        yn, err = _dp5(y, hstep, args)
+        yn, err = _dp5_3(y, aux, nl, tl, geo, rules, hstep)
         emax = 0.0
         # absolute, physical scales (positions are ~10³ times the overlap). While slipping the history is
         # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
@@ -722,13 +746,30 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 status = ST_TOLERANCE
                 break
             continue
-        best_theta, best_slot, best_dir = _earliest(y, yn, hstep, args)
+        best_theta, best_slot, best_dir = 2.0, -1, 0
+        for slot in range(NSLOT):
+            direction = _slot_direction(nl, tl, aux, slot)
+            if direction == 0:
+                continue
+            g0 = _event_value(y, aux, nl, tl, geo, rules, slot)
+            g1 = _event_value(yn, aux, nl, tl, geo, rules, slot)
+            if _crossed(g0, g1, direction):
+                theta = _locate(y, aux, nl, tl, geo, rules, hstep, slot, direction, g0, g1)
+                if theta < best_theta:
+                    best_theta, best_slot, best_dir = theta, slot, direction
         if best_slot < 0 and aux[A_NMODE] == M_PRE:
             # a graze: the gap may close and open again inside one free-flight step (δ < 0 at both ends,
             # its maximum inside, where the approach δ̇ turns into recession)
-            best_theta = _graze(y, yn, hstep, args)
-            if best_theta <= 1.0:
-                best_slot, best_dir = 0, 1
+            r0 = _event_value(y, aux, nl, tl, geo, rules, 2)
+            r1 = _event_value(yn, aux, nl, tl, geo, rules, 2)
+            if r0 > 0.0 and r1 <= 0.0:
+                tm = _locate(y, aux, nl, tl, geo, rules, hstep, 2, -1, r0, r1)
+                ym, _ = _dp5_3(y, aux, nl, tl, geo, rules, tm * hstep)
+                dm = kinematics(ym, geo, rules)[0]
+                if dm > 0.0:
+                    d0 = kinematics(y, geo, rules)[0]
+                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, 0, 1, d0, dm)
+                    best_slot, best_dir = 0, 1
         if best_slot < 0:
             t += hstep
             y = yn
@@ -747,7 +788,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             hstep *= 5.0 if emax == 0.0 else min(5.0, max(0.2, 0.9 * emax ** -0.2))
             continue
         he = best_theta * hstep
-        y, _ = _dp5(y, he, args)
+        y, _ = _dp5_3(y, aux, nl, tl, geo, rules, he)
         t += he
         delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
         code = 0
@@ -831,7 +872,8 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         n += 1
         ev_t[ne], ev_c[ne] = t, code
         ne += 1
-        if simultaneous_end(terminal, code == EV_START, aux[A_NMODE] != M_PRE, delta, rate):
+        if not terminal and code != EV_START and aux[A_NMODE] != M_PRE and delta <= 0.0 and rate < 0.0:
+            # a simultaneous root (elastic Hertz: force and overlap vanish together) landed past δ = 0
             ev_t[ne], ev_c[ne] = t, EV_END
             ne += 1
             terminal = True
