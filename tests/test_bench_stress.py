@@ -154,7 +154,8 @@ def test_cli_bench_reference_only_writes_reports(tmp_path):
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
     assert out["cases"][0]["sources"]["reference-verlet"]["cheapest"]["0.01"]["steps_per_contact"] in (10, 50, 200)
-    latest = tmp_path / "latest"
+    latest = tmp_path / "latest-bench"
+    assert not (tmp_path / "latest").exists()  # <report>/latest is verify's: bench keeps a link of its own
     assert "## Work–precision" in (latest / "report.md").read_text()
     assert '<img class="plot"' in (latest / "report.html").read_text()
     bad = subprocess.run([sys.executable, "-m", "demcheck", "bench", str(CASES / "hertz-wall.toml"), "--steps", "0,5"],
@@ -169,7 +170,7 @@ def test_cli_stress_reference_only_writes_reports(tmp_path):
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
     assert len(out["cases"][0]["limits"]) == 4
-    assert "## Stability" in (tmp_path / "latest" / "report.md").read_text()
+    assert "## Stability" in (tmp_path / "latest-stress" / "report.md").read_text()
 
 
 # ----------------------------------------------------------------------------- every case file read first

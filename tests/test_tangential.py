@@ -184,8 +184,12 @@ def _check_rotation(law, wall, q):
         raw["walls"] = [{"point": list(rot @ np.zeros(3)), "normal": list(rot @ np.array([0.0, 0.0, 1.0]))}]
     turned = C.from_dict(raw)
     m0, m1 = collide(base).metrics(), collide(turned).metrics()
+    # Walton's load rides the Coulomb limit within 1e-6 of it and is left out of the error control there
+    # (kernels3d.WALTON_NEAR_LIMIT: Kt ∝ x^{1/3} is non-Lipschitz at the limit), so where a step lands in that band —
+    # round-off, which the rotation changes — moves its answer by up to ~3e-7; every other law holds 1e-7
+    rel = 1e-6 if law == "walton" else 1e-7
     for k, v in m0.items():
-        assert m1[k] == pytest.approx(v, rel=1e-7, abs=1e-9 * (abs(v) + 1e-30)), k
+        assert m1[k] == pytest.approx(v, rel=rel, abs=1e-9 * (abs(v) + 1e-30)), k
 
 
 TRUNCATED = [(law, []) for law in LAWS] + [

@@ -142,7 +142,7 @@ def test_validate_summary_and_report_are_titled_validate(tmp_path):
     assert r.returncode == 0, r.stderr[-2000:]
     assert "demcheck validate: 2 of 2" in r.stderr and "demcheck verify" not in r.stderr  # the title wraps
     assert "validation: limit meets: 6" in r.stderr
-    html = (tmp_path / "latest" / "report.html").read_text()
+    html = (tmp_path / "latest-validate" / "report.html").read_text()
     assert "<title>demcheck validate " in html and "<title>demcheck verify" not in html
 
 
@@ -160,7 +160,7 @@ def test_validate_test7_reads_the_final_spin(tmp_path):
     for c in checks:
         assert c["source"] == "reference" and c["quantity"] == "spin_ratio" and c["points"] == 1
         assert c["verdict"] == VA.MEETS and c["deviation"] < 1e-9, c
-    assert (tmp_path / "latest" / "report.html").read_text().count("Validation against published benchmarks") == 1
+    assert (tmp_path / "latest-validate" / "report.html").read_text().count("Validation against published benchmarks") == 1
 
 # ----------------------------------------------------------------------------- end to end with the engines
 
@@ -228,20 +228,20 @@ def test_validate_end_to_end_with_the_installed_engines(tmp_path):
 
     # the reported metrics against the closed forms worked by hand: the reference to 1e-6 (its events), each
     # engine to 2e-3 (its time step at the suite's steps per contact)
-    summary = json.loads((tmp_path / "r1" / "latest" / "results.json").read_text())
+    summary = json.loads((tmp_path / "r1" / "latest-validate" / "results.json").read_text())
     for entry in summary["cases"]:
         exact = _hertz_by_hand(ROOT / f"{entry['case']}.toml")
         for src in {"reference"} | installed:
             m = entry["sources"][src]["metrics"]
             for q, v in exact.items():
                 assert m[q] == pytest.approx(v, rel=1e-6 if src == "reference" else 2e-3), (entry["case"], src, q)
-    md = (tmp_path / "r1" / "latest" / "report.md").read_text()
+    md = (tmp_path / "r1" / "latest-validate" / "report.md").read_text()
     assert md.count("## Validation against published benchmarks") == 1
     assert sum(line.startswith("| chung-ooi-1-") for line in md.splitlines()) >= len(checks)
-    assert (tmp_path / "r1" / "latest" / "report.html").read_text().count("Validation against published benchmarks") == 1
+    assert (tmp_path / "r1" / "latest-validate" / "report.html").read_text().count("Validation against published benchmarks") == 1
 
     # the second run reads every engine run from the cache and judges the same numbers
-    warm = json.loads((tmp_path / "r2" / "latest" / "results.json").read_text())
+    warm = json.loads((tmp_path / "r2" / "latest-validate" / "results.json").read_text())
     assert warm["cache"]["hits"] == len(files) * len(installed) and warm["cache"]["misses"] == 0
     assert [(c["source"], c["deviation"]) for c in runs[1]["validation"]["checks"]] == \
         [(c["source"], c["deviation"]) for c in checks]

@@ -135,6 +135,10 @@ DT = Number(lo=0, lo_open=True, unit="s")
 TIMEOUT = Number(lo=0, lo_open=True, hi=1e6, unit="s")  # the pipes' poll() takes at most ~2.1e6 s
 OUT_FILE = OutputPath()
 REPORT_DIR = OutputPath(directory=True, link="latest")  # <report>/<run-id>/… and the symlink <report>/latest
+# the other report-writing commands keep links of their own: <report>/latest is verify's
+BENCH_DIR = OutputPath(directory=True, link="latest-bench")
+STRESS_DIR = OutputPath(directory=True, link="latest-stress")
+VALIDATE_DIR = OutputPath(directory=True, link="latest-validate")
 PACK_CSV_DIR = OutputPath(directory=True, files=("particles.csv", "contacts.csv"))
 
 
@@ -596,8 +600,8 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
               help=f"comma-separated engines ({', '.join(ENGINE_NAMES)}), or 'none' for the reference alone")
 @click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
               help="cases run in parallel")
-@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True,
-              help="where reports/<run-id> and reports/latest go")
+@click.option("--report", "report_dir", type=VALIDATE_DIR, default="reports", show_default=True,
+              help="where reports/<run-id> and reports/latest-validate go")
 @click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again")
@@ -621,7 +625,7 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout)
                       junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]])
     except KeyboardInterrupt as exc:
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
-                   f"report {Path(report_dir) / 'latest'}", err=True)
+                   f"report {Path(report_dir) / 'latest-validate'}", err=True)
         sys.exit(runner.interrupt_exit_code(exc))
     val = summary["validation"]
     if as_json:
@@ -737,7 +741,8 @@ def _engine_text(names) -> str:
               help="steps per elastic contact time to sweep (default 5,10,20,50,100,200,500,1000,2000,5000)")
 @click.option("--batch", type=Number(lo=1, hi=10000, integer=True), default=16, show_default=True,
               help="copies per engine batch run")
-@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True)
+@click.option("--report", "report_dir", type=BENCH_DIR, default="reports", show_default=True,
+              help="where reports/<run-id> and reports/latest-bench go")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @_set_option
 def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
@@ -781,7 +786,8 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
 @click.option("--only", "only", multiple=True, metavar="NAME",
               help="stress only parameters whose name contains NAME (stiffness, restitution, radius, speed, "
                    "angle, mass); repeatable")
-@click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True)
+@click.option("--report", "report_dir", type=STRESS_DIR, default="reports", show_default=True,
+              help="where reports/<run-id> and reports/latest-stress go")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 def stress(paths, engines, only, report_dir, as_json):
     """Numerical stability: the largest stable time step of each source against stiffness, mass ratio,

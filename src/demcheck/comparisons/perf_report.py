@@ -24,7 +24,7 @@ def _publish(out_dir: Path, root: Path, data: dict, md: str, page: str) -> None:
     write_json(out_dir / "results.json", plain(data))
     write_text(out_dir / "report.md", md)
     write_text(out_dir / "report.html", page)
-    link_latest(root, out_dir)
+    link_latest(root, out_dir, f"latest-{out_dir.name.split('-')[0]}")  # latest-bench, latest-stress: not verify's
 
 
 # ----------------------------------------------------------------------------- work–precision

@@ -21,7 +21,7 @@ from ..io import number, plain, write_json, write_text
 from . import verdicts
 from .styles import engine_sources, style
 
-def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None) -> None:
+def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None, link: str = "latest") -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
     PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]) / "plots" if "cache" in summary else None
     data = {k: v for k, v in summary.items()}
@@ -33,20 +33,21 @@ def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = Non
     if junit is not None:
         write_text(junit, junit_text)
     write_text(out_dir / "report.html", render_html(summary))
-    link_latest(root, out_dir)
+    link_latest(root, out_dir, link)
 
 
-def link_latest(root: Path, out_dir: Path) -> None:
-    """Point the symlink ``<root>/latest`` at ``out_dir`` (a run directory in ``root``) in one step: a new
+def link_latest(root: Path, out_dir: Path, name: str = "latest") -> None:
+    """Point the symlink ``<root>/<name>`` (``latest`` is verify's; bench, stress and validate keep their own,
+    ``latest-bench`` …) at ``out_dir`` (a run directory in ``root``) in one step: a new
     link beside it renamed over it. ``latest`` is demcheck's own link — the command line refuses a real file
     or directory there before any work (cli.check_output) — and should the rename fail all the same, the new
     link is removed, never left behind."""
-    tmp = root / f".latest.{os.getpid()}"
+    tmp = root / f".{name}.{os.getpid()}"
     if tmp.is_symlink() or tmp.exists():
         tmp.unlink()
     tmp.symlink_to(out_dir.name)
     try:
-        os.replace(tmp, root / "latest")
+        os.replace(tmp, root / name)
     finally:
         if tmp.is_symlink():
             tmp.unlink()

@@ -206,7 +206,7 @@ def collect(paths) -> list[tuple[Path, Case]]:
 
 
 def run_suite(files: list[Path], report_root: Path, opts: Options | None = None, quiet: bool = False,
-              junit: Path | None = None, argv: list[str] | None = None) -> dict:
+              junit: Path | None = None, argv: list[str] | None = None, link: str = "latest") -> dict:
     from ..engines import run as runner
     from . import report
 
@@ -264,7 +264,7 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
             from .diff import apply_baseline
 
             apply_baseline(summary, opts.baseline)
-        report.write_all(summary, out_dir, report_root, junit=junit)
+        report.write_all(summary, out_dir, report_root, junit=junit, link=link)
     _print(console, summary)
     if interrupted is not None:
         raise interrupted

@@ -31,6 +31,7 @@ from typing import Callable
 import numpy as np
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "benchmarks"
+LINK = "latest-validate"  # <report>/latest is verify's
 MEETS, MISSES, NO_DATA = "meets", "misses", "no data"
 
 
@@ -561,9 +562,9 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
 
         raise ConfigError("NAME", names or "(all)", f"no benchmark case files in {root}")
     with _titled("demcheck validate"):
-        summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv)
+        summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv, link=LINK)
     summary["validation"] = validate(summary, benches, files, opts)
     summary["failed"] += len(summary["validation"]["failed"])
-    report.write_all(summary, Path(summary["report"]), report_root, junit=junit)
+    report.write_all(summary, Path(summary["report"]), report_root, junit=junit, link=LINK)
     return summary
 
