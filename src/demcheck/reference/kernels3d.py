@@ -37,8 +37,18 @@ EVENT_NAMES_3D = {EV_STICK_SLIP: "slip_start", EV_SLIP_STICK: "stick_start", EV_
 G_WALL, G_R0, G_R1, G_M0, G_M1, G_I0, G_I1, G_PX, G_NX, G_GX, G_TS = 0, 1, 2, 3, 4, 5, 6, 7, 10, 13, 16
 G_SIZE = 17
 # rules array
-R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION = 0, 1, 2, 3
-ARM_CONTACT, ARM_RADIUS = 0, 1
+R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION, R_WALL_SLIP_ARM = 0, 1, 2, 3, 4
+ARM_CONTACT, ARM_RADIUS, ARM_SURFACE = 0, 1, 2  # R − δ/2, R, R − δ (the last for walls: Yade's contact point)
+
+
+@njit(cache=True, inline="always")
+def wall_arm(code, r, delta):
+    """A sphere's lever arm to its contact with a wall, by rule code."""
+    if code == ARM_RADIUS:
+        return r
+    if code == ARM_SURFACE:
+        return r - delta
+    return r - 0.5 * delta
 ROT_NONE, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT = 0, 1, 2, 3
 # aux array: dmax, L*(3), t_ref(3), normal mode, tangential mode (0 stick, 1 slip)
 A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
@@ -75,9 +85,8 @@ def kinematics(y, geo, rules):
         n = -nw
         delta = r0 - _dot(x0 - geo[G_PX:G_PX + 3], nw)
         ndot = np.zeros(3)
-        a0c = r0 - 0.5 * delta
-        a0s = r0 if rules[R_SLIP_ARM] == ARM_RADIUS else a0c
-        a0t = r0 if rules[R_WALL_TORQUE_ARM] == ARM_RADIUS else a0c
+        a0s = wall_arm(rules[R_WALL_SLIP_ARM], r0, delta)
+        a0t = wall_arm(rules[R_WALL_TORQUE_ARM], r0, delta)
         vr = v0 + _cross(w0, a0s * n)
         a1s, a1t = 0.0, 0.0
     else:
@@ -350,7 +359,8 @@ def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
     """Tangential part of dv_t/dt with no tangential force (the normal force and gravity act along n for a
     pair; a wall sees gravity's tangential part): b in v̇_t = A F_t + b."""
     vr_n = rate
-    adot0 = 0.0 if rules[R_SLIP_ARM] == ARM_RADIUS else -0.5 * rate
+    arm = rules[R_WALL_SLIP_ARM] if geo[G_WALL] != 0.0 else rules[R_SLIP_ARM]
+    adot0 = 0.0 if arm == ARM_RADIUS else (-rate if arm == ARM_SURFACE else -0.5 * rate)
     acc = _cross(y[6:9], adot0 * n + a0s * ndot)
     if geo[G_WALL] != 0.0:
         acc = acc + geo[G_GX:G_GX + 3]

@@ -24,7 +24,8 @@ import numpy as np
 from numba import njit
 
 from .kernels import normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT, ROT_RESCALE,
+from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT,
+                        ROT_RESCALE, wall_arm,
                         ROT_RESCALE_SIGNIFICANT, eta_of, kt_of, normal_part_matters, return_map, slip_surface,
                         tangential_force, walton_reverses, walton_stiffness)
 from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
@@ -363,8 +364,8 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
             delta = rad[i] - dist
             if delta > 0.0:
                 n0, n1, n2 = -walls[k, 3], -walls[k, 4], -walls[k, 5]  # from the particle into the wall
-                ai = rad[i] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
-                bi = rad[i] if rules[R_WALL_TORQUE_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
+                ai = wall_arm(rules[R_WALL_SLIP_ARM], rad[i], delta)
+                bi = wall_arm(rules[R_WALL_TORQUE_ARM], rad[i], delta)
                 rate = v[i, 0] * n0 + v[i, 1] * n1 + v[i, 2] * n2
                 # the contact point's velocity v + ω × (a n), scalars: no allocation on the hot path
                 u0 = v[i, 0] + ai * (w[i, 1] * n2 - w[i, 2] * n1)

@@ -76,8 +76,10 @@ class Yade(PackageEngine):
     banner = _Banner()
     # slip velocity and torques at the contact point (R − δ/2 for a pair); the history's rotation is Yade's
     # first-order ScGeom::rotate, which the twin's "project" matches where the normal does not turn (walls,
-    # head-on pairs); on a wall Yade's slip arm is R − δ (see mapping.py)
-    rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
+    # head-on pairs); on a wall both arms are R − δ, the point on the wall's plane (measured: these rules, and
+    # no other combination of R, R − δ/2 and R − δ, meet a spinning oblique wall impact to round-off)
+    rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "surface", "rotation": "project",
+             "wall_slip_arm": "surface"}
     style = Style(colour="#e377c2", marker="X", linestyle=":")
 
     def executables(self) -> tuple[str, ...]:

@@ -86,8 +86,9 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 reasons.append("Yade caps the spring only (the dashpot is added uncapped while sticking, dropped "
                                "while slipping); the case asks for another truncation")
             fid = worst(fid, APPROXIMATE)
-            reasons.append("oblique impacts: Yade's slip velocity on a wall uses the arm R − δ (the contact point "
-                           "on the wall), and it turns the history with ScGeom's first-order rotation")
+            reasons.append("oblique impacts: on a wall Yade's slip velocity and torque use the arm R − δ (the "
+                           "contact point on the wall's plane), and it turns the history with ScGeom's first-order "
+                           "rotation")
         elif nat.normal == MINDLIN and kind == SPRING and tl.kt_sqrt:
             # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
             # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
