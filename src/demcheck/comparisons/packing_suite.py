@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..errors import EngineInterrupted, UnsupportedByEngine
-from . import packing_metrics as PM, verdicts as V
+from . import packing_metrics, verdicts
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
 TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
@@ -83,12 +83,12 @@ def reference_packing(case, cache=None):
     from ..engines.cache import key as cache_key
     from ..engines.cache import ke_series, number
     from ..inputs.packing_decks import CONTACT_COLUMNS
-    from ..reference import packing as P
+    from ..reference import packing
 
     k = None
     if cache is not None:
-        what = json.dumps({"case": case.hash, "dt": P.packing_dt(case), "rest": 0.0})
-        k = cache_key("reference-packing", P.solver_fingerprint(), what, {})
+        what = json.dumps({"case": case.hash, "dt": packing.packing_dt(case), "rest": 0.0})
+        k = cache_key("reference-packing", packing.solver_fingerprint(), what, {})
         hit = cache.get(k, columns=("x", "y", "z", "radius"), min_rows=1,
                         meta_keys={"ke": ke_series, "time": number, "seconds": number})
         hit_c = cache.get(k + "-contacts", columns=CONTACT_COLUMNS)
@@ -97,7 +97,7 @@ def reference_packing(case, cache=None):
             return (table[["x", "y", "z"]].to_numpy(), table["radius"].to_numpy(), con.to_numpy(),
                     [tuple(e) for e in meta["ke"]], meta["time"], meta["seconds"])
     t0 = time.perf_counter()
-    st = P.simulate(case, rest=0.0)
+    st = packing.simulate(case, rest=0.0)
     seconds = time.perf_counter() - t0
     nc = min(st.n_contacts, len(st.contacts))
     contacts = st.contacts[:nc].copy()
@@ -111,7 +111,7 @@ def reference_packing(case, cache=None):
 def run_packing(case, opts, found, file=None) -> dict:
     from ..engines.mapping import pair_mapping
     from ..engines.packing import run_engine
-    from ..reference import packing as P
+    from ..reference import packing
 
     entry = {"case": case.name, "file": str(file), "kind": "packing", "case_hash": case.hash, "sources": {},
              "comparisons": [],
@@ -125,14 +125,14 @@ def run_packing(case, opts, found, file=None) -> dict:
     x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
     states = {"reference": (x, rad)}
     ref_forces = contacts[:, 3]
-    ref_m = PM.compute(x, rad, box=box, forces=ref_forces, overlaps=contacts[:, 2],
+    ref_m = packing_metrics.compute(x, rad, box=box, forces=ref_forces, overlaps=contacts[:, 2],
                        ke=[e for _, e in ke])
     entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": t_end, "wall_time": seconds}
-    entry["packing"]["reference"] = {"ke": ke, "forces": PM.force_distribution(ref_forces),
-                                     "profile": PM.profile(x, rad, box) if box else None}
+    entry["packing"]["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
+                                     "profile": packing_metrics.profile(x, rad, box) if box else None}
 
     for engine in opts.engines:
-        if V.unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
+        if verdicts.unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
             continue
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
@@ -140,28 +140,28 @@ def run_packing(case, opts, found, file=None) -> dict:
             raise  # the case did not finish: it is left out of the (partial) report
         except UnsupportedByEngine as exc:  # an engine whose package writes no packing decks
             entry["sources"][engine] = {"status": "not expressible", "message": str(exc)}
-            comps.append(V.status_comparison(engine, V.NOT_EXPRESSIBLE, str(exc)))
+            comps.append(verdicts.status_comparison(engine, verdicts.NOT_EXPRESSIBLE, str(exc)))
             continue
         except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
-            comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
+            comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
             continue
         x = run.table[["x", "y", "z"]].to_numpy()
         rad = run.table["radius"].to_numpy()
         states[engine] = (x, rad)
         fn = run.contacts["fn"].to_numpy()
-        m = PM.compute(x, rad, box=box, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
+        m = packing_metrics.compute(x, rad, box=box, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
         entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": run.version}
-        dt = P.packing_dt(case)
+        dt = packing.packing_dt(case)
         entry["packing"][engine] = {"ke": [(step * dt, e) for step, e in run.ke],
-                                    "forces": PM.force_distribution(fn),
-                                    "profile": PM.profile(x, rad, box) if box else None}
+                                    "forces": packing_metrics.force_distribution(fn),
+                                    "profile": packing_metrics.profile(x, rad, box) if box else None}
         d, crit = ks_distance(fn, ref_forces)
         if math.isfinite(d):
             ok = d <= crit
-            comps.append(V.Comparison(engine, "force_distribution_ks", d, 0.0, d, d, crit,
-                                      V.AGREE if ok else V.UNEXPECTED,
+            comps.append(verdicts.Comparison(engine, "force_distribution_ks", d, 0.0, d, d, crit,
+                                      verdicts.AGREE if ok else verdicts.UNEXPECTED,
                                       "" if ok else f"the contact-force distributions P(f/⟨f⟩) differ beyond the "
                                                     f"Kolmogorov–Smirnov critical distance at α = {KS_ALPHA:g}"))
         for metric, tol in TOLERANCES.items():
@@ -169,16 +169,16 @@ def run_packing(case, opts, found, file=None) -> dict:
             if not (math.isfinite(a) and math.isfinite(b)):
                 continue
             diff = abs(a - b) / (abs(b) if metric in ("bed_height", "mean_contact_force") else 1.0)
-            verdict = V.AGREE if diff <= tol else V.UNEXPECTED
-            comps.append(V.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
-                                      "" if verdict == V.AGREE else
+            verdict = verdicts.AGREE if diff <= tol else verdicts.UNEXPECTED
+            comps.append(verdicts.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
+                                      "" if verdict == verdicts.AGREE else
                                       f"beyond the statistical tolerance {tol:g} between chaotic packings"))
     for src, (x, rad) in states.items():
         pairs = static_overlaps(case, x)
         if pairs is not None:
             worst = max(abs(d / e - 1.0) for d, e in pairs)
-            comps.append(V.Comparison(src, "static_overlap", worst, 0.0, worst, worst, CLOSED_FORM_RTOL,
-                                      V.AGREE if worst <= CLOSED_FORM_RTOL else V.UNEXPECTED,
+            comps.append(verdicts.Comparison(src, "static_overlap", worst, 0.0, worst, worst, CLOSED_FORM_RTOL,
+                                      verdicts.AGREE if worst <= CLOSED_FORM_RTOL else verdicts.UNEXPECTED,
                                       "" if worst <= CLOSED_FORM_RTOL else
                                       "the settled overlaps miss the static closed form (not settled?)"))
         elif case.packing is not None and case.packing.layout == "poured":
@@ -188,20 +188,20 @@ def run_packing(case, opts, found, file=None) -> dict:
                 * 2.0 * float(np.mean(rad))
             ratio = ke / lift if lift > 0 else math.nan
             ok = math.isfinite(ratio) and ratio <= SETTLED
-            comps.append(V.Comparison(src, "settled (kinetic energy / N m g d)", ratio, 0.0, ratio, ratio, SETTLED,
-                                      V.AGREE if ok else V.UNEXPECTED,
+            comps.append(verdicts.Comparison(src, "settled (kinetic energy / N m g d)", ratio, 0.0, ratio, ratio, SETTLED,
+                                      verdicts.AGREE if ok else verdicts.UNEXPECTED,
                                       "" if ok else "still moving at the end of packing.duration: its bulk values "
                                                     "are not those of a settled packing (lengthen the duration)"))
             for metric, (lo, hi) in RANGES.items():
                 val = m[metric]
                 ok = math.isfinite(val) and lo <= val <= hi
-                comps.append(V.Comparison(src, f"{metric} (range)", val, lo, 0.0, 0.0, hi - lo,
-                                          V.AGREE if ok else V.EXPECTED,
+                comps.append(verdicts.Comparison(src, f"{metric} (range)", val, lo, 0.0, 0.0, hi - lo,
+                                          verdicts.AGREE if ok else verdicts.EXPECTED,
                                           "" if ok else f"outside the physical range {lo:g}–{hi:g} of a "
                                                         "settled poured packing (not settled, or too small a bulk)"))
     entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = V.worst(c.verdict for c in comps)
-    entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    worst = verdicts.worst(c.verdict for c in comps)
+    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
     entry["verdict"] = worst
     entry["impact"] = {}
     entry["scales"] = {}

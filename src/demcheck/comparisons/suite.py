@@ -36,7 +36,7 @@ from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..reference.model import resolve
-from . import curves, verdicts as V
+from . import curves, verdicts
 
 SERIES_POINTS = 400
 
@@ -47,8 +47,8 @@ class Options:
     jobs: int = 1
     cache: object | None = None  # engines.cache.Cache
     timeout: float = 600.0
-    tolerances: V.Tolerances = field(default_factory=V.Tolerances.load)
-    expected: list = field(default_factory=V.load_expected)
+    tolerances: verdicts.Tolerances = field(default_factory=verdicts.Tolerances.load)
+    expected: list = field(default_factory=verdicts.load_expected)
     baseline: dict | None = None  # a stored earlier run (comparisons/diff.load): every source judged against it too
 
 
@@ -101,15 +101,15 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     # a grazing impact carries: the normal part alone vanishes at 90°)
     scales = impact_scales(case, model)
     entry["scales"] = scales
-    comps: list[V.Comparison] = []
+    comps: list[verdicts.Comparison] = []
 
     ref = adaptive.metrics()
     entry["sources"]["reference"] = _source(adaptive)
     entry["series"].append(_series(adaptive.contact, "reference"))
     if not adaptive.ok:
-        comps.append(V.status_comparison("reference", V.FAILED, f"{adaptive.status}: {adaptive.message}"))
+        comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
-        comps.append(V.judge_closed_form(metric, ref[metric], exact, scales, tol))
+        comps.append(verdicts.judge_closed_form(metric, ref[metric], exact, scales, tol))
 
     verlet = collide(case, "verlet")
     mv = verlet.metrics()
@@ -120,17 +120,17 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     if verlet.status != "ok":
         # the case's own time step does not give a healthy run (docs/reliability.md): the case fails, whatever
         # the engines do at that step
-        comps.append(V.status_comparison("reference-verlet", V.FAILED, f"{verlet.status}: {verlet.message}"))
+        comps.append(verdicts.status_comparison("reference-verlet", verdicts.FAILED, f"{verlet.status}: {verlet.message}"))
     else:
         tol_v = replace(tol, verlet_rtol=case.run.verlet_rtol) if case.run.verlet_rtol else tol
         for metric in ref:
-            comps.append(V.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
+            comps.append(verdicts.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
 
     seed_cache: dict = {}
     for engine in opts.engines:
         native = registry.get(engine).case_native(case)  # the case's [engine.NAME] setting, if any
         mp = contact_mapping(case, engine, native)
-        if V.unavailable(entry, comps, engine, mp, found):
+        if verdicts.unavailable(entry, comps, engine, mp, found):
             continue
         try:
             res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout, native=native)
@@ -138,12 +138,12 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
             raise  # the case did not finish: it is left out of the (partial) report
         except DemcheckError as exc:
             entry["sources"][engine] = {"status": "failed", "message": str(exc)}
-            comps.append(V.status_comparison(engine, V.FAILED, str(exc).splitlines()[0]))
+            comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
             continue
         if not res.ok:  # a run its health checks refuse (unstable, unresolved, failed): its metrics mean nothing
             entry["sources"][engine] = {"status": res.status, "message": res.message, "fidelity": mp.fidelity,
                                         "engine_version": res.engine_version}
-            comps.append(V.status_comparison(engine, V.FAILED, f"{res.status}: {res.message}"))
+            comps.append(verdicts.status_comparison(engine, verdicts.FAILED, f"{res.status}: {res.message}"))
             continue
         me = res.metrics()
         twin = twin_states(case, engine, res.dt, native=native).metrics()
@@ -155,13 +155,13 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         entry["series"].append(_series(res.contact, engine))
         entry["curves"][engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
         for metric in ref:
-            comps.append(V.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
+            comps.append(verdicts.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
                                         twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons), scales, tol,
                                         opts.expected))
     entry["series"] = [s for s in entry["series"] if s]
     entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = V.worst(c.verdict for c in comps)
-    entry["status"] = {V.FAILED: "failed", V.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    worst = verdicts.worst(c.verdict for c in comps)
+    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
     entry["verdict"] = worst
     return entry
 
@@ -278,8 +278,8 @@ def _safe_case(case, path, opts, found) -> dict:
         raise
     except DemcheckError as exc:
         return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
-                "verdict": V.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
-                "comparisons": [V.status_comparison("reference", V.FAILED, str(exc)).as_dict()]}
+                "verdict": verdicts.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
+                "comparisons": [verdicts.status_comparison("reference", verdicts.FAILED, str(exc)).as_dict()]}
 
 
 def _print(console: Console, summary: dict) -> None:
@@ -292,13 +292,13 @@ def _print(console: Console, summary: dict) -> None:
     bad = [c for c in summary["cases"] if c["status"] in ("failed", "unexpected")]
     for c in bad:
         for k in c.get("comparisons", []):
-            if k["verdict"] in V.FAILING:
+            if k["verdict"] in verdicts.FAILING:
                 console.print(f"[red]{k['verdict']}[/] {c['case']} {k['source']} {k['metric']}: {k['reason']}")
     t = Table(title=f"demcheck verify: {len(summary['cases'])} of {summary['planned']} cases"
               + (" (PARTIAL)" if summary["partial"] else ""))
     t.add_column("verdict")
     t.add_column("comparisons", justify="right")
-    for v in V.VERDICTS:
+    for v in verdicts.VERDICTS:
         if counts.get(v):
             t.add_row(v, str(counts[v]))
     console.print(t)
