@@ -99,3 +99,20 @@ def test_two_builds_of_the_toy_engine_side_by_side(tmp_path):
     d = json.loads(p.stdout)
     assert p.returncode == 0 and d["regressions"] == 0 and not [r for r in d["rows"] if r["source"] == "toy@v2"]
     assert d["engines"]["toy@v2"] == {"old": "1.0", "new": "2.0"}
+
+
+
+@pytest.mark.engine("lammps")
+def test_bench_and_stress_run_a_second_build_too(tmp_path):
+    """bench and stress read --engines as verify does: a build is a source of its own, with its version (here a
+    second label for the same LAMMPS binary)."""
+    exe = discovery.find("lammps").executable
+    p = _demcheck("bench", CASES / "hertz-wall.toml", "--engines", f"lammps@again={exe}", "--steps", "50",
+                  "--report", "r", "--json", tmp_path=tmp_path)
+    assert p.returncode in (0, 1), p.stderr
+    out = json.loads(p.stdout)
+    assert "lammps@again 22 Jul 2025" in out["engines"]
+    assert "lammps@again" in json.dumps(out["cases"])
+    bad = _demcheck("stress", CASES / "hertz-wall.toml", "--engines", "lammps@x=/bin/true", "--report", "r",
+                    tmp_path=tmp_path)
+    assert bad.returncode == 2 and "is not a usable lammps build" in bad.stderr

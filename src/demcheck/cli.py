@@ -716,11 +716,10 @@ def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
 
 
 def _engine_list(engines: str) -> list[str]:
-    names = [] if engines.strip().lower() == "none" else [e.strip() for e in engines.split(",") if e.strip()]
-    for e in names:
-        if e not in ENGINE_NAMES:
-            raise ConfigError("--engines", e, f"must be {', '.join(ENGINE_NAMES)} (comma-separated) or none")
-    return names
+    """The engines and builds of an --engines list (``lammps,lammps@2024=/opt/lmp-2024/lmp``), as verify reads it."""
+    from .engines import discovery
+
+    return discovery.resolve(engines, "--engines")
 
 
 def _engine_text(names) -> str:
