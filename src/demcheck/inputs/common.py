@@ -29,7 +29,12 @@ class Scene:
 
 
 def fmt(x: float) -> str:
-    return f"{x:.17g}"
+    """A number as a person writes it in a deck: the shortest text that reads back as the same double (repr:
+    ``0.24``, not ``0.23999999999999999``), integers without a decimal point."""
+    x = float(x)
+    if x.is_integer() and abs(x) < 1e16:
+        return str(int(x))
+    return repr(x)
 
 
 def scene(case: Case, dt: float | None = None, length: float = 1.0) -> Scene:
