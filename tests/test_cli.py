@@ -267,14 +267,15 @@ def test_a_latest_that_is_not_demcheck_s_symlink_is_refused_up_front(command, ki
     before any case runs (it was an IsADirectoryError after every case, with a stray .latest.PID left)."""
     reports = tmp_path / "rep"
     reports.mkdir()
+    link = {"verify": "latest"}.get(command[0], f"latest-{command[0]}")  # bench and stress keep links of their own
     if kind == "directory":
-        (reports / "latest").mkdir()
-        (reports / "latest" / "mine.txt").write_text("keep")
+        (reports / link).mkdir()
+        (reports / link / "mine.txt").write_text("keep")
     else:
-        (reports / "latest").write_text("keep")
+        (reports / link).write_text("keep")
     before = _tree(reports)
     p = demcheck(*command, "--report", reports, cwd=tmp_path)
-    _one_line_exit_2(p, f"--report = '{reports}': {reports / 'latest'} is a {kind}, not the symlink demcheck "
+    _one_line_exit_2(p, f"--report = '{reports}': {reports / link} is a {kind}, not the symlink demcheck "
                         "moves to each new run")
     assert _tree(reports) == before
 
