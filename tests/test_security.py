@@ -506,3 +506,25 @@ def test_a_comment_never_carries_a_triple_quote():
         line = common.comment(text)
         assert '"""' not in line and line.startswith("# ")
         common.check_deck(line + "\nunits si\n")
+
+
+@pytest.mark.parametrize("engine", ["yade", "kratos"])
+@pytest.mark.parametrize("name", ["x coding:raw_unicode_escape", "x coding=latin-1", "x -*- coding: utf-7 -*-"])
+def test_a_python_deck_cannot_be_given_a_source_encoding(engine, name, tmp_path):
+    """Yade's and Kratos' decks are Python scripts: Python decodes one by the encoding its first two lines may
+    declare (PEP 263), so a case name carrying `coding:` in the deck's comment would make Python run a different
+    text from the one the guard checked. Either the deck is refused (one line, exit 2, nothing written) or its first
+    two lines declare no encoding (Yade's are fixed)."""
+    import re
+    import tokenize
+
+    out = tmp_path / "d" / "in.deck"
+    p = subprocess.run([sys.executable, "-m", "demcheck", "deck", str(CASES / "hertz-wall.toml"), "--engine", engine,
+                        "--set", f'name="{name}"', "-o", str(out)], capture_output=True, text=True, timeout=300)
+    if p.returncode == 2:
+        assert p.stderr.strip().count("\n") == 0 and not out.exists(), p.stderr
+    else:
+        assert p.returncode == 0, p.stderr
+        assert not any(re.search(r"coding[:=]", line) for line in out.read_text().split("\n")[:2])
+        with out.open("rb") as f:
+            assert tokenize.detect_encoding(f.readline)[0] == "utf-8"

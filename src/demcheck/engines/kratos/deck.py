@@ -278,6 +278,13 @@ def check(text: str, files: dict | None = None) -> None:
     """Raise unless ``text`` is the runner template (after whole-line comments) with a numbers-only CASE line
     and ``files`` are the four files demcheck writes, each holding only what demcheck writes."""
     lines = text.split("\n")
+    # Python decodes a script by the encoding its first two lines may declare (PEP 263): a comment there that
+    # names one would make Python run a different text from the one checked here
+    for n, line in enumerate(lines[:2], 1):
+        if re.search(r"coding[:=]", line):
+            _refuse(f"line {n}", f"could declare the source encoding: {line[:80]!r}")
+    if "\\" in "\n".join(x for x in lines if x.startswith("#")):
+        _refuse("its comments", "hold a backslash")
     k = 0
     while k < len(lines) and lines[k].startswith("#"):
         if any(not ch.isprintable() for ch in lines[k]):
