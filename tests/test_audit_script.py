@@ -19,12 +19,13 @@ def test_comments_continuations_and_quotes(tmp_path):
                          "timestep 1e-7\nprint 'a # b' \"c d\"\nprint \"\"\"x\n# y\n\"\"\"\n")
     words = [c.words for c in sc.commands]
     assert words[0] == ["units", "si"]
-    # the '&' joins the next line; a '#' there starts a comment that runs to the end of the joined line
+    # the '&' joins the next line; a '#' there starts a comment that runs to the end of the joined line — and a
+    # comment that ends in '&' continues too, so LAMMPS never runs the timestep line (checked with lmp: a
+    # `# comment &` line followed by `print "HIDDEN"` prints nothing)
     assert words[1] == ["pair_style", "granular"]
-    assert words[2] == ["timestep", "1e-7"]
-    assert words[3] == ["print", "a # b", "c d"]
-    assert words[4] == ["print", "x\n# y\n"]
-    assert [c.line for c in sc.commands] == [2, 3, 5, 6, 7]
+    assert words[2] == ["print", "a # b", "c d"]
+    assert words[3] == ["print", "x\n# y\n"]
+    assert [c.line for c in sc.commands] == [2, 3, 6, 7]
 
 
 def test_variables_and_substitution(tmp_path):
@@ -94,3 +95,18 @@ def test_shell_and_python_lines_are_read_not_run(tmp_path):
     sc = _read(tmp_path, f"shell touch {marker}\npython f input 0 format f here \"\"\"\nopen('{marker}','w')\n\"\"\"\n")
     assert [c.name for c in sc.commands] == ["shell", "python"]
     assert not marker.exists()
+
+
+def test_a_metric_one_side_lacks_is_never_dropped_from_a_comparison():
+    """The audit's worst difference over a probe's metrics: one side's NaN is an infinite difference (Python's max()
+    would drop it where it is not first), a metric neither side produces is skipped."""
+    import math
+
+    from demcheck.comparisons.audit import _worst
+
+    scales = {"impact_energy": 1.0, "spin": 1.0}
+    ok = {"restitution": 0.5, "tangential_restitution": math.nan}
+    assert _worst(ok, dict(ok), ["restitution", "tangential_restitution"], scales) == 0.0
+    bad = {"restitution": math.nan, "tangential_restitution": math.nan}
+    assert _worst({"restitution": 0.5, "tangential_restitution": 0.7}, bad,
+                  ["tangential_restitution", "restitution"], scales) == math.inf

@@ -241,21 +241,33 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True) -> dic
         d = res.contact["delta"].to_numpy() if res.contact is not None and len(res.contact) else np.array([0.0])
         inside = d > 0
         out["engine"]["min_force"] = float(fn[inside].min()) if inside.any() else math.nan
-        out["engine_vs_twin"] = max((scaled(out["engine"][k], out["twin"][k], k, scales) for k in METRICS),
-                                    default=0.0)
+        out["engine_vs_twin"] = _worst(out["engine"], out["twin"], METRICS, scales)
     main = out.get("engine", out["twin"])
     if conv is not None and conv.ok and twin.ok:
-        out["dt_error"] = max((scaled(out["twin"][k], out["converged"][k], k, scales) for k in METRICS
-                               if k != "peak_force"), default=0.0)
+        out["dt_error"] = _worst(out["twin"], out["converged"], [k for k in METRICS if k != "peak_force"], scales)
     else:
         out["dt_error"] = math.nan
     t_c = main["contact_time"]
     out["steps_per_contact"] = t_c / setup.dt if math.isfinite(t_c) else math.nan
     mo = twin.metrics().get("max_overlap", math.nan)
     out["stability_margin"] = _stability(nl, m_eff, mo, setup.dt) if math.isfinite(mo) else math.nan
-    out["seed_gap"] = max((scaled(main[k], out["seed"][k], k, scales) for k in METRICS if k != "peak_force"),
-                          default=0.0)
+    out["seed_gap"] = _worst(main, out["seed"], [k for k in METRICS if k != "peak_force"], scales)
     return out
+
+
+def _worst(a: dict, b: dict, keys, scales) -> float:
+    """The largest scaled difference over ``keys``: a metric one side produced and the other did not (NaN) is an
+    infinite difference, never dropped (a metric neither side produces is skipped)."""
+    worst = 0.0
+    for k in keys:
+        x, y = a.get(k, math.nan), b.get(k, math.nan)
+        if math.isnan(x) and math.isnan(y):
+            continue
+        d = scaled(x, y, k, scales)
+        if not math.isfinite(d):
+            return math.inf
+        worst = max(worst, d)
+    return worst
 
 
 def _fidelity(gap: float, reasons: list) -> str:
@@ -336,7 +348,10 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
     e_asked = ps.asked.get("restitution")
     e_real = main["restitution"]
     codes = {f.code for f in found}
-    if e_asked is not None and math.isfinite(e_real):
+    if e_asked is not None and not math.isfinite(e_real):
+        found.append(deck_script.Finding("trap", "probe-unreadable", f"the realised restitution is {e_real} (the "
+                                         "probe produced no rebound to measure)", ps.where))
+    elif e_asked is not None:
         size = {"asked": e_asked, "realised": e_real, "difference": e_real - e_asked}
         for f in found:
             if f.code in ("tsuji", "limit"):
@@ -360,9 +375,12 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
     # time step
     spc = min(p["steps_per_contact"] for p in probes)
     margin = min(p["stability_margin"] for p in probes)
-    dt_err = max((p["dt_error"] for p in probes if math.isfinite(p["dt_error"])), default=math.nan)
+    dt_err = max((p["dt_error"] for p in probes if not math.isnan(p["dt_error"])), default=math.nan)
     entry["time_step"] = {"dt": setup.dt, "steps_per_contact": spc, "dt_error": dt_err, "stability_margin": margin}
-    if margin < 1.0:
+    if not (math.isfinite(spc) and math.isfinite(margin)):
+        found.append(deck_script.Finding("trap", "probe-unreadable", f"dt = {setup.dt:g} s: the probes give no contact "
+                                         "time or overlap to judge the time step by", setup.dt_where))
+    elif margin < 1.0:
         found.append(deck_script.Finding("trap", "dt-unstable", f"dt = {setup.dt:g} s is above velocity Verlet's stability "
                                f"limit {margin * setup.dt:.3g} s for this contact", setup.dt_where,
                                {"stability_margin": margin}))

@@ -217,7 +217,7 @@ def _logical_lines(text: str, name: str):
                 i += 1
                 continue
             stripped = buf.rstrip()
-            if stripped.endswith("&") and not _in_comment(stripped):
+            if stripped.endswith("&"):  # LAMMPS joins first and strips comments after: a comment's '&' continues it
                 if i >= len(lines):
                     raise ScriptError(f"{name}:{start}: the last line continues ('&') onto nothing")
                 buf = stripped[:-1] + " " + lines[i].rstrip("\r")
@@ -225,10 +225,6 @@ def _logical_lines(text: str, name: str):
                 continue
             break
         yield start, buf
-
-
-def _in_comment(text: str) -> bool:
-    return _strip_comment(text) != text
 
 
 def _strip_comment(text: str) -> str:
