@@ -245,3 +245,20 @@ def test_head_on_impact_with_a_friction_law_gets_a_time_step():
     assert all(math.isfinite(pt.error) for pt in b.points)
     rec = B.recommend(case)
     assert rec["dt"] is not None and rec["metrics"] == list(B.METRICS) and rec["limited_by"] in B.METRICS
+
+
+@pytest.mark.engine("kratos")
+@pytest.mark.engine("yade")
+def test_bench_times_engines_that_hold_one_collision_per_deck(tmp_path):
+    """Yade's and Kratos' decks hold one collision (no batched copies): bench times the single run and leaves the
+    batched time empty, instead of failing the point (Yade) or crashing (Kratos)."""
+    import json
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-m", "demcheck", "bench", str(CASES / "hertz-wall.toml"), "--engines",
+                        "kratos,yade", "--steps", "50", "--report", str(tmp_path), "--json"], capture_output=True,
+                       text=True, timeout=600)
+    assert p.returncode in (0, 1), p.stderr
+    rows = [r for c in json.loads(p.stdout)["cases"] for r in c["points"] if r["source"] in ("kratos", "yade")]
+    assert {r["source"] for r in rows} == {"kratos", "yade"} and all(r["status"] == "ok" for r in rows)

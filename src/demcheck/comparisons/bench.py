@@ -30,7 +30,7 @@ import numpy as np
 
 from ..case import Case
 from ..engines import registry
-from ..errors import DemcheckError, EngineInterrupted
+from ..errors import DemcheckError, EngineInterrupted, UnsupportedByEngine
 from ..reference.collision import characteristic_time, collide
 from ..reference.model import resolve
 
@@ -206,7 +206,10 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
             dt = t_c / spc
             try:
                 one = run_engine(case, engine, dt=dt, cache=None)
-                many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
+                try:
+                    many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
+                except UnsupportedByEngine:  # an engine whose decks hold one collision: no batched time
+                    many = None
             except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
                 raise
             except DemcheckError as exc:
@@ -216,7 +219,8 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
                 continue
             # an engine result carries the reference's own checks (reference/health.py)
             res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
-                                    many.meta["engine_wall_time"] / batch, _errors(one.metrics(), ref, metrics, scales),
+                                    many.meta["engine_wall_time"] / batch if many is not None else math.nan,
+                                    _errors(one.metrics(), ref, metrics, scales),
                                     one.status, one.message if not one.ok else ""))
             tick()
     return res

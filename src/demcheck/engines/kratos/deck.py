@@ -118,9 +118,15 @@ def _case_literal(steps: int, bodies: list, gamma: list) -> str:
     return f"CASE = {{'steps': {int(steps)}, 'bodies': [{b}], 'gamma': [{g}]}}"
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None) -> common.Deck:
+def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
     """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
-    model)."""
+    model). One copy of the collision only (no batched copies)."""
+    if options.get("copies", 1) != 1:
+        from ...errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine("Kratos decks are written for one copy of a collision")
+    if set(options) - {"copies"}:
+        raise TypeError(f"unknown deck options {sorted(set(options) - {'copies'})}")
     sc = common.scene(case, dt, length)
     mp = contact_mapping(case, "kratos", native)
     nat = mp.require()
