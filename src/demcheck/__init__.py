@@ -1,4 +1,5 @@
-"""demcheck: does a DEM contact force model, as LAMMPS and LIGGGHTS implement it, do what the textbook model does?"""
+"""demcheck: does a DEM contact force model, as LAMMPS, LIGGGHTS, Yade and Kratos DEM implement it, do what the
+textbook model does?"""
 
 import hashlib as _hashlib
 import os as _os

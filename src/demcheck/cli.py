@@ -163,7 +163,8 @@ def _load(case_path: str, overrides) -> "object":
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="demcheck")
 def cli():
-    """Verify DEM contact force models: a Python reference against LAMMPS and LIGGGHTS."""
+    """Verify DEM contact force models: a Python reference against the registered engines (LAMMPS, LIGGGHTS,
+    Yade, Kratos DEM and plug-ins) and the published benchmarks."""
 
 
 # ----------------------------------------------------------------------------- models

@@ -27,16 +27,34 @@ LAUNCHER = Path(__file__).with_name("launch.py")
 @functools.lru_cache(maxsize=None)
 def _versioned(executable: str) -> str:
     """A wrapper of ``executable`` that answers ``-h`` with Yade's version (Yade's own ``-h`` does not name it;
-    demcheck's discovery reads the version from ``<exe> -h``) and passes anything else on. Written once per
-    process into a private temporary directory (mode 0700)."""
-    where = Path(tempfile.mkdtemp(prefix="demcheck-yade-"))
-    path = where / "yade"
+    demcheck's discovery reads the version from ``<exe> -h``) and passes anything else on. Kept in the user's
+    cache (one per executable, mode 0700, rewritten atomically), so runs do not leave a directory each; a private
+    temporary directory, removed at exit, where the cache cannot be written."""
+    import atexit
+    import hashlib
+
     exe = shlex.quote(executable)
-    path.write_text("#!/bin/sh\n# demcheck: Yade with its version for -h\n"
-                    f'if [ "$#" = 1 ] && [ "$1" = -h ]; then exec {exe} --version; fi\n'
-                    f'exec {exe} "$@"\n')
-    path.chmod(0o700)
-    return str(path)
+    text = ("#!/bin/sh\n# demcheck: Yade with its version for -h\n"
+            f'if [ "$#" = 1 ] && [ "$1" = -h ]; then exec {exe} --version; fi\n'
+            f'exec {exe} "$@"\n')
+    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "demcheck" / "yade"
+    where = root / hashlib.sha256(executable.encode()).hexdigest()[:16]
+    try:
+        where.mkdir(parents=True, exist_ok=True, mode=0o700)
+        path = where / "yade"
+        if not (path.is_file() and path.read_text() == text):
+            tmp = where / f".yade.{os.getpid()}"
+            tmp.write_text(text)
+            tmp.chmod(0o700)
+            os.replace(tmp, path)
+        return str(path)
+    except OSError:
+        where = Path(tempfile.mkdtemp(prefix="demcheck-yade-"))
+        atexit.register(shutil.rmtree, where, True)
+        path = where / "yade"
+        path.write_text(text)
+        path.chmod(0o700)
+        return str(path)
 
 
 class _Banner:
