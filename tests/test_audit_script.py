@@ -110,3 +110,23 @@ def test_a_metric_one_side_lacks_is_never_dropped_from_a_comparison():
     bad = {"restitution": math.nan, "tangential_restitution": math.nan}
     assert _worst({"restitution": 0.5, "tangential_restitution": 0.7}, bad,
                   ["tangential_restitution", "restitution"], scales) == math.inf
+
+
+def test_quit_in_an_included_file_ends_the_whole_input(tmp_path):
+    """LAMMPS stops at `quit` wherever it stands: the lines after the include are never run, so never read."""
+    (tmp_path / "part.in").write_text("timestep 1e-7\nquit\n")
+    (tmp_path / "deck.in").write_text("units si\ninclude part.in\ntimestep 5e-7\n")
+    sc = S.read(tmp_path / "deck.in")
+    assert [c.words for c in sc.commands][-1] == ["quit"]
+    assert ["timestep", "5e-7"] not in [c.words for c in sc.commands]
+
+
+def test_a_huge_type_count_is_bad_input_not_a_memory_bomb(tmp_path):
+    import subprocess
+    import sys
+
+    deck = tmp_path / "big.in"
+    deck.write_text("units si\natom_style sphere\nregion box block 0 1 0 1 0 1\ncreate_box 300000000 box\n")
+    p = subprocess.run([sys.executable, "-m", "demcheck", "audit", str(deck)], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 2 and "atom types" in p.stderr and p.stderr.strip().count("\n") == 0, p.stderr

@@ -372,7 +372,9 @@ def read(path: str | Path) -> Script:
     return script
 
 
-def _read_file(path: Path, root: Path, script: Script, depth: int) -> None:
+def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
+    """Read one file of the deck into ``script``; True when a ``quit`` ended the whole input (in an included
+    file too, as in LAMMPS)."""
     name = path.name if path.parent == root else str(path.relative_to(root))
     try:
         text = path.read_text(encoding="utf-8")
@@ -394,7 +396,7 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> None:
         cmd = Command(words, name, line_no, body, problem)
         if cmd.name == "quit":
             script.commands.append(cmd)
-            return
+            return True
         if cmd.name == "variable" and not problem:
             _define(cmd, script)
         if cmd.name == "include":
@@ -410,9 +412,11 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> None:
             if depth >= MAX_INCLUDE_DEPTH:
                 raise ScriptError(f"{where}: include {words[1]!r}: more than {MAX_INCLUDE_DEPTH} nested includes")
             script.commands.append(cmd)
-            _read_file(target, root, script, depth + 1)
+            if _read_file(target, root, script, depth + 1):
+                return True
             continue
         script.commands.append(cmd)
+    return False
 
 
 def _define(cmd: Command, script: Script) -> None:
@@ -494,6 +498,7 @@ class Setup:
 # ----------------------------------------------------------------------------- what both engines' decks share
 
 # commands that set nothing a two-body contact depends on (output, neighbour lists, bookkeeping)
+MAX_TYPES = 10_000  # atom types the audit reads (a deck's type count builds one record each)
 NO_CONTACT_EFFECT = frozenset({
     "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "region", "neighbor",
     "neigh_modify", "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump", "compute",
@@ -501,7 +506,7 @@ NO_CONTACT_EFFECT = frozenset({
     "write_data", "write_dump", "reset_timestep", "group", "lattice", "restart", "info", "clear", "suffix",
     "package", "partition", "plugin", "units", "create_box", "create_atoms", "set", "read_data", "velocity",
     "timestep", "pair_style", "pair_coeff", "fix", "unfix", "hard_particles", "soft_particles", "delete_atoms",
-    "run_style", "min_style", "minimize", "displace_atoms", "mass", "atom_modify"})
+    "mass"})
 NEVER_RUN = frozenset({"shell", "python", "plugin", "labelmap", "read_restart", "read_dump", "rerun", "kim",
                        "mdi", "fitpod", "message", "server", "quit"})
 
@@ -553,6 +558,9 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
         return True
     if name == "create_box":
         setup.ntypes = int(_num(cmd, 1, "number of atom types"))
+        if not 1 <= setup.ntypes <= MAX_TYPES:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {setup.ntypes} atom types; the audit reads 1 to "
+                              f"{MAX_TYPES}")
         for t in range(1, setup.ntypes + 1):
             body(setup, t)
         return True
@@ -623,6 +631,9 @@ def _read_data(cmd: Command, setup: Setup, root: Path) -> None:
         if not section:
             if words[-2:] == ["atom", "types"]:
                 setup.ntypes = int(nums[0])
+                if not 1 <= setup.ntypes <= MAX_TYPES:
+                    raise ScriptError(f"{where}: {line[:60]!r}: {setup.ntypes} atom types; the audit reads 1 to "
+                                      f"{MAX_TYPES}")
                 for t in range(1, setup.ntypes + 1):
                     body(setup, t)
             continue
