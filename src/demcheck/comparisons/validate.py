@@ -337,9 +337,10 @@ def read_curve(file: str, key: str, root: Path = DATA) -> np.ndarray | None:
 # ----------------------------------------------------------------------------- judging
 
 
-def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float] | None:
-    """Largest |source − paper| over the paper's points inside the source's x range, and where (its x): the
-    source at a paper point is its sample within 2% of the x range of it, else linear interpolation."""
+def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float, int] | None:
+    """Largest |source − paper| over the paper's points inside the source's x range, where (its x), and how many
+    paper points were compared: the source at a paper point is its sample within 2% of the x range of it, else
+    linear interpolation."""
     pts = [(x, y) for x, y in zip(xs, ys) if y is not None and math.isfinite(y)]
     if len(pts) < 1:
         return None
@@ -347,7 +348,7 @@ def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float] | None:
     sx = np.array([p[0] for p in pts])
     sy = np.array([p[1] for p in pts])
     span = max(sx[-1] - sx[0], 1e-300)
-    worst = None
+    worst, used = None, 0
     for px, py in paper:
         k = int(np.argmin(np.abs(sx - px)))
         if abs(sx[k] - px) <= 0.02 * span:
@@ -356,10 +357,11 @@ def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float] | None:
             y = float(np.interp(px, sx, sy))
         else:
             continue
+        used += 1
         d = abs(y - py)
         if worst is None or d > worst[0]:
             worst = (d, float(px))
-    return worst
+    return None if worst is None else (*worst, used)
 
 
 _NOT_A_SOURCE = ("not expressible", "engine missing")  # comparisons/verdicts.py's statuses of a source left out
@@ -454,7 +456,10 @@ def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys) -> dict:
     d = deviation(xs, ys, paper)
     if d is None:
         return out
-    out.update(deviation=d[0], at=d[1], points=len(paper), verdict=MEETS if d[0] <= cur.tolerance else MISSES)
+    # the points compared are those inside the source's range: a source that covers part of a curve says so
+    out.update(deviation=d[0], at=d[1], points=d[2], verdict=MEETS if d[0] <= cur.tolerance else MISSES)
+    if d[2] < len(paper):
+        out["why"] = cur.why + f" ({d[2]} of the paper's {len(paper)} points lie in the source's range)"
     return out
 
 
