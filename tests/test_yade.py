@@ -71,6 +71,8 @@ def test_generated_script_passes_its_guard_and_numbers_round_trip():
     ("O.run(1, True)", "attribute 'run'"),
     ("x = 1e400", "finite"),
     ("exec('1')", "name 'exec'"),
+    ("O.bodies.append(utils.sphere((0, 0, 0), 1.0, wire=1))", "keyword 'wire'"),
+    ("from .yade import utils", "only 'from yade import utils'"),
 ])
 def test_guard_refuses_what_the_template_does_not_write(bad, why):
     with pytest.raises(DemcheckError, match=why):

@@ -34,6 +34,9 @@ NAMES = frozenset({
     # the template's own variables
     "DT", "STEPS", "G", "ids", "mass", "inertia", "radius", "out", "k", "n", "i", "s", "x", "v", "w", "f", "t", "a",
     "b", "b0", "b1"})
+# keyword arguments of the template's calls (Yade's own constructor keywords)
+KEYWORDS = frozenset({"axis", "betan", "betas", "cn", "cs", "damping", "density", "en", "frictionAngle", "gravity",
+                      "kn", "ks", "material", "poisson", "sense", "young", "dt"})
 ATTRIBUTES = frozenset({"materials", "bodies", "append", "sphere", "wall", "state", "mass", "inertia", "pos", "vel",
                         "angVel", "engines", "dt", "step", "forces", "f", "t", "write", "close"})
 NODES = (ast.Module, ast.Expr, ast.Assign, ast.Call, ast.Name, ast.Load, ast.Store, ast.Attribute, ast.Constant,
@@ -71,8 +74,10 @@ def check_script(text: str, files: dict | None = None) -> None:
             refuse(f"line {node.lineno}: attribute {node.attr!r} is not in the template")
         if isinstance(node, ast.keyword) and node.arg is None:
             refuse(f"line {node.lineno}: ** arguments are not in the template")
+        if isinstance(node, ast.keyword) and node.arg not in KEYWORDS:
+            refuse(f"line {node.lineno}: keyword {node.arg!r} is not in the template")
         if isinstance(node, ast.ImportFrom) and (node.module != "yade" or [a.name for a in node.names] != ["utils"]
-                                                 or node.names[0].asname):
+                                                 or node.names[0].asname or node.level != 0):
             refuse(f"line {node.lineno}: only 'from yade import utils' is imported")
         if isinstance(node, ast.Constant):
             v = node.value
@@ -141,6 +146,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         phys = (f"Ip2_FrictMat_FrictMat_MindlinPhys(betan={_num(p['betan'])}, betas={_num(p['betas'])})"
                 if p["betan"] > 0.0 or p["betas"] > 0.0 else "Ip2_FrictMat_FrictMat_MindlinPhys()")
         if p.get("en") is not None:  # Yade's own restitution input (never mapped: docs/findings.md's trap)
+            if p["betan"] > 0.0 or p["betas"] > 0.0:
+                raise DemcheckError("a Yade MindlinPhys takes en or betan/betas, not both")
             phys = f"Ip2_FrictMat_FrictMat_MindlinPhys(en={_num(p['en'])})"
         law = "Law2_ScGeom_MindlinPhys_Mindlin()"
     head = common.header("yade", sc, mp, VERSION_NOTE, "yade -x -n")
