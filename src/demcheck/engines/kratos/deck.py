@@ -279,6 +279,19 @@ def _check_case(line: str) -> None:
     if not isinstance(value["steps"], int) or value["steps"] < 0:
         _refuse("its data line", "has a step count that is not a whole number ≥ 0")
 
+    def num(x):
+        return type(x) in (int, float) and math.isfinite(x)
+
+    def vec(v):
+        return isinstance(v, list) and len(v) == 3 and all(num(x) for x in v)
+
+    if not (1 <= len(value["bodies"]) <= 2 and all(isinstance(b, list) and len(b) == 3 and num(b[0]) and vec(b[1])
+                                                   and vec(b[2]) for b in value["bodies"])):
+        _refuse("its data line", "has bodies that are not [radius, [3 numbers], [3 numbers]]")
+    if not all(isinstance(g, list) and len(g) == 3 and type(g[0]) is int and type(g[1]) is int and num(g[2])
+               for g in value["gamma"]):
+        _refuse("its data line", "has damping entries that are not [property id, property id, number]")
+
 
 def check(text: str, files: dict | None = None) -> None:
     """Raise unless ``text`` is the runner template (after whole-line comments) with a numbers-only CASE line
