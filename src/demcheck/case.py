@@ -561,6 +561,22 @@ def from_dict(raw: dict) -> Case:
 MAX_FLIGHT = 10.0
 
 
+def incidence(case: Case) -> tuple[float, float]:
+    """(v_n, |v_t|) of the initial relative velocity (v0 − v1, or v0 at a wall) on the contact normal (from body 0
+    into body 1 or the wall): v_n > 0 approaching."""
+    p0 = case.particles[0]
+    v = np.asarray(p0.velocity, float)
+    if case.walls:
+        n = -np.asarray(case.walls[0].normal, float)
+    else:
+        p1 = case.particles[1]
+        v = v - np.asarray(p1.velocity, float)
+        d = np.asarray(p1.position, float) - np.asarray(p0.position, float)
+        n = d / np.linalg.norm(d)
+    vn = float(v @ n)
+    return vn, float(np.linalg.norm(v - vn * n))
+
+
 def free_flight(case: Case) -> tuple[float, bool]:
     """(t, touches) of a collision's free flight (gravity included: both bodies fall alike, so only a wall
     sees it): the time until the surfaces first touch, touches = True (0 when they touch at the start); for

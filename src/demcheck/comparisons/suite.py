@@ -171,17 +171,10 @@ def _incidence(case: Case) -> dict:
     particle 0 (rad/s) — the axes of the suite's tangential plots."""
     import numpy as np
 
+    from ..case import incidence
+
     p0 = case.particles[0]
-    v = np.asarray(p0.velocity, float)
-    if case.walls:
-        n = -np.asarray(case.walls[0].normal, float)
-    else:
-        p1 = case.particles[1]
-        v = v - np.asarray(p1.velocity, float)
-        d = np.asarray(p1.position, float) - np.asarray(p0.position, float)
-        n = d / np.linalg.norm(d)
-    vn = float(v @ n)
-    vt = float(np.linalg.norm(v - vn * n))
+    vn, vt = incidence(case)
     return {"angle": float(np.degrees(np.arctan2(vt, abs(vn)))) if vn else None,
             "spin": float(np.linalg.norm(p0.angular_velocity))}
 

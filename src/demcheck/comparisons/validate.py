@@ -59,17 +59,10 @@ class Impact:
 
 
 def impact_of(case) -> Impact:
+    from ..case import incidence
+
     p0 = case.particles[0]
-    v = np.asarray(p0.velocity, float)
-    if case.walls:
-        n = -np.asarray(case.walls[0].normal, float)
-    else:
-        p1 = case.particles[1]
-        v = v - np.asarray(p1.velocity, float)
-        d = np.asarray(p1.position, float) - np.asarray(p0.position, float)
-        n = d / np.linalg.norm(d)
-    vn = float(v @ n)
-    vt = float(np.linalg.norm(v - vn * n))
+    vn, vt = incidence(case)
     mat = case.materials[p0.material]
     return Impact(material=p0.material, radius=p0.radius, e=float(mat.restitution if mat.restitution is not None
                                                                  else 1.0),
