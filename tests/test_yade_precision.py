@@ -38,9 +38,11 @@ def f128():
 
 @pytest.mark.engine("yade")
 def test_float128_build_is_found_with_its_version(f128):
-    """The build's own executable is asked for its version (Yade's -h does not print it)."""
+    """The build's own executable is asked for its version (Yade's -h does not print it): through the wrapper
+    demcheck writes around that very binary (a copy of it under another name, off PATH, is found as well)."""
     info = discovery.find(f128)
-    assert (info.executable, info.version) == (str(F128), "2023.02a")
+    assert info.version == "2023.02a"
+    assert str(F128.resolve()) in Path(info.executable).read_text()
 
 
 @pytest.mark.engine("yade")

@@ -136,6 +136,11 @@ class Engine(ABC):
     def executables(self) -> tuple[str, ...]:
         return ()
 
+    def build_executable(self, path: str) -> str:
+        """What discovery and runs call for a build given by path (``ENGINE@LABEL=PATH``): the path itself, unless
+        the engine needs a wrapper around it (Yade: one that names its version for ``-h``)."""
+        return path
+
     def argv(self, executable: str, deck: str) -> list[str]:
         """The command that runs ``deck`` (a file name in the work directory) with its log files there."""
         return [executable, "-in", deck, "-log", "log.txt", "-screen", "screen.txt"]

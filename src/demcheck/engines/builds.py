@@ -48,7 +48,7 @@ class BuildEngine:
         self.style = Style(s.colour, _MARKERS[index % len(_MARKERS)], ":")
 
     def candidates(self) -> list[str]:
-        return [self.executable]
+        return [self.base.build_executable(self.executable)]
 
     def __getattr__(self, attr):  # the vocabulary, decks, launch, rules, banner: the engine's
         return getattr(self.base, attr)

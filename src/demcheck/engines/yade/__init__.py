@@ -110,6 +110,9 @@ class Yade(PackageEngine):
         found = [env] if env else [shutil.which(e) for e in self.executables()]
         return [_versioned(str(Path(e).resolve())) for e in found if e]
 
+    def build_executable(self, path: str) -> str:
+        return _versioned(str(Path(path).resolve()))  # the version of this very binary, asked through the wrapper
+
     def argv(self, executable: str, deck: str) -> list[str]:
         return [executable, "-x", "-n", str(LAUNCHER), deck]
 
