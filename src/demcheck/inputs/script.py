@@ -511,6 +511,23 @@ NEVER_RUN = frozenset({"shell", "python", "plugin", "labelmap", "read_restart", 
                        "mdi", "fitpod", "message", "server", "quit"})
 
 
+def note_unread(setup, cmd: "Command", quiet_fixes=frozenset()) -> None:
+    """What every engine's reader does with a command it does not read: nothing for a fix style in
+    ``quiet_fixes`` or a command without effect on the contacts (NO_CONTACT_EFFECT); else it is listed as not
+    audited — a fix that runs code (python, shell) as never run by demcheck."""
+    w = cmd.words
+    if cmd.name == "fix":
+        style = w[3] if len(w) > 3 else ""
+        if style in quiet_fixes:
+            return
+        if style.startswith("python") or style == "shell":
+            setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
+        else:
+            setup.not_audited.append((cmd.where(), cmd.text, f"fix {style}: not read by the audit"))
+    elif cmd.name not in NO_CONTACT_EFFECT:
+        setup.not_audited.append((cmd.where(), cmd.text, "not audited: not a command the audit reads"))
+
+
 def _num(cmd: Command, k: int, what: str) -> float:
     if cmd.problem:
         raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {cmd.problem}")

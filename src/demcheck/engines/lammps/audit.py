@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ...inputs.script import (NEVER_RUN, NO_CONTACT_EFFECT, Command, Finding, PairSetting, ScriptError, Setup,
+from ...inputs.script import (NEVER_RUN, Command, note_unread, Finding, PairSetting, ScriptError, Setup,
                               _num, read_common, type_range)
 from ..base import Native
 
@@ -23,6 +23,9 @@ HEAT_ARGS = {"none": 0, "radius": 1, "area": 1}
 CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
 PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
 DEFAULT = True  # a LAMMPS-family deck that no other reader claims is read as LAMMPS's
+
+QUIET_FIXES = frozenset({"nve/sphere", "gravity", "print", "ave/time", "ave/atom"})  # fixes without effect on a contact
+
 
 
 def claims(script) -> bool:
@@ -244,18 +247,7 @@ def read(script, root: Path) -> Setup:
                 notes.append(f"fix group '{w[2]}': probed with every type")
             walls.append((spec, cmd.where(), notes, cmd, w[1]))
             continue
-        if name == "fix":
-            if len(w) >= 4 and (w[3].startswith("python") or w[3] in ("shell",)):
-                setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
-            elif len(w) >= 4 and w[3] in ("nve/sphere", "gravity", "print", "ave/time", "ave/atom"):
-                pass
-            else:
-                setup.not_audited.append((cmd.where(), cmd.text, f"fix {w[3] if len(w) > 3 else ''}: not read by "
-                                                                 "the audit"))
-            continue
-        if name in NO_CONTACT_EFFECT:
-            continue
-        setup.not_audited.append((cmd.where(), cmd.text, "not audited: not a command the audit reads"))
+        note_unread(setup, cmd, QUIET_FIXES)
     if style_cmd is None:
         raise ScriptError("the deck has no pair_style: nothing defines its contacts")
     if setup.dt is None:

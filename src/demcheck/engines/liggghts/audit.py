@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ...inputs.script import (NEVER_RUN, NO_CONTACT_EFFECT, Body, Command, Finding, PairSetting, ScriptError,
+from ...inputs.script import (NEVER_RUN, Body, Command, note_unread, Finding, PairSetting, ScriptError,
                               Setup, _num, body, read_common)
 from ..base import Native
 
@@ -16,6 +16,9 @@ MODELS = ("hertz", "hooke", "hooke/stiffness", "hertz/stiffness")  # the probed 
 OTHER_MODELS = ("luding", "edinburgh", "thornton_ning", "hooke/hysteresis", "hertz/stiffness/ttt")
 TANGENTIAL = ("off", "no_history", "history")
 OWN_MODULI = True  # the deck writer writes each type's own Young's modulus and Poisson's ratio
+
+QUIET_FIXES = frozenset({"nve/sphere", "gravity", "particledistribution/discrete", "check/timestep/gran"})
+
 
 
 def claims(script) -> bool:
@@ -123,16 +126,7 @@ def read(script, root: Path) -> Setup:
                 v = [_num(cmd, i + d, "vel") for d in range(3)]
                 setup.speeds.append((math.sqrt(sum(x * x for x in v)), cmd.where()))
             continue
-        if name == "fix":
-            if len(w) > 3 and w[3] in ("nve/sphere", "gravity", "particledistribution/discrete",
-                                       "check/timestep/gran"):
-                continue
-            setup.not_audited.append((cmd.where(), cmd.text, f"fix {w[3] if len(w) > 3 else ''}: not read by the "
-                                                             "audit"))
-            continue
-        if name in NO_CONTACT_EFFECT:
-            continue
-        setup.not_audited.append((cmd.where(), cmd.text, "not audited: not a command the audit reads"))
+        note_unread(setup, cmd, QUIET_FIXES)
     if style is None:
         raise ScriptError("the deck has no pair_style gran: nothing defines its contacts")
     if setup.dt is None:
