@@ -186,12 +186,18 @@ def check_deck(text: str, files: dict | None = None) -> None:
 
 
 def check_data(text: str, name: str = "data file") -> None:
-    """A data file: a one-line title (a comment), then header lines, section names and numbers only."""
+    """A data file: a one-line title (a comment), then header lines (whole-line comments among them, which
+    read_data skips), section names and numbers only."""
+    header = True
     for n, line in enumerate(_check_text(text, name), 1):
         if n == 1:
             if not line.startswith("#"):
                 _refuse(name, n, line, "is not a comment title")
             continue
+        if header and line.startswith("#"):
+            continue
+        if line.strip() in ("Atoms", "Velocities"):
+            header = False
         for word in line.split():
             if word not in DATA_WORDS:
                 try:
