@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from ...case import Case
 from ...errors import UnsupportedByEngine
-from ...inputs import common, packing_decks
+from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
 from ..mapping import pair_mapping
 from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
 
 
 def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
-    species, rep, rad, lo, hi, periodic, dt, steps = packing_decks.layout(case, duration, dt)
-    ns = len(rep)
+    lay = PD.layout(case, duration, dt)
+    rep, ns = lay.rep, len(lay.table)
     natives = {}
     for a in range(ns):
         for b in range(a, ns):
@@ -50,29 +48,33 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
             moduli.append(RIGID_WALL_MODULUS)
             ratios.append(ratios[0])
     model_lines, style, flags = model_setup(nat, matrices, moduli, ratios)
-    lines = packing_decks.head(case, "liggghts", VERSION_NOTE, ns, dt, steps, periodic,
-                  ["atom_style granular", "atom_modify map array", "BOUNDS", "newton off",
-                   "communicate single vel yes"])
-    lines += ["", f"neighbor {fmt(0.5 * float(rad.max()))} bin", "neigh_modify delay 0", *model_lines,
-              f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
+    lines = PD.head(case, "liggghts", VERSION_NOTE, "liggghts -in", lay, list(natives.values()), "granular",
+                    "communicate single vel yes")
+    walls = f", {ntypes} the walls" if case.walls else ""
+    lines += ["", common.comment("neighbour lists: a skin of half the largest radius, checked every step"),
+              f"neighbor {fmt(0.5 * float(lay.rad.max()))} bin", "neigh_modify delay 0",
+              "", common.comment(f"the contact law: per atom-type pair (types 1 to {ns} the species{walls}), the "
+                                 "property/global values below (docs/liggghts-users.md reads each setting)")]
+    lines += PD.law_comments([(f"species {a + 1} with " + ("the walls" if b == ns else f"{b + 1}"), mp)
+                              for (a, b), mp in natives.items()])
+    lines += [*model_lines, f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
     for k, w in enumerate(case.walls):
         ax, _ = common.wall_axis(w, k)
-        lines.append(f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[ax]}plane "
-                     f"{fmt(w.point[ax])} {' '.join(flags)}")
-    g = np.asarray(case.run.gravity, float)
-    gn = float(np.linalg.norm(g))
-    if gn > 0:
-        lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}")
-    every = max(1, steps // 50)
-    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(packing_decks.FINAL_COLUMNS) - 2))
+        lines += [common.comment(f"{PD.wall_comment(w, k)}; a primitive of atom type {ntypes}"),
+                  f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[ax]}plane "
+                  f"{fmt(w.point[ax])} {' '.join(flags)}"]
+    lines += PD.gravity(case)
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(PD.FINAL_COLUMNS) - 2))
     local_fmt = " ".join(["%.17g"] * 10)  # compute values are doubles, the ids too
-    lines += ["# per contact: the two ids, a periodic flag, the force on the first and its normal part, the overlap",
-              "# (defined before the first run, as LIGGGHTS requires; dumped at the final state only)",
-              "compute pairs all pair/gran/local id force force_normal delta",
-              "fix integrate all nve/sphere", f"timestep {fmt(dt)}", "thermo_style custom step ke atoms",
-              "thermo_modify norm no", f"thermo {every}", f"run {steps}",
-              f"dump final all custom 1 {packing_decks.FINAL_DUMP} {' '.join(packing_decks.FINAL_COLUMNS)}",
+    lines += ["", common.comment("per contact: the two ids, a periodic flag, the force on the first and its normal "
+                                 "part, the overlap"),
+              common.comment("(defined before the first run, as LIGGGHTS requires; dumped at the final state only)"),
+              "compute pairs all pair/gran/local id force force_normal delta"]
+    lines += PD.integration(lay)
+    lines += ["", common.comment("the final state: every particle and every contact at full precision (%.17g), "
+                                 "written by a run of no steps"),
+              f"dump final all custom 1 {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)}",
               f'dump_modify final format "{fmt_line}" sort id',
-              f"dump contacts all local 1 {packing_decks.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
+              f"dump contacts all local 1 {PD.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
               f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
-    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": packing_decks.data_file(case, species, lo, hi, ntypes)}, dt=dt)
+    return common.Deck("liggghts", "\n".join(lines), {PD.DATA_FILE: PD.data_file(case, lay, ntypes)}, dt=lay.dt)
