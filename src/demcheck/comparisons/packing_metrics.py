@@ -11,6 +11,12 @@ produced them, so the reference and the engines' dumps are measured the same way
 * kinetic_energy: the last value of the series — translational, in every source (the engines' thermo `ke`;
   without rolling or twisting resistance a sphere rolling or spinning about its contact normal keeps its
   rotational energy indefinitely, so rotation says nothing about whether a packing has settled).
+* the contact network: every particle–particle contact's branch vector (centre to centre, by minimum
+  image in periodic x and y) and the fabric tensor φ_ij = (1/N_c) Σ n_i n_j of their unit vectors (Satake's,
+  trace 1): ``fabric`` (3 × 3), ``fabric_zz`` and ``fabric_anisotropy`` = √(3/2 a′:a′) of the anisotropy
+  tensor a′ = 15/2 (φ − I/3) of Rothenburg and Bathurst's second-order approximation of the contact-normal
+  density, E(n) = (1 + a′_ij n_i n_j)/4π; for a fabric symmetric about z it is a′_zz − a′_xx
+  = 45/4 (φ_zz − 1/3). Wall contacts are not particle pairs and are not in it.
 """
 
 from __future__ import annotations
@@ -58,6 +64,37 @@ def contacts(x, rad, box=None, tol=1e-9):
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
 
 
+def branch_vectors(x, pairs, box=None) -> np.ndarray:
+    """x_j − x_i of every pair (i, j) (N_c × 3): by minimum image in x and y when ``box`` is the periodic
+    (lx, ly), so a contact across the boundary is the short vector between the two spheres, never one across
+    the box."""
+    x = np.asarray(x, float)
+    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+    b = x[pairs[:, 1]] - x[pairs[:, 0]]
+    if box is not None:
+        for k in range(2):
+            b[:, k] -= box[k] * np.round(b[:, k] / box[k])
+    return b
+
+
+def fabric(branches) -> np.ndarray:
+    """The fabric tensor φ_ij = (1/N_c) Σ n_i n_j of the unit contact normals n = b/|b| of the branch vectors
+    ``branches`` (N_c × 3): symmetric, trace 1; NaN without contacts."""
+    b = np.asarray(branches, float).reshape(-1, 3)
+    if not len(b):
+        return np.full((3, 3), math.nan)
+    n = b / np.linalg.norm(b, axis=1)[:, None]
+    return n.T @ n / len(n)
+
+
+def fabric_anisotropy(phi) -> float:
+    """√(3/2 a′:a′) of the anisotropy tensor a′ = 15/2 (φ − (tr φ/3) I) (see the module docstring): 0 for an
+    isotropic fabric, 15/2 for every contact along one axis, 15/4 for contacts spread evenly in one plane."""
+    phi = np.asarray(phi, float)
+    a = 7.5 * (phi - np.trace(phi) / 3.0 * np.eye(3))
+    return float(math.sqrt(1.5 * float(np.sum(a * a))))
+
+
 def surface_height(x, rad, box=None) -> float:
     """The bed's free-surface height (see the module docstring)."""
     x, rad = np.asarray(x, float), np.asarray(rad, float)
@@ -84,6 +121,10 @@ def compute(x, rad, box=None, floor=0.0, margin=BULK_MARGIN, forces=None, overla
     out = {"bed_height": top - floor, "solid_fraction": math.nan, "coordination_number": math.nan,
            "mean_contact_force": math.nan, "max_overlap_ratio": math.nan, "kinetic_energy": math.nan}
     pairs = contacts(x, rad, box)
+    phi = fabric(branch_vectors(x, pairs, box))  # every particle–particle contact, not only the bulk's
+    out["fabric_zz"] = float(phi[2, 2])
+    out["fabric_anisotropy"] = fabric_anisotropy(phi) if len(pairs) else math.nan
+    out["fabric"] = phi.tolist()
     if box is not None and z1 > z0:
         vol = float(_cap_volume(rad, z0 - x[:, 2], z1 - x[:, 2]).sum())
         out["solid_fraction"] = vol / (box[0] * box[1] * (z1 - z0))

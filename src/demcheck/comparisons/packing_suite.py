@@ -17,6 +17,11 @@ TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 
 # the contact-force distributions P(f/⟨f⟩) of two sources are compared by the two-sample Kolmogorov–Smirnov
 # distance, held to its critical value at this significance for the two sample sizes
 KS_ALPHA = 1e-3
+# the fabric's vertical component φ_zz of a poured packing: two sources' values, each the mean of n_z² over its
+# N contacts, are held to the difference critical at this significance, z(α/2)·√(s_a²/N_a + s_b²/N_b) with s² the
+# sample variance of n_z² (contacts taken as independent: on the poured packings this is about twice the spread
+# measured between realisations, docs/packing.md); the anisotropy and the full tensor are reported, not compared
+FABRIC_ALPHA = KS_ALPHA
 RANGES = {"solid_fraction": (0.55, 0.64), "coordination_number": (4.0, 6.0)}
 # a poured packing is settled when its translational kinetic energy is below this fraction of N m g d (the
 # energy of lifting every sphere by one diameter): a mean speed of about 1.4 % of √(g d); the bulk values of
@@ -69,6 +74,25 @@ def ks_distance(a, b) -> tuple[float, float]:
         return math.nan, math.nan
     d = float(ks_2samp(a / a.mean(), b / b.mean()).statistic)
     return d, math.sqrt(-math.log(KS_ALPHA / 2.0) / 2.0) * math.sqrt((len(a) + len(b)) / (len(a) * len(b)))
+
+
+def normals_zz(x, rad, box=None) -> np.ndarray:
+    """n_z² of every particle–particle contact's unit normal (packing_metrics' contacts and branch vectors): the
+    sample whose mean is the fabric's φ_zz."""
+    pairs = packing_metrics.contacts(x, rad, box)
+    b = packing_metrics.branch_vectors(x, pairs, box)
+    return (b[:, 2] / np.linalg.norm(b, axis=1)) ** 2 if len(b) else np.empty(0)
+
+
+def fabric_zz_distance(a, b) -> tuple[float, float]:
+    """(|φ_zz(a) − φ_zz(b)|, its critical value at FABRIC_ALPHA) of two samples of n_z² (``normals_zz``)."""
+    from scipy.stats import norm
+
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if len(a) < 2 or len(b) < 2:
+        return math.nan, math.nan
+    se = math.sqrt(a.var(ddof=1) / len(a) + b.var(ddof=1) / len(b))
+    return abs(float(a.mean()) - float(b.mean())), float(norm.isf(FABRIC_ALPHA / 2.0)) * se
 
 
 def reference_packing(case, cache=None):
@@ -164,6 +188,14 @@ def run_packing(case, opts, found, file=None) -> dict:
                                       verdicts.AGREE if ok else verdicts.UNEXPECTED,
                                       "" if ok else f"the contact-force distributions P(f/⟨f⟩) differ beyond the "
                                                     f"Kolmogorov–Smirnov critical distance at α = {KS_ALPHA:g}"))
+        if case.packing is not None and case.packing.layout == "poured":
+            d, crit = fabric_zz_distance(normals_zz(x, rad, box), normals_zz(*states["reference"], box))
+            if math.isfinite(d) and crit > 0:
+                ok = d <= crit
+                comps.append(verdicts.Comparison(engine, "fabric_zz", m["fabric_zz"], ref_m["fabric_zz"], d, d, crit,
+                                          verdicts.AGREE if ok else verdicts.UNEXPECTED,
+                                          "" if ok else "the contact fabric's vertical component φ_zz differs beyond "
+                                                        f"its sampling error at α = {FABRIC_ALPHA:g}"))
         for metric, tol in TOLERANCES.items():
             a, b = m[metric], ref_m[metric]
             if not (math.isfinite(a) and math.isfinite(b)):
