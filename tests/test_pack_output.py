@@ -1,4 +1,5 @@
-"""The contact network's fabric tensor (packing_metrics) and verify's comparison of it (packing_suite)."""
+"""The contact network's fabric tensor (packing_metrics) and verify's comparison of it (packing_suite), and the
+MDAnalysis reading of an engine's packing run (engines.packing.universe)."""
 
 import math
 
@@ -12,6 +13,35 @@ from demcheck.comparisons import packing_metrics as PM
 from demcheck.comparisons import packing_suite
 
 R = 1e-3
+BOX = 0.006  # three diameters: many contacts cross the periodic boundary
+# 40 spheres poured into a periodic 6 mm × 6 mm box: seconds in every source
+SMALL = f"""
+name = "small-pour"
+kind = "packing"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 1e8
+poisson_ratio = 0.3
+restitution = 0.3
+friction = 0.5
+[packing]
+layout = "poured"
+count = 40
+material = "glass"
+radius = {R}
+box = [{BOX}, {BOX}]
+seed = 3
+duration = 0.1
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[contact]
+normal = "lsd"
+kn = 2000.0
+tangential = "spring_sliding"
+[run]
+gravity = [0.0, 0.0, -9.81]
+"""
 
 
 # ----------------------------------------------------------------------------- the fabric tensor: closed forms
@@ -95,3 +125,64 @@ def test_fabric_zz_critical_difference_is_its_sampling_error():
     se = math.sqrt(a.var(ddof=1) / 100 + b.var(ddof=1) / 120)
     assert crit == pytest.approx(3.2905267 * se, rel=1e-7)
     assert all(math.isnan(v) for v in packing_suite.fabric_zz_distance([1.0], b))
+
+
+# ----------------------------------------------------------------------------- engines
+
+
+@pytest.fixture(scope="module")
+def lammps_run(tmp_path_factory):
+    from demcheck.case import loads
+    from demcheck.engines.packing import run_engine
+
+    wd = tmp_path_factory.mktemp("lammps-run")
+    case = loads(SMALL)
+    return case, run_engine(case, "lammps", workdir=wd / "run"), wd / "run"
+
+
+@pytest.mark.engine("lammps")
+def test_universe_reads_a_lammps_packing_to_float32_precision(lammps_run):
+    """MDAnalysis's float32 positions against the float64 reader's. Each coordinate is rounded to float32 once
+    when read (≤ |x|·2⁻²⁴); where the box's lower corner lo is not 0 (z here) MDAnalysis moves it to lo, in
+    float32, and universe() moves it back with lo rounded to float32: ≤ 2⁻²⁴(|x| + |x − lo| + |lo| + |x|)."""
+    pytest.importorskip("MDAnalysis")
+    from demcheck.engines.packing import _box_lo, universe
+    from demcheck.inputs.packing_decks import FINAL_DUMP
+
+    case, run, wd = lammps_run
+    u = universe(wd)
+    x = run.table[["x", "y", "z"]].to_numpy()
+    lo = _box_lo(wd / FINAL_DUMP)
+    assert lo[0] == lo[1] == 0.0 and lo[2] < 0.0
+    p = u.atoms.positions
+    assert p.dtype == np.float32 and len(p) == len(x)
+    eps = 2.0**-24 * (1 + 2.0**-20)  # the float64 steps between the roundings add a few 2⁻⁵³
+    bound = eps * np.where(lo != 0.0, 2 * np.abs(x) + np.abs(x - lo) + np.abs(lo), np.abs(x))
+    err = np.abs(p.astype(float) - x)
+    assert np.all(err <= bound)
+    assert err.max() > 0  # float32, not the dump's doubles: the bound is what is being tested
+    v = run.table[["vx", "vy", "vz"]].to_numpy()
+    assert np.all(np.abs(u.atoms.velocities.astype(float) - v) <= eps * np.abs(v))
+    # radius and mass are read as doubles (additional columns), exactly
+    assert np.array_equal(u.atoms.radii, run.table["radius"].to_numpy())
+    assert np.array_equal(u.atoms.masses, run.table["mass"].to_numpy())
+
+
+@pytest.mark.engine("lammps")
+def test_verify_compares_a_poured_packing_s_fabric_by_its_sampling_error(tmp_path):
+    """verify's packing entry holds fabric_zz per engine: |φ_zz − φ_zz(reference)| against the critical
+    difference of the two sources' own samples of n_z² (recomputed here from the written positions)."""
+    from demcheck.comparisons import suite
+
+    path = tmp_path / "small.toml"
+    path.write_text(SMALL)
+    s = suite.run_suite([path], tmp_path / "r", suite.Options(engines=("lammps",), cache=None), quiet=True)
+    (c,) = s["cases"]
+    (k,) = [k for k in c["comparisons"] if k["metric"] == "fabric_zz"]
+    assert k["source"] == "lammps"
+    ref, eng = c["sources"]["reference"]["metrics"], c["sources"]["lammps"]["metrics"]
+    assert k["value"] == eng["fabric_zz"] and k["reference"] == ref["fabric_zz"]
+    assert k["abs_diff"] == pytest.approx(abs(eng["fabric_zz"] - ref["fabric_zz"]), abs=1e-15)
+    # the tolerance is z(α/2)·√(s_a²/N_a + s_b²/N_b): a few tenths for some 50 contacts a source
+    assert 0.05 < k["tolerance"] < 0.5
+    assert k["verdict"] == ("agree" if k["abs_diff"] <= k["tolerance"] else "unexpected")

@@ -10,8 +10,10 @@ Two readers:
 
 * :func:`read_dump` — demcheck's float64 parser. Two-body comparisons need it: positions are ~10³ times the
   overlap, so the float32 coordinates of a general-purpose reader keep only ~4 digits of δ.
-* :func:`read_dump_mdanalysis` — MDAnalysis's LAMMPS ``DumpReader`` (float32 positions), for packings
-  where positions matter to ~1e-7 of the box and the reader's trajectory tools are worth having.
+* :func:`read_dump_mdanalysis` — MDAnalysis's LAMMPS ``DumpReader`` (float32 positions, moved to the box's
+  lower corner), for packings where positions matter to ~1e-7 of the box and the reader's trajectory tools
+  are worth having; :func:`demcheck.engines.packing.universe` reads a packing run that way, in the engines'
+  frame, with radii and masses (docs/packing.md has the measured precision).
 
 Files may be gzip-compressed (``.gz``). A malformed file raises :class:`ParseError` naming the file, the
 line and what was expected.

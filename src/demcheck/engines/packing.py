@@ -5,6 +5,7 @@ tables every source yields."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -14,7 +15,7 @@ from ..inputs.packing_decks import CONTACT_COLUMNS, CONTACT_DUMP, CONTACT_READER
 from . import dumps, registry
 from .cache import ke_series, text
 
-__all__ = ["PackingRun", "read_contacts", "run_engine", "CONTACT_COLUMNS"]
+__all__ = ["PackingRun", "read_contacts", "run_engine", "universe", "CONTACT_COLUMNS"]
 
 
 @dataclass
@@ -44,9 +45,10 @@ def read_contacts(engine: str, path, radius: np.ndarray, x: np.ndarray | None = 
 
 
 def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
-               cache=None) -> PackingRun:
+               cache=None, workdir=None) -> PackingRun:
     """Run the packing in an engine (``mpi`` ranks). ``cache`` (engines.cache.Cache) skips decks already
-    run (keyed with the ranks too)."""
+    run (keyed with the ranks too). ``workdir``: run there and keep it (the deck, its data file, the dumps — for
+    :func:`universe`); by default a temporary directory, removed once read (kept when the run fails)."""
     import re
 
     from . import discovery, run as runner
@@ -64,7 +66,7 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
             table, meta = hit
             contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
             return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
-    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi)
+    out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi, workdir=workdir)
     table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
     table = table[table["step"] == table["step"].max()]
     ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
@@ -81,4 +83,54 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     if k is not None:
         cache.put(k + "-contacts", contacts, {})
         cache.put(k, table, {"version": out.version, "ke": ke})
+    if workdir is None and out.workdir.name.startswith(f"demcheck-{engine}-"):
+        import shutil
+
+        shutil.rmtree(out.workdir, ignore_errors=True)  # a temporary directory of a run that succeeded, read
     return PackingRun(table, contacts, ke, out.version)
+
+
+def universe(path, dt: float = 1.0):
+    """An engine's packing as an MDAnalysis Universe, for one's own analysis: ``path`` is a run directory (a
+    deck written by ``demcheck deck`` and run by hand, or ``run_engine``'s ``workdir``: its final dump,
+    FINAL_DUMP) or a LAMMPS-style ``dump custom`` file with x, y, z (every frame of a trajectory). Positions,
+    velocities and forces are MDAnalysis's float32, in the engines' frame (MDAnalysis moves them to the box's
+    lower corner; they are moved back); per atom ``radii`` and, where dumped, ``masses``; ``ts.data`` holds the
+    radius and mass columns of each frame; a frame's ``time`` is its step × ``dt`` (give the packing's time step
+    for seconds: MDAnalysis labels them ps). Float32 keeps a position to |x|·2^-24 (1.8e-9 m at 30 mm), and
+    where the box's lower corner lo is not 0 (z), moved there and back, to 2^-24(2|x| + |x − lo| + |lo|):
+    enough for the particle tables, profiles, bed height and the fabric of a packing, not for overlaps, which
+    are ~1e-3 of the coordinates (docs/packing.md, measured); demcheck's own metrics read the float64 dump.
+    The translation is the first frame's lo (the packing decks' boxes do not move)."""
+    import MDAnalysis as mda
+    from MDAnalysis import transformations
+
+    p = Path(path)
+    p = p / FINAL_DUMP if p.is_dir() else p
+    lo = _box_lo(p)
+    u = mda.Universe(str(p), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled",
+                     additional_columns=["radius", "mass"], dt=dt)
+    data = u.trajectory.ts.data
+    if "radius" in data:
+        u.add_TopologyAttr("radii", np.asarray(data["radius"], float))
+    if "mass" in data:
+        u.atoms.masses = np.asarray(data["mass"], float)
+    if np.any(lo != 0.0):
+        u.trajectory.add_transformations(transformations.translate(lo))
+    return u
+
+
+def _box_lo(path) -> np.ndarray:
+    """The lower corner of a dump's box (its first frame's BOX BOUNDS), where MDAnalysis puts the origin."""
+    from ..errors import ParseError
+
+    if not Path(path).is_file():
+        raise ParseError(f"{path}: no such dump file")
+    with dumps._open(Path(path)) as fh:
+        for line in fh:
+            if line.startswith("ITEM: BOX BOUNDS"):
+                try:
+                    return np.array([float(next(fh).split()[0]) for _ in range(3)])
+                except (StopIteration, ValueError, IndexError):
+                    break
+    raise ParseError(f"{path}: no ITEM: BOX BOUNDS with three bounds lines")
