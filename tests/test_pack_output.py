@@ -1,9 +1,13 @@
-"""The contact network's fabric tensor (packing_metrics) and verify's comparison of it (packing_suite), and the
-MDAnalysis reading of an engine's packing run (engines.packing.universe)."""
+"""`demcheck pack --vtk DIR --xyz FILE` (packing_output), the contact network's fabric tensor (packing_metrics) and
+the MDAnalysis reading of an engine's packing run (engines.packing.universe)."""
 
+import json
 import math
+import subprocess
+import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -11,6 +15,8 @@ from hypothesis.extra import numpy as hnp
 
 from demcheck.comparisons import packing_metrics as PM
 from demcheck.comparisons import packing_suite
+
+from .conftest import ROOT
 
 R = 1e-3
 BOX = 0.006  # three diameters: many contacts cross the periodic boundary
@@ -42,6 +48,141 @@ tangential = "spring_sliding"
 [run]
 gravity = [0.0, 0.0, -9.81]
 """
+# ase writes every real extended-XYZ column with eight decimals: a value read back is within half the last one
+XYZ_ROUNDING = 0.5e-8
+
+
+def demcheck(*args, cwd=ROOT):
+    return subprocess.run([sys.executable, "-m", "demcheck", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=900)
+
+
+def _one_line_exit_2(p, needle):
+    assert p.returncode == 2, (p.returncode, p.stderr[-2000:])
+    assert p.stdout == ""
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("demcheck: error: ") and needle in lines[0], p.stderr[-2000:]
+
+
+def _pack(tmp, engine="reference"):
+    """`demcheck pack` of the small pour writing --csv, --vtk and --xyz: (JSON, the output directory)."""
+    case = tmp / "small.toml"
+    case.write_text(SMALL)
+    p = demcheck("pack", case, "--engine", engine, "--json", "--csv", tmp / "csv", "--vtk", tmp / "vtk",
+                 "--xyz", tmp / "state.xyz", cwd=tmp)
+    assert p.returncode == 0, p.stderr[-3000:]
+    return json.loads(p.stdout), tmp
+
+
+@pytest.fixture(scope="module")
+def reference_pack(tmp_path_factory):
+    return _pack(tmp_path_factory.mktemp("ref"))
+
+
+def _read_back(out):
+    import meshio
+
+    parts = pd.read_csv(out / "csv" / "particles.csv")  # 17 digits: the float64 state, by another writer
+    contacts = pd.read_csv(out / "csv" / "contacts.csv")
+    return parts, contacts, meshio.read(out / "vtk" / "particles.vtu"), meshio.read(out / "vtk" / "contacts.vtu")
+
+
+def _check_vtk(out, forces: bool):
+    parts, contacts, pv, cv = _read_back(out)
+    x = parts[["x", "y", "z"]].to_numpy()
+    # float64 end to end: the points and the fields are the state's own doubles
+    assert pv.points.dtype == np.float64 and np.array_equal(pv.points, x)
+    assert np.array_equal(pv.point_data["radius"], parts["radius"].to_numpy())
+    assert np.array_equal(pv.point_data["id"], parts["id"].to_numpy())
+    assert pv.point_data["velocity"].shape == (len(x), 3) and pv.point_data["angular_velocity"].shape == (len(x), 3)
+    assert ("force" in pv.point_data) == forces  # omitted, not zeros, where the source keeps no per-particle force
+    # one line per contact, the normal forces, overlaps and |Ft| of the contact table bit for bit
+    assert [c.type for c in cv.cells] == ["line"] and len(cv.cells[0].data) == len(contacts) > 0
+    for name, col in (("normal_force", "fn"), ("tangential_force", "ft"), ("overlap", "overlap"), ("i", "i"),
+                      ("j", "j")):
+        assert cv.cell_data[name][0].dtype == contacts[col].dtype
+        assert np.array_equal(cv.cell_data[name][0], contacts[col].to_numpy()), name
+    lines = cv.cells[0].data
+    start, end = cv.points[lines[:, 0]], cv.points[lines[:, 1]]
+    i, j = contacts["i"].to_numpy(), contacts["j"].to_numpy()
+    assert np.array_equal(start, x[i])
+    # every line is short — a contact, never a segment across the box: at most r_i + r_j (they overlap, up to
+    # the rounding of x_i + b − x_i) ≤ 2 R_max
+    length = np.linalg.norm(end - start, axis=1)
+    rad = parts["radius"].to_numpy()
+    assert np.all(length <= (rad[i] + rad[j]) * (1 + 1e-12)) and length.max() <= 2 * rad.max() * (1 + 1e-12)
+    # and it ends at j or at an image of j: a whole number of box lengths away in x and y, none in z
+    periodic = cv.cell_data["periodic"][0].astype(bool)
+    assert periodic.any() and not periodic.all()  # this packing has contacts across the boundary, and inside
+    assert np.array_equal(end[~periodic], x[j[~periodic]])
+    shift = (end[periodic] - x[j[periodic]]) / BOX
+    whole = np.round(shift[:, :2])
+    assert np.abs(shift[:, :2] - whole).max() < 1e-9 and np.all(np.abs(whole).sum(axis=1) >= 1)
+    assert np.abs(end[periodic, 2] - x[j[periodic], 2]).max() < 1e-18
+    return parts
+
+
+def _check_xyz(out, parts, forces: bool):
+    import ase.io
+
+    a = ase.io.read(out / "state.xyz", format="extxyz")
+    x = parts[["x", "y", "z"]].to_numpy()
+    assert len(a) == len(x)
+    assert np.abs(a.positions - x).max() <= XYZ_ROUNDING * (1 + 1e-9)
+    assert np.abs(a.arrays["radius"] - parts["radius"].to_numpy()).max() <= XYZ_ROUNDING * (1 + 1e-9)
+    assert list(a.pbc) == [True, True, False]
+    top = float((x[:, 2] + parts["radius"]).max())
+    np.testing.assert_allclose(np.asarray(a.cell), np.diag([BOX, BOX, top]), rtol=1e-15, atol=0)
+    assert np.array_equal(a.arrays["id"], parts["id"].to_numpy())
+    assert a.arrays["velo"].shape == (len(x), 3) and a.arrays["omega"].shape == (len(x), 3)
+    assert ("force" in a.arrays) == forces
+    return a
+
+
+def test_pack_writes_vtk_and_extended_xyz_that_read_back(reference_pack):
+    out, tmp = reference_pack
+    parts = _check_vtk(tmp, forces=False)
+    assert len(parts) == out["particles"] == 40
+    a = _check_xyz(tmp, parts, forces=False)
+    import meshio
+
+    pv = meshio.read(tmp / "vtk" / "particles.vtu")
+    assert np.abs(a.arrays["velo"] - pv.point_data["velocity"]).max() <= XYZ_ROUNDING * (1 + 1e-9)
+
+
+def test_pack_reports_the_fabric_of_its_own_positions(reference_pack):
+    """The metrics' fabric is that of the written positions' contacts (branch vectors by minimum image)."""
+    out, tmp = reference_pack
+    parts = pd.read_csv(tmp / "csv" / "particles.csv")
+    x, rad = parts[["x", "y", "z"]].to_numpy(), parts["radius"].to_numpy()
+    b = PM.branch_vectors(x, PM.contacts(x, rad, (BOX, BOX)), (BOX, BOX))
+    n = b / np.linalg.norm(b, axis=1)[:, None]
+    m = out["metrics"]
+    np.testing.assert_allclose(m["fabric"], n.T @ n / len(n), rtol=0, atol=1e-15)
+    assert m["fabric_zz"] == m["fabric"][2][2]
+    assert m["fabric_anisotropy"] == pytest.approx(PM.fabric_anisotropy(np.array(m["fabric"])), rel=1e-12)
+
+
+@pytest.mark.parametrize("option,make,needle", [
+    ("--vtk", lambda t: t / "a-file" / "out", "{t}/a-file/out': {t}/a-file is a file, not a directory"),
+    ("--vtk", lambda t: t / "a-file", "{t}/a-file': is a file, not a directory"),
+    ("--vtk", lambda t: t / "v", "{t}/v': {t}/v/contacts.vtu is a directory, not a file"),
+    ("--xyz", lambda t: t / "a-file" / "s.xyz", "{t}/a-file/s.xyz': {t}/a-file is a file, not a directory"),
+    ("--xyz", lambda t: t / "v", "{t}/v': is a directory, not a file"),
+])
+def test_bad_output_paths_are_refused_before_any_work(option, make, needle, tmp_path):
+    (tmp_path / "a-file").write_text("x")
+    (tmp_path / "v" / "contacts.vtu").mkdir(parents=True)
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    p = demcheck("pack", ROOT / "cases" / "packing" / "column-lsd.toml", option, make(tmp_path), cwd=tmp_path)
+    _one_line_exit_2(p, f"{option} = '" + needle.format(t=tmp_path))
+    assert sorted(str(p) for p in tmp_path.rglob("*")) == before  # nothing written
+
+
+def test_the_cli_and_the_writer_name_the_same_vtk_files():
+    from demcheck import cli, packing_output
+
+    assert cli.PACK_VTK_DIR.files == packing_output.VTK_FILES
 
 
 # ----------------------------------------------------------------------------- the fabric tensor: closed forms
@@ -130,6 +271,19 @@ def test_fabric_zz_critical_difference_is_its_sampling_error():
 # ----------------------------------------------------------------------------- engines
 
 
+@pytest.mark.engine("lammps")
+def test_pack_in_lammps_writes_the_dumped_forces(tmp_path):
+    out, tmp = _pack(tmp_path, "lammps")
+    parts = _check_vtk(tmp, forces=True)
+    a = _check_xyz(tmp, parts, forces=True)
+    import meshio
+
+    f = meshio.read(tmp / "vtk" / "particles.vtu").point_data["force"]
+    assert np.all(np.isfinite(f)) and np.abs(f).max() > 0
+    assert np.abs(a.arrays["force"] - f).max() <= XYZ_ROUNDING * (1 + 1e-9)
+    assert out["contacts"] == len(pd.read_csv(tmp / "csv" / "contacts.csv"))
+
+
 @pytest.fixture(scope="module")
 def lammps_run(tmp_path_factory):
     from demcheck.case import loads
@@ -138,6 +292,23 @@ def lammps_run(tmp_path_factory):
     wd = tmp_path_factory.mktemp("lammps-run")
     case = loads(SMALL)
     return case, run_engine(case, "lammps", workdir=wd / "run"), wd / "run"
+
+
+@pytest.mark.engine("lammps")
+def test_engine_vtk_forces_are_the_final_dump_s(lammps_run, tmp_path):
+    """particles.vtu's force is the final dump's fx, fy, fz (read again by demcheck's float64 parser)."""
+    import meshio
+
+    from demcheck import packing_output
+    from demcheck.engines import dumps
+    from demcheck.inputs.packing_decks import FINAL_DUMP
+
+    case, run, wd = lammps_run
+    packing_output.write_vtk(packing_output.from_engine(case, run), tmp_path)
+    dump = dumps.read_dump(wd / FINAL_DUMP).sort_values("id")
+    pv = meshio.read(tmp_path / "particles.vtu")
+    assert np.array_equal(pv.point_data["force"], dump[["fx", "fy", "fz"]].to_numpy())
+    assert np.array_equal(pv.point_data["velocity"], dump[["vx", "vy", "vz"]].to_numpy())
 
 
 @pytest.mark.engine("lammps")

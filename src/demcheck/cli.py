@@ -140,6 +140,8 @@ BENCH_DIR = OutputPath(directory=True, link="latest-bench")
 STRESS_DIR = OutputPath(directory=True, link="latest-stress")
 VALIDATE_DIR = OutputPath(directory=True, link="latest-validate")
 PACK_CSV_DIR = OutputPath(directory=True, files=("particles.csv", "contacts.csv"))
+PACK_VTK_DIR = OutputPath(directory=True, files=("particles.vtu", "contacts.vtu"))  # packing_output.VTK_FILES
+PACK_XYZ_FILE = OutputPath()
 
 
 def _seed_only(case, command: str) -> None:
@@ -655,11 +657,23 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout)
 @click.option("--csv", "csv_dir", type=PACK_CSV_DIR, default=None,
               help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "
                    "(i, j, overlap, fn, ft of every particle pair in contact)")
+@click.option("--vtk", "vtk_dir", type=PACK_VTK_DIR, default=None,
+              help="write the settled state for ParaView here (meshio, float64): particles.vtu (a vertex per centre: "
+                   "id, type, radius, mass, velocity, angular_velocity, and force — the net force — from an engine's "
+                   "final dump only: the reference keeps no per-particle force) and contacts.vtu (a line per "
+                   "particle-particle contact, to the minimum image across a periodic boundary: normal_force, "
+                   "tangential_force, overlap, i, j; wall contacts are not drawn)")
+@click.option("--xyz", "xyz_file", type=PACK_XYZ_FILE, default=None,
+              help="write the settled state as one extended XYZ frame (ase; OVITO reads it): Lattice and pbc from "
+                   "the box (x, y periodic), per particle id, species_id, radius, mass, velo, omega, and force from "
+                   "an engine only; ase writes eight decimals, so SI values to 5e-9 (--vtk keeps float64)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json):
+def pack(case_path, engine, duration, mpi, timeout, csv_dir, vtk_dir, xyz_file, overrides, as_json):
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
-    (a LAMMPS data file both engines read), and print its packing metrics."""
+    (a LAMMPS data file both engines read), and print its packing metrics (with the contact network's fabric
+    tensor); --csv, --vtk and --xyz write the settled state."""
+    from . import packing_output
     from .comparisons import packing_metrics
     from .reference import packing
 
@@ -683,6 +697,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
                "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
         x, rad = st.x, st.rad
         contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
+        settled = packing_output.from_reference(case, st)
     else:
         from .engines.packing import run_engine
 
@@ -693,6 +708,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
         out = {"case": case.name, "source": engine, "engine_version": run.version, "particles": len(run.table),
                "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
         x, rad, contacts = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), run.contacts
+        settled = packing_output.from_engine(case, run)
     if csv_dir:
         from .io import write_text
 
@@ -700,12 +716,21 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, overrides, as_json)
         for name, table in zip(PACK_CSV_DIR.files, (parts, contacts)):  # both checked up front
             write_text(Path(csv_dir) / name, table.to_csv(index=False, float_format="%.17g"))
             click.echo(f"wrote {Path(csv_dir) / name}", err=True)
+    if vtk_dir:
+        for path in packing_output.write_vtk(settled, vtk_dir):
+            click.echo(f"wrote {path}", err=True)
+    if xyz_file:
+        click.echo(f"wrote {packing_output.write_xyz(settled, xyz_file)}", err=True)
     if as_json:
         emit_json(out)
         return
     click.echo(f"{case.name} in {out['source']}: {out['particles']} particles")
     for k, v in m.items():
-        click.echo(f"  {k:22s} {show(v)}")
+        if k == "fabric":  # the 3 × 3 tensor, a row a line
+            for label, row in zip(("fabric (x)", "       (y)", "       (z)"), v):
+                click.echo(f"  {label:22s} {' '.join(f'{show(c):>16s}' for c in row)}")
+        else:
+            click.echo(f"  {k:22s} {show(v)}")
 
 
 def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
