@@ -10,6 +10,11 @@ an engine the difference is split in two (docs/verify.md):
 * formula: what is left is the engine's formula (an approximate mapping, documented) or a known engine
   behaviour (``data/expected_differences.toml``, matched by engine version).
 
+Each "differs as expected" carries the engine setting that causes it (``Comparison.setting``): an
+expected-differences entry's ``setting``, or, for an approximate mapping, the native configuration the
+mapping chose (recorded per case by :func:`unavailable` in ``entry["settings"]``). The report's traps
+section names them.
+
 Verdicts: agree, differs as expected, differs unexpectedly, not expressible, engine missing, failed.
 Only "differs unexpectedly" and "failed" fail a run.
 """
@@ -57,6 +62,7 @@ class ExpectedDifference:
     tangential: str = "*"
     metrics: tuple[str, ...] = ("*",)
     source: str = ""
+    setting: str = ""  # the engine's own setting (keyword, class, law) that causes the difference
 
     def matches(self, engine: str, version: str | None, model: dict, metric: str) -> bool:
         return (fnmatch.fnmatchcase(engine, self.engine)
@@ -82,12 +88,16 @@ def load_expected(path: str | Path | None = None) -> list[ExpectedDifference]:
                 raise ConfigError(f"{where}.{key}", None, "missing")
         if not isinstance(d["versions"], list) or not d["versions"]:
             raise ConfigError(f"{where}.versions", d["versions"], "must be a non-empty list of version patterns")
-        unknown = set(d) - {"engine", "versions", "reason", "normal", "tangential", "metrics", "source"}
+        unknown = set(d) - {"engine", "versions", "reason", "normal", "tangential", "metrics", "source", "setting"}
         if unknown:
             raise ConfigError(f"{where}.{sorted(unknown)[0]}", d[sorted(unknown)[0]], "unknown key")
+        if "setting" in d and not (isinstance(d["setting"], str) and d["setting"].strip()):
+            raise ConfigError(f"{where}.setting", d["setting"], "must be a non-empty string: the engine's own "
+                                                              "setting (keyword, class or law) that causes the difference")
         out.append(ExpectedDifference(engine=d["engine"], versions=tuple(d["versions"]), reason=d["reason"],
                                       normal=d.get("normal", "*"), tangential=d.get("tangential", "*"),
-                                      metrics=tuple(d.get("metrics", ["*"])), source=d.get("source", "")))
+                                      metrics=tuple(d.get("metrics", ["*"])), source=d.get("source", ""),
+                                      setting=d.get("setting", "")))
     return out
 
 
@@ -135,20 +145,22 @@ class Comparison:
     verdict: str
     reason: str = ""
     parts: dict = field(default_factory=dict)  # implementation / time step / formula, scaled
+    setting: str = ""  # for "differs as expected": the engine setting that causes it, when known
 
     def as_dict(self) -> dict:
         return {"source": self.source, "metric": self.metric, "value": self.value, "reference": self.reference,
                 "abs_diff": self.abs_diff, "rel_diff": self.rel_diff, "tolerance": self.tolerance,
-                "verdict": self.verdict, "reason": self.reason, "parts": self.parts}
+                "verdict": self.verdict, "reason": self.reason, "parts": self.parts, "setting": self.setting}
 
 
 def judge_engine(engine: str, version: str | None, model: dict, metric: str, value: float, reference: float,
                  twin: float, seed_verlet: float, fidelity: str, reasons: list[str], case_scales: dict,
                  tol: Tolerances, expected: list[ExpectedDifference], status: str = "ok",
-                 message: str = "") -> Comparison:
+                 message: str = "", setting: str = "") -> Comparison:
     """One metric of an engine run against the seed model. A run whose ``status`` is not "ok" (the
     reference's rules, reference/health.py) is FAILED whatever its values; so is a value that is not finite
-    where the reference or the twin has one (a broken run is never "agree" or "differs as expected")."""
+    where the reference or the twin has one (a broken run is never "agree" or "differs as expected").
+    ``setting``: the native configuration the mapping chose, named on an approximate mapping's difference."""
     diff = scaled(value, reference, metric, case_scales)
     impl = scaled(value, twin, metric, case_scales)
     step = scaled(seed_verlet, reference, metric, case_scales)
@@ -175,6 +187,7 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
     if not _finite(impl) or impl > tol.implementation:
         if match is not None:
             c.verdict, c.reason = EXPECTED, f"{match.reason} ({match.source})" if match.source else match.reason
+            c.setting = match.setting
         else:
             c.verdict = UNEXPECTED
             c.reason = (f"the engine does not compute its own documented formula: {impl:.3g} from its twin at "
@@ -184,8 +197,10 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
         return c
     if fidelity == "approximate":
         c.verdict, c.reason = EXPECTED, "approximate mapping: " + "; ".join(reasons)
+        c.setting = setting
     elif match is not None:
         c.verdict, c.reason = EXPECTED, f"{match.reason} ({match.source})" if match.source else match.reason
+        c.setting = match.setting
     else:
         c.verdict = UNEXPECTED
         c.reason = (f"{diff:.3g} from the seed model beyond the time step's own {step:.3g}; the engine meets its "
@@ -230,7 +245,11 @@ def worst(verdicts) -> str:
 
 
 def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
-    """Record an engine that cannot run this case (the model is not expressible, or it is not installed)."""
+    """Record an engine that cannot run this case (the model is not expressible, or it is not installed). For
+    one that can express it, the native configuration its mapping chose, in one line of the engine's own words
+    (``entry["settings"][engine]``): the setting the report's traps section names for an approximate mapping."""
+    if mp.native is not None:
+        entry.setdefault("settings", {})[engine] = native_setting(mp.native)
     if mp.native is None:
         entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
         comps.append(status_comparison(engine, NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
@@ -241,3 +260,10 @@ def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
         comps.append(status_comparison(engine, MISSING, why))
         return True
     return False
+
+
+def native_setting(native) -> str:
+    """A native configuration in one line of its engine's own words (the engine's ``summary``)."""
+    from ..engines.mapping import native_summary
+
+    return native_summary(native)
