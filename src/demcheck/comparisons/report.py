@@ -8,18 +8,20 @@ its files exist. report.html carries its plots inline (PNG, base64) and a small 
 from __future__ import annotations
 
 import base64
+import functools
 import html
 import io
 import logging
 import math
 import os
+import re
 import xml.etree.ElementTree as ET
 from collections import defaultdict
 from pathlib import Path
 
 from ..io import number, plain, write_json, write_text
 from . import verdicts
-from .styles import engine_sources, style
+from .styles import engine_sources
 
 def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None, link: str = "latest") -> None:
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -71,10 +73,18 @@ def _engine_text(summary: dict) -> str:
     return "; ".join(parts) if parts else "none selected (reference only)"
 
 
+def _cell(text) -> str:
+    """Text for a markdown table cell: a ``|`` (in a case name or a reason, from a user's case file) would end
+    the cell, a line break the row."""
+    return str(text).replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+
+
 def matrix(summary: dict) -> dict:
-    """(model, source, metric) → worst verdict over the cases."""
+    """(model, source, metric) → worst verdict over the collision cases (the packings have their own table)."""
     out: dict = defaultdict(list)
     for c in summary["cases"]:
+        if c.get("kind") == "packing":
+            continue
         for k in c.get("comparisons", []):
             out[(_model(c), k["source"], k["metric"])].append(k["verdict"])
     return {key: verdicts.worst(vs) for key, vs in out.items()}
@@ -82,6 +92,18 @@ def matrix(summary: dict) -> dict:
 
 _SHORT = {verdicts.AGREE: "✓", verdicts.EXPECTED: "≈", verdicts.UNEXPECTED: "✗", verdicts.NOT_EXPRESSIBLE: "n/e", verdicts.MISSING: "missing",
           verdicts.FAILED: "FAIL"}
+_LEGEND = {verdicts.MISSING: "missing: engine not installed", verdicts.FAILED: "FAIL: a run failed"}
+# the matrix's columns: (metric, its mark in the header, its name for people)
+MATRIX_METRICS = (("restitution", "e", "restitution"), ("contact_time", "t", "contact time"),
+                  ("max_overlap", "δ", "max overlap"), ("peak_force", "F", "peak force"),
+                  ("energy_dissipated", "E", "energy dissipated"),
+                  ("tangential_restitution", "et", "tangential restitution"),
+                  ("rebound_angular_velocity", "ω", "rebound spin"))
+REFERENCE_SOURCES = ("closed-form", "reference-verlet")
+
+
+def _matrix_sources(summary: dict) -> list[str]:
+    return [*REFERENCE_SOURCES, *[s for s in engine_sources() if s in summary["engines"]]]
 
 
 # ----------------------------------------------------------------------------- markdown
@@ -89,6 +111,14 @@ _SHORT = {verdicts.AGREE: "✓", verdicts.EXPECTED: "≈", verdicts.UNEXPECTED: 
 
 def render_markdown(summary: dict) -> str:
     lines = [f"# demcheck verification {summary['run_id']}", ""]
+    for section in (_md_header, _md_matrix, _md_traps, _md_disagreements, _md_packings, _md_cases,
+                    validation_markdown):
+        lines += section(summary)
+    return "\n".join(lines) + "\n"
+
+
+def _md_header(summary: dict) -> list[str]:
+    lines = []
     if summary["partial"]:
         lines += [f"**PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of {summary['planned']} "
                   "cases finished and are reported below.**", ""]
@@ -108,32 +138,35 @@ def render_markdown(summary: dict) -> str:
         from .diff import baseline_markdown
 
         lines += baseline_markdown(summary["baseline"])
+    return lines
 
-    # the agreement matrix: models × sources × metrics
+
+def _md_matrix(summary: dict) -> list[str]:
+    """The agreement matrix: models × sources × metrics, the worst verdict over each model's collision cases."""
     mat = matrix(summary)
-    sources = ["closed-form", "reference-verlet", *[s for s in engine_sources() if s in summary["engines"]]]
+    sources = _matrix_sources(summary)
     models = sorted({m for m, _, _ in mat})
-    lines += ["## Agreement matrix", "",
-              "Worst verdict over the cases of each model: ✓ agree, ≈ differs as expected, ✗ differs unexpectedly, "
-              "n/e not expressible, missing (engine not installed), FAIL (a run failed). Columns: "
-              "restitution, contact time, max overlap, peak force, energy, tangential restitution, rebound spin.",
-              ""]
-    keys = ("restitution", "contact_time", "max_overlap", "peak_force", "energy_dissipated",
-            "tangential_restitution", "rebound_angular_velocity")
-    head = "| model | " + " | ".join(f"{s}: e · t · δ · F · E · et · ω" for s in sources) + " |"
-    lines += [head, "|---|" + "---|" * len(sources)]
+    lines = ["## Agreement matrix", "",
+             "Worst verdict over the collision cases of each model: ✓ agree, ≈ differs as expected, ✗ differs "
+             "unexpectedly, n/e not expressible, missing (engine not installed), FAIL (a run failed), · not "
+             "compared. Columns: " + ", ".join(name for _, _, name in MATRIX_METRICS) + ".", ""]
+    marks = " · ".join(mark for _, mark, _ in MATRIX_METRICS)
+    lines += ["| model | " + " | ".join(f"{s}: {marks}" for s in sources) + " |",
+              "|---|" + "---|" * len(sources)]
     for m in models:
         cells = []
         for s in sources:
             if (m, s, "*") in mat:
                 cells.append(_SHORT[mat[(m, s, "*")]])
                 continue
-            marks = [_SHORT.get(mat.get((m, s, k)), "·") if (m, s, k) in mat else "·" for k in keys]
-            cells.append(" ".join(marks))
-        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+            cells.append(" ".join(_SHORT[mat[(m, s, k)]] if (m, s, k) in mat else "·" for k, _, _ in MATRIX_METRICS))
+        lines.append(f"| {_cell(m)} | " + " | ".join(cells) + " |")
+    return lines + [""]
 
-    # every disagreement, explained
-    lines += ["", "## Disagreements and their reasons", ""]
+
+def _md_disagreements(summary: dict) -> list[str]:
+    """Every comparison that does not agree, grouped by verdict, source and reason."""
+    lines = ["## Disagreements and their reasons", ""]
     reasons: dict = defaultdict(list)
     for c in summary["cases"]:
         for k in c.get("comparisons", []):
@@ -149,36 +182,114 @@ def render_markdown(summary: dict) -> str:
                   f"  {len(hits)} comparison(s) in {len(cases)} case(s); metrics {', '.join(metrics)}"
                   + (f"; largest scaled difference {worst:.3g}" if worst is not None else "")
                   + f". Cases: {', '.join(cases[:6])}{' …' if len(cases) > 6 else ''}"]
+    return lines + [""]
 
+
+APPROXIMATE = "approximate mapping: "
+MAPPING_DOC = "docs/models.md (the mapping table: each engine's configuration and why it is approximate)"
+
+
+def _generic_setting(text: str) -> str:
+    """A native configuration with its numbers left out (``E*=7.1e+10`` → ``E*=…``): the setting, whatever
+    the case's values, so that one trap is named once."""
+    return re.sub(r"=\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?", "=…", text)
+
+
+def traps(summary: dict) -> list[dict]:
+    """Every expected difference of an engine met in the run, with the engine setting that causes it: an
+    entry of data/expected_differences.toml (its ``setting`` and ``source``), or an approximate mapping (the
+    native configuration the mapping chose for those cases, ``entry["settings"]``; documented in the mapping
+    table). Most comparisons first."""
+    # the shipped entries by the reason a comparison carries (judge_engine's words): their source, and the
+    # setting of a comparison from a results.json written before comparisons carried it
+    documented = {f"{e.reason} ({e.source})" if e.source else e.reason: e for e in verdicts.load_expected()}
+    groups: dict = {}
+    for c in summary["cases"]:
+        for k in c.get("comparisons", []):
+            if k["verdict"] != verdicts.EXPECTED or k["source"] in (*REFERENCE_SOURCES, "reference"):
+                continue
+            reason = k["reason"]
+            entry = documented.get(reason)
+            if not (reason.startswith(APPROXIMATE) or entry is not None or k.get("setting")):
+                continue  # not an engine setting's doing (a poured packing outside its physical range)
+            if reason.startswith(APPROXIMATE):
+                setting = k.get("setting") or (c.get("settings") or {}).get(k["source"], "")
+                g = groups.setdefault((k["source"], reason), {
+                    "engine": k["source"], "reason": reason[len(APPROXIMATE):], "kind": "approximate mapping",
+                    "settings": set(), "source": MAPPING_DOC, "cases": set(), "metrics": set(), "comparisons": 0})
+            else:
+                setting = k.get("setting") or (entry.setting if entry else "")
+                g = groups.setdefault((k["source"], reason), {
+                    "engine": k["source"], "reason": entry.reason if entry else reason,
+                    "kind": "expected difference", "settings": set(),
+                    "source": entry.source if entry else "", "cases": set(), "metrics": set(), "comparisons": 0})
+            if setting:
+                g["settings"].add(_generic_setting(setting))
+            g["cases"].add(c["case"])
+            g["metrics"].add(k["metric"])
+            g["comparisons"] += 1
+    out = [{**g, "settings": sorted(g["settings"]), "cases": sorted(g["cases"]), "metrics": sorted(g["metrics"])}
+           for g in groups.values()]
+    return sorted(out, key=lambda g: (-g["comparisons"], g["engine"], g["reason"]))
+
+
+def _code(text: str) -> str:
+    """Inline code in markdown, whatever backticks the text holds."""
+    return f"`` {text} ``" if "`" in text else f"`{text}`"
+
+
+def _md_traps(summary: dict) -> list[str]:
+    """The traps: for each expected difference met, the engine setting a user's own deck would meet it with."""
+    lines = ["## Traps", "",
+             "Each expected difference met in this run, by the engine setting that causes it: the setting to look "
+             "for in a deck of your own, why it differs from the seed model, how much of this run it touched, "
+             "and where it is documented.", ""]
+    found = traps(summary)
+    if not found:
+        return lines + ["None met in this run.", ""]
+    for t in found:
+        settings = ", ".join(_code(s) for s in t["settings"]) or "(the setting was not recorded)"
+        cases = ", ".join(t["cases"][:6]) + (" …" if len(t["cases"]) > 6 else "")
+        lines += [f"* **{t['engine']}** — {settings} ({t['kind']}): {t['reason']}",
+                  f"  {t['comparisons']} comparison(s) in {len(t['cases'])} case(s); metrics "
+                  f"{', '.join(t['metrics'])}. Documented in {t['source'] or '—'}. Cases: {cases}"]
+    return lines + [""]
+
+
+def _md_packings(summary: dict) -> list[str]:
     packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
-    if packings:
-        lines += ["", "## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
-                  "within statistical tolerances; column and layer against their static closed form).", "",
-                  "| case | source | solid fraction | coordination | bed height (m) | mean contact force (N) | "
-                  "force distribution: KS distance to the reference (critical) | max overlap / d | static closed form |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        for c in packings:
-            for src, v in c["sources"].items():
-                m = v.get("metrics") or {}
+    if not packings:
+        return []
+    lines = ["## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
+             "within statistical tolerances; column and layer against their static closed form).", "",
+             "| case | source | solid fraction | coordination | bed height (m) | mean contact force (N) | "
+             "force distribution: KS distance to the reference (critical) | max overlap / d | static closed form |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for c in packings:
+        for src, v in c["sources"].items():
+            m = v.get("metrics") or {}
 
-                def comp(metric, src=src, c=c):
-                    return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
+            def comp(metric, src=src, c=c):
+                return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
 
-                cf, ks = comp("static_overlap"), comp("force_distribution_ks")
-                lines.append(f"| {c['case']} | {src} | {number(m.get('solid_fraction'), '.4f')} | "
-                             f"{number(m.get('coordination_number'), '.3f')} | {number(m.get('bed_height'), '.5g')} | "
-                             f"{number(m.get('mean_contact_force'), '.4g')} | "
-                             f"{number(ks['value'], '.3f') + ' (' + number(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
-                             f"{number(m.get('max_overlap_ratio'), '.3g')} | "
-                             f"{number(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
-    # per case
-    lines += ["", "## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
-              "|---|---|---|---|---|"]
+            cf, ks = comp("static_overlap"), comp("force_distribution_ks")
+            lines.append(f"| {_cell(c['case'])} | {src} | {number(m.get('solid_fraction'), '.4f')} | "
+                         f"{number(m.get('coordination_number'), '.3f')} | {number(m.get('bed_height'), '.5g')} | "
+                         f"{number(m.get('mean_contact_force'), '.4g')} | "
+                         f"{number(ks['value'], '.3f') + ' (' + number(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
+                         f"{number(m.get('max_overlap_ratio'), '.3g')} | "
+                         f"{number(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
+    return lines + [""]
+
+
+def _md_cases(summary: dict) -> list[str]:
+    lines = ["## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
+             "|---|---|---|---|---|"]
     for c in summary["cases"]:
         srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
         worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
-        lines.append(f"| {c['case']} | {_model(c)} | {c['status']} | {srcs} | {number(worst_curve, '.3g')} |")
-    return "\n".join(lines + validation_markdown(summary)) + "\n"
+        lines.append(f"| {_cell(c['case'])} | {_model(c)} | {c['status']} | {srcs} | {number(worst_curve, '.3g')} |")
+    return lines
 
 
 # ----------------------------------------------------------------------------- validation (demcheck validate)
@@ -209,23 +320,30 @@ def validation_plots(summary: dict) -> list[tuple[str, str]]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from . import plots
+
     out = []
     for line in (summary.get("validation") or {}).get("series", []):
         if not line["x_label"]:
             continue
-        fig, ax = plt.subplots(figsize=(5.2, 3.4))
-        for src, xy in line["sources"].items():
+        fig, ax = plt.subplots(figsize=(5.2, 3.6), layout="constrained")
+        ys = []
+        for src, xy in sorted(line["sources"].items(), key=lambda kv: plots.source_order(kv[0])):
             pts = sorted((x, y) for x, y in zip(xy["x"], xy["y"]) if y is not None)
             if pts:
-                st = style(src)
-                ax.plot([p[0] for p in pts], [p[1] for p in pts], color=st.colour, linestyle=st.linestyle,
-                        marker=st.marker, ms=3, label=src)
+                plots.source_line(ax, [p[0] for p in pts], [p[1] for p in pts], src)
+                ys += [p[1] for p in pts]
         if line["paper"]:
             ax.plot([p[0] for p in line["paper"]], [p[1] for p in line["paper"]], "k*", ms=7, label="paper")
-        ax.set(xlabel=line["x_label"], ylabel=line["label"], title=f"{line['file']}: {line['quantity']}")
+            ys += [p[1] for p in line["paper"]]
+        ax.set(xlabel=line["x_label"], ylabel=line["label"],
+               title=plots.wrap_title(f"{line['file']}: {line['quantity']}", 50))
+        ax.title.set_fontsize(9)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-        fig.tight_layout()
+        plots.plain_ticks(ax)
+        plots.min_span(ax, ys)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
         out.append((f"{line['file']} {line['quantity']}", _png(fig)))
     return out
 
@@ -277,12 +395,22 @@ def render_junit(summary: dict) -> str:
 
 # ----------------------------------------------------------------------------- html
 
+# verdict → the class of its matrix and table cells (and their colours below)
+VERDICT_CLASS = {verdicts.AGREE: "v-agree", verdicts.EXPECTED: "v-expected", verdicts.UNEXPECTED: "v-unexpected",
+                 verdicts.FAILED: "v-failed", verdicts.NOT_EXPRESSIBLE: "v-not-expressible",
+                 verdicts.MISSING: "v-missing"}
 _STYLE = """
 body{font-family:system-ui,sans-serif;margin:2em;max-width:1400px;color:#222}
-table{border-collapse:collapse;margin:1em 0;font-size:13px}td,th{border:1px solid #ccc;padding:3px 6px}
-th{background:#f3f3f3}.agree{color:#1a7f37}.expected{color:#9a6700}.unexpected,.failed{color:#cf222e;font-weight:bold}
+table{border-collapse:collapse;margin:1em 0;font-size:13px}td,th{border:1px solid #ccc;padding:3px 6px;
+overflow-wrap:break-word}th{background:#f3f3f3}
+.v-agree{background:#c8ecd0}.v-expected{background:#ffe08a}.v-unexpected,.v-failed{background:#f5a3a3;font-weight:bold}
+.v-not-expressible,.v-missing{background:#d9d9d9}.v-none{color:#999}
+table.matrix td.mark{text-align:center;min-width:1.4em}table.matrix th.src{border-left:2px solid #888}
+table.matrix td.first{border-left:2px solid #888}
+.legend span{display:inline-block;padding:1px 8px;margin:0 4px 4px 0;border:1px solid #bbb}
+.status-ok{color:#1a7f37}.status-unexpected,.status-failed{color:#cf222e;font-weight:bold}
 .partial{background:#fff3cd;padding:.5em;border:1px solid #e0c060}img{max-width:100%;border:1px solid #ddd;margin:4px 0}
-details{margin:.4em 0}summary{cursor:pointer}
+details{margin:.4em 0}summary{cursor:pointer}code{background:#f3f3f3;padding:0 3px}
 """
 _SCRIPT = """
 <script>
@@ -294,6 +422,30 @@ window.addEventListener('load', function () {
 });
 </script>
 """
+# what a plot draws, in every plot-cache key: raise it when a plot changes, so that no stale PNG is reused
+PLOT_VERSION = 2
+# P(f/⟨f⟩) is drawn for a source with at least this many contact forces: a histogram of a handful (a column
+# of five spheres has four) shows the few forces' values, not a distribution
+MIN_CONTACTS = 50
+
+
+def _markdown_html(lines: list[str]) -> str:
+    """Markdown rendered by markdown-it (CommonMark and tables). Raw HTML is not let through: case names and
+    reasons come from users' case files, so ``<script>`` in one is shown as text, never run. A line break is
+    kept (a list item's second line, its counts, starts a line of its own)."""
+    return _markdown().render("\n".join(lines))
+
+
+def _inline(text: str) -> str:
+    """One line of markdown (a reason in a table cell) rendered inline, raw HTML escaped."""
+    return _markdown().renderInline(str(text))
+
+
+@functools.lru_cache(maxsize=1)
+def _markdown():
+    from markdown_it import MarkdownIt
+
+    return MarkdownIt("commonmark", {"html": False, "breaks": True}).enable("table")
 
 
 def _png(fig) -> str:
@@ -374,30 +526,31 @@ def case_panels(entry: dict) -> str | None:
     series = entry.get("series") or []
     if not series:
         return None
-    return _cached({"case": entry["case"], "series": series}, lambda: _draw_case(entry["case"], series), _png_ok)
+    return _cached({"case": entry["case"], "series": series, "v": PLOT_VERSION},
+                   lambda: _png(case_figure(entry["case"], series)), _png_ok)
 
 
-def _draw_case(name, series) -> str:
+def case_figure(name, series):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.2))
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.16, top=0.85, wspace=0.25)
-    for s in series:
-        st = style(s["source"])
-        lw = 2.0 if s["source"] == "reference" else 1.2
+    from . import plots
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.4), layout="constrained")
+    for s in sorted(series, key=lambda s: plots.source_order(s["source"])):
         for ax, x in ((a1, [d * 1e6 for d in s["delta"]]), (a2, [t * 1e6 for t in s["t"]])):
-            ax.plot(x, s["fn"], st.linestyle, color=st.colour, lw=lw, label=s["source"])
+            plots.source_line(ax, x, s["fn"], s["source"], markers=False)
     a1.set(xlabel="overlap δ (µm)", ylabel="Fn (N)", title="force–overlap")
     a2.set(xlabel="time since contact start (µs)", ylabel="Fn (N)", title="force–time")
     for a in (a1, a2):
         a.grid(alpha=0.3)
         a.axhline(0, color="0.6", lw=0.5)
+        plots.plain_ticks(a)
     a1.legend(fontsize=7)
-    fig.suptitle(name, fontsize=9)
-    return _png(fig)
+    fig.suptitle(plots.wrap_title(name, 90), fontsize=9)
+    return fig
 
 
 def _metric_of(entry, source, metric):
@@ -410,93 +563,253 @@ def suite_plots(summary: dict) -> list[tuple[str, str]]:
     against incidence angle — each per model and source."""
     import json
 
-    key = [(c["case"], c.get("impact"), {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()})
-           for c in summary["cases"]]
-    text = _cached({"suite": key}, lambda: json.dumps(_suite_plots(summary)), _plot_list_ok)
+    key = [(c["case"], c.get("file"), _model(c), c.get("impact"),
+            {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()}) for c in summary["cases"]]
+    text = _cached({"suite": key, "v": PLOT_VERSION}, lambda: json.dumps(_suite_plots(summary)), _plot_list_ok)
     return [tuple(x) for x in json.loads(text)]
 
 
 def _suite_plots(summary: dict) -> list[tuple[str, str]]:
+    return [(title, _png(fig)) for title, fig in suite_figures(summary)]
+
+
+def speed_panels(cases: list[dict]) -> dict:
+    """The panels of "restitution against impact speed": one per case file (its variants over speed), titled
+    by the model, pair or wall, and the file — a line never joins the cases of two files."""
+    groups = defaultdict(list)
+    for c in cases:
+        if c["impact"].get("speed") is None:
+            continue
+        kind = "wall" if "wall" in c["case"] else "pair"
+        groups[(_model(c), kind, c.get("file") or c["case"])].append(c)
+    return {f"{model} {kind} ({Path(file).stem})": cs for (model, kind, file), cs in groups.items()
+            if len({c["impact"]["speed"] for c in cs}) > 1}
+
+
+def angle_panels(cases: list[dict]) -> dict:
+    """The panels against incidence angle: one per case file and initial spin."""
+    groups = defaultdict(list)
+    for c in cases:
+        groups[(c.get("file") or c["case"], round(c["impact"].get("spin") or 0.0, 6))].append(c)
+    return {f"{_model(cs[0])}, spin {spin:g} ({Path(file).stem})": cs for (file, spin), cs in groups.items()
+            if len(cs) > 1}
+
+
+def suite_figures(summary: dict) -> list[tuple[str, object]]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from . import plots
+
     out = []
     sources = ["reference", *engine_sources()]
-    collisions = [c for c in summary["cases"] if c.get("kind") != "packing"]
+    collisions = [c for c in summary["cases"] if c.get("kind") != "packing" and c.get("impact")]
     normal = [c for c in collisions if c.get("model") and c["model"]["tangential"] == "none"]
-    if normal:
-        fig, ax = plt.subplots(figsize=(4.5, 4))
+    with_input = [c for c in normal if c["impact"].get("restitution_input") is not None]
+    if with_input:
+        fig, ax = plt.subplots(figsize=(4.6, 4.2), layout="constrained")
         for src in sources:
-            xs = [c["impact"]["restitution_input"] for c in normal if c["impact"].get("restitution_input") is not None]
-            ys = [_metric_of(c, src, "restitution") for c in normal if c["impact"].get("restitution_input") is not None]
-            pts = [(x, y) for x, y in zip(xs, ys) if y is not None and math.isfinite(y)]
+            pts = [(c["impact"]["restitution_input"], _metric_of(c, src, "restitution")) for c in with_input]
+            pts = [(x, y) for x, y in pts if y is not None and math.isfinite(y)]
             if pts:
-                st = style(src)
-                ax.plot(*zip(*pts), st.marker, color=st.colour, ms=4, alpha=0.6, label=src)
+                plots.source_line(ax, *zip(*pts), src, line=False)
         ax.plot([0, 1], [0, 1], color="0.5", lw=0.8)
         ax.set(xlabel="input restitution", ylabel="measured restitution", title="restitution: in vs out")
         ax.legend(fontsize=7)
         ax.grid(alpha=0.3)
-        fig.tight_layout()
-        out.append(("restitution in vs out", _png(fig)))
-        groups = defaultdict(list)
-        for c in normal:
-            groups[_model(c) + (" wall" if "wall" in c["case"] else " pair")].append(c)
-        groups = {k: v for k, v in groups.items() if len({c["impact"]["speed"] for c in v}) > 1}
-        if groups:
-            panels = {name: cs for name, cs in groups.items()}
-            out.append(("restitution against impact speed",
-                        _panel_grid(panels, sources, "speed", "restitution", "impact speed (m/s)", "restitution",
-                                    log_x=True)))
+        plots.plain_ticks(ax)
+        out.append(("restitution in vs out", fig))
+    panels = speed_panels(normal)
+    if panels:
+        out.append(("restitution against impact speed",
+                    panel_grid(panels, sources, "speed", "restitution", "impact speed (m/s)", "restitution",
+                               log_x=True)))
     oblique = [c for c in collisions if c.get("model") and c["model"]["tangential"] != "none"
                and c["impact"].get("angle") is not None]
-    groups = defaultdict(list)
-    for c in oblique:
-        groups[(c["file"], round(c["impact"].get("spin") or 0.0, 6))].append(c)
-    groups = {k: v for k, v in groups.items() if len(v) > 1}
-    panels = {f"{_model(cs[0])}, spin {spin:g} ({Path(file).stem})": cs for (file, spin), cs in groups.items()}
+    panels = angle_panels(oblique)
     for metric, label in (("tangential_restitution", "tangential restitution"),
                           ("rebound_angular_velocity", "rebound spin (rad/s)")):
         if panels:
             out.append((f"{label} against incidence angle",
-                        _panel_grid(panels, sources, "angle", metric, "incidence angle (°)", label)))
+                        panel_grid(panels, sources, "angle", metric, "incidence angle (°)", label)))
     return out
 
 
-def _panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_label: str,
-                log_x: bool = False) -> str:
-    """One panel per group of cases: a metric against an impact parameter, a line per source."""
+def panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_label: str, log_x: bool = False):
+    """One panel per group of cases: a metric against an impact parameter, a line per source; one legend for
+    the figure, above the panels."""
     import matplotlib.pyplot as plt
 
+    from . import plots
+
     n = len(panels)
-    cols = 4
+    cols = min(4, n)
     rows = (n + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(12, 2.6 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.1 * cols + 0.6, 2.7 * rows + 0.9), squeeze=False,
+                             layout="constrained")
+    handles = {}
     for ax, (name, cs) in zip(axes.ravel(), sorted(panels.items())):
         cs = sorted(cs, key=lambda c: c["impact"][x_key])
+        ys = []
         for src in sources:
-            st = style(src)
             pts = [(c["impact"][x_key], _metric_of(c, src, metric)) for c in cs]
             pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
             if pts:
-                ax.plot(*zip(*pts), st.marker + "-", color=st.colour, ms=4, lw=0.8, label=src)
+                handles.setdefault(src, plots.source_line(ax, *zip(*pts), src))
+                ys += [p[1] for p in pts]
         if log_x:
             ax.set_xscale("log")
-        ax.set_title(name, fontsize=8)
+        ax.set_title(plots.wrap_title(name), fontsize=8)
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=7)
+        plots.plain_ticks(ax)
+        if ys:
+            plots.min_span(ax, ys)
+        else:
+            plots.note(ax, f"no {metric} from any source")
     for ax in axes.ravel()[n:]:
         ax.axis("off")
-    axes[0][0].legend(fontsize=6)
+    if handles:
+        fig.legend(list(handles.values()), list(handles), loc="outside upper center", ncol=len(handles),
+                   fontsize=7, frameon=False)
     fig.supxlabel(x_label, fontsize=8)
     fig.supylabel(y_label, fontsize=8)
-    fig.tight_layout()
-    return _png(fig)
+    return fig
+
+
+def packing_plots(entry: dict) -> str:
+    return _png(packing_figure(entry))
+
+
+def force_count(forces: dict) -> int:
+    """How many contact forces a P(f/⟨f⟩) histogram holds: its ``n`` when recorded, else read off the
+    densities — bin k holds p_k·w·n forces (w the bin width), a whole number, so n is the least N making every
+    p_k·w·N whole (to 1e-6). That is n divided by the common factor of the bins' counts: a lower bound, equal
+    to n whenever one bin holds a count prime to the others (a single force in a tail bin, as in any real
+    distribution)."""
+    import numpy as np
+
+    if forces.get("n") is not None:
+        return int(forces["n"])
+    x, p = np.asarray(forces.get("x") or [], float), np.asarray(forces.get("p") or [], float)
+    if len(x) < 2 or not (p > 0).any():
+        return 0
+    share = p[p > 0] * (x[1] - x[0])  # each nonzero bin's fraction of the forces
+    for lo in range(1, 100_001, 5000):
+        n = np.arange(lo, lo + 5000)[:, None]
+        whole = np.all(np.abs(share * n - np.round(share * n)) <= 1e-6 * np.maximum(1.0, share * n), axis=1)
+        if whole.any():
+            return int(n[np.argmax(whole), 0])
+    return 100_000
+
+
+def packing_figure(entry: dict):
+    """Solid fraction against height, P(f/⟨f⟩) and kinetic energy against time, per source. What a panel
+    cannot draw is said in it: a source without that output (or one that did not run), a packing without a
+    periodic box (no profile), a source with fewer than MIN_CONTACTS contact forces (no distribution)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from . import plots
+
+    data = entry["packing"]
+    order = sorted(data, key=plots.source_order)
+    absent = [f"{src} ({v.get('status', 'no output')})" for src, v in entry.get("sources", {}).items()
+              if src not in data]
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(12, 3.6), layout="constrained")
+    notes: dict = {a1: [], a2: [], a3: []}
+    for src in order:
+        d = data[src]
+        prof = d.get("profile") or {}
+        if prof.get("z"):
+            plots.source_line(a1, prof["solid_fraction"], [z * 1e3 for z in prof["z"]], src, markers=False)
+        else:
+            notes[a1].append(src)
+        ke = [k for k in d.get("ke") or [] if k[1] > 0]  # log axis: the start at rest left out
+        if ke:
+            plots.source_line(a3, [k[0] for k in ke], [k[1] for k in ke], src, markers=False)
+        else:
+            notes[a3].append(src)
+        forces = d.get("forces") or {}
+        n = force_count(forces)
+        if n >= MIN_CONTACTS:
+            pts = [(x, p) for x, p in zip(forces["x"], forces["p"]) if p > 0]  # log axis: the empty bins left out
+            plots.source_line(a2, [q[0] for q in pts], [q[1] for q in pts], src)
+        else:
+            notes[a2].append(f"{src}: {n} contact force(s)" if n else f"{src}: no contact forces")
+    a3.set_yscale("log")
+    if a2.get_lines():
+        a2.set_yscale("log")
+    a1.set(xlabel="solid fraction", ylabel="height (mm)", title="solid fraction against height")
+    a2.set(xlabel=r"$f/\langle f\rangle$", ylabel=r"$P(f/\langle f\rangle)$", title="contact force distribution")
+    a3.set(xlabel="time (s)", ylabel="kinetic energy (J)", title="kinetic energy")
+    for a in (a1, a2, a3):
+        a.grid(alpha=0.3)
+        a.title.set_fontsize(9)
+        plots.plain_ticks(a)
+        if a.get_legend_handles_labels()[0]:
+            a.legend(fontsize=7)
+    said = {a1: [], a2: [], a3: []}
+    if notes[a1]:
+        said[a1].append("no solid-fraction profile: the packing has no periodic box" if not a1.get_lines()
+                        else "no profile from " + ", ".join(notes[a1]))
+    if notes[a2]:
+        said[a2].append(f"P(f) is drawn from {MIN_CONTACTS} contact forces or more; not for "
+                        + "; ".join(notes[a2]))
+    if notes[a3]:
+        said[a3].append("no kinetic energy from " + ", ".join(notes[a3]))
+    for a in (a1, a2, a3):
+        if absent:
+            said[a].append("no data from " + ", ".join(absent))
+        if said[a]:
+            plots.note(a, ". ".join(said[a]), centre=not a.get_lines())
+    fig.suptitle(plots.wrap_title(f"packing {entry['case']}", 100), fontsize=9)
+    return fig
+
+
+def _matrix_html(summary: dict) -> str:
+    """The agreement matrix as a table: a column per source and metric, each cell coloured by its verdict
+    (VERDICT_CLASS), with a legend."""
+    esc = html.escape
+    mat = matrix(summary)
+    sources = _matrix_sources(summary)
+    models = sorted({m for m, _, _ in mat})
+    legend = "".join(f"<span class='{VERDICT_CLASS[v]}'>{esc(_LEGEND.get(v, _SHORT[v] + ' ' + v))}</span>"
+                     for v in verdicts.VERDICTS) + "<span class='v-none'>· not compared</span>"
+    out = [f"<p class='legend'>{legend}</p>",
+           "<p>Worst verdict over the collision cases of each model (packings: their own table below).</p>",
+           "<table class='matrix'><tr><th rowspan='2'>model</th>"
+           + "".join(f"<th class='src' colspan='{len(MATRIX_METRICS)}'>{esc(s)}</th>" for s in sources) + "</tr><tr>"
+           + "".join(f"<th title='{esc(name)}'{' class=src' if i == 0 else ''}>{esc(mark)}</th>"
+                     for _ in sources for i, (_, mark, name) in enumerate(MATRIX_METRICS)) + "</tr>"]
+    for m in models:
+        cells = []
+        for s in sources:
+            if (m, s, "*") in mat:
+                v = mat[(m, s, "*")]
+                cells.append(f"<td class='mark first {VERDICT_CLASS[v]}' colspan='{len(MATRIX_METRICS)}' "
+                             f"title='{esc(s)}: {esc(v)}'>{esc(_SHORT[v])}</td>")
+                continue
+            for i, (k, _, name) in enumerate(MATRIX_METRICS):
+                first = " first" if i == 0 else ""
+                v = mat.get((m, s, k))
+                if v is None:
+                    cells.append(f"<td class='mark{first} v-none' title='{esc(s)} {esc(name)}: not compared'>·</td>")
+                else:
+                    cells.append(f"<td class='mark{first} {VERDICT_CLASS[v]}' title='{esc(s)} {esc(name)}: "
+                                 f"{esc(v)}'>{esc(_SHORT[v])}</td>")
+        out.append(f"<tr><td>{esc(m)}</td>" + "".join(cells) + "</tr>")
+    out.append("</table>")
+    return "\n".join(out)
 
 
 def render_html(summary: dict) -> str:
+    from . import plots
+
     esc = html.escape
     parts = ["<!doctype html><html><head><meta charset='utf-8'>",
              f"<title>demcheck {'validate' if summary.get('validation') else 'verify'} {esc(summary['run_id'])}</title>"
@@ -505,30 +818,31 @@ def render_html(summary: dict) -> str:
     if summary["partial"]:
         parts.append(f"<p class='partial'>PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of "
                      f"{summary['planned']} cases finished.</p>")
-    parts.append(f"<p>demcheck {esc(summary['demcheck'])} · engines: {esc(_engine_text(summary))} · "
-                 f"{summary['failed']} case(s) failing</p>")
-    # matrix
-    md = render_markdown(summary)
-    mat_start = md.index("## Agreement matrix")
-    mat_end = md.index("## Disagreements")
-    parts.append("<h2>Agreement matrix</h2>" + _md_table_to_html(md[mat_start:mat_end]))
-    parts.append("<h2>Suite plots</h2>")
+    header = _md_header({**summary, "partial": False})  # the partial note is above, in its own box
+    parts.append(_markdown_html(header))
+    parts.append("<h2>Agreement matrix</h2>" + _matrix_html(summary))
+    parts.append(_markdown_html(_md_traps(summary)))
+    parts.append(_markdown_html(_md_disagreements(summary)))
+    parts.append("<h2>Suite plots</h2><p>Each source in its own colour and marker in every panel (hollow markers, "
+                 "larger for the sources drawn first, so that sources that agree show one inside the other). A "
+                 f"y axis spans at least {100 * plots.MIN_REL_SPAN:g} % of its panel's largest value: smaller differences "
+                 "are read in the tables, not the plots.</p>")
     for title, b64 in suite_plots(summary):
         parts.append(f"<h3>{esc(title)}</h3>{_img(b64, title)}")
-    for c in summary["cases"]:
-        if c.get("kind") == "packing" and c.get("packing"):
-            parts.append(f"<h3>packing {esc(c['case'])}</h3>" + _img(packing_plots(c), f"packing {c['case']}"))
+    packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
+    if packings:
+        parts.append(_markdown_html(_md_packings(summary)))
+        for c in packings:
+            if c.get("packing"):
+                parts.append(f"<h3>packing {esc(c['case'])}</h3>" + _img(packing_plots(c), f"packing {c['case']}"))
     if summary.get("validation"):
-        val_md = "\n".join(validation_markdown(summary)[3:])
-        parts.append("<h2>Validation against published benchmarks</h2>" + _md_table_to_html(val_md.split("\n\nTolerances:")[0]))
+        parts.append(_markdown_html(validation_markdown(summary)))
         parts += [f"<h3>{esc(title)}</h3>{_img(b64, title)}" for title, b64 in validation_plots(summary)]
-    parts.append("<h2>Disagreements</h2>" + "".join(
-        f"<p>{esc(line.strip('* '))}</p>" for line in md[mat_end:md.index('## Cases')].splitlines()[2:] if line.strip()))
     parts.append("<h2>Cases</h2>")
     # one plot per case file (its first variant), every case's numbers in a table
     shown = set()
     for c in summary["cases"]:
-        cls = {"ok": "agree", "unexpected": "unexpected", "failed": "failed"}.get(c["status"], "expected")
+        cls = {"ok": "status-ok", "unexpected": "status-unexpected", "failed": "status-failed"}.get(c["status"], "")
         parts.append(f"<details><summary><span class='{cls}'>{esc(c['status'])}</span> {esc(c['case'])} — "
                      f"{esc(_model(c))}</summary>")
         if c.get("kind") != "packing" and c["file"] not in shown:
@@ -536,62 +850,15 @@ def render_html(summary: dict) -> str:
             if b64:
                 parts.append(_img(b64, f"force curves of {c['case']}"))
                 shown.add(c["file"])
-        rows = [k for k in c.get("comparisons", [])]
         parts.append("<table><tr><th>source</th><th>metric</th><th>value</th><th>reference</th><th>scaled diff"
                      "</th><th>tolerance</th><th>verdict</th><th>reason</th></tr>")
-        for k in rows:
-            vcls = {verdicts.AGREE: "agree", verdicts.EXPECTED: "expected", verdicts.UNEXPECTED: "unexpected", verdicts.FAILED: "failed"}.get(
-                k["verdict"], "")
+        for k in c.get("comparisons", []):
             parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{number(k['value'])}</td>"
                          f"<td>{number(k['reference'])}</td><td>{number(k['rel_diff'], '.3g')}</td>"
-                         f"<td>{number(k['tolerance'], '.3g')}</td><td class='{vcls}'>{esc(k['verdict'])}</td>"
-                         f"<td>{esc(k['reason'])}</td></tr>")
+                         f"<td>{number(k['tolerance'], '.3g')}</td>"
+                         f"<td class='{VERDICT_CLASS.get(k['verdict'], '')}'>{esc(k['verdict'])}</td>"
+                         f"<td>{_inline(k['reason'])}</td></tr>")
         parts.append("</table></details>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
 
-
-def packing_plots(entry: dict) -> str:
-    """Solid fraction against height, P(f/⟨f⟩) and kinetic energy against time, per source."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    data = entry["packing"]
-    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(12, 3.2))
-    fig.subplots_adjust(left=0.06, right=0.98, bottom=0.16, top=0.86, wspace=0.3)
-    for src, d in data.items():
-        if d.get("profile"):
-            a1.plot(d["profile"]["solid_fraction"], [z * 1e3 for z in d["profile"]["z"]], label=src)
-        if d.get("ke"):
-            pts = [k for k in d["ke"] if k[1] > 0]  # log axis: the start at rest left out
-            a3.semilogy([k[0] for k in pts], [k[1] for k in pts], label=src)
-        forces = d.get("forces") or {}
-        if forces.get("x"):
-            pts = [(x, p) for x, p in zip(forces["x"], forces["p"]) if p > 0]  # log axis: the empty bins left out
-            a2.semilogy([q[0] for q in pts], [q[1] for q in pts], "o-", ms=3, label=src)
-    a1.set(xlabel="solid fraction", ylabel="height (mm)", title="solid fraction against height")
-    a2.set(xlabel=r"$f/\langle f\rangle$", ylabel=r"$P(f/\langle f\rangle)$", title="contact force distribution")
-    a3.set(xlabel="time (s)", ylabel="kinetic energy (J)", title="kinetic energy")
-    for a in (a1, a2, a3):
-        a.grid(alpha=0.3)
-        if a.get_legend_handles_labels()[0]:
-            a.legend(fontsize=7)
-    fig.suptitle(entry["case"], fontsize=9)
-    return _png(fig)
-
-
-def _md_table_to_html(text: str) -> str:
-    rows = [line for line in text.splitlines() if line.startswith("|")]
-    if not rows:
-        return ""
-    out = ["<table>"]
-    for i, row in enumerate(rows):
-        if set(row.replace("|", "").strip()) <= {"-"}:
-            continue
-        cells = [html.escape(c.strip()) for c in row.strip("|").split("|")]
-        tag = "th" if i == 0 else "td"
-        out.append("<tr>" + "".join(f"<{tag}>{c}</{tag}>" for c in cells) + "</tr>")
-    out.append("</table>")
-    return "".join(out)
