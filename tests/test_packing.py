@@ -235,6 +235,25 @@ def test_the_packing_solver_is_the_two_body_verlet_method_against_a_wall(tangent
         _same_as_two_body(case, auto_dt(case), rules)
 
 
+@pytest.mark.parametrize("truncation", ["overlap", "spring", "force"])
+@pytest.mark.parametrize("wall", [False, True])
+def test_a_slip_with_a_lower_kinetic_friction_goes_on_as_in_the_two_body_verlet_method(truncation, wall):
+    """μk < μs: once slipping, a contact slips on while its force exceeds μk|Fn| (not μs|Fn|) — the packing
+    loop keeps each contact's slip state for it, as the two-body verlet kernel does (before, the packing
+    tested every step against μs, and a slipping contact stuck again at once). Both share
+    kernels3d.spring_slip; they meet to round-off, for pair and wall, with the seed's and the engines' rules."""
+    from demcheck.engines import registry
+    from demcheck.reference.collision import auto_dt
+
+    from .helpers import oblique_case
+
+    case = oblique_case("lsd_sliding", {"truncation": truncation, "tangential_restitution": 0.5}, wall=wall,
+                        angle=30.0, spin=500.0, friction=0.4,
+                        overrides=["contact.reference_velocity=1.0", "contact.friction_kinetic=0.15"])
+    for rules in (None, registry.get("lammps").rules, registry.get("liggghts").rules):
+        _same_as_two_body(case, auto_dt(case), rules)
+
+
 def _same_as_two_body(case, dt, rules):
     from demcheck.reference import collision3d
     from demcheck.reference.model import resolve

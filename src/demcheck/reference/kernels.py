@@ -12,6 +12,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
+                         illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
+                         stage6)
+
 L_KIND, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
 
 # modes of the piecewise-smooth normal law (adaptive method)
@@ -97,31 +101,22 @@ def _acc(law, mode, d, r, dmax, m, an):
 
 @njit(cache=True)
 def _dp5(law, mode, d, r, h, dmax, m, an):
-    """One Dormand–Prince 5(4) step of (δ, δ̇); returns the 5th-order state and the error estimate."""
+    """One Dormand–Prince 5(4) step of (δ, δ̇) (integrator.py's stages); returns the 5th-order state and the
+    error estimate."""
     k1d, k1r = r, _acc(law, mode, d, r, dmax, m, an)
-    d2, r2 = d + h * (k1d / 5), r + h * (k1r / 5)
+    d2, r2 = stage2(d, h, k1d), stage2(r, h, k1r)
     k2d, k2r = r2, _acc(law, mode, d2, r2, dmax, m, an)
-    d3 = d + h * (3 / 40 * k1d + 9 / 40 * k2d)
-    r3 = r + h * (3 / 40 * k1r + 9 / 40 * k2r)
+    d3, r3 = stage3(d, h, k1d, k2d), stage3(r, h, k1r, k2r)
     k3d, k3r = r3, _acc(law, mode, d3, r3, dmax, m, an)
-    d4 = d + h * (44 / 45 * k1d - 56 / 15 * k2d + 32 / 9 * k3d)
-    r4 = r + h * (44 / 45 * k1r - 56 / 15 * k2r + 32 / 9 * k3r)
+    d4, r4 = stage4(d, h, k1d, k2d, k3d), stage4(r, h, k1r, k2r, k3r)
     k4d, k4r = r4, _acc(law, mode, d4, r4, dmax, m, an)
-    d5 = d + h * (19372 / 6561 * k1d - 25360 / 2187 * k2d + 64448 / 6561 * k3d - 212 / 729 * k4d)
-    r5 = r + h * (19372 / 6561 * k1r - 25360 / 2187 * k2r + 64448 / 6561 * k3r - 212 / 729 * k4r)
+    d5, r5 = stage5(d, h, k1d, k2d, k3d, k4d), stage5(r, h, k1r, k2r, k3r, k4r)
     k5d, k5r = r5, _acc(law, mode, d5, r5, dmax, m, an)
-    d6 = d + h * (9017 / 3168 * k1d - 355 / 33 * k2d + 46732 / 5247 * k3d + 49 / 176 * k4d
-                  - 5103 / 18656 * k5d)
-    r6 = r + h * (9017 / 3168 * k1r - 355 / 33 * k2r + 46732 / 5247 * k3r + 49 / 176 * k4r
-                  - 5103 / 18656 * k5r)
+    d6, r6 = stage6(d, h, k1d, k2d, k3d, k4d, k5d), stage6(r, h, k1r, k2r, k3r, k4r, k5r)
     k6d, k6r = r6, _acc(law, mode, d6, r6, dmax, m, an)
-    dn = d + h * (35 / 384 * k1d + 500 / 1113 * k3d + 125 / 192 * k4d - 2187 / 6784 * k5d + 11 / 84 * k6d)
-    rn = r + h * (35 / 384 * k1r + 500 / 1113 * k3r + 125 / 192 * k4r - 2187 / 6784 * k5r + 11 / 84 * k6r)
+    dn, rn = solution(d, h, k1d, k3d, k4d, k5d, k6d), solution(r, h, k1r, k3r, k4r, k5r, k6r)
     k7d, k7r = rn, _acc(law, mode, dn, rn, dmax, m, an)
-    e1, e3, e4, e5, e6, e7 = 71 / 57600, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40
-    ed = h * (e1 * k1d + e3 * k3d + e4 * k4d + e5 * k5d + e6 * k6d + e7 * k7d)
-    er = h * (e1 * k1r + e3 * k3r + e4 * k4r + e5 * k5r + e6 * k6r + e7 * k7r)
-    return dn, rn, ed, er
+    return dn, rn, error(h, k1d, k3d, k4d, k5d, k6d, k7d), error(h, k1r, k3r, k4r, k5r, k6r, k7r)
 
 
 @njit(cache=True)
@@ -153,13 +148,6 @@ def _event_value(law, mode, slot, d, r, dmax, m, an):
 
 
 @njit(cache=True)
-def _crossed(g0, g1, direction):
-    if direction < 0:
-        return g0 > 0.0 and g1 <= 0.0
-    return g0 < 0.0 and g1 >= 0.0
-
-
-@njit(cache=True)
 def _slot_direction(law, mode, slot):
     """+1 / −1 for a live event of this mode, 0 for none."""
     if mode == M_PRE:
@@ -185,62 +173,32 @@ def _slot_direction(law, mode, slot):
     return 0
 
 
-@njit(cache=True, inline="always")
-def illinois_trial(lo, hi, glo, ghi):
-    """The regula falsi point of the bracket [lo, hi] (event values glo, ghi), or its midpoint where the
-    secant is undefined or leaves the bracket. Shared by the 1-D and the 3-D event location."""
-    theta = lo - glo * (hi - lo) / (ghi - glo) if (math.isfinite(glo) and math.isfinite(ghi)
-                                                    and ghi != glo) else 0.5 * (lo + hi)
-    if not (lo < theta < hi) or not math.isfinite(theta):
-        theta = 0.5 * (lo + hi)
-    return theta
-
-
-@njit(cache=True, inline="always")
-def illinois_update(lo, hi, glo, ghi, side, theta, g, crossed):
-    """Shrink the bracket to the side of θ that holds the root (``crossed``: between lo and θ), halving the
-    value kept on the other side when the same side moves twice (Illinois). Returns (lo, hi, glo, ghi,
-    side)."""
-    if crossed:
-        hi, ghi = theta, g
-        if side == -1:
-            glo *= 0.5
-        side = -1
-    else:
-        lo, glo = theta, g
-        if side == 1:
-            ghi *= 0.5
-        side = 1
-    return lo, hi, glo, ghi, side
-
-
 @njit(cache=True)
-def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta):
+def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1):
     """Root of event ``slot`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
     bisection fallback, each trial evaluated by a fresh RK step of length θh (5th-order accurate)."""
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
-    for _ in range(200):
-        if hi - lo <= tol_theta:
+    for _ in range(LOCATE_ITERATIONS):
+        if hi - lo <= THETA_TOL:
             break
         theta = illinois_trial(lo, hi, glo, ghi)
         dt_, rt_, _, _ = _dp5(law, mode, d, r, theta * h, dmax, m, an)
         g = _event_value(law, mode, slot, dt_, rt_, dmax, m, an)
-        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, theta, g,
-                                                 _crossed(glo, g, direction) or g == 0.0)
+        lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
     return hi
 
 
 @njit(cache=True)
-def _touch_inside(law, d, r, h, m, an, rn, tol_theta):
+def _touch_inside(law, d, r, h, m, an, rn):
     """A free-flight step [0, h] whose ends both have a gap (δ < 0) but whose approach turned into
     recession (δ̇: + → −) may hold a touch between them (δ has its maximum inside): the step fraction of the
     touch (the root of δ before the maximum), or 2 when the maximum has no overlap."""
-    tm = _locate(law, M_PRE, 2, -1, d, r, h, 0.0, m, an, r, rn, tol_theta)
+    tm = _locate(law, M_PRE, 2, -1, d, r, h, 0.0, m, an, r, rn)
     dm, _, _, _ = _dp5(law, M_PRE, d, r, tm * h, 0.0, m, an)
     if not (dm > 0.0):
         return 2.0
-    return tm * _locate(law, M_PRE, 0, 1, d, r, tm * h, 0.0, m, an, d, dm, tol_theta)
+    return tm * _locate(law, M_PRE, 0, 1, d, r, tm * h, 0.0, m, an, d, dm)
 
 
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
@@ -259,7 +217,6 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
     ER = np.empty(64)
     EF = np.empty(64)
     atol_d, atol_r = rtol * l_scale, rtol * v_scale
-    tol_theta = 1e-15
     d, r, t = d_init, r_init, 0.0
     mode = M_PRE if d <= 0.0 else (M_LOAD if law[L_KIND] == 1.0 else M_VE)
     dmax = max(d, 0.0)
@@ -267,11 +224,11 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
     n, ne = 0, 0
     T[0], D[0], R[0], F[0] = t, d, r, normal_force(law, d, r, dmax)
     n = 1
-    h = 1e-3 * t_scale
+    h = H_START * t_scale
     if mode == M_PRE and r > 0.0:
         h = min(h, 0.5 * (-d) / r) if d < 0 else h
         h = max(h, 1e-6 * t_scale)
-    h_min = 1e-14 * t_scale
+    h_min = H_MIN * t_scale
     status = ST_NO_SEPARATION
     for _ in range(10_000_000):
         if t >= t_max:
@@ -285,11 +242,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
         err = max(abs(ed) / (atol_d + rtol * max(abs(d), abs(dn))),
                   abs(er) / (atol_r + rtol * max(abs(r), abs(rn))))
         if not (err <= 1.0):
-            if not math.isfinite(err):
-                fac = 0.1
-            else:
-                fac = max(0.1, 0.9 * err ** -0.2)
-            h *= fac
+            h *= shrink(err)
             if h < h_min:
                 status = ST_TOLERANCE
                 break
@@ -302,12 +255,12 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
                 continue
             g0 = _event_value(law, mode, slot, d, r, dmax, m, an)
             g1 = _event_value(law, mode, slot, dn, rn, dmax, m, an)
-            if _crossed(g0, g1, direction):
-                theta = _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1, tol_theta)
+            if crossed(g0, g1, direction):
+                theta = _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1)
                 if theta < best_theta:
                     best_theta, best_slot, best_dir = theta, slot, direction
         if best_slot < 0 and mode == M_PRE and r > 0.0 and rn <= 0.0:
-            best_theta = _touch_inside(law, d, r, h, m, an, rn, tol_theta)
+            best_theta = _touch_inside(law, d, r, h, m, an, rn)
             if best_theta <= 1.0:
                 best_slot, best_dir = 0, 1
         if best_slot < 0:
@@ -319,8 +272,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
             F[n] = max(_mode_force(law, mode, d, r, dmax), 0.0) if (law[L_LIMIT] != 0.0 or mode != M_VE) \
                 else _mode_force(law, mode, d, r, dmax)
             n += 1
-            fac = 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** -0.2))
-            h *= fac
+            h *= grow(err)
             continue
         # advance exactly to the event
         he = best_theta * h
@@ -371,15 +323,14 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
         n += 1
         ET[ne], EC[ne], ED[ne], ER[ne], EF[ne] = t, code, d, r, fv
         ne += 1
-        if not terminal and code != EV_START and mode != M_PRE and d <= 0.0 and r < 0.0:
-            # a simultaneous root (elastic Hertz: force and overlap vanish together) landed past δ = 0
+        if ended_with_it(terminal, code == EV_START, mode != M_PRE, d, r):
             ET[ne], EC[ne], ED[ne], ER[ne], EF[ne] = t, EV_END, d, r, 0.0
             ne += 1
             terminal = True
         if terminal:
             status = ST_OK
             break
-        h = max(h * (1.0 - best_theta), 1e-6 * t_scale) if best_theta < 1.0 else h
+        h = resume(h, best_theta, t_scale)
     if status == ST_NO_SEPARATION and mode == M_PRE:
         status = ST_NO_CONTACT
     return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy(), ne, \

@@ -23,7 +23,10 @@ from numba import njit
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
                       L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
-                      illinois_trial, illinois_update, normal_force, spow, viscoelastic_force)
+                      normal_force, spow, viscoelastic_force)
+from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
+                         illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
+                         stage6)
 from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_KIND, T_KT,
                          T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
@@ -454,6 +457,8 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
 
 @njit(cache=True)
 def _dp5_3(y, aux, nl, tl, geo, rules, h):
+    """One Dormand–Prince 5(4) step of the state (integrator.py's stages); returns the 5th-order state and the
+    error estimate."""
     n = y.shape[0]
     k1 = np.empty(n)
     k2 = np.empty(n)
@@ -463,18 +468,14 @@ def _dp5_3(y, aux, nl, tl, geo, rules, h):
     k6 = np.empty(n)
     k7 = np.empty(n)
     rhs(y, aux, nl, tl, geo, rules, k1)
-    rhs(y + h * (k1 / 5), aux, nl, tl, geo, rules, k2)
-    rhs(y + h * (3 / 40 * k1 + 9 / 40 * k2), aux, nl, tl, geo, rules, k3)
-    rhs(y + h * (44 / 45 * k1 - 56 / 15 * k2 + 32 / 9 * k3), aux, nl, tl, geo, rules, k4)
-    rhs(y + h * (19372 / 6561 * k1 - 25360 / 2187 * k2 + 64448 / 6561 * k3 - 212 / 729 * k4),
-        aux, nl, tl, geo, rules, k5)
-    rhs(y + h * (9017 / 3168 * k1 - 355 / 33 * k2 + 46732 / 5247 * k3 + 49 / 176 * k4 - 5103 / 18656 * k5),
-        aux, nl, tl, geo, rules, k6)
-    yn = y + h * (35 / 384 * k1 + 500 / 1113 * k3 + 125 / 192 * k4 - 2187 / 6784 * k5 + 11 / 84 * k6)
+    rhs(stage2(y, h, k1), aux, nl, tl, geo, rules, k2)
+    rhs(stage3(y, h, k1, k2), aux, nl, tl, geo, rules, k3)
+    rhs(stage4(y, h, k1, k2, k3), aux, nl, tl, geo, rules, k4)
+    rhs(stage5(y, h, k1, k2, k3, k4), aux, nl, tl, geo, rules, k5)
+    rhs(stage6(y, h, k1, k2, k3, k4, k5), aux, nl, tl, geo, rules, k6)
+    yn = solution(y, h, k1, k3, k4, k5, k6)
     rhs(yn, aux, nl, tl, geo, rules, k7)
-    err = h * (71 / 57600 * k1 - 71 / 16695 * k3 + 71 / 1920 * k4 - 17253 / 339200 * k5 + 22 / 525 * k6
-               - 1 / 40 * k7)
-    return yn, err
+    return yn, error(h, k1, k3, k4, k5, k6, k7)
 
 
 NSLOT = 8
@@ -652,27 +653,16 @@ def _event_value(y, aux, nl, tl, geo, rules, slot):
 
 
 @njit(cache=True)
-def _crossed(g0, g1, direction):
-    if direction == 2:
-        return (g0 > 0.0 and g1 <= 0.0) or (g0 < 0.0 and g1 >= 0.0)
-    if direction < 0:
-        return g0 > 0.0 and g1 <= 0.0
-    # rising from exactly 0 counts: at contact start the slip function of a fresh history is 0
-    return (g0 < 0.0 and g1 >= 0.0) or (g0 == 0.0 and g1 > 0.0)
-
-
-@njit(cache=True)
 def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
-    for _ in range(200):
-        if hi - lo <= 1e-15:
+    for _ in range(LOCATE_ITERATIONS):
+        if hi - lo <= THETA_TOL:
             break
         theta = illinois_trial(lo, hi, glo, ghi)
         yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
         g = _event_value(yt, aux, nl, tl, geo, rules, slot)
-        lo, hi, glo, ghi, side = illinois_update(lo, hi, glo, ghi, side, theta, g,
-                                                 _crossed(glo, g, direction) or g == 0.0)
+        lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
     return hi
 
 
@@ -720,7 +710,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     _record(rec, 0, t, y, aux, nl, tl, geo, rules)
     n, ne = 1, 0
     ts = geo[G_TS]
-    hstep = 1e-3 * ts
+    hstep = H_START * ts
     status = ST_NO_SEPARATION
     force_ended = False
     graze_t = -1.0  # the time of the last stick→slip graze
@@ -751,8 +741,8 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             if sc > 0.0:
                 emax = max(emax, abs(err[i]) / sc)
         if not (emax <= 1.0):
-            hstep *= 0.1 if not math.isfinite(emax) else max(0.1, 0.9 * emax ** -0.2)
-            if hstep < 1e-14 * ts:
+            hstep *= shrink(emax)
+            if hstep < H_MIN * ts:
                 status = ST_TOLERANCE
                 break
             continue
@@ -763,7 +753,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 continue
             g0 = _event_value(y, aux, nl, tl, geo, rules, slot)
             g1 = _event_value(yn, aux, nl, tl, geo, rules, slot)
-            if _crossed(g0, g1, direction):
+            if crossed(g0, g1, direction):
                 theta = _locate(y, aux, nl, tl, geo, rules, hstep, slot, direction, g0, g1)
                 if theta < best_theta:
                     best_theta, best_slot, best_dir = theta, slot, direction
@@ -795,7 +785,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                     aux[A_TREF:A_TREF + 3] = vt / vn
             _record(rec, n, t, y, aux, nl, tl, geo, rules)
             n += 1
-            hstep *= 5.0 if emax == 0.0 else min(5.0, max(0.2, 0.9 * emax ** -0.2))
+            hstep *= grow(emax)
             continue
         he = best_theta * hstep
         y, _ = _dp5_3(y, aux, nl, tl, geo, rules, he)
@@ -882,15 +872,14 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         n += 1
         ev_t[ne], ev_c[ne] = t, code
         ne += 1
-        if not terminal and code != EV_START and aux[A_NMODE] != M_PRE and delta <= 0.0 and rate < 0.0:
-            # a simultaneous root (elastic Hertz: force and overlap vanish together) landed past δ = 0
+        if ended_with_it(terminal, code == EV_START, aux[A_NMODE] != M_PRE, delta, rate):
             ev_t[ne], ev_c[ne] = t, EV_END
             ne += 1
             terminal = True
         if terminal:
             status = ST_OK
             break
-        hstep = max(hstep * (1.0 - best_theta), 1e-6 * ts) if best_theta < 1.0 else hstep
+        hstep = resume(hstep, best_theta, ts)
     if status == ST_NO_SEPARATION and aux[A_NMODE] == M_PRE:
         status = ST_NO_CONTACT
     return status, n, rec[:n].copy(), ne, ev_t[:ne].copy(), ev_c[:ne].copy()
@@ -911,17 +900,64 @@ def normal_part_matters(normal_part, scale, mu, fabs):
     return abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs
 
 
-@njit(cache=True)
-def _rotate_history(h, n, mode):
-    if mode == ROT_NONE:
-        return h
-    old = _norm(h)
-    hp = h - _dot(h, n) * n
-    if mode == ROT_RESCALE:
-        new = _norm(hp)
-        if new > 0.0:
-            hp = hp * (old / new)
-    return hp
+@njit(cache=True, inline="always")
+def turn_history(h0, h1, h2, n, rot, scale, mu, fabs):
+    """The verlet history rule before the increment: LAMMPS turns the history (h0, h1, h2) into the new tangent
+    plane and rescales it to its old length — always (ROT_RESCALE) or only where its normal part matters
+    (ROT_RESCALE_SIGNIFICANT, ``normal_part_matters`` with ``scale``, ``mu`` and ``fabs``). The one rule of the
+    two-body verlet kernel and the packing loop (scalars: it is inlined into the packing's force loop)."""
+    if rot == ROT_RESCALE or rot == ROT_RESCALE_SIGNIFICANT:
+        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+        if rot == ROT_RESCALE or normal_part_matters(hn, scale, mu, fabs):
+            old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+            h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
+            new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+            if new > 0.0:
+                r = old / new
+                h0, h1, h2 = h0 * r, h1 * r, h2 * r
+    return h0, h1, h2
+
+
+@njit(cache=True, inline="always")
+def project_history(h0, h1, h2, n, rot):
+    """The verlet history rule after the increment: LIGGGHTS projects the history onto the tangent plane
+    (ROT_PROJECT), with no rescale."""
+    if rot == ROT_PROJECT:
+        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
+    return h0, h1, h2
+
+
+@njit(cache=True, inline="always")
+def spring_slip(h0, h1, h2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
+    """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
+    trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
+    force) exceeds ``mu_test`` |Fn|, and is then cut to ``mu_k`` |Fn|: along the trial force with the history
+    kept (force cap), along it with the history put back on the limit (Maw: spring + dashpot = μ|Fn|), or the
+    spring shortened to the limit and the dashpot dropped. Returns (h0, h1, h2, f0, f1, f2, sliding). The one
+    rule of the two-body verlet kernel and the packing loop."""
+    s0, s1, s2 = -kt * h0 - eta * vt[0], -kt * h1 - eta * vt[1], -kt * h2 - eta * vt[2]
+    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    hm = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    cap_test = mu_test * fabs
+    psi = kt * hm - cap_test if trunc == TRUNC_SPRING else sn - cap_test
+    if psi <= 0.0:
+        return h0, h1, h2, s0, s1, s2, False
+    cap = mu_k * fabs
+    if kt <= 0.0:  # no spring, no history
+        h0 = h1 = h2 = 0.0
+        hm = 0.0
+    if trunc == TRUNC_SPRING:
+        if hm > 0.0:
+            r = cap / (kt * hm)
+            h0, h1, h2 = h0 * r, h1 * r, h2 * r
+            return h0, h1, h2, -kt * h0, -kt * h1, -kt * h2, True
+        return h0, h1, h2, 0.0, 0.0, 0.0, True
+    r = cap / sn if sn > 0.0 else 0.0
+    f0, f1, f2 = s0 * r, s1 * r, s2 * r
+    if trunc == TRUNC_MAW and kt > 0.0:
+        h0, h1, h2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
+    return h0, h1, h2, f0, f1, f2, True
 
 
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
@@ -996,11 +1032,9 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 if a_now < a_prev:
                     hist = hist * (a_now / a_prev)
             if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
-                rot = rules[R_ROTATION]
                 # (a force history's normal part is a force already: its scale is 1)
-                if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and normal_part_matters(
-                        _dot(hist, n), 1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)):
-                    hist = _rotate_history(hist, n, ROT_RESCALE)
+                hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION],
+                                                         1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)
             if force_hist:
                 # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the
                 # history keeps the elastic part of the capped force
@@ -1029,16 +1063,20 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     hist = hist + vt * dt
                 if kind == SPRING and tl[T_RESCALE] != 0.0:
                     a_prev = math.sqrt(tl[T_R] * delta)
-                if rules[R_ROTATION] == ROT_PROJECT:
-                    hist = _rotate_history(hist, n, ROT_PROJECT)
-                mu = tl[T_MU_K] if sliding else tl[T_MU_S]
-                psi, w, d = slip_surface(tl, nl, hist, vt, fabs, delta, mu)
-                if psi > 0.0:
-                    sliding = True
-                    hist = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+                hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION])
+                mu = tl[T_MU_K] if sliding else tl[T_MU_S]  # a slip goes on while the force exceeds μk|Fn|
+                if kind == SPRING:
+                    hist[0], hist[1], hist[2], ft[0], ft[1], ft[2], sliding = spring_slip(
+                        hist[0], hist[1], hist[2], vt, kt_of(tl, delta), eta_of(tl, nl, delta), tl[T_TRUNC], mu,
+                        tl[T_MU_K], fabs)
                 else:
-                    sliding = False
-                ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
+                    psi, w, d = slip_surface(tl, nl, hist, vt, fabs, delta, mu)
+                    if psi > 0.0:
+                        sliding = True
+                        hist = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+                    else:
+                        sliding = False
+                    ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
             elif kind != NONE:
                 ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, aux[A_TREF:A_TREF + 3])
         else:

@@ -24,16 +24,15 @@ import numpy as np
 from numba import njit
 
 from .kernels import normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, ROT_PROJECT,
-                        ROT_RESCALE, wall_arm,
-                        ROT_RESCALE_SIGNIFICANT, eta_of, kt_of, normal_part_matters, return_map, slip_surface,
-                        tangential_force, walton_reverses, walton_stiffness)
-from .tangential import (LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TRUNC_MAW,
-                         TRUNC_SPRING, WALTON, ZZY)
+from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
+                        kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
+                        turn_history, wall_arm, walton_reverses, walton_stiffness)
+from .tangential import LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
 
-# per contact slot: the tangential history (3); Walton's also the load at the last reversal (3) and the last
-# nonzero v_t·L (1), so its slots are wider (only when a Walton law is in the packing: memory and bandwidth)
-HIST_WIDTH, WALTON_HIST_WIDTH = 3, 9
+# per contact slot: the tangential history (3); a spring law with μk < μs also its slip state (1); Walton's the
+# load at the last reversal (3) and the last nonzero slip velocity (3). Slots are only as wide as the packing's
+# laws need (memory and bandwidth)
+HIST_WIDTH, SLIP_HIST_WIDTH, WALTON_HIST_WIDTH = 3, 4, 9
 
 
 @njit(cache=True)
@@ -186,16 +185,8 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
         # the last reversal L* in hist[3:6] and the last nonzero slip velocity in hist[6:9]), by kernels3d's functions
         # in verlet_3d's order
-        hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-        if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT
-                                  and normal_part_matters(hn, kt_of(tl, delta), tl[T_MU_K], fabs)):
-            old = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-            for k in range(3):
-                hist[k] -= hn * n[k]
-            new = math.sqrt(hist[0] ** 2 + hist[1] ** 2 + hist[2] ** 2)
-            if new > 0.0:
-                for k in range(3):
-                    hist[k] *= old / new
+        hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rot, kt_of(tl, delta), tl[T_MU_K],
+                                                 fabs)
         if kind == WALTON:
             if walton_reverses(vt, hist[6:9]):  # L* = L
                 hist[3], hist[4], hist[5] = hist[0], hist[1], hist[2]
@@ -207,10 +198,7 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         else:
             for k in range(3):
                 hist[k] += vt[k] * dt
-        if rot == ROT_PROJECT:
-            hn = hist[0] * n[0] + hist[1] * n[1] + hist[2] * n[2]
-            for k in range(3):
-                hist[k] -= hn * n[k]
+        hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rot)
         sliding = slip_surface(tl, nl, hist, vt, fabs, delta, tl[T_MU_S])[0] > 0.0
         if sliding:
             mapped = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
@@ -232,51 +220,19 @@ ZERO3 = np.zeros(3)
 
 @njit(cache=True, inline="always")
 def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
-    """The spring family (kernels3d's SPRING: slip_surface, return_map, tangential_force) with scalars only,
-    for the packing solver's inner loop: rotate and rescale the history, increment it, test the slip
-    surface with μs, truncate with μk by the law's rule (force cap, Maw overlap limit, spring cap)."""
-    h0, h1, h2 = hist[row, 0], hist[row, 1], hist[row, 2]
+    """The spring family with scalars only, for the packing solver's inner loop, by the verlet rules of
+    kernels3d (turn_history, the increment, project_history, spring_slip — as verlet_3d). A slip goes on while
+    the force exceeds μk|Fn|: where μk < μs the contact's slip state is kept in hist[row, 3]."""
     kt = kt_of(tl, delta)
-    hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-    if rot == ROT_RESCALE or (rot == ROT_RESCALE_SIGNIFICANT and normal_part_matters(hn, kt, tl[T_MU_K], fabs)):
-        old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
-        new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-        if new > 0.0:
-            r = old / new
-            h0, h1, h2 = h0 * r, h1 * r, h2 * r
-    h0, h1, h2 = h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt
-    if rot == ROT_PROJECT:  # LIGGGHTS: project after the increment, no rescale
-        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
-    eta = eta_of(tl, nl, delta)
-    trunc = tl[T_TRUNC]
-    s0, s1, s2 = -kt * h0 - eta * vt[0], -kt * h1 - eta * vt[1], -kt * h2 - eta * vt[2]  # the trial force
-    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
-    hm = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    cap_s = tl[T_MU_S] * fabs
-    psi = kt * hm - cap_s if trunc == TRUNC_SPRING else sn - cap_s
-    if psi <= 0.0:
-        ft[0], ft[1], ft[2] = s0, s1, s2
-    else:
-        cap = tl[T_MU_K] * fabs
-        if kt <= 0.0:  # as kernels3d.return_map: no spring, no history
-            h0 = h1 = h2 = 0.0
-            hm = 0.0
-        if trunc == TRUNC_SPRING:
-            if hm > 0.0:  # the spring limited to the cap (its length cap/Kt), the dashpot dropped
-                r = cap / (kt * hm)
-                h0, h1, h2 = h0 * r, h1 * r, h2 * r
-                ft[0], ft[1], ft[2] = -kt * h0, -kt * h1, -kt * h2
-            else:
-                ft[0] = ft[1] = ft[2] = 0.0
-        else:
-            r = cap / sn if sn > 0.0 else 0.0
-            f0, f1, f2 = s0 * r, s1 * r, s2 * r
-            if trunc == TRUNC_MAW and kt > 0.0:
-                h0, h1, h2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
-            ft[0], ft[1], ft[2] = f0, f1, f2
+    h0, h1, h2 = turn_history(hist[row, 0], hist[row, 1], hist[row, 2], n, rot, kt, tl[T_MU_K], fabs)
+    h0, h1, h2 = project_history(h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt, n, rot)
+    two_mu = tl[T_MU_K] != tl[T_MU_S]
+    mu = tl[T_MU_K] if two_mu and hist[row, 3] != 0.0 else tl[T_MU_S]
+    h0, h1, h2, ft[0], ft[1], ft[2], sliding = spring_slip(h0, h1, h2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC],
+                                                           mu, tl[T_MU_K], fabs)
     hist[row, 0], hist[row, 1], hist[row, 2] = h0, h1, h2
+    if two_mu:
+        hist[row, 3] = 1.0 if sliding else 0.0
     return fn, dmax
 
 
@@ -541,8 +497,12 @@ class PackState:
         self.rad = np.array([p.radius for p in case.particles], float)
         self.mass = np.array([case.mass(i) for i in range(n)], float)
         _, _, laws_t, _, wall_t = resolve_laws(case)
-        walton = bool(np.any(laws_t[..., T_KIND] == WALTON) or (case.walls and np.any(wall_t[..., T_KIND] == WALTON)))
-        width = WALTON_HIST_WIDTH if walton else HIST_WIDTH
+        def any_law(test):
+            return bool(np.any(test(laws_t)) or (case.walls and np.any(test(wall_t))))
+
+        walton = any_law(lambda t: t[..., T_KIND] == WALTON)
+        two_mu = any_law(lambda t: (t[..., T_KIND] == SPRING) & (t[..., T_MU_K] != t[..., T_MU_S]))
+        width = WALTON_HIST_WIDTH if walton else SLIP_HIST_WIDTH if two_mu else HIST_WIDTH
         # the Verlet list (compressed rows) and, beside each listed pair, its contact state; built by run()
         self.start = np.zeros(n + 1, np.int64)
         self.nbj = np.zeros(0, np.int64)
