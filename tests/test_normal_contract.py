@@ -27,7 +27,7 @@ def independent_solution(law, m, v):
     """scipy's DOP853 on the seed's piecewise law written out again here, phase by phase (loading,
     unloading, free flight), without the project's kernels."""
     def force(d, r, phase, dmax):
-        if law.kind == normal.HYSTERETIC:
+        if law.family == normal.HYSTERETIC:
             if phase == "load":
                 return law.kl * d
             ku = law.ku if law.ku > 0 else law.kl + law.s * law.kl * dmax
@@ -40,7 +40,7 @@ def independent_solution(law, m, v):
 
     opts = dict(method="DOP853", rtol=1e-12, atol=1e-22)
     t_end = 1.0
-    if law.kind == normal.HYSTERETIC:
+    if law.family == normal.HYSTERETIC:
         top = lambda t, y: y[1]  # noqa: E731
         top.terminal, top.direction = True, -1
         a = solve_ivp(rhs("load", 0), (0, t_end), [0.0, v], events=top, **opts)

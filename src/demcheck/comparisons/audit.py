@@ -19,6 +19,7 @@ import numpy as np
 
 from ..case import Case, from_dict
 from ..errors import ConfigError, DemcheckError
+from ..io import number
 from ..inputs import script as deck_script
 from ..reference import collision3d
 from ..reference.model import resolve
@@ -111,7 +112,7 @@ def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
     """The nearest seed model of a twin's laws, with what the deck asks for: (normal, tangential, params,
     reasons why it is only near)."""
     reasons, params = [], {}
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         normal = "hls"
         params["kl"] = nl.kl
     elif nl.a == 1.0:
@@ -139,15 +140,15 @@ def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
     if nl.limit:
         params["limit_force"] = True
     mu = tl.mu_s
-    if tl.kind == NONE or mu == 0.0:
+    if tl.family == NONE or mu == 0.0:
         tangential = "none"
-    elif tl.kind == SPRING and tl.kt_sqrt:
+    elif tl.family == SPRING and tl.kt_sqrt:
         tangential = "tti" if normal == "tti" else "ddt"
         params["truncation"] = "overlap"
-    elif tl.kind == SPRING:
+    elif tl.family == SPRING:
         tangential = "spring_sliding"
         params["kt"] = tl.kt
-    elif tl.kind == VISCOUS_SLIDING:
+    elif tl.family == VISCOUS_SLIDING:
         tangential = "sliding"
         reasons.append("the engine's tangential dashpot regularises sliding friction")
     else:
@@ -205,7 +206,7 @@ def _metrics(res) -> dict:
 
 def _stability(nl, m_eff: float, max_overlap: float, dt: float) -> float:
     """dt_crit/dt: velocity Verlet is stable for ω dt < 2, ω² = (dF/dδ)/m̄ at the largest overlap."""
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         k = max(nl.kl, nl.ku)
     else:
         k = nl.a * nl.k * max(max_overlap, 0.0) ** (nl.a - 1.0)
@@ -451,7 +452,7 @@ def text_report(r: dict) -> str:
 
 
 def _f(x) -> str:
-    return "—" if x is None or not math.isfinite(x) else f"{x:.4g}"
+    return number(x, ".4g")
 
 
 def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.0) -> dict:
@@ -470,7 +471,7 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
                "limit": nl.limit}
     if nl.a == 1.5:
         implied["E*"] = nl.k / (4.0 / 3.0 * math.sqrt(radius / 2.0))
-    if tl.kind == SPRING:
+    if tl.family == SPRING:
         implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if tl.kt_sqrt else "")
     return {"engine": engine, "setting": line, "native": native_summary(ps.native), "seed": {
         "normal": normal, "tangential": tangential, "params": params, "reasons": reasons},

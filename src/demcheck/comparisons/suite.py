@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import datetime as _dt
-import math
 import os
 import sys
 import time
@@ -299,9 +298,3 @@ def _print(console: Console, summary: dict) -> None:
     console.print(f"engines: {engines or 'none (reference only)'}")
     console.print(f"{summary['failed']} case(s) failing; wall time {summary['wall_time']:.1f} s; "
                   f"report: {summary['report']}/report.md (and report.html, results.json, junit.xml)")
-
-
-def _f(v, spec=".10g"):
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "—"
-    return format(v, spec)

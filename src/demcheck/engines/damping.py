@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 
-from ..reference.twins import beta
+from ..reference.twins import damping_ratio
 
 # Marshall's polynomial α(e) of Tsuji's damping, as LAMMPS 22Jul2025 evaluates it (no √2 factor)
 TSUJI_POLY = (1.2728, -4.2783, 11.087, -22.348, 27.467, -18.022, 4.8218)
@@ -41,7 +41,7 @@ def damping(style: str, coeff: float, k_el: float, a: float, m_eff: float, r_eff
         if coeff >= 1.0:
             return 0.0, b_secant
         factor = 2.0 if a == 1.0 else math.sqrt(5.0)
-        return factor * beta(coeff) * root, b_secant
+        return factor * damping_ratio(coeff) * root, b_secant
     raise ValueError(f"unknown damping style {style!r}")
 
 

@@ -88,7 +88,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         l_scale = 0.3 * v * t_c
         f_scale = model.pair.m_eff * v / t_c
         scales = np.concatenate([np.full(3, l_scale), np.full(3, v_scale), np.full(3, v_scale / r0)] * 2
-                                + [np.full(3, f_scale if model.tangential_law.kind == WALTON else l_scale)])
+                                + [np.full(3, f_scale if model.tangential_law.family == WALTON else l_scale)])
         status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
         names = {**kernels.EVENT_NAMES, **k3.EVENT_NAMES_3D}
         idx = np.searchsorted(rec[:, k3.C_T], ev_t)

@@ -1,6 +1,6 @@
 """Compiled (numba, cached on disk) pure force laws and the 1-D normal-impact integrators.
 
-The law array is ``NormalLaw.array()``: [kind, k, a, eta, b, kl, ku, s, limit].
+The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, limit].
 
 State of the 1-D problem: δ (overlap, > 0 in contact) and r = δ̇ (approach rate); m̄ δ̈ = −F + m̄ a_n.
 """
@@ -16,7 +16,7 @@ from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, 
                          illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
                          stage6)
 
-L_KIND, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
+L_FAMILY, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
 
 # modes of the piecewise-smooth normal law (adaptive method)
 M_PRE, M_VE, M_LOAD, M_UNLOAD, M_FREE = 0, 1, 2, 3, 4
@@ -69,7 +69,7 @@ def normal_force(law, delta, rate, dmax):
     hysteretic law, the largest overlap so far (the history). No force without overlap."""
     if delta <= 0.0:
         return 0.0
-    if law[L_KIND] == 1.0:
+    if law[L_FAMILY] == 1.0:
         ku, d0 = hls_unloading(law, dmax)
         f = min(law[L_KL] * delta, ku * (delta - d0))
         return max(f, 0.0)
@@ -120,21 +120,21 @@ def _dp5(law, mode, d, r, h, dmax, m, an):
 
 
 @njit(cache=True)
-def _event_value(law, mode, slot, d, r, dmax, m, an):
-    """Value of event function ``slot`` in ``mode`` (see _ACTIVE for which are live)."""
-    if slot == 0:
+def _event_value(law, mode, event, d, r, dmax, m, an):
+    """Value of event function ``event`` in ``mode`` (_event_direction tells which are live)."""
+    if event == 0:
         return d
-    if slot == 1:  # the force of the law, unclipped (VE), or of the unloading branch (HLS)
+    if event == 1:  # the force of the law, unclipped (VE), or of the unloading branch (HLS)
         if mode == M_FREE:
             if d <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
-            if law[L_KIND] == 1.0:
+            if law[L_FAMILY] == 1.0:
                 return _mode_force(law, M_UNLOAD, d, r, dmax)
             return viscoelastic_force(law, d, r)
         return _mode_force(law, mode, d, r, dmax)
-    if slot == 2:
+    if event == 2:
         return r
-    if slot == 3:  # dF/dt of the viscoelastic law
+    if event == 3:  # dF/dt of the viscoelastic law
         acc = _acc(law, mode, d, r, dmax, m, an)
         ad = abs(d)
         a, b = law[L_A], law[L_B]
@@ -144,38 +144,38 @@ def _event_value(law, mode, slot, d, r, dmax, m, an):
         else:
             dfv = law[L_ETA] * (b * ad ** (b - 1.0) * r * r + spow(d, b) * acc)
         return dfd + dfv
-    return d - dmax  # slot 4
+    return d - dmax  # event 4
 
 
 @njit(cache=True)
-def _slot_direction(law, mode, slot):
+def _event_direction(law, mode, event):
     """+1 / −1 for a live event of this mode, 0 for none."""
     if mode == M_PRE:
-        return 1 if slot == 0 else 0
+        return 1 if event == 0 else 0
     if mode == M_VE:
-        if slot == 0 or slot == 1 or slot == 2:
+        if event == 0 or event == 1 or event == 2:
             return -1
-        if slot == 3 and law[L_ETA] != 0.0:
+        if event == 3 and law[L_ETA] != 0.0:
             return -1
         return 0
     if mode == M_LOAD:
-        return -1 if (slot == 0 or slot == 2) else 0
+        return -1 if (event == 0 or event == 2) else 0
     if mode == M_UNLOAD:
-        if slot == 0 or slot == 1:
+        if event == 0 or event == 1:
             return -1
-        return 1 if slot == 4 else 0
+        return 1 if event == 4 else 0
     if mode == M_FREE:
-        if slot == 0:
+        if event == 0:
             return -1
-        if slot == 1:
+        if event == 1:
             return 1
         return 0
     return 0
 
 
 @njit(cache=True)
-def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1):
-    """Root of event ``slot`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
+def _locate(law, mode, event, direction, d, r, h, dmax, m, an, g0, g1):
+    """Root of event function ``event`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
     bisection fallback, each trial evaluated by a fresh RK step of length θh (5th-order accurate)."""
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
@@ -184,7 +184,7 @@ def _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1):
             break
         theta = illinois_trial(lo, hi, glo, ghi)
         dt_, rt_, _, _ = _dp5(law, mode, d, r, theta * h, dmax, m, an)
-        g = _event_value(law, mode, slot, dt_, rt_, dmax, m, an)
+        g = _event_value(law, mode, event, dt_, rt_, dmax, m, an)
         lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
     return hi
 
@@ -218,7 +218,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
     EF = np.empty(64)
     atol_d, atol_r = rtol * l_scale, rtol * v_scale
     d, r, t = d_init, r_init, 0.0
-    mode = M_PRE if d <= 0.0 else (M_LOAD if law[L_KIND] == 1.0 else M_VE)
+    mode = M_PRE if d <= 0.0 else (M_LOAD if law[L_FAMILY] == 1.0 else M_VE)
     dmax = max(d, 0.0)
     force_ended = False
     n, ne = 0, 0
@@ -248,22 +248,22 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
                 break
             continue
         # accepted: look for the earliest live event in the step
-        best_theta, best_slot, best_dir = 2.0, -1, 0
-        for slot in range(5):
-            direction = _slot_direction(law, mode, slot)
+        best_theta, best_event, best_dir = 2.0, -1, 0
+        for event in range(5):
+            direction = _event_direction(law, mode, event)
             if direction == 0:
                 continue
-            g0 = _event_value(law, mode, slot, d, r, dmax, m, an)
-            g1 = _event_value(law, mode, slot, dn, rn, dmax, m, an)
+            g0 = _event_value(law, mode, event, d, r, dmax, m, an)
+            g1 = _event_value(law, mode, event, dn, rn, dmax, m, an)
             if crossed(g0, g1, direction):
-                theta = _locate(law, mode, slot, direction, d, r, h, dmax, m, an, g0, g1)
+                theta = _locate(law, mode, event, direction, d, r, h, dmax, m, an, g0, g1)
                 if theta < best_theta:
-                    best_theta, best_slot, best_dir = theta, slot, direction
-        if best_slot < 0 and mode == M_PRE and r > 0.0 and rn <= 0.0:
+                    best_theta, best_event, best_dir = theta, event, direction
+        if best_event < 0 and mode == M_PRE and r > 0.0 and rn <= 0.0:
             best_theta = _touch_inside(law, d, r, h, m, an, rn)
             if best_theta <= 1.0:
-                best_slot, best_dir = 0, 1
-        if best_slot < 0:
+                best_event, best_dir = 0, 1
+        if best_event < 0:
             t += h
             d, r = dn, rn
             if mode == M_LOAD:
@@ -280,35 +280,35 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
         t += he
         code = 0
         terminal = False
-        if best_slot == 0 and best_dir > 0:
+        if best_event == 0 and best_dir > 0:
             code = EV_START
             d = 0.0
-            mode = M_LOAD if law[L_KIND] == 1.0 else M_VE
+            mode = M_LOAD if law[L_FAMILY] == 1.0 else M_VE
             dmax = 0.0
-        elif best_slot == 0:
+        elif best_event == 0:
             code = EV_END
             d = 0.0
             terminal = True
-        elif best_slot == 1 and best_dir < 0:
+        elif best_event == 1 and best_dir < 0:
             code = EV_FORCE_END
             if not force_ended:
                 force_ended = True
             else:
                 code = -EV_FORCE_END  # a later force end, kept but not the first
-            if law[L_KIND] == 1.0 or law[L_LIMIT] != 0.0:
+            if law[L_FAMILY] == 1.0 or law[L_LIMIT] != 0.0:
                 mode = M_FREE
-        elif best_slot == 1:
+        elif best_event == 1:
             code = EV_REENTER
-            mode = M_UNLOAD if law[L_KIND] == 1.0 else M_VE
-        elif best_slot == 2:
+            mode = M_UNLOAD if law[L_FAMILY] == 1.0 else M_VE
+        elif best_event == 2:
             code = EV_MAX_OVERLAP
             if mode == M_LOAD:
                 dmax = d
                 mode = M_UNLOAD
             r = 0.0
-        elif best_slot == 3:
+        elif best_event == 3:
             code = EV_PEAK
-        elif best_slot == 4:
+        elif best_event == 4:
             code = EV_RELOAD
             mode = M_LOAD
             dmax = d

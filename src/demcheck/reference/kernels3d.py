@@ -1,6 +1,7 @@
 """Compiled 3-D two-body contact: kinematics of seed 000 §2, every tangential family, and both methods.
 
-State y (21): x0 v0 ω0 x1 v1 ω1 h, with h the tangential history (ξ, a displacement; for Walton the load L).
+State y (21): x0 v0 ω0 x1 v1 ω1 ξ, with ξ the tangential history (a displacement; for Walton the load L).
+In the code ``xi`` is a history, ``h`` a time step.
 Body 1 is a particle, or a fixed plane wall (its state is then unused). n points from body 0 into body 1
 (into the wall); δ > 0 in contact; the relative velocity at the contact point is v_r = v_c0 − v_c1, its
 normal part δ̇ = v_r·n (> 0 approaching) and its tangential part v_t (the slip velocity). The force on body 0
@@ -21,13 +22,13 @@ import numpy as np
 from numba import njit
 
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
-                      L_B, L_KIND, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
+                      L_B, L_FAMILY, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
                       normal_force, spow, viscoelastic_force)
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
                          illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
                          stage6)
-from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_KIND, T_KT,
+from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_FAMILY, T_KT,
                          T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
                          VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)
@@ -128,24 +129,24 @@ def kt_of(tl, delta):
 @njit(cache=True, inline="always")
 def eta_of(tl, nl, delta):
     if tl[T_ETA_NORMAL] != 0.0:
-        if nl[L_KIND] == 1.0:
+        if nl[L_FAMILY] == 1.0:
             return 0.0
         return tl[T_ETA] * nl[L_ETA] * spow(max(delta, 0.0), nl[L_B])
     return tl[T_ETA]
 
 
 @njit(cache=True)
-def _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, mu):
+def _lth_zzy_force(tl, family, xi, vt, fn_abs, delta, mu):
     xm = tl[T_XI] * max(delta, 0.0)
-    hn = _norm(h)
+    hn = _norm(xi)
     f = np.zeros(3)
     if xm <= 0.0 or mu * fn_abs <= 0.0:
         return f
     u = min(hn, xm) / xm
     root = math.sqrt(max(1.0 - u, 0.0))
     if hn > 0.0:
-        f = -(mu * fn_abs * (1.0 - (1.0 - u) ** 1.5) / hn) * h
-    if kind == LTH:
+        f = -(mu * fn_abs * (1.0 - (1.0 - u) ** 1.5) / hn) * xi
+    if family == LTH:
         f = f - tl[T_ETA] * math.sqrt(6.0 * tl[T_M] * mu * fn_abs * root / xm) * vt
     else:
         c = tl[T_ETA1] / (2.0 * tl[T_G] * xm)
@@ -158,24 +159,24 @@ def _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, mu):
 
 
 @njit(cache=True)
-def slip_surface(tl, nl, h, vt, fn_abs, delta, mu):
+def slip_surface(tl, nl, xi, vt, fn_abs, delta, mu):
     """(ψ, w, D): the slip function of the history laws (ψ ≤ 0 sticks), the direction w in history space
     along which a slip reduces ψ, and D = ∇_hψ·w."""
-    kind = tl[T_KIND]
-    hn = _norm(h)
-    w = h / hn if hn > 0.0 else np.zeros(3)
+    family = tl[T_FAMILY]
+    hn = _norm(xi)
+    w = xi / hn if hn > 0.0 else np.zeros(3)
     cap = mu * fn_abs
-    if kind == SPRING:
+    if family == SPRING:
         kt = kt_of(tl, delta)
         eta = eta_of(tl, nl, delta)
         if tl[T_TRUNC] == TRUNC_SPRING:
             return kt * hn - cap, w, kt
-        s = kt * h + eta * vt
+        s = kt * xi + eta * vt
         sn = _norm(s)
         return sn - cap, (s / sn if sn > 0.0 else w), kt
-    if kind == LTH or kind == ZZY:
+    if family == LTH or family == ZZY:
         return hn - tl[T_XI] * max(delta, 0.0), w, 1.0
-    if kind == WALTON:
+    if family == WALTON:
         # the load saturates by itself on a rising limit (Kt → 0 at μ|Fn|); a falling limit μk|Fn| below |L|
         # carries the stored load down with it (seed 000 §4.8: the force is the state and obeys Coulomb's law)
         return hn - tl[T_MU_K] * fn_abs, w, 1.0
@@ -183,61 +184,61 @@ def slip_surface(tl, nl, h, vt, fn_abs, delta, mu):
 
 
 @njit(cache=True)
-def return_map(tl, nl, h, vt, fn_abs, delta, mu):
+def return_map(tl, nl, xi, vt, fn_abs, delta, mu):
     """The history on the slip surface of friction coefficient mu (Coulomb truncation)."""
-    kind = tl[T_KIND]
-    hn = _norm(h)
+    family = tl[T_FAMILY]
+    hn = _norm(xi)
     cap = mu * fn_abs
-    if kind == SPRING:
+    if family == SPRING:
         kt = kt_of(tl, delta)
         if kt <= 0.0:
             return np.zeros(3)
         eta = eta_of(tl, nl, delta)
         trunc = tl[T_TRUNC]
         if trunc == TRUNC_CAP:  # the force is capped, the spring keeps its extension
-            return h
+            return xi
         if trunc == TRUNC_MAW:  # spring + dashpot = μ|Fn| along the trial force
-            s = -kt * h - eta * vt
+            s = -kt * xi - eta * vt
             sn = _norm(s)
             f = s * (cap / sn) if sn > 0.0 else np.zeros(3)
             return -(f + eta * vt) / kt
-        return h * (cap / (kt * hn)) if hn > 0.0 else h
+        return xi * (cap / (kt * hn)) if hn > 0.0 else xi
     if hn == 0.0:
-        return h
-    if kind == LTH or kind == ZZY:
-        return h * (tl[T_XI] * max(delta, 0.0) / hn)
-    return h * (cap / hn)  # WALTON
+        return xi
+    if family == LTH or family == ZZY:
+        return xi * (tl[T_XI] * max(delta, 0.0) / hn)
+    return xi * (cap / hn)  # WALTON
 
 
 @njit(cache=True)
-def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
+def tangential_force(tl, nl, xi, vt, fn_abs, delta, slipping, tref):
     """Force on body 0 of the tangential law, in its stick or slip state (SLIDING's stick force is the
     constraint force, computed by the caller)."""
-    kind = tl[T_KIND]
-    if kind == NONE:
+    family = tl[T_FAMILY]
+    if family == NONE:
         return np.zeros(3)
     mu = tl[T_MU_K] if slipping else tl[T_MU_S]
     vn = _norm(vt)
-    if kind == VISCOUS:
+    if family == VISCOUS:
         return -eta_of(tl, nl, delta) * vt
-    if kind == VISCOUS_SLIDING:
+    if family == VISCOUS_SLIDING:
         if vn == 0.0:
             return np.zeros(3)
         return -(min(eta_of(tl, nl, delta) * vn, tl[T_MU_K] * fn_abs) / vn) * vt
-    if kind == SLIDING:
+    if family == SLIDING:
         if vn > 0.0:
             return -(tl[T_MU_K] * fn_abs / vn) * vt
         return -(tl[T_MU_K] * fn_abs) * tref
-    if kind == WALTON:  # −L, limited to μ|Fn| when a falling normal force drops the limit below |L|
-        hn = _norm(h)
+    if family == WALTON:  # −L, limited to μ|Fn| when a falling normal force drops the limit below |L|
+        hn = _norm(xi)
         cap = tl[T_MU_K] * fn_abs
-        return -(cap / hn) * h if hn > cap else -h
-    if kind == LTH or kind == ZZY:
-        return _lth_zzy_force(tl, kind, h, vt, fn_abs, delta, tl[T_MU_K])
+        return -(cap / hn) * xi if hn > cap else -xi
+    if family == LTH or family == ZZY:
+        return _lth_zzy_force(tl, family, xi, vt, fn_abs, delta, tl[T_MU_K])
     # SPRING
     kt = kt_of(tl, delta)
     eta = eta_of(tl, nl, delta)
-    trial = -kt * h - eta * vt
+    trial = -kt * xi - eta * vt
     if not slipping:
         return trial
     trunc = tl[T_TRUNC]
@@ -245,18 +246,18 @@ def tangential_force(tl, nl, h, vt, fn_abs, delta, slipping, tref):
     if trunc != TRUNC_SPRING:
         tn = _norm(trial)
         return trial * (cap / tn) if tn > 0.0 else trial
-    hn = _norm(h)
-    return -(cap / hn) * h if hn > 0.0 else np.zeros(3)
+    hn = _norm(xi)
+    return -(cap / hn) * xi if hn > 0.0 else np.zeros(3)
 
 
 @njit(cache=True)
-def walton_margin(tl, h, vt, fn_abs, lstar):
+def walton_margin(tl, xi, vt, fn_abs, lstar):
     """x = 1 − (T − T*)/(μ|Fn| − T*): the fraction of the way left to the Coulomb limit (≤ 0: at it)."""
     vn = _norm(vt)
     if vn == 0.0:
         return 1.0
     t = vt / vn
-    tt, ts = _dot(h, t), _dot(lstar, t)
+    tt, ts = _dot(xi, t), _dot(lstar, t)
     den = tl[T_MU_K] * fn_abs - ts
     if den <= 0.0:
         return 0.0
@@ -277,13 +278,13 @@ def walton_reverses(vt, previous):
 
 
 @njit(cache=True)
-def walton_stiffness(tl, h, vt, fn_abs, lstar):
+def walton_stiffness(tl, xi, vt, fn_abs, lstar):
     """Kt = K0 (1 − (T − T*)/(μ|Fn| − T*))^{1/3} with T, T* the load and the load at the last reversal,
     both measured along the current slip direction (docs/models.md: the 3-D definition); 0 without slip
     or at the limit."""
     if _norm(vt) == 0.0:
         return 0.0
-    x = walton_margin(tl, h, vt, fn_abs, lstar)
+    x = walton_margin(tl, xi, vt, fn_abs, lstar)
     if x <= 0.0:
         return 0.0
     return tl[T_K0] * x ** (1.0 / 3.0)
@@ -330,8 +331,8 @@ def _accelerations(y, geo, fvec0, tau0, tau1, dy):
 @njit(cache=True, inline="always")
 def _tangent_history(y, n):
     """The history in the current tangent plane: exact in continuous time, and immune to numerical drift."""
-    h = y[18:21]
-    return h - _dot(h, n) * n
+    xi = y[18:21]
+    return xi - _dot(xi, n) * n
 
 
 @njit(cache=True)
@@ -381,15 +382,15 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     contact = nmode != M_PRE
     fn = _contact_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
     fabs = abs(fn)
-    kind = tl[T_KIND]
+    family = tl[T_FAMILY]
     slipping = aux[A_TMODE] == SLIP
-    h = _tangent_history(y, n)
+    xi = _tangent_history(y, n)
     ft = np.zeros(3)
     req_margin = -1.0
     lam = 0.0
     ts = geo[G_TS]
-    if contact and kind != NONE:
-        if kind == SLIDING and not slipping:
+    if contact and family != NONE:
+        if family == SLIDING and not slipping:
             # constraint force keeping v_t = 0: v̇_t = A F + b
             amob = 1.0 / geo[G_M0] + a0t * a0s / geo[G_I0]
             if geo[G_WALL] == 0.0:
@@ -397,24 +398,24 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
             b = _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s)
             ft = -b / amob
             req_margin = _norm(ft) - tl[T_MU_S] * fabs
-        elif slipping and (kind == LTH or kind == ZZY):
+        elif slipping and (family == LTH or family == ZZY):
             # a slipping history lies on its surface |ξ| = ξm by definition: the force reads it there, not the
             # integrated value, which is not error-controlled while slipping (below) and would drift off it —
             # a drift the viscous term's (1 − |ξ|/ξm)^{1/4} magnifies a thousandfold
-            ft = tangential_force(tl, nl, return_map(tl, nl, h, vt, fabs, delta, tl[T_MU_K]), vt, fabs, delta,
+            ft = tangential_force(tl, nl, return_map(tl, nl, xi, vt, fabs, delta, tl[T_MU_K]), vt, fabs, delta,
                                   slipping, aux[A_TREF:A_TREF + 3])
         else:
-            ft = tangential_force(tl, nl, h, vt, fabs, delta, slipping, aux[A_TREF:A_TREF + 3])
+            ft = tangential_force(tl, nl, xi, vt, fabs, delta, slipping, aux[A_TREF:A_TREF + 3])
     fvec0 = -fn * n + ft
     tau0 = _cross(a0t * n, ft)
     tau1 = _cross(a1t * n, ft)
     _accelerations(y, geo, fvec0, tau0, tau1, dy)
     dy[18:21] = 0.0
-    if contact and (kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON):
-        rot = _dot(h, ndot) * n
-        if kind == WALTON:
-            dh = walton_stiffness(tl, h, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
-            hn = _norm(h)
+    if contact and (family == SPRING or family == LTH or family == ZZY or family == WALTON):
+        rot = _dot(xi, ndot) * n
+        if family == WALTON:
+            dh = walton_stiffness(tl, xi, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+            hn = _norm(xi)
             cap = tl[T_MU_K] * fabs
             if hn > 0.0 and cap > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
                 # at the Coulomb limit the load rides it, |L|/μ|Fn| held — within WALTON_NEAR_LIMIT of a falling
@@ -427,16 +428,16 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
                 capdot = _limit_rate(y, aux, nl, tl, geo, rules, fn, dy)
                 if capdot < 0.0 or hn >= (1.0 - WALTON_RIDE) * cap:
                     most = (hn / cap) * capdot
-                    u = h / hn
+                    u = xi / hn
                     radial = _dot(u, dh)
                     if radial > most:
                         dh = dh - (radial - most) * u
             dy[18:21] = dh
         else:
             dy[18:21] = vt - rot
-        if slipping and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        if slipping and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
             mu = tl[T_MU_K]
-            psi, w, dpsi = slip_surface(tl, nl, h, vt, fabs, delta, mu)
+            psi, w, dpsi = slip_surface(tl, nl, xi, vt, fabs, delta, mu)
             # one-sided (forward, second order) along the flow: |ξ| has a kink at ξ = 0, where every slip
             # begins at contact start, and a central difference would straddle it
             s = 1e-7 * ts
@@ -478,7 +479,7 @@ def _dp5_3(y, aux, nl, tl, geo, rules, h):
     return yn, error(h, k1, k3, k4, k5, k6, k7)
 
 
-NSLOT = 8
+N_EVENTS = 8
 # LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
 # of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
 # the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
@@ -490,8 +491,8 @@ UNLOAD_MARGIN = 1e-4
 
 @njit(cache=True, inline="always")
 def _margin(tl, vt):
-    kind = tl[T_KIND]
-    return UNLOAD_MARGIN * _norm(vt) if (kind == LTH or kind == ZZY) else 0.0
+    family = tl[T_FAMILY]
+    return UNLOAD_MARGIN * _norm(vt) if (family == LTH or family == ZZY) else 0.0
 
 
 @njit(cache=True, inline="always")
@@ -520,17 +521,17 @@ def _walton_truncate(y, aux, nl, tl, geo, rules):
     if aux[A_NMODE] == M_PRE:
         return
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    h = _tangent_history(y, n)
-    hn = _norm(h)
+    xi = _tangent_history(y, n)
+    hn = _norm(xi)
     fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
     cap = tl[T_MU_K] * abs(fn)
     if hn > cap:
-        y[18:21] = h * (cap / hn)
+        y[18:21] = xi * (cap / hn)
     elif hn > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
         dy = np.empty(y.shape[0])
         rhs(y, aux, nl, tl, geo, rules, dy)
         if _limit_rate(y, aux, nl, tl, geo, rules, fn, dy) < 0.0:
-            y[18:21] = h * (cap / hn)
+            y[18:21] = xi * (cap / hn)
 
 
 @njit(cache=True)
@@ -538,19 +539,19 @@ def _settle(y, aux, nl, tl, geo, rules):
     """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
     is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
     fall inside one step there)."""
-    kind = tl[T_KIND]
-    if aux[A_NMODE] == M_PRE or kind == NONE:
+    family = tl[T_FAMILY]
+    if aux[A_NMODE] == M_PRE or family == NONE:
         return
-    if kind == WALTON:  # no slip state: its load rides the limit (rhs), and is truncated to it
+    if family == WALTON:  # no slip state: its load rides the limit (rhs), and is truncated to it
         _walton_truncate(y, aux, nl, tl, geo, rules)
         return
-    if not (kind == SPRING or kind == LTH or kind == ZZY or kind == SLIDING):
+    if not (family == SPRING or family == LTH or family == ZZY or family == SLIDING):
         return
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     dy = np.empty(y.shape[0])
     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
     if aux[A_TMODE] == SLIP:
-        if kind != SLIDING and not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        if family != SLIDING and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
             # back onto the slip surface (the multiplier is least accurate at |Fn|'s kink); a slip that
             # would unload the history (λ < 0) sticks from there
             y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
@@ -558,7 +559,7 @@ def _settle(y, aux, nl, tl, geo, rules):
             if _unloads(tl, lam, vt) and fn != 0.0:
                 aux[A_TMODE] = STICK
         return
-    if kind == SLIDING:
+    if family == SLIDING:
         if req > 0.0:
             aux[A_TMODE] = SLIP
             fnorm = _norm(ft)
@@ -569,7 +570,7 @@ def _settle(y, aux, nl, tl, geo, rules):
     if psi > 1e-12 * max(tl[T_MU_S] * abs(fn), 1e-300):
         aux[A_TMODE] = SLIP
         y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
-        if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
             # as at a stick→slip event: from the surface, a slip that would unload the history sticks
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
             if _unloads(tl, lam, vt) and fn != 0.0:
@@ -577,83 +578,83 @@ def _settle(y, aux, nl, tl, geo, rules):
 
 
 @njit(cache=True)
-def _slot_direction(nl, tl, aux, slot):
+def _event_direction(nl, tl, aux, event):
     nmode = aux[A_NMODE]
-    kind = tl[T_KIND]
+    family = tl[T_FAMILY]
     slipping = aux[A_TMODE] == SLIP
     in_contact = nmode != M_PRE
-    if slot == 0:
+    if event == 0:
         return 1 if nmode == M_PRE else -1
     if not in_contact:
         return 0
-    if slot == 1:
+    if event == 1:
         if nmode == M_VE or nmode == M_UNLOAD:
             return -1
         if nmode == M_FREE:
             return 1
         return 0
-    if slot == 2:
+    if event == 2:
         return -1 if (nmode == M_VE or nmode == M_LOAD) else 0
-    if slot == 3:
+    if event == 3:
         return -1 if (nmode == M_VE and nl[L_ETA] != 0.0) else 0
-    if slot == 4:
+    if event == 4:
         return 1 if nmode == M_UNLOAD else 0
-    history = kind == SPRING or kind == LTH or kind == ZZY
-    if slot == 5:
-        return 1 if ((history or kind == SLIDING) and not slipping) else 0
-    if slot == 6:
-        return -1 if ((history or kind == SLIDING) and slipping) else 0
-    if slot == 7:
-        return 2 if (kind == WALTON or kind == VISCOUS_SLIDING) else 0
+    history = family == SPRING or family == LTH or family == ZZY
+    if event == 5:
+        return 1 if ((history or family == SLIDING) and not slipping) else 0
+    if event == 6:
+        return -1 if ((history or family == SLIDING) and slipping) else 0
+    if event == 7:
+        return 2 if (family == WALTON or family == VISCOUS_SLIDING) else 0
     return 0
 
 
 @njit(cache=True)
-def _event_value(y, aux, nl, tl, geo, rules, slot):
+def _event_value(y, aux, nl, tl, geo, rules, event):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     nmode = aux[A_NMODE]
-    if slot == 0:
+    if event == 0:
         return delta
-    if slot == 1:
+    if event == 1:
         if nmode == M_FREE:
             if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
-            if nl[L_KIND] == 1.0:
+            if nl[L_FAMILY] == 1.0:
                 return _normal_mode_force(nl, M_UNLOAD, delta, rate, aux[A_DMAX])
             return viscoelastic_force(nl, delta, rate)
         return _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX])
-    if slot == 2:
+    if event == 2:
         return rate
-    if slot == 4:
+    if event == 4:
         return delta - aux[A_DMAX]
     dy = np.empty(y.shape[0])
     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-    if slot == 3:
+    if event == 3:
         s = 1e-7 * geo[G_TS]
         return (_fn_at(y + s * dy, aux, nl, geo, rules) - _fn_at(y - s * dy, aux, nl, geo, rules)) / (2 * s)
-    kind = tl[T_KIND]
-    if slot == 5:
-        if kind == SLIDING:
+    family = tl[T_FAMILY]
+    if event == 5:
+        if family == SLIDING:
             return req
         psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])
         return psi
-    if slot == 6:
-        if kind == SLIDING:
+    if event == 6:
+        if family == SLIDING:
             return _dot(vt, aux[A_TREF:A_TREF + 3])
-        if kind == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
+        if family == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
             return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
         if fn == 0.0:  # a zero cap (limit_force, force ended) admits only the slip state's zero force
             return 1.0
         return lam + _margin(tl, vt)  # falls through 0 where the slip ends (_unloads)
-    if slot == 7:
-        if kind == WALTON:  # a reversal of the slip (walton_reverses)
+    if event == 7:
+        if family == WALTON:  # a reversal of the slip (walton_reverses)
             return _dot(vt, aux[A_TREF:A_TREF + 3])
         return eta_of(tl, nl, delta) * _norm(vt) - tl[T_MU_K] * abs(fn)
     return 1.0
 
 
 @njit(cache=True)
-def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
+def _locate(y, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
     for _ in range(LOCATE_ITERATIONS):
@@ -661,7 +662,7 @@ def _locate(y, aux, nl, tl, geo, rules, h, slot, direction, g0, g1):
             break
         theta = illinois_trial(lo, hi, glo, ghi)
         yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
-        g = _event_value(yt, aux, nl, tl, geo, rules, slot)
+        g = _event_value(yt, aux, nl, tl, geo, rules, event)
         lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
     return hi
 
@@ -705,7 +706,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     aux = np.zeros(A_SIZE)
     y = y0.copy()
     delta0 = kinematics(y, geo, rules)[0]
-    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_KIND] == 1.0 else M_VE)
+    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_FAMILY] == 1.0 else M_VE)
     t = 0.0
     _record(rec, 0, t, y, aux, nl, tl, geo, rules)
     n, ne = 1, 0
@@ -727,7 +728,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
         # so only the bodies' state is error-controlled then.
         n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
-        if tl[T_KIND] == WALTON and aux[A_NMODE] != M_PRE:
+        if tl[T_FAMILY] == WALTON and aux[A_NMODE] != M_PRE:
             # within 1e-6 of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely stiff as x → 0
             # with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
             # integration error, and is left out of the error control (else the steps shrink without end)
@@ -746,18 +747,18 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 status = ST_TOLERANCE
                 break
             continue
-        best_theta, best_slot, best_dir = 2.0, -1, 0
-        for slot in range(NSLOT):
-            direction = _slot_direction(nl, tl, aux, slot)
+        best_theta, best_event, best_dir = 2.0, -1, 0
+        for event in range(N_EVENTS):
+            direction = _event_direction(nl, tl, aux, event)
             if direction == 0:
                 continue
-            g0 = _event_value(y, aux, nl, tl, geo, rules, slot)
-            g1 = _event_value(yn, aux, nl, tl, geo, rules, slot)
+            g0 = _event_value(y, aux, nl, tl, geo, rules, event)
+            g1 = _event_value(yn, aux, nl, tl, geo, rules, event)
             if crossed(g0, g1, direction):
-                theta = _locate(y, aux, nl, tl, geo, rules, hstep, slot, direction, g0, g1)
+                theta = _locate(y, aux, nl, tl, geo, rules, hstep, event, direction, g0, g1)
                 if theta < best_theta:
-                    best_theta, best_slot, best_dir = theta, slot, direction
-        if best_slot < 0 and aux[A_NMODE] == M_PRE:
+                    best_theta, best_event, best_dir = theta, event, direction
+        if best_event < 0 and aux[A_NMODE] == M_PRE:
             # a graze: the gap may close and open again inside one free-flight step (δ < 0 at both ends,
             # its maximum inside, where the approach δ̇ turns into recession)
             r0 = _event_value(y, aux, nl, tl, geo, rules, 2)
@@ -769,15 +770,15 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 if dm > 0.0:
                     d0 = kinematics(y, geo, rules)[0]
                     best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, 0, 1, d0, dm)
-                    best_slot, best_dir = 0, 1
-        if best_slot < 0:
+                    best_event, best_dir = 0, 1
+        if best_event < 0:
             t += hstep
             y = yn
             if aux[A_NMODE] == M_LOAD:
                 aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
-            if tl[T_KIND] == WALTON:
+            if tl[T_FAMILY] == WALTON:
                 _walton_truncate(y, aux, nl, tl, geo, rules)
-            if (tl[T_KIND] == SLIDING and aux[A_TMODE] == SLIP) or tl[T_KIND] == WALTON:
+            if (tl[T_FAMILY] == SLIDING and aux[A_TMODE] == SLIP) or tl[T_FAMILY] == WALTON:
                 # the slip direction: SLIDING's force direction, Walton's reference for a reversal
                 vt = kinematics(y, geo, rules)[4]
                 vn = _norm(vt)
@@ -793,54 +794,54 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
         code = 0
         terminal = False
-        kind = tl[T_KIND]
-        if best_slot == 0 and best_dir > 0:
+        family = tl[T_FAMILY]
+        if best_event == 0 and best_dir > 0:
             code = EV_START
-            aux[A_NMODE] = M_LOAD if nl[L_KIND] == 1.0 else M_VE
+            aux[A_NMODE] = M_LOAD if nl[L_FAMILY] == 1.0 else M_VE
             aux[A_DMAX] = 0.0
             y[18:21] = 0.0
             aux[A_LSTAR:A_LSTAR + 3] = 0.0
             aux[A_TMODE] = STICK
             vn = _norm(vt)
             aux[A_TREF:A_TREF + 3] = 0.0
-            if (kind == SLIDING or kind == WALTON) and vn > 0.0:
+            if (family == SLIDING or family == WALTON) and vn > 0.0:
                 aux[A_TREF:A_TREF + 3] = vt / vn
-            if kind == SLIDING and vn > 0.0:
+            if family == SLIDING and vn > 0.0:
                 aux[A_TMODE] = SLIP
-        elif best_slot == 0:
+        elif best_event == 0:
             code = EV_END
             terminal = True
-        elif best_slot == 1 and best_dir < 0:
+        elif best_event == 1 and best_dir < 0:
             code = EV_FORCE_END if not force_ended else -EV_FORCE_END
             force_ended = True
-            if nl[L_KIND] == 1.0 or nl[L_LIMIT] != 0.0:
+            if nl[L_FAMILY] == 1.0 or nl[L_LIMIT] != 0.0:
                 aux[A_NMODE] = M_FREE
-        elif best_slot == 1:
+        elif best_event == 1:
             code = EV_REENTER
-            aux[A_NMODE] = M_UNLOAD if nl[L_KIND] == 1.0 else M_VE
-        elif best_slot == 2:
+            aux[A_NMODE] = M_UNLOAD if nl[L_FAMILY] == 1.0 else M_VE
+        elif best_event == 2:
             code = EV_MAX_OVERLAP
             if aux[A_NMODE] == M_LOAD:
                 aux[A_DMAX] = delta
                 aux[A_NMODE] = M_UNLOAD
-        elif best_slot == 3:
+        elif best_event == 3:
             code = EV_PEAK
-        elif best_slot == 4:
+        elif best_event == 4:
             code = EV_RELOAD
             aux[A_NMODE] = M_LOAD
             aux[A_DMAX] = delta
-        elif best_slot == 5:
+        elif best_event == 5:
             code = EV_STICK_SLIP
             dy = np.empty(21)
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
             aux[A_TMODE] = SLIP
-            if kind == SLIDING:
+            if family == SLIDING:
                 fnorm = _norm(ft)
                 if fnorm > 0.0:
                     aux[A_TREF:A_TREF + 3] = -ft / fnorm
             else:
                 y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
-                if not (kind == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+                if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
                     # slip only where sticking would push past the surface (λ > 0); else it is a graze —
                     # unless a graze was taken at this very instant already: then the first-order test
                     # contradicts the step it predicts (near contact end |Fn| ∝ δ^{1/4} has an unbounded
@@ -849,15 +850,15 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                     if _unloads(tl, lam, vt) and t != graze_t:
                         aux[A_TMODE] = STICK
                         graze_t = t
-        elif best_slot == 6:
+        elif best_event == 6:
             code = EV_SLIP_STICK
-            if kind != SLIDING:  # stick from exactly on the surface
+            if family != SLIDING:  # stick from exactly on the surface
                 dy = np.empty(21)
                 lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
                 y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
             aux[A_TMODE] = STICK
-        elif best_slot == 7:
-            if kind == WALTON:
+        elif best_event == 7:
+            if family == WALTON:
                 code = EV_REVERSAL
                 aux[A_LSTAR:A_LSTAR + 3] = _tangent_history(y, nvec)
                 aux[A_TREF:A_TREF + 3] = -aux[A_TREF:A_TREF + 3]  # the slip now runs the other way
@@ -901,63 +902,63 @@ def normal_part_matters(normal_part, scale, mu, fabs):
 
 
 @njit(cache=True, inline="always")
-def turn_history(h0, h1, h2, n, rot, scale, mu, fabs):
-    """The verlet history rule before the increment: LAMMPS turns the history (h0, h1, h2) into the new tangent
+def turn_history(xi0, xi1, xi2, n, rot, scale, mu, fabs):
+    """The verlet history rule before the increment: LAMMPS turns the history (xi0, xi1, xi2) into the new tangent
     plane and rescales it to its old length — always (ROT_RESCALE) or only where its normal part matters
     (ROT_RESCALE_SIGNIFICANT, ``normal_part_matters`` with ``scale``, ``mu`` and ``fabs``). The one rule of the
     two-body verlet kernel and the packing loop (scalars: it is inlined into the packing's force loop)."""
     if rot == ROT_RESCALE or rot == ROT_RESCALE_SIGNIFICANT:
-        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
+        hn = xi0 * n[0] + xi1 * n[1] + xi2 * n[2]
         if rot == ROT_RESCALE or normal_part_matters(hn, scale, mu, fabs):
-            old = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-            h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
-            new = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+            old = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
+            xi0, xi1, xi2 = xi0 - hn * n[0], xi1 - hn * n[1], xi2 - hn * n[2]
+            new = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
             if new > 0.0:
                 r = old / new
-                h0, h1, h2 = h0 * r, h1 * r, h2 * r
-    return h0, h1, h2
+                xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
+    return xi0, xi1, xi2
 
 
 @njit(cache=True, inline="always")
-def project_history(h0, h1, h2, n, rot):
+def project_history(xi0, xi1, xi2, n, rot):
     """The verlet history rule after the increment: LIGGGHTS projects the history onto the tangent plane
     (ROT_PROJECT), with no rescale."""
     if rot == ROT_PROJECT:
-        hn = h0 * n[0] + h1 * n[1] + h2 * n[2]
-        h0, h1, h2 = h0 - hn * n[0], h1 - hn * n[1], h2 - hn * n[2]
-    return h0, h1, h2
+        hn = xi0 * n[0] + xi1 * n[1] + xi2 * n[2]
+        xi0, xi1, xi2 = xi0 - hn * n[0], xi1 - hn * n[1], xi2 - hn * n[2]
+    return xi0, xi1, xi2
 
 
 @njit(cache=True, inline="always")
-def spring_slip(h0, h1, h2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
+def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
     """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
     trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
     force) exceeds ``mu_test`` |Fn|, and is then cut to ``mu_k`` |Fn|: along the trial force with the history
     kept (force cap), along it with the history put back on the limit (Maw: spring + dashpot = μ|Fn|), or the
-    spring shortened to the limit and the dashpot dropped. Returns (h0, h1, h2, f0, f1, f2, sliding). The one
+    spring shortened to the limit and the dashpot dropped. Returns (xi0, xi1, xi2, f0, f1, f2, sliding). The one
     rule of the two-body verlet kernel and the packing loop."""
-    s0, s1, s2 = -kt * h0 - eta * vt[0], -kt * h1 - eta * vt[1], -kt * h2 - eta * vt[2]
+    s0, s1, s2 = -kt * xi0 - eta * vt[0], -kt * xi1 - eta * vt[1], -kt * xi2 - eta * vt[2]
     sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
-    hm = math.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
+    hm = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
     cap_test = mu_test * fabs
     psi = kt * hm - cap_test if trunc == TRUNC_SPRING else sn - cap_test
     if psi <= 0.0:
-        return h0, h1, h2, s0, s1, s2, False
+        return xi0, xi1, xi2, s0, s1, s2, False
     cap = mu_k * fabs
     if kt <= 0.0:  # no spring, no history
-        h0 = h1 = h2 = 0.0
+        xi0 = xi1 = xi2 = 0.0
         hm = 0.0
     if trunc == TRUNC_SPRING:
         if hm > 0.0:
             r = cap / (kt * hm)
-            h0, h1, h2 = h0 * r, h1 * r, h2 * r
-            return h0, h1, h2, -kt * h0, -kt * h1, -kt * h2, True
-        return h0, h1, h2, 0.0, 0.0, 0.0, True
+            xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
+            return xi0, xi1, xi2, -kt * xi0, -kt * xi1, -kt * xi2, True
+        return xi0, xi1, xi2, 0.0, 0.0, 0.0, True
     r = cap / sn if sn > 0.0 else 0.0
     f0, f1, f2 = s0 * r, s1 * r, s2 * r
     if trunc == TRUNC_MAW and kt > 0.0:
-        h0, h1, h2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
-    return h0, h1, h2, f0, f1, f2, True
+        xi0, xi1, xi2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
+    return xi0, xi1, xi2, f0, f1, f2, True
 
 
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
@@ -977,7 +978,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     a_prev = 0.0
     dmax = 0.0
     sliding = False
-    kind = tl[T_KIND]
+    family = tl[T_FAMILY]
     wall = geo[G_WALL] != 0.0
     touched = False
     status = ST_NO_SEPARATION
@@ -1025,13 +1026,13 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 dmax = delta
             fn = normal_force(nl, delta, rate, dmax)
             fabs = abs(fn)
-            force_hist = kind == SPRING and tl[T_FORCE] != 0.0
-            if kind == SPRING and tl[T_RESCALE] != 0.0:
+            force_hist = family == SPRING and tl[T_FORCE] != 0.0
+            if family == SPRING and tl[T_RESCALE] != 0.0:
                 # mindlin_rescale: a shrinking contact radius scales the history by a/a_prev first
                 a_now = math.sqrt(tl[T_R] * delta)
                 if a_now < a_prev:
                     hist = hist * (a_now / a_prev)
-            if kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
+            if family == SPRING or family == LTH or family == ZZY or family == WALTON:
                 # (a force history's normal part is a force already: its scale is 1)
                 hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION],
                                                          1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)
@@ -1052,8 +1053,8 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                         hist = ft + eta * vt
                     else:
                         ft = np.zeros(3)
-            elif kind == SPRING or kind == LTH or kind == ZZY or kind == WALTON:
-                if kind == WALTON:
+            elif family == SPRING or family == LTH or family == ZZY or family == WALTON:
+                if family == WALTON:
                     if walton_reverses(vt, prev_vt):
                         lstar = hist.copy()
                     if _norm(vt) != 0.0:
@@ -1061,11 +1062,11 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
                 else:
                     hist = hist + vt * dt
-                if kind == SPRING and tl[T_RESCALE] != 0.0:
+                if family == SPRING and tl[T_RESCALE] != 0.0:
                     a_prev = math.sqrt(tl[T_R] * delta)
                 hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION])
                 mu = tl[T_MU_K] if sliding else tl[T_MU_S]  # a slip goes on while the force exceeds μk|Fn|
-                if kind == SPRING:
+                if family == SPRING:
                     hist[0], hist[1], hist[2], ft[0], ft[1], ft[2], sliding = spring_slip(
                         hist[0], hist[1], hist[2], vt, kt_of(tl, delta), eta_of(tl, nl, delta), tl[T_TRUNC], mu,
                         tl[T_MU_K], fabs)
@@ -1077,7 +1078,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     else:
                         sliding = False
                     ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
-            elif kind != NONE:
+            elif family != NONE:
                 ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, aux[A_TREF:A_TREF + 3])
         else:
             hist[:] = 0.0

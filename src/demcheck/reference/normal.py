@@ -30,7 +30,7 @@ HYSTERETIC = 1
 
 @dataclass(frozen=True)
 class NormalLaw:
-    kind: int
+    family: int
     k: float = 0.0
     a: float = 1.0
     eta: float = 0.0
@@ -41,24 +41,24 @@ class NormalLaw:
     limit: bool = False
 
     def array(self) -> np.ndarray:
-        """The law as the compiled kernels read it (kernels.L_KIND … L_LIMIT): the only positional form."""
-        return np.array([self.kind, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s,
+        """The law as the compiled kernels read it (kernels.L_FAMILY … L_LIMIT): the only positional form."""
+        return np.array([self.family, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s,
                          1.0 if self.limit else 0.0])
 
     @classmethod
     def from_array(cls, law) -> "NormalLaw":
-        kind, k, a, eta, b, kl, ku, s, limit = (float(x) for x in law)
-        return cls(int(kind), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0)
+        family, k, a, eta, b, kl, ku, s, limit = (float(x) for x in law)
+        return cls(int(family), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0)
 
     def loading_overlap(self, force: float) -> float:
         """The overlap at which the loading branch carries ``force`` at rest: (F/k)^{1/a}, or F/K_L for HLS."""
-        if self.kind == HYSTERETIC:
+        if self.family == HYSTERETIC:
             return force / self.kl
         return (force / self.k) ** (1.0 / self.a)
 
     def characteristic_time(self, m: float, v: float) -> float:
         """The elastic contact time of the law's spring at speed v (for dt = auto and solver scales)."""
-        if self.kind == HYSTERETIC:
+        if self.family == HYSTERETIC:
             return analytic.power_law_duration(self.kl, 1.0, m, v)
         return analytic.power_law_duration(self.k, self.a, m, v)
 

@@ -27,11 +27,11 @@ from .kernels import normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
                         kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
                         turn_history, wall_arm, walton_reverses, walton_stiffness)
-from .tangential import LTH, NONE, SPRING, T_FORCE, T_KIND, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
+from .tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
 
-# per contact slot: the tangential history (3); a spring law with μk < μs also its slip state (1); Walton's the
-# load at the last reversal (3) and the last nonzero slip velocity (3). Slots are only as wide as the packing's
-# laws need (memory and bandwidth)
+# per contact (a row beside its neighbour-list entry): the tangential history (3); a spring law with μk < μs
+# also its slip state (1); Walton's the load at the last reversal (3) and the last nonzero slip velocity (3).
+# Rows are only as wide as the packing's laws need (memory and bandwidth)
 HIST_WIDTH, SLIP_HIST_WIDTH, WALTON_HIST_WIDTH = 3, 4, 9
 
 
@@ -166,11 +166,11 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, 
     :func:`_other_tangential`, called."""
     dmax = max(dmax_in, delta)
     fn = normal_force(nl, delta, rate, dmax)
-    kind = tl[T_KIND]
+    family = tl[T_FAMILY]
     ft[0] = ft[1] = ft[2] = 0.0
-    if kind == NONE:
+    if family == NONE:
         return fn, dmax
-    if kind == SPRING and update:
+    if family == SPRING and update:
         return _spring(nl, tl, delta, n, vt, hist2, row, abs(fn), dt, ft, fn, dmax, rot)
     _other_tangential(nl, tl, delta, n, vt, hist2[row], abs(fn), dt, update, ft, rot)
     return fn, dmax
@@ -180,14 +180,14 @@ def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, 
 def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
     """The tangential force of every law but the updated spring family, into ``ft`` (history ``hist``, one
     contact's row, updated in place)."""
-    kind = tl[T_KIND]
-    if (kind == LTH or kind == ZZY or kind == WALTON) and update:
+    family = tl[T_FAMILY]
+    if (family == LTH or family == ZZY or family == WALTON) and update:
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
         # the last reversal L* in hist[3:6] and the last nonzero slip velocity in hist[6:9]), by kernels3d's functions
         # in verlet_3d's order
         hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rot, kt_of(tl, delta), tl[T_MU_K],
                                                  fabs)
-        if kind == WALTON:
+        if family == WALTON:
             if walton_reverses(vt, hist[6:9]):  # L* = L
                 hist[3], hist[4], hist[5] = hist[0], hist[1], hist[2]
             if vt[0] != 0.0 or vt[1] != 0.0 or vt[2] != 0.0:
@@ -207,7 +207,7 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         ft[0], ft[1], ft[2] = out[0], out[1], out[2]
         return
     out = tangential_force(tl, nl, hist, vt, fabs, delta, False, ZERO3)
-    if kind == SPRING:  # setup: the trial force within the static limit, history untouched
+    if family == SPRING:  # setup: the trial force within the static limit, history untouched
         tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
         cap = tl[T_MU_S] * fabs
         if tn > cap and tn > 0.0:
@@ -224,13 +224,13 @@ def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
     kernels3d (turn_history, the increment, project_history, spring_slip — as verlet_3d). A slip goes on while
     the force exceeds μk|Fn|: where μk < μs the contact's slip state is kept in hist[row, 3]."""
     kt = kt_of(tl, delta)
-    h0, h1, h2 = turn_history(hist[row, 0], hist[row, 1], hist[row, 2], n, rot, kt, tl[T_MU_K], fabs)
-    h0, h1, h2 = project_history(h0 + vt[0] * dt, h1 + vt[1] * dt, h2 + vt[2] * dt, n, rot)
+    xi0, xi1, xi2 = turn_history(hist[row, 0], hist[row, 1], hist[row, 2], n, rot, kt, tl[T_MU_K], fabs)
+    xi0, xi1, xi2 = project_history(xi0 + vt[0] * dt, xi1 + vt[1] * dt, xi2 + vt[2] * dt, n, rot)
     two_mu = tl[T_MU_K] != tl[T_MU_S]
     mu = tl[T_MU_K] if two_mu and hist[row, 3] != 0.0 else tl[T_MU_S]
-    h0, h1, h2, ft[0], ft[1], ft[2], sliding = spring_slip(h0, h1, h2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC],
+    xi0, xi1, xi2, ft[0], ft[1], ft[2], sliding = spring_slip(xi0, xi1, xi2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC],
                                                            mu, tl[T_MU_K], fabs)
-    hist[row, 0], hist[row, 1], hist[row, 2] = h0, h1, h2
+    hist[row, 0], hist[row, 1], hist[row, 2] = xi0, xi1, xi2
     if two_mu:
         hist[row, 3] = 1.0 if sliding else 0.0
     return fn, dmax
@@ -462,7 +462,7 @@ def resolve_laws(case):
         nl, _ = normal.resolve(pair, params, case.contact.limit_force)
         tl, _ = tangential.resolve(pair, params, nl)
         arr = tl.array()
-        if arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:  # every tangential kind runs, these two variants not
+        if arr[T_FORCE] != 0.0 or arr[T_RESCALE] != 0.0:  # every tangential family runs, these two variants not
             raise ConfigError("contact.tangential", tangential.id,
                               "is not supported by the packing solver (a force history or a contact-radius "
                               "rescale of the history: engine twins of the two-body solver)")
@@ -500,8 +500,8 @@ class PackState:
         def any_law(test):
             return bool(np.any(test(laws_t)) or (case.walls and np.any(test(wall_t))))
 
-        walton = any_law(lambda t: t[..., T_KIND] == WALTON)
-        two_mu = any_law(lambda t: (t[..., T_KIND] == SPRING) & (t[..., T_MU_K] != t[..., T_MU_S]))
+        walton = any_law(lambda t: t[..., T_FAMILY] == WALTON)
+        two_mu = any_law(lambda t: (t[..., T_FAMILY] == SPRING) & (t[..., T_MU_K] != t[..., T_MU_S]))
         width = WALTON_HIST_WIDTH if walton else SLIP_HIST_WIDTH if two_mu else HIST_WIDTH
         # the Verlet list (compressed rows) and, beside each listed pair, its contact state; built by run()
         self.start = np.zeros(n + 1, np.int64)

@@ -36,7 +36,7 @@ TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING = 0, 1, 2
 TRUNCATIONS = {"force": TRUNC_CAP, "overlap": TRUNC_MAW, "spring": TRUNC_SPRING}
 
 # layout of TangentialLaw.array()
-T_KIND, T_KT, T_KT_SQRT, T_ETA, T_ETA_NORMAL, T_MU_S, T_MU_K, T_TRUNC, T_R, T_M, T_XI, T_ETA1, T_G, T_K0 = range(14)
+T_FAMILY, T_KT, T_KT_SQRT, T_ETA, T_ETA_NORMAL, T_MU_S, T_MU_K, T_TRUNC, T_R, T_M, T_XI, T_ETA1, T_G, T_K0 = range(14)
 # engine-twin variants of SPRING (verlet method only): the history stores the elastic force (LAMMPS
 # mindlin/force), and is scaled by a/a_prev when the contact radius shrinks (mindlin_rescale)
 T_FORCE, T_RESCALE = 14, 15
@@ -45,7 +45,7 @@ T_SIZE = 16
 
 @dataclass(frozen=True)
 class TangentialLaw:
-    kind: int = NONE
+    family: int = NONE
     kt: float = 0.0  # constant Kt, or c in Kt = c √(R̄ δn) when kt_sqrt
     kt_sqrt: bool = False
     eta: float = 0.0  # constant ηt, or a factor of the normal damping prefactor when eta_normal
@@ -63,18 +63,18 @@ class TangentialLaw:
     rescale_history: bool = False  # engine twin: history × a/a_prev when the contact radius a shrinks
 
     def array(self) -> np.ndarray:
-        return np.array([self.kind, self.kt, float(self.kt_sqrt), self.eta, float(self.eta_normal), self.mu_s,
+        return np.array([self.family, self.kt, float(self.kt_sqrt), self.eta, float(self.eta_normal), self.mu_s,
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
                          self.k0, float(self.force_history), float(self.rescale_history)])
 
     @property
     def has_history(self) -> bool:
-        return self.kind in (SPRING, LTH, ZZY, WALTON)
+        return self.family in (SPRING, LTH, ZZY, WALTON)
 
     @property
     def caps(self) -> bool:
         """Whether the law limits |Ft| by Coulomb (μ|Fn|) in its slip state."""
-        return self.kind in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
+        return self.family in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
 
 
 @dataclass(frozen=True)
@@ -131,7 +131,7 @@ def deen_eta(m: float, kt: float, et: float) -> float:
 
 
 def _linear_kn(normal: NormalLaw) -> float | None:
-    if normal.kind == HYSTERETIC:
+    if normal.family == HYSTERETIC:
         return normal.kl
     if normal.a == 1.0:
         return normal.k
@@ -247,7 +247,7 @@ def _zzy(pair, params, normal):
 def _tti(pair, params, normal):
     mu = _friction(pair, "tti")
     c = 8.0 * pair.g_eff  # = √(2R)E/((2−ν)(1+ν)) √δn for like spheres of radius R (seed 000)
-    if normal.kind == HYSTERETIC:
+    if normal.family == HYSTERETIC:
         raise ConfigError("contact.normal", "hls", "tangential model 'tti' takes ηt = ηn from a viscoelastic normal model")
     trunc = _truncation(params)
     return (TangentialLaw(SPRING, kt=c, kt_sqrt=True, eta=1.0, eta_normal=True, truncation=trunc,

@@ -16,8 +16,9 @@ from .normal import VISCOELASTIC, NormalLaw
 from .tangential import NONE, SPRING, TRUNC_MAW, TRUNC_SPRING, VISCOUS_SLIDING, TangentialLaw
 
 
-def beta(e: float) -> float:
-    """−ln e/√(π² + ln² e) (> 0 for e < 1)."""
+def damping_ratio(e: float) -> float:
+    """The damping ratio of a linear spring-dashpot whose restitution is e: −ln e/√(π² + ln² e) (> 0 for
+    e < 1; the engines' docs call it β(e) — not Chung & Ooi's tangential restitution β of validate)."""
     le = math.log(e)
     return -le / math.sqrt(math.pi**2 + le * le)
 
@@ -53,5 +54,5 @@ def no_friction() -> TangentialLaw:
     return TangentialLaw(NONE)
 
 
-__all__ = ["TRUNC_MAW", "TRUNC_SPRING", "beta", "normal_law", "no_friction", "restitution_for_eta",
+__all__ = ["TRUNC_MAW", "TRUNC_SPRING", "damping_ratio", "normal_law", "no_friction", "restitution_for_eta",
            "tangential_spring", "tangential_viscous_sliding"]

@@ -47,9 +47,9 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nid = model.normal.id
     reasons: list[str] = []
     fid = EXACT
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         return refused("kratos", "Kratos DEM 10.4.4 has no linear hysteretic (HLS) discontinuum law")
-    if tl.kind != NONE:
+    if tl.family != NONE:
         return refused("kratos", f"Kratos' tangential force is part of its normal law (incremental spring Kt = "
                                   f"4G*Kn/E*, dashpot 2γ√(m̄Kt), μ decaying with the slip speed, the Coulomb cap "
                                   f"split between spring and dashpot in its own way); no seed tangential law, "

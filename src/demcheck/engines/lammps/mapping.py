@@ -23,7 +23,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     reasons: list[str] = []
     comments: list[str] = []
     nid = model.normal.id
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
     nat = Native("lammps", normal="", limit=model.limit_force)
     fid = EXACT
@@ -63,18 +63,18 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     if model.limit_force:
         comments.append("limit_damping: total normal force ≥ 0 (the collision-time reduction)")
     # tangential: LAMMPS's dashpot is x_t times the normal damping prefactor η(δ)
-    kind = tl.kind
+    family = tl.family
     tid = model.tangential.id
     eta_n_const = nl.b == 0.0 and nl.eta > 0.0
-    if kind == NONE:
+    if family == NONE:
         nat.tangential, nat.tangential_args = "linear_nohistory", (0.0, 0.0)
-    elif kind in (LTH, ZZY, WALTON):
+    elif family in (LTH, ZZY, WALTON):
         return refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
                                   "(nearest: mindlin_rescale/force, a different law)")
     else:
         mu, f_mu = mu_of(model, reasons)
         fid = worst(fid, f_mu)
-        if kind == SLIDING:
+        if family == SLIDING:
             if nl.eta == 0.0:
                 return refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
                                           "is x_t × the normal damping, and this normal law has none")
@@ -82,21 +82,21 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             fid = worst(fid, APPROXIMATE)
             reasons.append(f"simple sliding friction as linear_nohistory with x_t = {SLIDING_XT:g}: "
                            "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
-        elif kind in (VISCOUS, VISCOUS_SLIDING):
+        elif family in (VISCOUS, VISCOUS_SLIDING):
             if tl.eta_normal or not eta_n_const:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
                                           f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}"
                                           + (" and has no damping" if nl.eta == 0 else ""))
             x_t = tl.eta / nl.eta
-            if kind == VISCOUS and model.limit_force:
+            if family == VISCOUS and model.limit_force:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append("with limit_damping the Coulomb cap μ|Fn| is 0 wherever the normal force is held "
                                "at 0, so the viscous force vanishes there too")
             nat.tangential = "linear_nohistory"
-            nat.tangential_args = (x_t, HUGE_MU if kind == VISCOUS else mu)
+            nat.tangential_args = (x_t, HUGE_MU if family == VISCOUS else mu)
             comments.append(f"linear_nohistory x_t = ηt/ηn = {x_t:.10g}"
-                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if kind == VISCOUS else ""))
-        elif kind == SPRING:
+                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if family == VISCOUS else ""))
+        elif family == SPRING:
             if tl.eta_normal:  # TTIt: ηt = ηn
                 if not (nl.a == 1.5 and nl.b == 0.25):
                     return refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")

@@ -25,7 +25,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nat = Native("liggghts", normal="", limit=model.limit_force)
     fid = EXACT
     p = nat.props
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         if nl.ku == 0.0:
             return _luding(model, nat)
         # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
@@ -35,7 +35,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         comments.append(f"edinburgh (fixKc on, overlapExponent 1, no adhesion, coefficientRestitution 1): "
                         f"K_L = 2E*R̄ = {nl.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
                         f"K_U/K_L = {nl.ku / nl.kl:.17g}")
-        if tl.kind != NONE:
+        if tl.family != NONE:
             return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
                                         "no seed tangential law shares it")
         nat.tangential = "off"
@@ -68,39 +68,39 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         return refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
     if model.limit_force:
         comments.append("limitForce on: total normal force ≥ 0")
-    kind = tl.kind
+    family = tl.family
     tid = model.tangential.id
     stiff = nat.normal == "hooke/stiffness"
-    if kind == NONE:
+    if family == NONE:
         nat.tangential = "off"
-    elif kind in (LTH, ZZY, WALTON):
+    elif family in (LTH, ZZY, WALTON):
         return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
     else:
         mu, f_mu = mu_of(model, reasons)
         fid = worst(fid, f_mu)
         p["friction"] = mu
-        if kind in (SLIDING, VISCOUS, VISCOUS_SLIDING):
+        if family in (SLIDING, VISCOUS, VISCOUS_SLIDING):
             if not stiff:
                 return refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
                                             f"needs hooke/stiffness, i.e. normal 'lsd' (not '{nid}')")
             nat.tangential = "no_history"
-            if kind == SLIDING:
+            if family == SLIDING:
                 p["gammat"] = SLIDING_XT * max(nl.eta, 1.0) / m
                 fid = worst(fid, APPROXIMATE)
                 reasons.append(f"simple sliding friction as no_history with gammat = {p['gammat']:.4g} 1/s: a "
                                "regularised slider near v_t = 0")
             else:
                 p["gammat"] = tl.eta / m
-                if kind == VISCOUS:
+                if family == VISCOUS:
                     p["friction"] = HUGE_MU
                     if model.limit_force:
                         fid = worst(fid, APPROXIMATE)
                         reasons.append("with limitForce the Coulomb cap μ|Fn| is 0 wherever the normal force is "
                                        "held at 0, so the viscous force vanishes there too")
                 comments.append(f"no_history gammat = ηt/m̄ = {p['gammat']:.10g} 1/s"
-                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if kind == VISCOUS
+                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if family == VISCOUS
                                    else ""))
-        elif kind == SPRING:
+        elif family == SPRING:
             nat.tangential = "history"
             if tl.eta_normal and nl.eta > 0.0:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot
                 # outside the cap (undamped, ηt = ηn = 0, it is DDt's case below on hertz/stiffness)
@@ -159,7 +159,7 @@ def _luding(model: ResolvedModel, nat: Native) -> Mapping:
     exactly when (r − 1)/δ_lim = S. r is free: δ_lim is chosen above the largest overlap the impact can reach
     (and r ≥ 2, so that k2Max − k1 = (r − 1)k1 loses no digits), and phiF follows."""
     nl, tl, pair = model.normal_law, model.tangential_law, model.pair
-    if tl.kind != NONE:
+    if tl.family != NONE:
         return refused("liggghts", "luding's tangential stiffness is its loading stiffness (kt = kn); no seed "
                                     "tangential law shares it")
     kl, s, r_eff, m = nl.kl, nl.s, pair.r_eff, pair.m_eff
@@ -237,10 +237,10 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if factor is not None and math.isnan(factor):
         raise ValueError("hertz/stiffness with gammat > 0 and gamman = 0 has no twin")
 
-    def law(kind, **kw):
+    def law(family, **kw):
         if factor is None:
-            return TangentialLaw(kind, eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
-        return TangentialLaw(kind, eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+            return TangentialLaw(family, eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+        return TangentialLaw(family, eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
 
     if nat.tangential == "no_history":
         return nl, law(VISCOUS_SLIDING)

@@ -41,7 +41,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     reasons: list[str] = []
     comments: list[str] = []
     fid = EXACT
-    if nl.kind == HYSTERETIC:
+    if nl.family == HYSTERETIC:
         return refused("yade", "no linear hysteretic law is mapped for Yade (its nearest, "
                                "Law2_ScGeom6D_NormalInelasticityPhys_NormalInelasticity, is unverified here)")
     if nl.a == 1.0 and (nl.eta == 0.0 or nl.b == 0.0):
@@ -65,19 +65,19 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         fid = APPROXIMATE
         reasons.append(CLAMP.format(law=nat.normal))
     p = nat.props
-    kind = tl.kind
-    if kind == NONE:
+    family = tl.family
+    if family == NONE:
         nat.tangential = "none"
     else:
         mu, f_mu = mu_of(model, reasons)
         fid = worst(fid, f_mu)
         p["mu"] = mu
-        if nat.normal == VISCEL and kind == VISCOUS:
+        if nat.normal == VISCEL and family == VISCOUS:
             # ks = 0: the elastic part stays 0, never above μ|Fn|, so cs v_t is added uncapped
             nat.tangential = "viscous"
             p["cs"] = tl.eta
             comments.append(f"ViscElMat ks = 0, cs = {tl.eta:.10g} kg/s: Ft = cs v_t, never capped")
-        elif nat.normal == VISCEL and kind == SPRING and not tl.kt_sqrt and not tl.eta_normal:
+        elif nat.normal == VISCEL and family == SPRING and not tl.kt_sqrt and not tl.eta_normal:
             nat.tangential = "spring"
             p["ks"], p["cs"] = tl.kt, tl.eta
             comments.append(f"ViscElMat ks = {tl.kt:.10g} N/m, cs = {tl.eta:.10g} kg/s, frictionAngle = atan μ")
@@ -89,7 +89,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             reasons.append("oblique impacts: on a wall Yade's slip velocity and torque use the arm R − δ (the "
                            "contact point on the wall's plane), and it turns the history with ScGeom's first-order "
                            "rotation")
-        elif nat.normal == MINDLIN and kind == SPRING and tl.kt_sqrt:
+        elif nat.normal == MINDLIN and family == SPRING and tl.kt_sqrt:
             # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
             # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
             return refused("yade", "not mapped yet: Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t "
