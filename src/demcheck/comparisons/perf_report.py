@@ -93,7 +93,8 @@ def bench_plots(b: dict) -> str:
                       label=f"{src} (batched)")
         steps = [p for p in pts if p["steps_per_contact"]]
         if steps:
-            a2.loglog([p["steps_per_contact"] for p in steps], [p["error"] for p in steps], m + "-", label=src)
+            a2.loglog([p["steps_per_contact"] for p in steps], [p["error"] for p in steps], m + "-", color=st.colour,
+                      label=src)
     a1.set(xlabel="wall time per collision (s)", ylabel="worst relative error", title="error against run time")
     a2.set(xlabel="steps per elastic contact time", ylabel="worst relative error", title="error against steps")
     for a in (a1, a2):
