@@ -110,3 +110,22 @@ def test_verify_reference_only_returns_the_results(monkeypatch, tmp_path):
     assert entry["status"] == "ok" and set(entry["sources"]) == {"reference", "reference-verlet"}
     written = demcheck.verify(["cases/glass-pair.toml"], engines=(), report=tmp_path, cache=False)
     assert (Path(written["report"]) / "results.json").is_file()
+
+
+def test_packing_universe_reads_a_lammps_style_dump(tmp_path):
+    """demcheck.packing_universe: a hand-written two-atom dump read back with its radii, masses and positions
+    (float32: each within |x|·2^-24 of the text)."""
+    import numpy as np
+
+    import demcheck
+
+    (tmp_path / "d.txt").write_text(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp ff\n0 0.01\n0 0.01\n0 0.02\n"
+        "ITEM: ATOMS id type radius mass x y z\n1 1 0.001 1.2e-05 0.002 0.003 0.0011\n"
+        "2 1 0.0015 3.1e-05 0.004 0.0035 0.0031\n")
+    u = demcheck.packing_universe(tmp_path / "d.txt")
+    assert len(u.atoms) == 2
+    np.testing.assert_array_equal(u.atoms.radii, [0.001, 0.0015])
+    np.testing.assert_allclose(u.atoms.masses, [1.2e-05, 3.1e-05], rtol=1e-7)
+    want = np.array([[0.002, 0.003, 0.0011], [0.004, 0.0035, 0.0031]])
+    assert np.all(np.abs(u.atoms.positions - want) <= np.abs(want) * 2.0**-24)

@@ -127,6 +127,20 @@ def test_a_gone_source_or_case_is_a_regression(runs, tmp_path):
     assert demcheck("diff", tmp_path / "c.json", a).returncode == 0  # a case added is news, not a regression
 
 
+def test_a_metric_new_in_NEW_is_news_and_one_gone_from_NEW_a_regression(runs, tmp_path):
+    """A newer demcheck measures more (the packings' fabric_zz, say): a metric OLD never had is listed as new,
+    not as a move from NaN; one NEW lost is a regression."""
+    _, a, b = runs
+    more = plant(b, tmp_path / "m.json", lambda c: c["kk-wall"]["sources"]["reference"]["metrics"].update(fabric_zz=0.35))
+    d = D.compare(D.load(a), D.load(more))
+    assert d["regressions"] == 0 and not d["rows"]
+    assert {"case": "kk-wall", "source": "reference", "what": "metric fabric_zz not in OLD"} in d["added"]
+    p = demcheck("diff", a, more)
+    assert p.returncode == 0 and "metric fabric_zz not in OLD" in p.stdout
+    d = D.compare(D.load(more), D.load(a))  # the other way round: gone from NEW
+    assert d["regressions"] == 1 and d["rows"][0]["metric"] == "fabric_zz"
+
+
 def test_sources_compared_under_another_name(runs, tmp_path):
     _, a, b = runs
 

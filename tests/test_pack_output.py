@@ -180,7 +180,8 @@ def test_bad_output_paths_are_refused_before_any_work(option, make, needle, tmp_
 
 
 def test_the_cli_and_the_writer_name_the_same_vtk_files():
-    from demcheck import cli, packing_output
+    from demcheck import cli
+    from demcheck.comparisons import packing_output
 
     assert cli.PACK_VTK_DIR.files == packing_output.VTK_FILES
 
@@ -299,7 +300,7 @@ def test_engine_vtk_forces_are_the_final_dump_s(lammps_run, tmp_path):
     """particles.vtu's force is the final dump's fx, fy, fz (read again by demcheck's float64 parser)."""
     import meshio
 
-    from demcheck import packing_output
+    from demcheck.comparisons import packing_output
     from demcheck.engines import dumps
     from demcheck.inputs.packing_decks import FINAL_DUMP
 

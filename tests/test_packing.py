@@ -101,9 +101,10 @@ def test_metrics_of_a_face_centred_cubic_lattice():
 
 def test_force_distribution_is_a_density():
     f = np.random.default_rng(1).exponential(size=5000)
-    d = PM.force_distribution(f)
+    d = PM.force_distribution(np.concatenate([f, [0.0, -1.0]]))  # a zero and an attractive force: not counted
     width = d["x"][1] - d["x"][0]
     assert sum(p * width for p in d["p"]) == pytest.approx(1.0, rel=1e-9)
+    assert d["n"] == 5000
 
 
 @pytest.mark.parametrize("change,message", [

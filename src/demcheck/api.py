@@ -26,7 +26,7 @@ from . import case as _case
 from .errors import ConfigError, DemcheckError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "sweep", "verify", "audit", "calibrate", "Result", "ConfigError"]
+__all__ = ["load", "collide", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result", "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
 
@@ -273,3 +273,13 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
 
     c = load(case, overrides, **keyword)
     return run(c, engine, dict(targets), dt=dt, confirm=confirm)
+
+
+def packing_universe(path, dt: float = 1.0):
+    """An engine's packing as an MDAnalysis Universe (float32 positions, radii and masses per atom): ``path`` is
+    the run directory of a packing deck (``demcheck deck``, run by hand) or a LAMMPS-style dump; ``dt`` the
+    packing's time step, for frame times in seconds. Fine for particle tables, profiles and fabric, not for
+    overlaps (docs/packing.md)."""
+    from .engines.packing import universe
+
+    return universe(path, dt)

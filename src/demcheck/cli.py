@@ -673,7 +673,7 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, vtk_dir, xyz_file, 
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics (with the contact network's fabric
     tensor); --csv, --vtk and --xyz write the settled state."""
-    from . import packing_output
+    from .comparisons import packing_output
     from .comparisons import packing_metrics
     from .reference import packing
 

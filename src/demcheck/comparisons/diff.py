@@ -198,6 +198,10 @@ def compare(old: dict, new: dict, tolerance: float | None = None, rename: dict |
                 continue
             om, nm = (os_ or {}).get("metrics", {}), (ns or {}).get("metrics", {})
             for metric in dict.fromkeys([*om, *nm, *ov, *nv]):
+                if metric in nm and metric not in om and metric not in ov:
+                    # a quantity demcheck did not measure when OLD was written (a newer release): new, not moved
+                    added.append({"case": case, "source": src, "what": f"metric {metric} not in OLD"})
+                    continue
                 a, b = om.get(metric, math.nan), nm.get(metric, math.nan)
                 tol = tolerance if tolerance is not None else _tolerance(old, case, old_name, metric, default)
                 has_value = metric in om or metric in nm

@@ -145,14 +145,15 @@ def compute(x, rad, box=None, floor=0.0, margin=BULK_MARGIN, forces=None, overla
 
 
 def force_distribution(forces, bins: int = 20) -> dict:
-    """P(f/⟨f⟩): bin centres and probability densities."""
+    """P(f/⟨f⟩): bin centres and probability densities, and n, the number of (repulsive) contact forces they
+    are drawn from."""
     f = np.asarray(forces, float)
     f = f[f > 0]
     if not f.size:
-        return {"x": [], "p": []}
+        return {"x": [], "p": [], "n": 0}
     ratio = f / f.mean()
     p, edges = np.histogram(ratio, bins=bins, range=(0.0, max(4.0, float(ratio.max()))), density=True)
-    return {"x": (0.5 * (edges[1:] + edges[:-1])).tolist(), "p": p.tolist()}
+    return {"x": (0.5 * (edges[1:] + edges[:-1])).tolist(), "p": p.tolist(), "n": int(f.size)}
 
 
 def profile(x, rad, box, bins: int = 30) -> dict:

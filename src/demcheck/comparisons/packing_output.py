@@ -50,8 +50,8 @@ class Settled:
 
 def from_reference(case, st) -> Settled:
     """The reference solver's final state (reference.packing.PackState): no per-particle force is kept."""
-    from .inputs.packing_decks import CONTACT_COLUMNS
-    from .reference import packing
+    from ..inputs.packing_decks import CONTACT_COLUMNS
+    from ..reference import packing
 
     nc = min(st.n_contacts, len(st.contacts))
     contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": np.int64, "j": np.int64})
@@ -82,7 +82,7 @@ def contact_lines(x, contacts: pd.DataFrame, box=None):
     """(points, lines, periodic): the particle centres followed by one extra point per contact that crosses a
     periodic boundary (x_i plus the minimum-image branch vector: the image of j beside i); ``lines`` (N_c × 2)
     joins i to j, or i to j's image; ``periodic`` flags the latter."""
-    from .comparisons.packing_metrics import branch_vectors
+    from .packing_metrics import branch_vectors
 
     x = np.asarray(x, float)
     ij = contacts[["i", "j"]].to_numpy(np.int64).reshape(-1, 2)
