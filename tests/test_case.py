@@ -397,6 +397,64 @@ def test_a_bad_variant_says_which_one(tmp_path):
     assert info.value.key == "impact.speed" and info.value.variant == "speed=-2,angle=0"
 
 
+ZIPPED = """
+[variants]
+"impact.speed" = [1.0, 2.0]
+
+[variants.spin]
+labels = ["low", "high"]
+"impact.spin" = [1.0, 10.0]
+"particles.1.angular_velocity" = [[0.0, -1.0, 0.0], [0.0, -10.0, 0.0]]
+"""
+
+
+def test_a_group_of_variants_varies_its_keys_together(tmp_path):
+    """[variants.GROUP]: its keys' lists zipped — one dimension of the product (2 speeds × 2 spin pairs = 4
+    cases, not 2 × 2 × 2), labelled by the group's name and its labels."""
+    from .conftest import CASES
+
+    path = tmp_path / "z.toml"
+    path.write_text((CASES / "glass-pair.toml").read_text() + ZIPPED)
+    cases = C.expand(path)
+    assert [c.name.split("[")[1] for c in cases] == ["speed=1,spin=low]", "speed=1,spin=high]", "speed=2,spin=low]",
+                                                     "speed=2,spin=high]"]
+    spins = [(math.hypot(*c.particles[0].angular_velocity), c.particles[1].angular_velocity[1]) for c in cases]
+    assert spins == [(1.0, -1.0), (10.0, -10.0)] * 2
+    # without labels the members are numbered
+    path.write_text((CASES / "glass-pair.toml").read_text() + ZIPPED.replace('labels = ["low", "high"]\n', ""))
+    assert [c.name.rsplit("=", 1)[1] for c in C.expand(path)] == ["1]", "2]", "1]", "2]"]
+
+
+@pytest.mark.parametrize("group,key,words", [
+    ('"particles.0.angular_velocity" = [[0.0, 1.0, 0.0]]\n"particles.1.angular_velocity" = [[0.0, 1.0, 0.0], '
+     '[0.0, 2.0, 0.0]]', "variants.spin", "must be of one length"),
+    ('labels = ["a"]\n"impact.speed" = [1.0, 2.0]', "variants.spin.labels", "must be a list of 2 labels"),
+    ('labels = ["a", "a"]\n"impact.speed" = [1.0, 2.0]', "variants.spin.labels", "must be distinct"),
+    ('labels = ["a b;", "c"]\n"impact.speed" = [1.0, 2.0]', "variants.spin.labels", "labels its variant"),
+    ('"impact.speed" = []', "variants.spin.impact.speed", "non-empty list"),
+    ("", "variants.spin", "at least one dotted key"),
+])
+def test_a_bad_group_of_variants_is_one_clear_line(tmp_path, group, key, words):
+    from .conftest import CASES
+
+    path = tmp_path / "z.toml"
+    path.write_text((CASES / "glass-pair.toml").read_text() + "\n[variants.spin]\n" + group + "\n")
+    with pytest.raises(ConfigError) as info:
+        C.expand(path)
+    assert info.value.key == key and words in info.value.rule, (info.value.key, info.value.rule)
+
+
+def test_an_unquoted_dotted_variant_key_is_named_with_the_fix(tmp_path):
+    """impact.speed = [...] without quotes is a TOML table: said in one line, not read as a group."""
+    from .conftest import CASES
+
+    path = tmp_path / "z.toml"
+    path.write_text((CASES / "glass-pair.toml").read_text() + "\n[variants]\nimpact.speed = [1.0, 2.0]\n")
+    with pytest.raises(ConfigError) as info:
+        C.expand(path)
+    assert info.value.key == "variants.impact" and '"impact.speed" = [' in info.value.rule
+
+
 # ----------------------------------------------------------------------------- [contact] pair keys
 
 GLASS_LSD = ["contact.normal=lsd", "contact.stiffness_method=duration"]

@@ -151,9 +151,11 @@ def load(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Case:
 
 def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> list[Case]:
     """The cases of a file: one, or with a ``[variants]`` table one per combination of its values
-    (``"impact.speed" = [0.1, 1.0, 10.0]``: dotted keys as in ``--set``, each a non-empty list). Each
-    variant is named ``name[key=value,…]`` after the last part of its keys; a variant that breaks a rule raises
-    the ConfigError with its label as ``variant``."""
+    (``"impact.speed" = [0.1, 1.0, 10.0]``: dotted keys as in ``--set``, each a non-empty list). A sub-table
+    ``[variants.GROUP]`` is a group of keys that vary together (their lists zipped, all of one length; an
+    optional ``labels`` list names the members, else 1, 2, …): one dimension of the product, labelled
+    ``GROUP=label``. Each variant is named ``name[key=value,…]`` after the last part of its keys; a variant that
+    breaks a rule raises the ConfigError with its label as ``variant``."""
     raw = apply_overrides(_read(path), overrides)
     variants = raw.pop("variants", None) or {}
     if not isinstance(variants, dict):
@@ -161,21 +163,31 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
     if not variants:
         return [from_dict(raw)]
     base = check_name("name", raw.get("name"))
+    # each dimension: (label key, [(label, {dotted key: value})])
+    dims = []
     for key, values in variants.items():
         where = f"variants.{_key_text(key)}"
+        if isinstance(values, dict):
+            if key in TOP_KEYS:  # impact.speed = [...] unquoted: TOML made it a table
+                raise ConfigError(where, values, f"a variant's key is quoted, \"{key}.{next(iter(values), 'x')}\" = "
+                                                 "[…]; a table [variants.GROUP] is a group of keys that vary together")
+            dims.append((check_name(where, key, " (the group's name labels each variant)"), _zipped(where, values)))
+            continue
         if not isinstance(values, list) or not values:
-            raise ConfigError(where, values, "must be a non-empty list of values")
-        check_name(where, key.rsplit(".", 1)[-1], " (the key's last part labels each variant)")
+            raise ConfigError(where, values, "must be a non-empty list of values, or a table of keys that vary "
+                                             "together")
+        label_key = check_name(where, key.rsplit(".", 1)[-1], " (the key's last part labels each variant)")
         for v in values:  # a variant's value is part of its name
             if _name_problem(_label(v)):
                 raise ConfigError(where, v, f"labels its variant, so its text {NAME_RULE}")
+        dims.append((label_key, [(_label(v), {key: v}) for v in values]))
     cases = []
-    keys = list(variants)
-    for combo in itertools.product(*(variants[k] for k in keys)):
+    for combo in itertools.product(*(members for _, members in dims)):
         r = copy.deepcopy(raw)
-        for key, value in zip(keys, combo):
-            set_path(r, key, value)
-        label = ",".join(f"{k.rsplit('.', 1)[-1]}={_label(v)}" for k, v in zip(keys, combo))
+        for _, settings in combo:
+            for key, value in settings.items():
+                set_path(r, key, value)
+        label = ",".join(f"{label_key}={text}" for (label_key, _), (text, _) in zip(dims, combo))
         r["name"] = f"{base}[{label}]"
         try:
             cases.append(from_dict(r))
@@ -183,6 +195,34 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
             exc.variant = label  # which variant broke the rule (verify names it with the file)
             raise
     return cases
+
+
+def _zipped(where: str, group: dict) -> list[tuple[str, dict]]:
+    """The members of a ``[variants.GROUP]`` table: its keys' lists zipped, with their labels."""
+    group = dict(group)
+    labels = group.pop("labels", None)
+    if not group:
+        raise ConfigError(where, {}, "a group of variants needs at least one dotted key with a list of values")
+    lengths = set()
+    for key, values in group.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"{where}.{_key_text(key)}", values, "must be a non-empty list of values")
+        lengths.add(len(values))
+    if len(lengths) != 1:
+        raise ConfigError(where, {k: len(v) for k, v in group.items()},
+                          "the keys of a group vary together, so their lists must be of one length")
+    n = lengths.pop()
+    if labels is None:
+        labels = [str(i + 1) for i in range(n)]
+    if not isinstance(labels, list) or len(labels) != n:
+        raise ConfigError(f"{where}.labels", labels, f"must be a list of {n} labels, one per member of the group")
+    texts = [_label(v) for v in labels]
+    for v, text in zip(labels, texts):
+        if _name_problem(text):
+            raise ConfigError(f"{where}.labels", v, f"labels its variant, so its text {NAME_RULE}")
+    if len(set(texts)) != n:
+        raise ConfigError(f"{where}.labels", labels, "must be distinct (each labels its own variant)")
+    return [(texts[i], {key: values[i] for key, values in group.items()}) for i in range(n)]
 
 
 @contextlib.contextmanager
