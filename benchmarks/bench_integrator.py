@@ -1,7 +1,7 @@
 """The adaptive solvers of this tree against those of another copy (OLD_SRC): written to judge a shared
-integrator core (issue 13 item 4; the attempt of commit 3c73b35 missed both limits and was reverted, see
-the recorded result) against the two hand-written ones — limits: the 1-D solver ≤ 1.10x per collision, a cold-cache
-compile ≤ 1.20x.
+integrator core (issue "Engines as plug-ins", item 4) against the two hand-written solvers — limits: the 1-D
+solver ≤ 1.10x per collision, a cold-cache compile ≤ 1.20x. The recorded result is of the core in
+reference/integrator.py (met); a first attempt, 3c73b35, missed both and was reverted.
 
 Run: .venv/bin/python benchmarks/bench_integrator.py OLD_SRC
      (writes benchmarks/results/bench_integrator.txt)
