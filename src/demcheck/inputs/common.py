@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 
@@ -26,6 +27,16 @@ class Scene:
     wall_axis: int | None  # 0, 1, 2
     wall_side: str | None  # "lo" (normal +axis) or "hi"
     wall_position: float | None
+
+
+def float_literal(x: float) -> str:
+    """A number for a deck that is a Python script or JSON (Yade, Kratos), where an integer and a float differ:
+    repr of the double (``2500.0``, ``0.00318``), which reads back as the same double; a non-finite number is
+    refused (it is no literal)."""
+    x = float(x)
+    if not math.isfinite(x):
+        raise DemcheckError(f"refusing to write the number {x!r} into an engine's script")
+    return repr(x)
 
 
 def fmt(x: float) -> str:

@@ -196,8 +196,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     return common.Deck("kratos", text, files, dt=sc.dt, check=check)
 
 
-def _f(x) -> str:
-    return repr(float(x))
+_f = common.float_literal
 
 
 def _spheres_mdpa(case: Case) -> str:

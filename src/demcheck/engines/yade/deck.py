@@ -94,11 +94,7 @@ def ascii_comment(line: str) -> str:
     return line.encode("ascii", "backslashreplace").decode("ascii")
 
 
-def _num(x: float) -> str:
-    x = float(x)
-    if not math.isfinite(x):
-        raise DemcheckError(f"refusing to write a Yade script with the number {x!r}")
-    return repr(x)
+_num = common.float_literal
 
 
 def _vec(xs) -> str:
