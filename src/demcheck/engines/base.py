@@ -11,8 +11,8 @@ over the registry. What an engine owns:
   the reference laws that compute exactly what it computes (:meth:`Engine.twin`), with the kinematic rules
   its scheme uses (:attr:`Engine.rules`: slip arm, torque arms, rotation of the tangential history);
 * deck writers for every scenario (:meth:`Engine.collision_deck`, :meth:`Engine.packing_deck`);
-* how it is launched (:meth:`Engine.argv`, :meth:`Engine.mpi_launcher`) and how its per-contact output is
-  read (:meth:`Engine.read_contacts`);
+* how it is launched (:meth:`Engine.argv`, :meth:`Engine.mpi_launcher`, and :meth:`Engine.worker_argv`, a
+  long-lived worker where it has one) and how its per-contact output is read (:meth:`Engine.read_contacts`);
 * how a report draws it (:attr:`Engine.style`).
 
 Its expected differences live in ``data/expected_differences.toml``, keyed by the engine's name and version.
@@ -144,6 +144,12 @@ class Engine(ABC):
     def argv(self, executable: str, deck: str) -> list[str]:
         """The command that runs ``deck`` (a file name in the work directory) with its log files there."""
         return [executable, "-in", deck, "-log", "log.txt", "-screen", "screen.txt"]
+
+    def worker_argv(self, executable: str) -> list[str] | None:
+        """The command of a long-lived worker that runs this engine's decks case after case in one process
+        (the protocol of engines/run.py's workers), when ``executable`` is the build the worker loads; None (the
+        default): every run is a process of its own."""
+        return None
 
     def check_deck(self, text: str, files: dict | None = None) -> None:
         """The final guard before the engine runs a deck: every line is one demcheck writes (raises

@@ -39,10 +39,13 @@ def _every_body(bodies: int):
 
 
 def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
-            timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, **options) -> Result:
+            timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, worker: bool = False,
+            **options) -> Result:
     """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
     four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
-    ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run.
+    ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run; ``worker``
+    runs the decks in the engine's long-lived worker where it has one (engines/run.py), the same numbers
+    without a process start per run.
 
     The Result's status is the reference's own rules for a time-stepped run (reference/health.py): "ok",
     or "failed" (NaN or infinite output: never cached), "unresolved", "unstable", "out-of-range",
@@ -88,7 +91,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
                                    meta["warnings"])
             cached = True
         else:
-            out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files)
+            out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:

@@ -8,12 +8,26 @@ Each engine runs in its own session (a process group of its own, with its MPI ra
 Ctrl-C does not reach it: an interrupt of demcheck (SIGINT, or SIGTERM once ``handle_sigterm`` is installed)
 kills the group of every running engine (``kill_all``), starts no new one, and each run killed so raises
 EngineInterrupted — "interrupted", never "failed".
+
+``run(..., worker=True)`` runs the deck in a long-lived worker process of the engine instead, when the engine
+has one for the executable discovery found (``Engine.worker_argv``; LAMMPS: engines/lammps/worker.py) and
+``mpi`` is 1; otherwise it is the subprocess above. The worker loads the engine's library once and runs deck
+after deck, each in its work directory as above, with the same timeout, interrupt and failure rules and the
+same RunOutput: a run past its timeout or stopped by an interrupt kills the worker's process group (the next
+run starts a new worker; its start is not counted in the run's timeout), an engine error is EngineFailed with
+the log's tail and leaves the worker usable, a worker that died is replaced. Each worker serves one run at a
+time: concurrent jobs take one each (a pool per engine and command). A worker runs in a session of its own,
+as a run's process does, and dies with the thread that started it (a job's, or the main thread); an
+interrupt kills the workers that are running, ``shutdown_workers`` (also run at exit) ends the idle ones.
 """
 
 from __future__ import annotations
 
+import atexit
+import json
 import os
 import re
+import select
 import signal
 import subprocess
 import tempfile
@@ -116,9 +130,10 @@ def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
 
 
 def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: float = DEFAULT_TIMEOUT,
-        files: dict[str, str] | None = None, mpi: int = 1) -> RunOutput:
+        files: dict[str, str] | None = None, mpi: int = 1, worker: bool = False) -> RunOutput:
     """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it (``mpi`` ranks: the
-    engine's own domain decomposition)."""
+    engine's own domain decomposition); ``worker``: in the engine's long-lived worker where it has one (see
+    the module's notes), else as a process of its own."""
     info = discovery.find(engine)
     if info is None:
         raise EngineNotFound(discovery.missing(engine))
@@ -130,6 +145,9 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     (wd / "in.deck").write_text(deck)
     for name, text in (files or {}).items():
         (wd / name).write_text(text)
+    argv = registry.get(engine).worker_argv(info.executable) if worker and mpi == 1 else None
+    if argv is not None:
+        return _run_in_worker(engine, info, list(argv), wd, workdir, timeout)
     cmd = registry.get(engine).argv(info.executable, "in.deck")
     if mpi > 1:
         cmd = mpi_launcher(engine, info.executable, mpi) + cmd
@@ -190,3 +208,213 @@ def _read_log(wd: Path, out: str | None) -> str:
         parts.append(out)
     # the log and the screen carry the same lines; keep the longer account
     return max(parts, key=len) if parts else ""
+
+
+# ----------------------------------------------------------------------------- long-lived workers
+
+WORKER_START_TIMEOUT = 120.0  # s for a worker to load its engine and answer (a loaded machine included)
+WORKER_STOP_TIMEOUT = 10.0  # s for a worker to end after its input is closed, before it is killed
+_IDLE: dict[tuple, list] = {}  # (engine, worker command) → workers waiting for a run
+_WORKERS: set = set()  # every worker started and not yet ended
+_POOL = threading.Lock()
+_AT_EXIT = []
+
+
+class _Worker:
+    """One worker process: its own session (as a run's process), requests on its stdin, one JSON answer a
+    line on its stdout."""
+
+    def __init__(self, engine: str, argv: list[str]):
+        self.engine = engine
+        self.buffer = b""
+        self.version = ""
+        env = dict(os.environ, OMP_NUM_THREADS="1")
+        self.proc = subprocess.Popen(argv + ["--parent", str(os.getpid())], cwd=tempfile.gettempdir(),
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     env=env, start_new_session=True, bufsize=0)
+
+    def send(self, request: dict) -> bool:
+        """False when the worker is gone (its input closed)."""
+        try:
+            self.proc.stdin.write((json.dumps(request) + "\n").encode())
+            self.proc.stdin.flush()
+            return True
+        except (BrokenPipeError, OSError):
+            return False
+
+    def receive(self, timeout: float) -> dict | None:
+        """The next answer; None when the worker ended first; TimeoutError past ``timeout`` seconds."""
+        deadline = time.monotonic() + timeout
+        fd = self.proc.stdout.fileno()
+        while b"\n" not in self.buffer:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise TimeoutError
+            ready, _, _ = select.select([fd], [], [], left)
+            if ready:
+                chunk = os.read(fd, 65536)
+                if not chunk:
+                    return None
+                self.buffer += chunk
+        line, _, self.buffer = self.buffer.partition(b"\n")
+        try:
+            return json.loads(line)
+        except ValueError:
+            return {"ok": False, "error": f"the worker answered {line[:200]!r}"}
+
+    def alive(self) -> bool:
+        return self.proc.poll() is None
+
+    def end(self, kill: bool = False) -> int | None:
+        """Stop the worker (its input closed, then its group killed if it has not ended within
+        WORKER_STOP_TIMEOUT s, or at once with ``kill``) and reap it; its exit code."""
+        if kill:
+            _kill_group(self.proc)
+        for pipe in (self.proc.stdin, self.proc.stderr):
+            try:
+                if pipe is not None:
+                    pipe.close()
+            except OSError:
+                pass
+        try:
+            self.proc.wait(timeout=WORKER_STOP_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            _kill_group(self.proc)
+            self.proc.wait()
+        try:
+            self.proc.stdout.close()
+        except OSError:
+            pass
+        with _POOL:
+            _WORKERS.discard(self)
+        return self.proc.returncode
+
+
+def _start_worker(engine: str, argv: list[str], info) -> _Worker:
+    """A new worker, ready: its engine loaded, its version the one discovery read from the executable. It is
+    a running engine while it starts (an interrupt kills it)."""
+    with _LOCK:
+        if _STOP.is_set():
+            raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
+        try:
+            w = _Worker(engine, argv)
+        except OSError as exc:
+            raise EngineFailed(f"{engine}'s worker did not start: {argv[0]}: {exc.strerror or exc}") from None
+        _RUNNING.add(w.proc)
+    with _POOL:
+        _WORKERS.add(w)
+        if not _AT_EXIT:
+            _AT_EXIT.append(atexit.register(shutdown_workers))
+    try:
+        hello = w.receive(WORKER_START_TIMEOUT)
+    except TimeoutError:
+        w.end(kill=True)
+        raise EngineFailed(f"{engine}'s worker did not start within {WORKER_START_TIMEOUT:g} s") from None
+    except KeyboardInterrupt as exc:
+        kill_all()
+        w.end(kill=True)
+        exc2 = EngineInterrupted(f"{engine} was stopped by the interrupt")
+        exc2.exit_code = interrupt_exit_code(exc)
+        raise exc2 from exc
+    finally:
+        with _LOCK:
+            _RUNNING.discard(w.proc)
+    if w.proc in _KILLED:
+        w.end(kill=True)
+        raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
+    if not hello or not hello.get("ready"):
+        why = (hello or {}).get("error") or ""
+        if not why:
+            w.proc.stdin.close()
+            why = log_tail(w.proc.stderr.read().decode(errors="replace"), 1) or f"exit code {w.proc.wait()}"
+        w.end(kill=True)
+        raise EngineFailed(f"{engine}'s worker did not start: {why}")
+    w.version = str(hello.get("version", ""))
+    w.proc.stderr.close()  # the worker's own stderr now points at /dev/null or a run's screen.txt
+    if w.version != info.version:
+        w.end(kill=True)
+        raise EngineFailed(f"{engine}'s worker loads version {w.version!r}, but {info.executable} is "
+                           f"{info.version!r}: run it without the worker")
+    return w
+
+
+def _checkout(engine: str, argv: list[str], info) -> _Worker:
+    """An idle live worker of this engine and command, or a new one."""
+    key = (engine, tuple(argv))
+    while True:
+        with _POOL:
+            idle = _IDLE.get(key)
+            w = idle.pop() if idle else None
+        if w is None:
+            return _start_worker(engine, argv, info)
+        if w.alive():
+            return w
+        w.end()  # died while idle (killed, or its parent thread ended): replaced
+
+
+def _checkin(w: _Worker, argv: list[str]) -> None:
+    if w.alive():
+        with _POOL:
+            if w in _WORKERS:
+                _IDLE.setdefault((w.engine, tuple(argv)), []).append(w)
+                return
+    w.end()
+
+
+def shutdown_workers() -> None:
+    """End every worker this process has started and that no run is using (their input closed; killed if
+    they have not ended within WORKER_STOP_TIMEOUT s)."""
+    with _POOL:
+        idle = [w for ws in _IDLE.values() for w in ws]
+        _IDLE.clear()
+    for w in idle:
+        w.end()
+
+
+def workers() -> list[int]:
+    """The process ids of the workers alive now (idle or running)."""
+    with _POOL:
+        return sorted(w.proc.pid for w in _WORKERS if w.alive())
+
+
+def _run_in_worker(engine: str, info, argv: list[str], wd: Path, workdir, timeout: float) -> RunOutput:
+    """``in.deck`` in ``wd`` run by a worker: the subprocess path's RunOutput and errors."""
+    w = _checkout(engine, argv, info)
+    try:
+        with _LOCK:  # as a process's start: an interrupt either sees this run or stops it from starting
+            if _STOP.is_set():
+                raise _interrupted(engine, wd, workdir, interrupt_exit_code(None),
+                                   "not started: demcheck was interrupted")
+            _RUNNING.add(w.proc)
+        started = time.perf_counter()
+        try:
+            answer = w.receive(timeout) if w.send({"workdir": str(wd.resolve()), "deck": "in.deck"}) else None
+        except TimeoutError:
+            w.end(kill=True)
+            log = _read_log(wd, None)
+            raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
+                                f"kept: {wd}\n{log_tail(log)}", pid=w.proc.pid) from None
+        except KeyboardInterrupt as exc:  # SIGINT or SIGTERM while waiting on the engine: stop it, and the others
+            kill_all()
+            w.end(kill=True)
+            raise _interrupted(engine, wd, workdir, interrupt_exit_code(exc)) from exc
+        finally:
+            with _LOCK:
+                _RUNNING.discard(w.proc)
+        if w.proc in _KILLED:  # stopped by an interrupt handled elsewhere (another thread's kill_all)
+            w.end(kill=True)
+            raise _interrupted(engine, wd, workdir, interrupt_exit_code(None))
+        wall = time.perf_counter() - started
+        log = _read_log(wd, None)
+        errors = _ERROR.findall(log)
+        if answer is None:  # the worker died during the run: the next run starts a new one
+            code = w.end(kill=True)
+            what = errors[0] if errors else f"its worker process ended: exit code {code}"
+            raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
+        if not answer.get("ok") or errors:
+            message = str(answer.get("error") or "").strip()
+            what = errors[0] if errors else (message.splitlines()[0] if message else "no message")
+            raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log or message)}")
+        return RunOutput(engine, info.version, wd, log, wall, warnings_of(log))
+    finally:
+        _checkin(w, argv)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import sys
 from pathlib import Path
 
 from .. import registry
@@ -25,6 +26,13 @@ class Lammps(PackageEngine):
 
     def executables(self) -> tuple[str, ...]:
         return ("lmp",)
+
+    def worker_argv(self, executable: str) -> list[str] | None:
+        """The worker (worker.py) when ``executable`` is this Python's wheel: its Python module loads the same
+        library as that ``lmp``."""
+        from . import worker
+
+        return [sys.executable, "-m", worker.MODULE] if worker.serves(executable) else None
 
     def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
         """The mpich wheel's mpiexec beside lmp (the MPI the wheel is built with)."""
