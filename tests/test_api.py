@@ -129,3 +129,16 @@ def test_packing_universe_reads_a_lammps_style_dump(tmp_path):
     np.testing.assert_allclose(u.atoms.masses, [1.2e-05, 3.1e-05], rtol=1e-7)
     want = np.array([[0.002, 0.003, 0.0011], [0.004, 0.0035, 0.0031]])
     assert np.all(np.abs(u.atoms.positions - want) <= np.abs(want) * 2.0**-24)
+
+
+def test_packing_universe_says_unknown_masses_without_a_mass_column(tmp_path):
+    """A dump with no mass column: NaN masses (MDAnalysis alone would guess 1.0 from the atom names)."""
+    import numpy as np
+
+    import demcheck
+
+    (tmp_path / "d.txt").write_text(
+        "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS pp pp ff\n0 0.01\n0 0.01\n0 0.02\n"
+        "ITEM: ATOMS id type radius x y z\n1 1 0.001 0.002 0.003 0.0011\n")
+    u = demcheck.packing_universe(tmp_path / "d.txt")
+    assert np.isnan(u.atoms.masses).all() and u.atoms.radii[0] == 0.001

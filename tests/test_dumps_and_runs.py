@@ -99,7 +99,9 @@ def test_mdanalysis_float32_positions_are_too_coarse_for_two_body_overlaps(tmp_p
     res = collide(glass_case("hertz", {}), "lammps", workdir=tmp_path / "run")
     path = tmp_path / "run" / "dump.txt"
     ours = dumps.read_dump(path)
-    u = dumps.read_dump_mdanalysis(path)
+    from demcheck.engines.packing import universe
+
+    u = universe(path)
     steps = ours["step"].unique()
     errs = []
     for ts in u.trajectory:

@@ -122,7 +122,7 @@ def _check_vtk(out, forces: bool):
     return parts
 
 
-def _check_xyz(out, parts, forces: bool):
+def _check_xyz(out, parts):
     import ase.io
 
     a = ase.io.read(out / "state.xyz", format="extxyz")
@@ -135,7 +135,7 @@ def _check_xyz(out, parts, forces: bool):
     np.testing.assert_allclose(np.asarray(a.cell), np.diag([BOX, BOX, top]), rtol=1e-15, atol=0)
     assert np.array_equal(a.arrays["id"], parts["id"].to_numpy())
     assert a.arrays["velo"].shape == (len(x), 3) and a.arrays["omega"].shape == (len(x), 3)
-    assert ("force" in a.arrays) == forces
+    assert "force" not in a.arrays and "mass" not in a.arrays  # too few digits at 8 decimals: in the VTU only
     return a
 
 
@@ -143,7 +143,7 @@ def test_pack_writes_vtk_and_extended_xyz_that_read_back(reference_pack):
     out, tmp = reference_pack
     parts = _check_vtk(tmp, forces=False)
     assert len(parts) == out["particles"] == 40
-    a = _check_xyz(tmp, parts, forces=False)
+    a = _check_xyz(tmp, parts)
     import meshio
 
     pv = meshio.read(tmp / "vtk" / "particles.vtu")
@@ -276,12 +276,11 @@ def test_fabric_zz_critical_difference_is_its_sampling_error():
 def test_pack_in_lammps_writes_the_dumped_forces(tmp_path):
     out, tmp = _pack(tmp_path, "lammps")
     parts = _check_vtk(tmp, forces=True)
-    a = _check_xyz(tmp, parts, forces=True)
+    _check_xyz(tmp, parts)
     import meshio
 
     f = meshio.read(tmp / "vtk" / "particles.vtu").point_data["force"]
     assert np.all(np.isfinite(f)) and np.abs(f).max() > 0
-    assert np.abs(a.arrays["force"] - f).max() <= XYZ_ROUNDING * (1 + 1e-9)
     assert out["contacts"] == len(pd.read_csv(tmp / "csv" / "contacts.csv"))
 
 
@@ -343,7 +342,10 @@ def test_universe_reads_a_lammps_packing_to_float32_precision(lammps_run):
 @pytest.mark.engine("lammps")
 def test_verify_compares_a_poured_packing_s_fabric_by_its_sampling_error(tmp_path):
     """verify's packing entry holds fabric_zz per engine: |φ_zz − φ_zz(reference)| against the critical
-    difference of the two sources' own samples of n_z² (recomputed here from the written positions)."""
+    difference of the two sources' own samples of n_z². The value and its reference are the sources' own
+    fabric_zz; the tolerance is checked for its size: an isotropic fabric has var(n_z²) = 1/5 − 1/9 = 4/45,
+    so with some 50 contacts a source z(α/2)·√(2·(4/45)/50) = 3.29 × 0.060 ≈ 0.2 (0.05–0.5 allows for the
+    sample's own variance and size)."""
     from demcheck.comparisons import suite
 
     path = tmp_path / "small.toml"

@@ -14,8 +14,8 @@ produced them, so the reference and the engines' dumps are measured the same way
 * the contact network: every particle–particle contact's branch vector (centre to centre, by minimum
   image in periodic x and y) and the fabric tensor φ_ij = (1/N_c) Σ n_i n_j of their unit vectors (Satake's,
   trace 1): ``fabric`` (3 × 3), ``fabric_zz`` and ``fabric_anisotropy`` = √(3/2 a′:a′) of the anisotropy
-  tensor a′ = 15/2 (φ − I/3) of Rothenburg and Bathurst's second-order approximation of the contact-normal
-  density, E(n) = (1 + a′_ij n_i n_j)/4π; for a fabric symmetric about z it is a′_zz − a′_xx
+  tensor a′ = 15/2 (φ − I/3) of the second-order approximation of the contact-normal density in 3-D,
+  E(n) = (1 + a′_ij n_i n_j)/4π (Rothenburg and Bathurst's Fourier fit for discs, carried to spheres); for a fabric symmetric about z it is a′_zz − a′_xx
   = 45/4 (φ_zz − 1/3). Wall contacts are not particle pairs and are not in it.
 """
 
@@ -55,10 +55,7 @@ def contacts(x, rad, box=None, tol=1e-9):
     pairs = tree.query_pairs(reach, output_type="ndarray").astype(np.int64)
     if not len(pairs):
         return np.empty((0, 2), np.int64)
-    d = x[pairs[:, 1]] - x[pairs[:, 0]]
-    if box is not None:
-        for k in range(2):
-            d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+    d = minimum_image(x[pairs[:, 1]] - x[pairs[:, 0]], box)
     keep = np.linalg.norm(d, axis=1) <= (rad[pairs[:, 0]] + rad[pairs[:, 1]]) * (1.0 + tol)
     pairs = np.sort(pairs[keep], axis=1)
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
@@ -70,11 +67,16 @@ def branch_vectors(x, pairs, box=None) -> np.ndarray:
     the box."""
     x = np.asarray(x, float)
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    b = x[pairs[:, 1]] - x[pairs[:, 0]]
+    return minimum_image(x[pairs[:, 1]] - x[pairs[:, 0]], box)
+
+
+def minimum_image(d, box=None) -> np.ndarray:
+    """Separations ``d`` (N × 3, changed in place and returned) moved by whole box lengths in x and y into
+    [−L/2, L/2) when ``box`` is the periodic (lx, ly): the one minimum-image rule of the packing metrics."""
     if box is not None:
         for k in range(2):
-            b[:, k] -= box[k] * np.round(b[:, k] / box[k])
-    return b
+            d[:, k] -= box[k] * np.floor(d[:, k] / box[k] + 0.5)
+    return d
 
 
 def fabric(branches) -> np.ndarray:

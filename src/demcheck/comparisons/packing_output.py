@@ -14,11 +14,12 @@
   wall contacts are not drawn.
 * Extended XYZ, through ase: species ``X`` (no element), positions, ``Lattice`` and ``pbc`` from the packing's
   box (periodic x and y, z not: the cell's height is the highest sphere top; no lattice for a packing without
-  a box), and per particle ``id``, ``species_id`` (the VTK ``type``), ``radius``, ``mass``, ``velo``,
-  ``omega`` and, where available, ``force`` (names for OVITO's Radius, Velocity and Force; its reader's
-  column mapping says what it took them for). ase writes every real column with eight decimals (``%16.8f``): in SI
-  units positions, velocities and forces are rounded to 5e-9 m, m/s and N — ample to look at a millimetre
-  packing, not for analysis (``--vtk`` keeps float64, ``--csv`` 17 digits).
+  a box), and per particle ``id``, ``species_id`` (the VTK ``type``), ``radius``, ``velo`` and ``omega``
+  (names for OVITO's Radius and Velocity; its reader's column mapping says what it took them for). ase writes
+  every real column with eight decimals (``%16.8f``): in SI units positions and velocities are rounded to
+  5e-9 m and m/s — ample to look at a millimetre packing, not for analysis (``--vtk`` keeps float64, ``--csv``
+  17 digits). Masses (~1e-5 kg) and a settled bed's net forces (~1e-6 N) would keep one to four digits, so
+  the XYZ file leaves them out; particles.vtu has both.
 """
 
 from __future__ import annotations
@@ -127,7 +128,8 @@ def xyz_atoms(state: Settled):
                       pbc=[True, True, False])
     else:
         atoms = Atoms(["X"] * n, positions=state.x, pbc=False)
-    names = {"type": "species_id", "mass": "mass", "velocity": "velo", "angular_velocity": "omega", "force": "force"}
+    # mass and force left out: eight decimals keep too few of their digits (module docstring)
+    names = {"type": "species_id", "velocity": "velo", "angular_velocity": "omega"}
     atoms.new_array("id", np.arange(n, dtype=np.int64))
     atoms.new_array("radius", np.asarray(state.radius, float))
     for key, name in names.items():

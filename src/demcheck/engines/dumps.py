@@ -6,14 +6,11 @@ same with ``ENTRIES`` for ``ATOMS`` and one row per entry (a contact). The colum
 from the block's own header, so decks may order or extend them freely, and the number of rows may change
 from block to block.
 
-Two readers:
-
-* :func:`read_dump` — demcheck's float64 parser. Two-body comparisons need it: positions are ~10³ times the
-  overlap, so the float32 coordinates of a general-purpose reader keep only ~4 digits of δ.
-* :func:`read_dump_mdanalysis` — MDAnalysis's LAMMPS ``DumpReader`` (float32 positions, moved to the box's
-  lower corner), for packings where positions matter to ~1e-7 of the box and the reader's trajectory tools
-  are worth having; :func:`demcheck.engines.packing.universe` reads a packing run that way, in the engines'
-  frame, with radii and masses (docs/packing.md has the measured precision).
+:func:`read_dump` is demcheck's float64 parser. Two-body comparisons need it: positions are ~10³ times the
+overlap, so the float32 coordinates of a general-purpose reader keep only ~4 digits of δ. For packings,
+where positions matter to ~1e-7 of the box and a trajectory toolkit is worth having,
+:func:`demcheck.engines.packing.universe` reads a dump through MDAnalysis's LAMMPS ``DumpReader`` instead
+(float32, in the engines' frame, with radii and masses; docs/packing.md has the measured precision).
 
 Files may be gzip-compressed (``.gz``). A malformed file raises :class:`ParseError` naming the file, the
 line and what was expected.
@@ -118,14 +115,6 @@ def read_dump(path, columns: tuple[str, ...] | None = None) -> pd.DataFrame:
             table[c] = table[c].astype(np.int64)
     table.insert(0, "step", np.concatenate(steps))
     return table
-
-
-def read_dump_mdanalysis(path):
-    """The dump as an MDAnalysis Universe (float32 positions; see the module docstring for when that is
-    enough)."""
-    import MDAnalysis as mda
-
-    return mda.Universe(str(path), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled")
 
 
 def non_finite(table: pd.DataFrame) -> str:

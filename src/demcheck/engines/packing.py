@@ -102,19 +102,24 @@ def universe(path, dt: float = 1.0):
     enough for the particle tables, profiles, bed height and the fabric of a packing, not for overlaps, which
     are ~1e-3 of the coordinates (docs/packing.md, measured); demcheck's own metrics read the float64 dump.
     The translation is the first frame's lo (the packing decks' boxes do not move)."""
+    import warnings
+
     import MDAnalysis as mda
     from MDAnalysis import transformations
 
     p = Path(path)
     p = p / FINAL_DUMP if p.is_dir() else p
     lo = _box_lo(p)
-    u = mda.Universe(str(p), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled",
-                     additional_columns=["radius", "mass"], dt=dt)
+    with warnings.catch_warnings():  # its guess of the masses is replaced below, and said when unknown
+        warnings.filterwarnings("ignore", message="Guessed all Masses")
+        warnings.filterwarnings("ignore", message="Some of the additional columns are not present")
+        u = mda.Universe(str(p), format="LAMMPSDUMP", lammps_coordinate_convention="unscaled",
+                         additional_columns=["radius", "mass"], dt=dt)
     data = u.trajectory.ts.data
     if "radius" in data:
         u.add_TopologyAttr("radii", np.asarray(data["radius"], float))
-    if "mass" in data:
-        u.atoms.masses = np.asarray(data["mass"], float)
+    # without a mass column MDAnalysis would guess masses from atom names (1.0 for these): say "unknown" instead
+    u.atoms.masses = np.asarray(data["mass"], float) if "mass" in data else np.full(len(u.atoms), np.nan)
     if np.any(lo != 0.0):
         u.trajectory.add_transformations(transformations.translate(lo))
     return u
