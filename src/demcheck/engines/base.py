@@ -65,12 +65,14 @@ class Native:
 @dataclass
 class Mapping:
     """A seed model in an engine's terms: the fidelity (exact, approximate, none), the reasons, and the
-    native configuration (None when the engine cannot express the model)."""
+    native configuration (None when the engine cannot express the model). ``keywords``: for a reason of an
+    approximate mapping, the native setting it is about, in the engine's own words (a report's traps name it)."""
 
     engine: str
     fidelity: str
     reasons: list[str]
     native: Native | None
+    keywords: dict[str, str] = field(default_factory=dict)  # reason → the native keyword that causes it
 
     def require(self) -> Native:
         from ..errors import UnsupportedByEngine
