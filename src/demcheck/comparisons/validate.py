@@ -8,9 +8,10 @@ can express the model, with the run cache), and every source's curve over a file
 against two independent kinds of expected values:
 
 * exact limits — the elastic Hertz closed forms (Tests 1, 2), the restitution a law is given (Test 3),
-  rigid-body gross sliding (the tangential impulse is μ times the normal one: e_t = 1 − μ(1 + e)/tan θ and a
-  rebound spin of 2.5 μ (1 + e) v_n / R in the rolling sense; Thornton's Ψ2 = Ψ1 − 7 and |Ω| = 5), and
-  Test 7's unchanged spin (no slip at the contact, no tangential force);
+  gross sliding (Coulomb's tangential impulse is μ times the normal impulse's magnitude, μ ∫|F_n| dt, read off
+  each source's own force history: e_t = 1 − μJ/tan θ and a rebound spin of 2.5 μ J v_n / R in the rolling
+  sense with J = 1 + e for a rigid body; Thornton's Ψ2 = Ψ1 − 7 and |Ω| = 5), and Test 7's unchanged spin (no
+  slip at the contact, no tangential force);
 * the papers' digitised curves (data/benchmarks/*.dat, each file naming its source): the largest deviation
   of the source's curve from the paper's points, in the quantity's own units, against a tolerance that says
   what it stands for.
@@ -51,6 +52,7 @@ class Impact:
     spin: float  # |ω0| of particle 0 (rad/s)
     angle: float  # incidence from the normal (degrees)
     normal: str = ""  # the case's normal law (its id in reference/normal.py): which exact limit applies
+    tangential: str = ""  # the case's tangential law (its id in reference/tangential.py)
 
     @property
     def key(self) -> str:
@@ -60,6 +62,7 @@ class Impact:
 
 def impact_of(case) -> Impact:
     from ..case import incidence
+    from ..reference.model import models_of
 
     p0 = case.particles[0]
     vn, vt = incidence(case)
@@ -68,7 +71,79 @@ def impact_of(case) -> Impact:
                                                                  else 1.0),
                   mu=float(mat.friction or 0.0), vn=abs(vn), vt=vt,
                   spin=float(np.linalg.norm(p0.angular_velocity)), angle=math.degrees(math.atan2(vt, abs(vn))),
-                  normal=str(case.contact.normal))
+                  normal=str(case.contact.normal), tangential=models_of(case)[1].id)
+
+
+# ----------------------------------------------------------------------------- a source's own force history
+# Coulomb's gross sliding gives a tangential impulse of μ ∫|F_n| dt, and the seed's dissipative laws pull at the
+# end of contact (F_n < 0: the dashpot outlasts the spring), so ∫|F_n| dt exceeds the normal impulse
+# ∫F_n dt = m̄ v_n (1 + e′). Two numbers off each source's own contact table say what its law gives:
+# * pull — ∫_{F_n<0} |F_n| dt in units of m̄ v_n, from the normal velocity the pull takes back (m̄ dδ̇/dt = −F_n,
+#   so the pull's impulse is m̄ times the separation speed lost while it acts: exact at the adaptive method's
+#   events, interpolated between an engine's steps); the normal impulse's magnitude is m̄ v_n (1 + e′ + 2 pull);
+# * shortfall — how far the tangential force stays below its Coulomb cap, ∫(μ|F_n| − |F_t|)₊ dt, as a share
+#   of μ ∫|F_n| dt: 0 for a contact that slides throughout; a spring law sticks at first (its force builds up
+#   from zero behind the normal force's jump at contact start), a viscous one may never reach the cap. A force
+#   that opposes the slip, as sliding friction does, gives a tangential impulse of (1 − shortfall) μ ∫|F_n| dt;
+#   one above the cap, or along the slip, is no part of it: the judging says how much of the force was
+#   (above_cap: ∫(|F_t| − μ|F_n|)₊ dt, along_slip: ∫|F_t| dt where F_t·v_t > 0, both shares of μ ∫|F_n| dt).
+
+SHORTFALL_MAX = 0.05  # a contact short of its Coulomb cap by more than this share does not slide: no sliding limit
+
+
+def _window(c: dict, events) -> tuple[int, int]:
+    """Rows of the contact: from its start (the adaptive method's event row, else the last step before the
+    overlap) to its end (event row, else the first step after), as metrics.py reads them."""
+    t, d = np.asarray(c["t"], float), np.asarray(c["delta"], float)
+    if events and len(events["event"]):
+        names = list(np.asarray(events["event"]))
+        if "contact_start" in names and "contact_end" in names:
+            ts, te = (float(events["t"][names.index(n)]) for n in ("contact_start", "contact_end"))
+            return int(np.argmin(np.abs(t - ts))), int(np.argmin(np.abs(t - te)))
+    inside = np.flatnonzero(d > 0)
+    if not inside.size:
+        raise ValueError("no contact")
+    ks = int(inside[0])
+    after = np.flatnonzero(d[ks:] <= 0)
+    if not after.size:
+        raise ValueError("the contact does not end")
+    return max(ks - 1, 0), ks + int(after[0])
+
+
+def force_history(contact: dict, events, mu: float) -> dict:
+    """``pull``, ``shortfall``, ``above_cap`` and ``along_slip`` (above) of a contact table (Result.table("contact"): t, delta, delta_dot, fn,
+    ft*) with friction coefficient ``mu``."""
+    k0, k1 = _window(contact, events)
+    t = np.asarray(contact["t"], float)[k0:k1 + 1]
+    fn = np.asarray(contact["fn"], float)[k0:k1 + 1]
+    rate = np.asarray(contact["delta_dot"], float)[k0:k1 + 1]
+    ft = np.sqrt(sum(np.asarray(contact[k], float)[k0:k1 + 1] ** 2 for k in ("ftx", "fty", "ftz")))
+    v_in = rate[0]
+    # the pull: each run of rows with F_n < 0, from the sign change that opens it (linear in t between the two
+    # rows) to the one that closes it, or the contact's end; the separation speed it takes back
+    pull, opened = 0.0, (rate[0] if fn[0] < 0 else None)
+    for k in range(1, len(fn)):
+        if (fn[k] < 0) != (fn[k - 1] < 0):
+            x = fn[k - 1] / (fn[k - 1] - fn[k])
+            r = rate[k - 1] + x * (rate[k] - rate[k - 1])
+            if fn[k] < 0:
+                opened = r
+            else:
+                pull, opened = pull + abs(r - opened), None
+    if opened is not None:
+        pull += abs(rate[-1] - opened)
+    cap = mu * np.abs(fn)
+    dt = np.diff(t)
+
+    def integral(y) -> float:  # trapezoid over the contact's rows
+        return float(np.sum(0.5 * (y[1:] + y[:-1]) * dt))
+
+    total = integral(cap)
+    share = (lambda y: integral(y) / total) if total > 0 else (lambda y: math.nan)
+    along = sum(np.asarray(contact[f], float)[k0:k1 + 1] * np.asarray(contact[v], float)[k0:k1 + 1]
+                for f, v in (("ftx", "vtx"), ("fty", "vty"), ("ftz", "vtz"))) > 0 if "vtx" in contact else 0.0
+    return {"pull": float(pull / v_in), "shortfall": share(np.maximum(cap - ft, 0.0)),
+            "above_cap": share(np.maximum(ft - cap, 0.0)), "along_slip": share(ft * along)}
 
 
 # ----------------------------------------------------------------------------- quantities
@@ -147,6 +222,8 @@ class Limit:
     # the size of the limit's spin part in its scale's units (0: no spin in it): the seed's torque arm R − δ/2
     # departs from the rigid body's R, which moves a spin by up to δ_max/(2R) of it (0.39 δ_max/R measured)
     arm: Callable[[Impact, dict], float] | None = None
+    # gross sliding: the limit reads the source's force history (pull, shortfall) and applies where it slides
+    sliding: bool = False
 
 
 def _hertz(metric: str):
@@ -163,51 +240,65 @@ def _hertz(metric: str):
                  "step at 200 steps per contact)")
 
 
+# laws without Coulomb's cap μ|F_n|, to which no gross-sliding limit applies: frictionless, and simple viscous
+# damping (F_t = −η_t v_t, no μ: its force is whatever the slip makes it, above or below μ|F_n|)
+NO_COULOMB = ("none", "viscous")
+
+
 def _sliding(c: Impact) -> bool:
-    """Gross sliding throughout with margin: the rigid-body threshold is v_t = 3.5 μ (1 + e) v_n."""
-    return c.vt > 1.2 * 3.5 * c.mu * (1 + c.e) * c.vn
+    """Gross sliding throughout with margin: the rigid-body threshold is v_t = 3.5 μ (1 + e) v_n (a law with
+    Coulomb friction)."""
+    return c.tangential not in NO_COULOMB and c.vt > 1.2 * 3.5 * c.mu * (1 + c.e) * c.vn
 
 
-# gross sliding: the tangential impulse is μ (1 + e') m v_n, e' the source's own restitution
+# Gross sliding: Coulomb's law gives a tangential impulse of μ times the normal impulse's magnitude, μ m̄ v_n J with
+# J = ∫|F_n| dt/(m̄ v_n) = 1 + e′ + 2 pull from the source's own force history (e′ its own restitution; pull the
+# attractive end's impulse, force_history above): the rigid-body values with 1 + e′ in place of 1 + e where no
+# force pulls, and the law's own where one does. (_short: the judging's bound for a force short of its cap.)
+def _J(m: dict) -> float:
+    return (1 + m["restitution"] + 2 * m["pull"]) * (1 - m.get("_short", 0.0))
+
+
 def _WHOLE(c, m) -> float:
     return 1.0
 
 
-_SLIDE_WHY = ("rigid-body gross sliding (tangential impulse μ(1+e')m v_n): where the law slides throughout, "
-              "met to 1e-4 by the reference (the laws' uncapped attractive normal force at the end of contact "
-              "moves it by ~1e-5) and 1e-2 by the engines (their time step); spins also by δ_max/R (torque arm "
-              "R − δ/2, not R); a law that sticks at first misses it by what it sticks")
-SLIDE_ET = Limit("et", "gross sliding e_t = 1 − μ(1+e')/tanθ",
-                 lambda c, m: 1 - c.mu * (1 + m["restitution"]) * c.vn / c.vt, _sliding, lambda c, v: 1.0,
-                 1e-4, 1e-2, _SLIDE_WHY)
-SLIDE_SPIN = Limit("spin_paper", "gross sliding ω' = −2.5 μ(1+e') v_n/R",
-                   lambda c, m: -2.5 * c.mu * (1 + m["restitution"]) * c.vn / c.radius, _sliding,
-                   lambda c, v: abs(v), 1e-4, 1e-2, _SLIDE_WHY, arm=_WHOLE)
-T5_ANGLE = Limit("t5_angle", "gross sliding v'_c/(μ v'_n) = (ψ − 3.5(1+e'))/e'",
-                 lambda c, m: (c.vt / (c.mu * c.vn) - 3.5 * (1 + m["restitution"])) / m["restitution"], _sliding,
+_SLIDE_WHY = ("gross sliding: a tangential impulse of μ∫|F_n|dt = μ m̄ v_n J, J = 1 + e' + 2·pull from the source's "
+              "own force history (its restitution e', and the impulse of its attractive end, on which friction "
+              "μ|F_n| acts too); reference 1e-4, engines 1e-2 (their time step); spins also δ_max/R of their "
+              "part (torque arm R − δ/2, not R); a tangential force short of its Coulomb cap μ|F_n| (a spring "
+              "sticks at first) by a share s of μ∫|F_n|dt also the value at (1 − s) J on that side; where s > "
+              f"{SHORTFALL_MAX:g} the contact does not slide and the limit does not apply")
+SLIDE_ET = Limit("et", "gross sliding e_t = 1 − μJ/tanθ", lambda c, m: 1 - c.mu * _J(m) * c.vn / c.vt, _sliding,
+                 lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY, sliding=True)
+SLIDE_SPIN = Limit("spin_paper", "gross sliding ω' = −2.5 μJ v_n/R",
+                   lambda c, m: -2.5 * c.mu * _J(m) * c.vn / c.radius, _sliding,
+                   lambda c, v: abs(v), 1e-4, 1e-2, _SLIDE_WHY, arm=_WHOLE, sliding=True)
+T5_ANGLE = Limit("t5_angle", "gross sliding v'_c/(μ v'_n) = (ψ − 3.5J)/e'",
+                 lambda c, m: (c.vt / (c.mu * c.vn) - 3.5 * _J(m)) / m["restitution"], _sliding,
                  lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; the contact point's velocity carries R ω'",
-                 arm=lambda c, m: 2.5 * (1 + m["restitution"]) / m["restitution"])
-T5_SPIN = Limit("t5_spin", "gross sliding R ω'/(μ v_n) = −2.5(1+e')", lambda c, m: -2.5 * (1 + m["restitution"]),
+                 arm=lambda c, m: 2.5 * _J(m) / m["restitution"], sliding=True)
+T5_SPIN = Limit("t5_spin", "gross sliding R ω'/(μ v_n) = −2.5J", lambda c, m: -2.5 * _J(m),
                 _sliding, lambda c, v: 2.5 * (1 + c.e), 1e-4, 1e-2, _SLIDE_WHY,
-                arm=lambda c, m: (1 + m["restitution"]) / (1 + c.e))
-PSI2 = Limit("psi2", "Ψ2 = Ψ1 − 3.5(1+e')·2/(1+e)",
-             lambda c, m: 2 * c.vt / (c.mu * (1 + c.e) * c.vn) - 7 * (1 + m["restitution"]) / (1 + c.e),
-             _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; Ψ2 = Ψ1 − 7 when e' = e; Ψ2 carries Ω",
-             arm=lambda c, m: 5 * (1 + m["restitution"]) / (1 + c.e))
-OMEGA = Limit("omega", "Ω = −5(1+e')/(1+e)", lambda c, m: -5 * (1 + m["restitution"]) / (1 + c.e), _sliding,
-              lambda c, v: 5.0, 1e-4, 1e-2, _SLIDE_WHY + "; |Ω| = 5 when e' = e",
-              arm=lambda c, m: (1 + m["restitution"]) / (1 + c.e))
+                arm=lambda c, m: _J(m) / (1 + c.e), sliding=True)
+PSI2 = Limit("psi2", "Ψ2 = Ψ1 − 7J/(1+e)",
+             lambda c, m: 2 * c.vt / (c.mu * (1 + c.e) * c.vn) - 7 * _J(m) / (1 + c.e),
+             _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; Ψ2 = Ψ1 − 7 when J = 1 + e; Ψ2 carries Ω",
+             arm=lambda c, m: 5 * _J(m) / (1 + c.e), sliding=True)
+OMEGA = Limit("omega", "Ω = −5J/(1+e)", lambda c, m: -5 * _J(m) / (1 + c.e), _sliding,
+              lambda c, v: 5.0, 1e-4, 1e-2, _SLIDE_WHY + "; |Ω| = 5 when J = 1 + e",
+              arm=lambda c, m: _J(m) / (1 + c.e), sliding=True)
 
 
 def _spin_slide(c: Impact) -> bool:
     """Tests 6 and 8: the contact slides throughout when 3.5 μ (1 + e) v_n < R ω0 (β1 < 1), with margin."""
-    return 3.5 * c.mu * (1 + c.e) * c.vn < 0.6 * c.radius * c.spin
+    return c.tangential not in NO_COULOMB and 3.5 * c.mu * (1 + c.e) * c.vn < 0.6 * c.radius * c.spin
 
 
-BETA = Limit("beta", "gross sliding β = 3.5μ(1+e')v_n/(Rω0) − 1",
-             lambda c, m: 3.5 * c.mu * (1 + m["restitution"]) * c.vn / (c.radius * c.spin) - 1, _spin_slide,
+BETA = Limit("beta", "gross sliding β = 3.5μJ v_n/(Rω0) − 1",
+             lambda c, m: 3.5 * c.mu * _J(m) * c.vn / (c.radius * c.spin) - 1, _spin_slide,
              lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; β carries 1.4 ω'/ω0",
-             arm=lambda c, m: 1.4 * abs(m["rebound_angular_velocity"]) / c.spin)
+             arm=lambda c, m: 1.4 * abs(m["rebound_angular_velocity"]) / c.spin, sliding=True)
 GIVEN_E = Limit("restitution", "e' = the given e", lambda c, m: c.e, lambda c: c.normal != "tti", lambda c, v: 1.0,
                 1e-6, 1e-2, "a law calibrated to the restitution it is given returns it: exact for LSDn and HLS "
                 "(reference 1e-6: its events); engines 1e-2 (their time step)")
@@ -412,28 +503,45 @@ def _value(fn, m, imp):
 def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     fn = QUANTITIES[lim.quantity][1]
     tol = lim.tol_reference if src == "reference" else lim.tol_engine
-    worst, at, n, tol_at = None, None, 0, tol
+    worst, at, n, tol_at, stuck, breach = None, None, 0, tol, 0, {}
     for imp, ms in rows:
         if src not in ms or not lim.applies(imp):
             continue
         m = ms[src]  # None: the run failed, which never meets a limit
         y = _value(fn, m, imp)
+        short, short_value = 0.0, None
         try:
             exact = lim.value(imp, m) if m is not None else None
+            if lim.sliding and m is not None:
+                short = m["shortfall"]
+                short_value = lim.value(imp, {**m, "_short": short})  # the limit's value at (1 − s) J
         except (KeyError, ZeroDivisionError, TypeError):
             exact = None
+        if lim.sliding and short > SHORTFALL_MAX:
+            stuck += 1  # its force stays short of the Coulomb cap: the contact does not slide
+            continue
         n += 1
-        if y is None or exact is None or not math.isfinite(exact):
+        if y is None or exact is None or not math.isfinite(exact) or not math.isfinite(short):
             worst, at = math.inf, X_AXES[bench.x][1](imp)  # a NaN is never an agreement
             break
-        d = abs(y - exact) / max(lim.scale(imp, exact), 1e-300)
+        scale = max(lim.scale(imp, exact), 1e-300)
+        d = abs(y - exact) / scale
         allowed = tol + (lim.arm(imp, m) * m.get("max_overlap", 0.0) / imp.radius if lim.arm else 0.0)
+        if short_value is not None and (y - exact) * (short_value - exact) > 0:
+            allowed += abs(short_value - exact) / scale  # on the side a force short of its cap moves it to
         if worst is None or d / allowed > worst / tol_at:
             worst, at, tol_at = d, X_AXES[bench.x][1](imp), allowed
+            breach = {k: m.get(k, 0.0) for k in ("above_cap", "along_slip")} if lim.sliding else {}
     verdict = NO_DATA if n == 0 else (MEETS if worst <= tol_at else MISSES)
-    tol = tol_at
+    why = lim.why
+    said = [f"{k.replace('_', ' ')} {v:.2g}" for k, v in breach.items() if v > 1e-3]
+    if said:  # where the worst variant's tangential force broke Coulomb's cap or pushed along the slip
+        why += f" (its tangential force, as shares of μ∫|F_n|dt: {', '.join(said)})"
+    if stuck:
+        why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold short of the cap by "
+                f"more than {SHORTFALL_MAX:g}: not judged)")
     return {"benchmark": bench.name, "file": file, "source": src, "kind": "limit", "quantity": lim.quantity,
-            "expected": lim.name, "deviation": worst, "at": at, "tolerance": tol, "why": lim.why,
+            "expected": lim.name, "deviation": worst, "at": at, "tolerance": tol_at, "why": why,
             "verdict": verdict, "points": n}
 
 
@@ -459,17 +567,20 @@ def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys) -> dict:
 # ----------------------------------------------------------------------------- running
 
 
-def _final_spin_ratio(case, src: str, opts) -> float | None:
-    """ω'·ω0/|ω0|² of particle 0 from the source's own Result (the reference's adaptive run, or the engine's
-    run, from the run cache the suite filled)."""
+def _result(case, src: str, opts):
+    """The source's own Result: the reference's adaptive run again, or the engine's run from the run cache the
+    suite filled."""
     from ..reference.collision import collide
 
     if src == "reference":
-        res = collide(case, "adaptive")
-    else:
-        from ..engines.collide import collide as run_engine
+        return collide(case, "adaptive")
+    from ..engines.collide import collide as run_engine
 
-        res = run_engine(case, src, cache=opts.cache, timeout=opts.timeout)
+    return run_engine(case, src, cache=opts.cache, timeout=opts.timeout)
+
+
+def _final_spin_ratio(case, res) -> float | None:
+    """ω'·ω0/|ω0|² of particle 0 from a source's Result."""
     if not res.ok:
         return None
     p = res.particles
@@ -477,6 +588,15 @@ def _final_spin_ratio(case, src: str, opts) -> float | None:
     w0 = np.asarray(case.particles[0].angular_velocity, float)
     w = np.array([last["wx"], last["wy"], last["wz"]], float)
     return float(w @ w0 / (w0 @ w0))
+
+
+def _coulomb_mu(pair) -> float:
+    """The friction coefficient of a slipping contact (kinetic, else static)."""
+    return float(pair.friction_kinetic if pair.friction_kinetic is not None else pair.friction or 0.0)
+
+
+def _needs_history(bench: Benchmark, imp: Impact) -> bool:
+    return any(lim.sliding and lim.applies(imp) for lim in bench.limits)
 
 
 def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path]], opts,
@@ -501,9 +621,16 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
                         continue  # an engine that cannot express the model is no source here (a failed run is)
                     m = _source_metrics(entry, src)
                     if m is not None:
-                        m["_pair"] = resolve(case).pair
-                        if bench.final_spin:
-                            m["spin_ratio"] = _final_spin_ratio(case, src, opts)
+                        m["_pair"] = pair = resolve(case).pair
+                        history = _needs_history(bench, imp) and not {"pull", "shortfall"} <= m.keys()
+                        if bench.final_spin or history:
+                            res = _result(case, src, opts)
+                            if bench.final_spin:
+                                m["spin_ratio"] = _final_spin_ratio(case, res)
+                            if history and res.ok:
+                                with contextlib.suppress(ValueError):  # no contact, or no end: no history
+                                    m.update(force_history(res.table("contact"), res.table("events"),
+                                                           _coulomb_mu(pair)))
                     ms[src] = m
                 groups.setdefault(Path(f).stem, []).append((imp, ms))
         checks, series = judge(bench, groups, root)
