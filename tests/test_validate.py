@@ -281,6 +281,18 @@ def test_every_data_file_names_its_source_and_reads():
     assert VA.read_curve("chung-ooi-4-et.dat", "al_oxide")[1, 1] == pytest.approx(0.6869851729818782)
 
 
+def test_the_quick_subset_is_one_file_of_each_benchmark():
+    """validate's quick run: one case file per benchmark (its own, existing), 68 cases of the 614."""
+    total = quick = 0
+    for b in VA.BENCHMARKS:
+        (f,) = VA.files_of(b, ROOT, quick=True)
+        assert f.is_file() and f.stem.startswith(b.prefix) and f in VA.files_of(b, ROOT), b.name
+        quick += len(expand(f))
+        total += sum(len(expand(g)) for g in VA.files_of(b, ROOT))
+    assert (quick, total) == (68, 614)
+    assert len(VA.QUICK) == len(VA.BENCHMARKS)
+
+
 def test_verify_default_run_leaves_benchmarks_out():
     from demcheck.cli import _case_files
 

@@ -351,42 +351,51 @@ class Benchmark:
     curves: tuple[Curve, ...] = ()
     limits: tuple[Limit, ...] = ()
     final_spin: bool = False  # needs particle 0's final spin (Test 7): read from each source's own Result
+    quick: str = ""  # the case file (its stem) of the quick subset (validate's quick run): one per benchmark
 
 
 BENCHMARKS: tuple[Benchmark, ...] = (
     Benchmark("chung-ooi-1", "Chung & Ooi Test 1: elastic normal impact of two identical spheres", "chung-ooi-1-",
               "none", ("contact_time", "max_overlap", "peak_force"),
-              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force"))),
+              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force")),
+              quick="chung-ooi-1-glass"),
     Benchmark("chung-ooi-2", "Chung & Ooi Test 2: elastic normal impact of a sphere on a rigid plane", "chung-ooi-2-",
               "none", ("contact_time", "max_overlap", "peak_force"),
-              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force"))),
+              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force")),
+              quick="chung-ooi-2-al-alloy"),
     Benchmark("chung-ooi-3", "Chung & Ooi Test 3: normal impact with a given restitution", "chung-ooi-3-", "e",
-              ("restitution",), limits=(GIVEN_E, TTI_E)),
+              ("restitution",), limits=(GIVEN_E, TTI_E), quick="chung-ooi-3-al-oxide-lsd"),
     Benchmark("chung-ooi-4", "Chung & Ooi Test 4: oblique impact at constant speed, incidence 5°–85°", "chung-ooi-4-",
               "angle", ("et", "spin_paper", "contact_angle"),
               curves=(Curve("et", "chung-ooi-4-et.dat", 0.03, "e_t ± 0.03: " + _DIGITISED),
                       Curve("spin_paper", "chung-ooi-4-spin.dat", 30.0, "ω' ± 30 rad/s (5% of the axis): " + _DIGITISED),
                       Curve("contact_angle", "chung-ooi-4-angle.dat", 2.0, "± 2°: " + _DIGITISED)),
-              limits=(SLIDE_ET, SLIDE_SPIN)),
+              limits=(SLIDE_ET, SLIDE_SPIN), quick="chung-ooi-4-al-oxide-tti"),
     Benchmark("chung-ooi-5", "Chung & Ooi Test 5: constant normal, varied tangential velocity", "chung-ooi-5-", "psi",
               ("t5_angle", "t5_spin"),
               curves=(Curve("t5_angle", "chung-ooi-5-angle.dat", 0.3, "± 0.3 (3% of the axis): " + _DIGITISED),
                       Curve("t5_spin", "chung-ooi-5-spin.dat", 0.2, "± 0.2 (4% of the axis): " + _DIGITISED)),
-              limits=(T5_ANGLE, T5_SPIN)),
+              limits=(T5_ANGLE, T5_SPIN), quick="chung-ooi-5-steel-spring-sliding"),
     Benchmark("chung-ooi-6", "Chung & Ooi Test 6: normal impact of a spinning sphere on a plane", "chung-ooi-6-",
               "beta1", ("beta",), curves=(Curve("beta", "chung-ooi-6-beta.dat", 0.05, "β ± 0.05: " + _DIGITISED),),
-              limits=(BETA,)),
+              limits=(BETA,), quick="chung-ooi-6-al-alloy-spring-sliding"),
     Benchmark("chung-ooi-7", "Chung & Ooi Test 7: two identical spheres spinning in opposite senses", "chung-ooi-7-",
-              "spin", ("spin_ratio",), limits=(SPIN_KEPT,), final_spin=True),
+              "spin", ("spin_ratio",), limits=(SPIN_KEPT,), final_spin=True, quick="chung-ooi-7-al-alloy-spring-sliding"),
     Benchmark("chung-ooi-8", "Chung & Ooi Test 8: a spinning sphere on a large, heavy sphere", "chung-ooi-8-",
               "beta1", ("beta",), curves=(Curve("beta", "chung-ooi-8-beta.dat", 0.05, "β ± 0.05: " + _DIGITISED),),
-              limits=(BETA,)),
+              limits=(BETA,), quick="chung-ooi-8-al-alloy-spring-sliding"),
     Benchmark("thornton", "Thornton, Cummins & Cleary: oblique impacts, elastic (2011) and inelastic (2013)",
               "thornton-", "psi1", ("psi2", "omega"),
               curves=(Curve("psi2", "thornton-psi2.dat", 0.3, "Ψ2 ± 0.3 (2% of the axis): " + _DIGITISED),
                       Curve("omega", "thornton-omega.dat", 0.2, "Ω ± 0.2 (4% of the axis): " + _DIGITISED)),
-              limits=(PSI2, OMEGA)),
+              limits=(PSI2, OMEGA), quick="thornton-e050-tti"),
 )
+
+
+# The quick subset (``run(..., quick=True)``): one case file per benchmark, 68 cases of the 614 — every test's
+# exact limits and its paper's curve in one material, with laws every engine that can run the test expresses
+# (spring-sliding where Yade has no TTIt; not Test 5's and Thornton's TTIt at e 1, which stop LIGGGHTS).
+QUICK = tuple(b.quick for b in BENCHMARKS)
 
 
 def by_name(name: str | None) -> list[Benchmark]:
@@ -400,7 +409,10 @@ def by_name(name: str | None) -> list[Benchmark]:
     return hits
 
 
-def files_of(bench: Benchmark, root: Path) -> list[Path]:
+def files_of(bench: Benchmark, root: Path, quick: bool = False) -> list[Path]:
+    """The benchmark's case files under ``root``; ``quick``: its quick subset's one file (QUICK)."""
+    if quick:
+        return [root / f"{bench.quick}.toml"]
     return sorted(root.glob(f"{bench.prefix}*.toml"))
 
 
@@ -673,14 +685,15 @@ def _titled(title: str):
         suite._print = printer
 
 
-def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, junit=None, argv=None) -> dict:
+def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, junit=None, argv=None,
+        quick: bool = False) -> dict:
     """Run the benchmarks' case files through the suite, judge them, and rewrite the run's report with the
-    validation section."""
+    validation section. ``quick``: each benchmark's quick subset alone (QUICK)."""
     from . import report
     from .suite import run_suite
 
     benches = by_name(names)
-    files = {b.name: files_of(b, root) for b in benches}
+    files = {b.name: files_of(b, root, quick) for b in benches}
     every = [f for fs in files.values() for f in fs]
     if not every:
         from ..errors import ConfigError
