@@ -244,6 +244,75 @@ def test_a_planted_wrong_paper_value_fails(tmp_path):
     assert et["verdict"] == VA.MISSES and et["deviation"] == pytest.approx(0.09) and et["at"] == 20.0
 
 
+def _rigid_sliding(imp, x: float, axis: str):
+    """The Impact at the paper's x on ``axis`` and a rigid body's metrics there, sliding throughout with
+    J = 1 + e (by hand: tangential impulse μ(1 + e)m v_n, e' = e)."""
+    import dataclasses
+
+    mu, e, vn, r = imp.mu, imp.e, imp.vn, imp.radius
+    if axis == "beta1":  # Tests 6, 8: spin only; ω0 reads −ω0 in the rolling sense of the slip it drives
+        imp = dataclasses.replace(imp, vt=0.0, spin=3.5 * mu * (1 + e) * vn / (r * x))
+        return imp, {"restitution": e, "rebound_angular_velocity": -imp.spin + 2.5 * mu * (1 + e) * vn / r}
+    if axis == "angle":  # Test 4: a constant impact speed
+        speed = math.hypot(vn, imp.vt)
+        vn, vt = speed * math.cos(math.radians(x)), speed * math.sin(math.radians(x))
+    else:  # Test 5, Thornton: normalised by v_n
+        vt = {"psi": x * mu * vn, "psi1": x * mu * (1 + e) * vn / 2}[axis]
+    imp = dataclasses.replace(imp, vn=vn, vt=vt, angle=math.degrees(math.atan2(vt, vn)))
+    return imp, {"restitution": e, "tangential_restitution": 1 - mu * (1 + e) * vn / vt,
+                 "rebound_angular_velocity": 2.5 * mu * (1 + e) * vn / r}
+
+
+def test_the_papers_sliding_branches_are_the_rigid_body_through_validates_quantities():
+    """The axes and sign conventions against the papers' own points: past the gross-sliding threshold every
+    paper's curve (Tests 4, 5, 6, 8, Thornton's Ψ2 and Ω) is the rigid body sliding with J = 1 + e, so validate's
+    x axes and quantities (the papers' definitions: v'_c/(μ v'_n) with the rebound normal speed, R ω'/(μ v_n) and
+    Ω negative in the rolling sense, β = −v'_c/v_c against 3.5μ(1 + e)v_n/(Rω0), Ψ2 = 2v'_c/(μ(1 + e)v_n)) applied
+    to a rigid body's metrics at each paper point land on it within the digitisation tolerance; a sign or a
+    factor wrong in one of them would not (Test 5's sliding branch is Ψ − 7, its spin −5; β = β1 − 1)."""
+    checked = 0
+    for b in VA.BENCHMARKS:
+        templates = {}
+        for f in VA.files_of(b, ROOT):
+            imp = VA.impact_of(expand(f)[0])
+            templates.setdefault(imp.key, imp)
+        for cur in b.curves:
+            for key, imp in templates.items():
+                paper = VA.read_curve(cur.file, key)
+                if paper is None:
+                    continue
+                regimes = dict(VA.regimes(b, paper, imp))
+                for x, y in regimes.get(VA.SLIDING_REGIME, []):
+                    at, m = _rigid_sliding(imp, float(x), b.x)
+                    assert VA.X_AXES[b.x][1](at) == pytest.approx(x, rel=1e-12)
+                    got = VA.QUANTITIES[cur.quantity][1](m, at)
+                    assert abs(got - y) <= cur.tolerance, (b.name, cur.quantity, key, x, y, got)
+                    checked += 1
+    assert checked >= 50
+
+
+def test_the_curves_are_judged_apart_past_and_below_the_sliding_threshold(tmp_path):
+    """Test 6 (β against β1): a source on the rigid body's line β = β1 − 1 where it slides (β1 < 0.6) and 0.3 off
+    the paper below meets the sliding part (its paper points judged by interpolation between the source's samples
+    at β1 0.42 and 0.7, not by the sample at 0.42) and misses the partial-slip part."""
+    b = VA.by_name("chung-ooi-6")[0]
+    imp0 = VA.Impact("al_alloy", 0.1, 0.5, 0.4, 0.2, 0.0, 1.0, 0.0, "lsd", "spring_sliding")
+    rows = []
+    for x in (0.2, 0.42, 0.7, 2.0, 6.0):
+        imp, m = _rigid_sliding(imp0, x, "beta1")
+        if x > 1:  # below the threshold: a source 0.3 above the paper's 0.1
+            m["rebound_angular_velocity"] = (0.4 - 0.4) * imp.spin / 1.4
+        rows.append((imp, {"reference": m}))
+    (tmp_path / "chung-ooi-6-beta.dat").write_text("# block: al_alloy\n0.35 -0.65\n0.55 -0.45\n2.0 -0.3\n6.0 -0.3\n")
+    checks = [c for c in VA.judge(b, {"f": rows}, root=tmp_path)[0] if c["kind"] == "curve"]
+    by = {c["regime"]: c for c in checks}
+    assert set(by) == {VA.SLIDING_REGIME, VA.PARTIAL_REGIME}
+    assert by[VA.SLIDING_REGIME]["verdict"] == VA.MEETS and by[VA.SLIDING_REGIME]["points"] == 2
+    assert by[VA.SLIDING_REGIME]["deviation"] < 1e-12  # linear between 0.42 and 0.7: interpolation is exact
+    assert by[VA.PARTIAL_REGIME]["verdict"] == VA.MISSES and by[VA.PARTIAL_REGIME]["points"] == 2
+    assert by[VA.PARTIAL_REGIME]["deviation"] == pytest.approx(0.7)
+
+
 def test_a_nan_is_never_a_match():
     b = VA.by_name("chung-ooi-4")[0]
     imp = VA.Impact("al_oxide", 2.5e-3, 0.98, 0.092, 1.0, 3.0, 0.0, 71.6)
@@ -279,6 +348,9 @@ def test_every_data_file_names_its_source_and_reads():
         for cur in b.curves:
             assert (VA.DATA / cur.file).is_file()
     assert VA.read_curve("chung-ooi-4-et.dat", "al_oxide")[1, 1] == pytest.approx(0.6869851729818782)
+    # Test 5's third block: the paper's finite-element reference, judged for both materials
+    assert [len(VA.read_curve(f, "fem")) for f in ("chung-ooi-5-angle.dat", "chung-ooi-5-spin.dat")] == [17, 17]
+    assert {c.key for c in VA.by_name("chung-ooi-5")[0].curves} == {"", "fem"}
 
 
 def test_the_quick_subset_is_one_file_of_each_benchmark():
