@@ -156,10 +156,17 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
           dt: float | None = None, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword):
     """Metrics over a grid of case keys → a DataFrame: one row per point (its values, every metric, and its
     status). ``vary`` maps dotted keys to their values (``{"impact.angle": [0, 30, 60]}``); several keys make a
-    grid. Every point is validated before any is solved; a point whose solve fails keeps its row with the
-    error as its status."""
+    grid. ``source`` as :func:`collide` takes it: an engine and its twin run the case's ``[engine.NAME]``
+    setting, which a ``contact.*`` key (the seed model's) does not change, nor a ``materials.*`` key the
+    setting does not read: such a sweep is a ConfigError. Every point is validated before any is solved; a
+    point whose solve fails keeps its row with the error as its status."""
     import pandas as pd
 
+    from .comparisons.sweep import native_vary_rule
+
+    known = sources()
+    if source not in known:
+        raise ConfigError("source", source, f"must be one of {', '.join(known)}")
     if not isinstance(vary, Mapping) or not vary:
         raise ConfigError("vary", vary, "must be a dict of dotted case keys to lists of values")
     axes = []
@@ -178,6 +185,7 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     for combo in itertools.product(*(v for _, v in axes)):
         values = {k: (v.item() if hasattr(v, "item") else v) for (k, _), v in zip(axes, combo)}
         points.append((values, _build(case, [*pairs, *values.items()])))
+    native_vary_rule(points, source, "vary.")  # a key that cannot move the native law: refused before any solve
     rows = []
     for values, c in points:
         row = dict(values)

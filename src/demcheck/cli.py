@@ -144,14 +144,6 @@ PACK_VTK_DIR = OutputPath(directory=True, files=("particles.vtu", "contacts.vtu"
 PACK_XYZ_FILE = OutputPath()
 
 
-def _seed_only(case, command: str) -> None:
-    """Commands that run the seed model's mapping refuse a case with native settings, in one line, rather than
-    run something else than the case asks for."""
-    for name in getattr(case, "natives", {}) or {}:
-        raise ConfigError(f"engine.{name}", "(native settings)", f"are run by collide, verify, deck and calibrate; "
-                          f"`demcheck {command}` runs the seed model's mapping in every engine: drop the table")
-
-
 def _load(case_path: str, overrides) -> "object":
     from . import case as case_mod
     from .engines import registry
@@ -441,24 +433,43 @@ def _print_summary(s: dict) -> None:
 @click.argument("case_path", metavar="CASE")
 @click.option("--vary", "varies", multiple=True, required=True, metavar="KEY=START:STOP:N",
               help="a case key and its values (N evenly spaced, or KEY=a,b,c); several make a grid")
-@click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None)
-@click.option("--dt", type=DT, default=None, help="time step of the verlet method (s)")
+@click.option("--engine", "source", default="reference", show_default=True, metavar="SOURCE",
+              help=f"the source: reference (the seed model), an engine ({', '.join(ENGINE_NAMES)}: its deck run "
+                   "for real, or a build ENGINE@LABEL=PATH) or an engine's twin (NAME-twin); an engine and its twin "
+                   "run the case's [engine.NAME] setting when it has one")
+@click.option("--method", type=click.Choice(["adaptive", "verlet"]), default=None,
+              help="the reference's method (default: the case's run.method)")
+@click.option("--dt", type=DT, default=None, help="time step of the verlet method and of an engine or twin (s)")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--csv", "csv_path", type=OUT_FILE, default=None, help="write the table")
 @click.option("--plot", type=OUT_FILE, default=None, help="plot metrics against the first key")
-def sweep(case_path, varies, method, dt, overrides, as_json, csv_path, plot):
-    """Metrics of a collision over one or more case keys, e.g. --vary impact.angle=5:85:17."""
+def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, plot):
+    """Metrics of a collision over one or more case keys, e.g. --vary impact.angle=5:85:17, from one source.
+    With the case's own setting for the source's engine ([engine.NAME]), a contact.* key (the seed model's) or
+    a materials.* key the setting does not read is refused: it would not change the law that runs."""
     from rich.progress import Progress
 
-    from .comparisons.sweep import parse_vary, plot_sweep, run_sweep, sweep_points
+    from .comparisons.sweep import check_source, native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points
 
+    if "=" not in source:
+        check_source(source, method)
+    if source != "reference" and not source.endswith("-twin"):
+        from .engines import discovery
+        from .errors import EngineNotFound
+
+        labels = discovery.resolve(source, "--engine")  # an engine, or a build registered under its label
+        if len(labels) != 1:
+            raise ConfigError("--engine", source, "a sweep runs one source (collide and verify compare several)")
+        source = labels[0]
+        if discovery.find(source) is None:
+            raise EngineNotFound(discovery.missing(source))
+    check_source(source, method)
     points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
-    for _, point in points[:1]:
-        _seed_only(point, "sweep")
+    native_vary_rule(points, source)
     with Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("sweep", total=len(points))
-        table = run_sweep(points, method, dt, lambda: progress.advance(task))
+        table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source)
     if csv_path:
         from .io import atomic_path
 
@@ -784,17 +795,21 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     grid = bench.STEPS_PER_CONTACT
     if steps:
         grid = tuple(number("--steps", x, lo=1, hi=1e6, unit="steps per contact") for x in steps.split(","))
+    from .engines import registry
+    from .engines.base import case_natives
+
     cases = []
     for f in _case_files(paths):  # every file read and checked before any work; an error names the file
         with naming_file(f):
             cases.append(load(f, list(overrides)))
-            _seed_only(cases[-1], "bench")
+            case_natives(cases[-1], registry.all_engines())  # [engine.NAME] settings read before any work
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
     per_case = len(bench.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
+    twins = sum(len(bench.native_sources(c, names)) for c in cases)  # a native law's twin: one more grid
     with Progress(transient=True, disable=as_json) as progress:
-        task = progress.add_task("bench", total=per_case * len(cases))
+        task = progress.add_task("bench", total=per_case * len(cases) + len(grid) * twins)
         for case in cases:
             results.append(bench.bench_case(case, names, grid, batch=batch,
                                         progress=lambda: progress.advance(task)).summary())
@@ -803,6 +818,26 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
             "speed_goal": bench.speed_goal_text(results)}
     write_bench(data, root)
     _show_report(data, out_dir, as_json)
+    if not as_json:
+        for b in results:
+            for engine, law in b["natives"].items():
+                _native_lines(b["case"], engine, law, b["reference"])
+
+
+def _native_lines(case: str, engine: str, law: dict, seed: dict) -> None:
+    """What bench measured a native law against, and how far its converged answer lies from the seed model's
+    (``seed``: its converged metrics): on stdout after the report."""
+    click.echo(f"{case}: {engine} runs the case's own setting ({law['native']}); {engine} and {engine}-twin are "
+               f"measured against {engine}-twin converged ({law['converged_by']})")
+    gap = {k: v for k, v in (law.get("seed_gap") or {}).items() if math.isfinite(v)}
+    if gap:
+        k = max(gap, key=gap.get)
+        e_n, e_s = law["converged"].get("restitution"), seed.get("restitution")
+        click.echo(f"  the seed model of [contact] is another law: converged, they differ by up to {gap[k]:.3g} "
+                   f"({k})" + (f"; restitution {e_n:.4f} native, {e_s:.4f} seed" if e_n is not None and
+                               e_s is not None and math.isfinite(e_n) and math.isfinite(e_s) else ""))
+    if law.get("note"):
+        click.echo(f"  note: {law['note']}")
 
 
 @cli.command()
@@ -823,10 +858,16 @@ def stress(paths, engines, only, report_dir, as_json):
     from .comparisons.perf_report import new_run_dir, write_stress
     from .comparisons.stress import read_stress, stress_case
 
+    from .case import naming_file
+    from .engines import registry
+    from .engines.base import case_natives
+
     names = _engine_list(engines)
-    cases = [read_stress(f) for f in _case_files(paths)]  # every file read and checked before any work
-    for _, case in cases:
-        _seed_only(case, "stress")
+    files = _case_files(paths)
+    cases = [read_stress(f) for f in files]  # every file read and checked before any work
+    for f, (_, case) in zip(files, cases):
+        with naming_file(f):
+            case_natives(case, registry.all_engines())  # [engine.NAME] settings read before any work
     root = Path(report_dir)
     out_dir = new_run_dir(root, "stress")
     results = []
@@ -839,6 +880,11 @@ def stress(paths, engines, only, report_dir, as_json):
             "command": ["demcheck", "stress", *sys.argv[2:]], "cases": results}
     write_stress(data, root)
     _show_report(data, out_dir, as_json)
+    for c in results if not as_json else ():
+        for engine, native in c["natives"].items():
+            click.echo(f"{c['case']}: {engine} runs the case's own setting ({native}): {engine} and {engine}-twin's "
+                       f"dt_max / t_c are in that law's elastic contact time, and {engine} is flagged against "
+                       f"{engine}-twin, not the seed model's reference-verlet")
     if any(c["disagreements"] for c in results):
         sys.exit(1)
 
@@ -855,10 +901,11 @@ def dt(case_path, target, overrides, as_json):
     from .comparisons.bench import recommend
 
     case = _load(case_path, overrides)
-    _seed_only(case, "dt")
     rec = recommend(case, target)
     if as_json:
         emit_json(rec)
+        if rec["dt"] is None or any(n["dt"] is None for n in rec["natives"].values()):
+            sys.exit(1)
         return
     click.echo(f"{rec['case']}: normal={rec['model']['normal']} tangential={rec['model']['tangential']}")
     click.echo(f"  elastic contact time t_c = {rec['t_contact']:.4g} s; Hertz time {rec['hertz_time']:.4g} s; "
@@ -867,11 +914,24 @@ def dt(case_path, target, overrides, as_json):
                f"t_Hertz/50 = {rec['rules_of_thumb']['t_Hertz / 50']:.4g} s")
     if rec["dt"] is None:
         click.echo(f"  {rec['message']}")
+    else:
+        click.echo(f"  recommended dt = {rec['dt']:.4g} s ({rec['steps_per_contact']:g} steps per contact, "
+                   f"{rec['dt_over_rayleigh']:.3g} t_Rayleigh): expected error {rec['expected_error']:.2g} "
+                   f"in {rec['limited_by']} (target {target:g}; measured order {rec['order']:.2f}; errors of "
+                   f"{', '.join(rec['metrics'])})")
+    for engine, n in rec["natives"].items():
+        click.echo(f"{engine} (the case's own setting: {n['native']}): elastic contact time {n['t_contact']:.4g} s")
+        if n["dt"] is None:
+            click.echo(f"  {n['message']}")
+        else:
+            click.echo(f"  recommended dt = {n['dt']:.4g} s ({n['steps_per_contact']:g} steps per contact): expected "
+                       f"error {n['expected_error']:.2g} in {n['limited_by']} against {engine}-twin converged "
+                       f"({n['converged_by']}; measured order {n['order']:.2f}; errors of {', '.join(n['metrics'])}; "
+                       "the engine computes its twin's numbers)")
+        if n["note"]:
+            click.echo(f"  note: {n['note']}")
+    if rec["dt"] is None or any(n["dt"] is None for n in rec["natives"].values()):
         sys.exit(1)
-    click.echo(f"  recommended dt = {rec['dt']:.4g} s ({rec['steps_per_contact']:g} steps per contact, "
-               f"{rec['dt_over_rayleigh']:.3g} t_Rayleigh): expected error {rec['expected_error']:.2g} "
-               f"in {rec['limited_by']} (target {target:g}; measured order {rec['order']:.2f}; errors of "
-               f"{', '.join(rec['metrics'])})")
 
 
 @cli.command()

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..case import Case
 from ..engines import registry
-from ..errors import DemcheckError, EngineInterrupted, UnsupportedByEngine
+from ..errors import ConfigError, DemcheckError, EngineInterrupted, UnsupportedByEngine
 from ..reference.collision import characteristic_time, collide
 from ..reference.model import resolve
 
@@ -40,6 +40,9 @@ STEPS_PER_CONTACT = (5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
 ADAPTIVE_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 TARGETS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 BATCH = 16
+# a native law whose twin has no adaptive solve (a force history): its converged answer is the twin at t_c over
+# this many steps, four times finer than the finest default grid point
+CONVERGED_STEPS = 20_000
 
 
 @dataclass
@@ -144,18 +147,27 @@ class BenchResult:
     reference: dict
     points: list[Point] = field(default_factory=list)
     skipped: dict = field(default_factory=dict)
+    natives: dict = field(default_factory=dict)  # engine → NativeLaw
+
+    def against(self, src: str) -> str:
+        """What a source's errors are measured against."""
+        engine = src.removesuffix("-twin")
+        if engine in self.natives:
+            return f"{engine}-twin converged ({self.natives[engine].how})"
+        return "reference-adaptive converged (the seed model)"
 
     def sources(self) -> list[str]:
         return list(dict.fromkeys(p.source for p in self.points))
 
     def summary(self) -> dict:
         out = {"case": self.case, "model": self.model, "t_contact": self.t_contact, "reference": self.reference,
-               "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {}}
+               "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {},
+               "natives": {e: law.as_dict() for e, law in self.natives.items()}}
         for src in self.sources():
             pts = [p for p in self.points if p.source == src]
             names = _used(pts) if pts else list(METRICS)
             s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in names},
-                 "cheapest": {}}
+                 "against": self.against(src), "cheapest": {}}
             for tgt in TARGETS + ((1e-7, 1e-8) if src == "reference-adaptive" else ()):
                 if src == "reference-adaptive":
                     ok = [p for p in pts if math.isfinite(p.error) and p.error <= tgt]
@@ -169,12 +181,89 @@ class BenchResult:
         return out
 
 
+@dataclass
+class NativeLaw:
+    """An engine's own setting of the case (``[engine.NAME]``) and the answer its runs are measured against:
+    the twin's converged contact (``converged``, obtained ``how``), with the native law's elastic contact time
+    and how far that answer lies from the seed model's (``seed_gap``, per metric, in the bench's units)."""
+
+    engine: str
+    native: object  # engines.base.Native
+    model: object  # the twin's ResolvedModel
+    t_contact: float
+    converged: dict
+    how: str
+    status: str
+    message: str
+    seed_gap: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        from ..engines.mapping import native_summary
+
+        return {"native": native_summary(self.native), "t_contact": self.t_contact, "converged": self.converged,
+                "converged_by": self.how, "status": self.status, "note": self.message,
+                "seed_gap": self.seed_gap}
+
+
+def native_sources(case: Case, engines) -> dict:
+    """{source: the Native it runs} for each engine (or build of one) among ``engines`` whose engine the case
+    gives its own setting (``[engine.NAME]``)."""
+    out = {}
+    for name in engines:
+        try:
+            eng = registry.get(name)
+        except ValueError:
+            continue
+        nat = eng.case_native(case)
+        if nat is not None:
+            out[name] = nat
+    return out
+
+
+def native_law(case: Case, engine: str, native, seed: dict | None = None) -> NativeLaw:
+    """The native law of ``engine`` for the case and its converged answer: the twin solved by the adaptive
+    method with the engine's kinematic rules, or — a twin with a force history has no adaptive solve — by its
+    own scheme at t_c/CONVERGED_STEPS. ``seed``: the seed model's converged metrics, for ``seed_gap``."""
+    from ..engines import states
+    from ..engines.mapping import twin_model
+    from ..reference import collision3d
+    from ..reference.health import impact_scales
+
+    model = twin_model(resolve(case), native)
+    t_c = characteristic_time(model)
+    rules = registry.get(engine).rules
+    try:
+        conv = collision3d.collide(case, model, "adaptive", rules=rules)
+        how = f"adaptive, rtol {conv.rtol:g}"
+    except ConfigError:  # a force history is defined for the engines' scheme only
+        conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),
+                              case)
+        how = f"verlet at t_c/{CONVERGED_STEPS}: a force history has no adaptive solve"
+    m = conv.metrics()
+    # the solver's note on a tangential history concerns a contact that slides: none in a head-on impact
+    note = conv.message if _defined(m.get("tangential_restitution")) or conv.status != "ok" else ""
+    law = NativeLaw(engine, native, model, t_c, m, how, conv.status, note)
+    if seed is not None:
+        law.seed_gap = _errors(law.converged, seed, METRICS + OBLIQUE_METRICS, impact_scales(case, model))
+    return law
+
+
+def _native_errors(case: Case, law: NativeLaw, metrics: dict, scales) -> dict:
+    """A native run's errors against its twin's converged answer: every metric the scene produces (a head-on
+    impact's tangential restitution, undefined on both sides, is left out)."""
+    return _errors(metrics, law.converged, METRICS + OBLIQUE_METRICS, scales)
+
+
 def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
                batch: int = BATCH, cache=None, progress=None) -> BenchResult:
+    """The work–precision of each source for one collision case (module docstring). ``engines``: the engines
+    and builds to time (default every registered one); an engine the case gives its own setting runs it, as
+    its twin does, both against the twin's converged answer."""
     from ..engines import discovery
     from ..engines.collide import collide as run_engine
     from ..engines.mapping import contact_mapping
 
+    engines = registry.names() if engines is None else tuple(engines)
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
@@ -182,6 +271,7 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
 
     metrics, scales = metrics_of(case, model), impact_scales(case, model)
     res = BenchResult(case.name, model.describe(), t_c, ref)
+    res.natives = {e: native_law(case, e, nat, ref) for e, nat in native_sources(case, engines).items()}
     tick = progress or (lambda: None)
     for rtol in rtols:
         wall, r = _timed(lambda: collide(case, "adaptive", rtol=rtol))
@@ -194,8 +284,11 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
         errors = _errors(r.metrics(), ref, metrics, scales)
         res.points.append(Point("reference-verlet", spc, dt, None, wall, None, errors, r.status, r.message))
         tick()
-    for engine in registry.names() if engines is None else engines:
-        mp = contact_mapping(case, engine)
+    for engine, law in res.natives.items():  # the native law in the reference: the engine's twin
+        res.points += _twin_points(case, engine, law, steps, repeat=3, tick=tick)
+    for engine in engines:
+        law = res.natives.get(engine)
+        mp = contact_mapping(case, engine, law.native if law else None)
         if mp.native is None:
             res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
             continue
@@ -203,11 +296,12 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
             res.skipped[engine] = discovery.missing(engine)
             continue
         for spc in steps:
-            dt = t_c / spc
+            dt = (law.t_contact if law else t_c) / spc
+            native = law.native if law else None
             try:
-                one = run_engine(case, engine, dt=dt, cache=None)
+                one = run_engine(case, engine, dt=dt, cache=None, native=native)
                 try:
-                    many = run_engine(case, engine, dt=dt, cache=None, copies=batch)
+                    many = run_engine(case, engine, dt=dt, cache=None, copies=batch, native=native)
                 except UnsupportedByEngine:  # an engine whose decks hold one collision: no batched time
                     many = None
             except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
@@ -218,10 +312,11 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
                 tick()
                 continue
             # an engine result carries the reference's own checks (reference/health.py)
+            errors = (_native_errors(case, law, one.metrics(), scales) if law
+                      else _errors(one.metrics(), ref, metrics, scales))
             res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
                                     many.meta["engine_wall_time"] / batch if many is not None else math.nan,
-                                    _errors(one.metrics(), ref, metrics, scales),
-                                    one.status, one.message if not one.ok else ""))
+                                    errors, one.status, one.message if not one.ok else ""))
             tick()
     return res
 
@@ -254,14 +349,38 @@ def _used(points: list[Point]) -> list[str]:
     return [k for k in METRICS + OBLIQUE_METRICS if k in seen] + sorted(seen - set(METRICS + OBLIQUE_METRICS))
 
 
-def recommend(case: Case, target: float = 1e-3) -> dict:
+DT_STEPS = (10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000)  # the grid ``demcheck dt`` measures
+
+
+def _choose(pts: list[Point], target: float) -> dict:
+    """The cheapest step of ``pts`` meeting ``target``: dt, steps per contact, the error to expect and the metric
+    that limits it — or dt None and the message saying how far the finest step still is."""
+    c = cheapest(pts, target)
+    if c is not None:
+        return {"dt": c.dt, "steps_per_contact": c.steps_per_contact, "expected_error": c.error,
+                "limited_by": max(c.errors, key=lambda k: c.errors[k])}
+    finest = min((p for p in pts if p.status == "ok"), key=lambda p: p.dt, default=None)
+    why = ""
+    if finest is not None:
+        worst = sorted(((v, k) for k, v in finest.errors.items() if math.isfinite(v)), reverse=True)
+        parts = [f"{v:.2g} in {k}" for v, k in worst if v > target]
+        parts += [f"undefined in {k} (one side only)" for k, v in finest.errors.items() if not math.isfinite(v)]
+        why = ": at t_c/{:g} the error is still {}".format(finest.steps_per_contact, ", ".join(parts) or "—")
+    finest_steps = max((p.steps_per_contact for p in pts), default=math.nan)
+    return {"dt": None, "message": f"no time step of the grid (down to t_c/{finest_steps:g}) meets {target:g}{why}"}
+
+
+def recommend(case: Case, target: float = 1e-3, engines=None) -> dict:
     """A time step for the case's model meeting ``target`` (worst relative error of restitution, contact
     time, maximum overlap and peak force; for an oblique impact with friction also of tangential restitution
     and rebound spin in the suite's units), from the measured work-precision data of the reference's verlet
-    method (the engines' scheme, which exact engine mappings reproduce to round-off)."""
-    b = bench_case(case, engines=(), rtols=(), steps=(10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000))
+    method (the engines' scheme, which exact engine mappings reproduce to round-off).
+
+    For each engine among ``engines`` (default every registered one) the case gives its own setting
+    (``[engine.NAME]``), ``natives[NAME]`` is the same for that native law: its twin's error against the twin's
+    converged answer (the engine computes what its twin does, to round-off)."""
+    b = bench_case(case, engines=(), rtols=(), steps=DT_STEPS)
     pts = [p for p in b.points if p.source == "reference-verlet"]
-    c = cheapest(pts, target)
     t_r, t_h = rayleigh_time(case), hertz_time(case)
     out = {"case": case.name, "model": b.model, "target": target, "t_contact": b.t_contact,
            "rayleigh_time": t_r, "hertz_time": t_h, "order": fit_order(pts),
@@ -269,20 +388,45 @@ def recommend(case: Case, target: float = 1e-3) -> dict:
            "rules_of_thumb": {"0.2 t_Rayleigh": 0.2 * t_r, "t_Hertz / 50": t_h / 50},
            "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
                       "status": p.status} for p in pts]}
-    if c is None:
-        finest = min((p for p in pts if p.status == "ok"), key=lambda p: p.dt, default=None)
-        why = ""
-        if finest is not None:
-            worst = sorted(((v, k) for k, v in finest.errors.items() if math.isfinite(v)), reverse=True)
-            parts = [f"{v:.2g} in {k}" for v, k in worst if v > target]
-            parts += [f"undefined in {k} (one side only)" for k, v in finest.errors.items() if not math.isfinite(v)]
-            why = ": at t_c/{:g} the error is still {}".format(finest.steps_per_contact, ", ".join(parts) or "—")
-        out.update(dt=None, message=f"no time step of the grid (down to t_c/10000) meets {target:g}{why}")
-    else:
-        out.update(dt=c.dt, steps_per_contact=c.steps_per_contact, expected_error=c.error,
-                   limited_by=max(c.errors, key=lambda k: c.errors[k]),
-                   dt_over_rayleigh=c.dt / t_r, dt_over_hertz=c.dt / t_h)
+    out.update(_choose(pts, target))
+    if out["dt"] is not None:
+        out.update(dt_over_rayleigh=out["dt"] / t_r, dt_over_hertz=out["dt"] / t_h)
+    out["natives"] = {}
+    natives = native_sources(case, registry.names() if engines is None else engines)
+    for engine, nat in natives.items():
+        law = native_law(case, engine, nat, b.reference)
+        twin = _twin_points(case, engine, law, DT_STEPS)
+        entry = {**law.as_dict(), "target": target, "order": fit_order(twin), "metrics": _used(twin),
+                 "against": f"{engine}-twin converged ({law.how})",
+                 "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
+                            "status": p.status} for p in twin]}
+        entry.update(_choose(twin, target))
+        out["natives"][engine] = entry
     return out
+
+
+def _twin_points(case: Case, engine: str, law: NativeLaw, steps, repeat: int = 1, tick=None) -> list[Point]:
+    """The native law's twin over a grid of steps per its elastic contact time, each point's error against the
+    twin's converged answer (best wall time of ``repeat`` runs). A step the run cannot hold (too many steps) is
+    that point's failure."""
+    from ..engines.collide import twin_states
+    from ..reference.health import impact_scales
+
+    scales = impact_scales(case, law.model)
+    pts = []
+    for spc in steps:
+        dt = law.t_contact / spc
+        try:
+            wall, r = _timed(lambda: twin_states(case, engine, dt, native=law.native), repeat)
+        except ConfigError as exc:
+            pts.append(Point(f"{engine}-twin", spc, dt, None, math.nan, None, {k: math.nan for k in METRICS},
+                             "failed", str(exc).splitlines()[0]))
+        else:
+            pts.append(Point(f"{engine}-twin", spc, dt, None, wall, None,
+                             _native_errors(case, law, r.metrics(), scales), r.status, r.message))
+        if tick:
+            tick()
+    return pts
 
 
 def speed_goal_text(results: list[dict]) -> str:

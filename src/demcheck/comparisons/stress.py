@@ -8,6 +8,12 @@ contact time. A run fails when it is unresolved, produces NaN, overlaps beyond h
 energy (a law that only stores or dissipates it; reference/health.py), does not separate, or
 the engine errors (lost atoms, …). The stability map is dt_max / t_c against each parameter; where an
 engine and the reference disagree about the limit by more than one grid step, the point is flagged.
+
+A case with an engine's own setting (``[engine.NAME]``) runs that native law in the engine and in its twin
+(``NAME-twin``), on a grid of steps per the native law's own elastic contact time; the engine is flagged against
+its twin (the seed model's verlet run is a different law). A parameter that does not move the native run (the
+materials' stiffness or restitution, when the setting gives its own) is left out for those two sources, and
+the report says so.
 """
 
 from __future__ import annotations
@@ -100,6 +106,7 @@ class Limit:
     steps_per_contact: float | None  # the finest grid point that failed, or None when all were stable
     dt_max_over_tc: float | None
     failure: str = ""
+    t_contact: float | None = None  # the elastic contact time the grid is in (a native law's own)
 
 
 @dataclass
@@ -108,24 +115,30 @@ class StressResult:
     model: dict
     limits: list[Limit] = field(default_factory=list)
     skipped: dict = field(default_factory=dict)
+    natives: dict = field(default_factory=dict)  # engine → its native setting in one line (the case's own)
 
     def flags(self) -> list[dict]:
-        """Where an engine and the reference disagree about stability by more than one grid step."""
+        """Where an engine and what it computes disagree about stability by more than one grid step: the
+        reference's verlet method for a mapped seed model, the engine's twin for its native setting (a twin
+        is the native law itself, never flagged against the seed model's run)."""
         out = []
-        ref = {(l.parameter, l.value): l for l in self.limits if l.source == "reference-verlet"}
+        by = {(l.parameter, l.value, l.source): l for l in self.limits}
         for l in self.limits:
-            r = ref.get((l.parameter, l.value))
-            if l.source == "reference-verlet" or r is None:
+            if l.source == "reference-verlet" or l.source.endswith("-twin"):
+                continue
+            against = f"{l.source}-twin" if (l.parameter, l.value, f"{l.source}-twin") in by else "reference-verlet"
+            r = by.get((l.parameter, l.value, against))
+            if r is None:
                 continue
             a, b = _grid_index(r.dt_max_over_tc), _grid_index(l.dt_max_over_tc)
             if abs(a - b) > 1:
-                out.append({"parameter": l.parameter, "value": l.value, "source": l.source,
+                out.append({"parameter": l.parameter, "value": l.value, "source": l.source, "against": against,
                             "reference_dt_max_over_tc": r.dt_max_over_tc, "engine_dt_max_over_tc": l.dt_max_over_tc,
                             "engine_failure": l.failure, "reference_failure": r.failure})
         return out
 
     def summary(self) -> dict:
-        return {"case": self.case, "model": self.model, "skipped": self.skipped,
+        return {"case": self.case, "model": self.model, "skipped": self.skipped, "natives": self.natives,
                 "limits": [l.__dict__ for l in self.limits], "disagreements": self.flags()}
 
 
@@ -149,17 +162,49 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
     return status == "ok", why
 
 
-def _stable_engine(case: Case, engine: str, dt: float, t_c: float) -> tuple[bool, str]:
+def _stable_engine(case: Case, engine: str, dt: float, t_c: float, native=None, model=None) -> tuple[bool, str]:
+    """An engine run's stability (``native``: the case's own setting, judged with its twin's ``model``)."""
     from ..engines.collide import collide as run_engine
 
     try:
-        r = run_engine(case, engine, dt=dt, timeout=120.0)
+        r = run_engine(case, engine, dt=dt, timeout=120.0, native=native)
     except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
         raise
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
-    status, why = health.check(r, case, min_steps=1)
+    status, why = health.check(r, case, model, min_steps=1)
     return status == "ok", why
+
+
+def _stable_twin(case: Case, engine: str, native, model, dt: float) -> tuple[bool, str]:
+    """The native law's stability in the engine's scheme: its twin (engines.collide.twin_states)."""
+    from ..engines.collide import twin_states
+
+    try:
+        r = twin_states(case, engine, dt, native=native)
+    except DemcheckError as exc:
+        return False, str(exc).splitlines()[0]
+    if r.status not in ("ok", "unresolved", "unstable"):
+        return False, f"{r.status}: {r.message}"
+    status, why = health.check(r, case, model, min_steps=1)
+    return status == "ok", why
+
+
+def _native_run(case: Case, engine: str):
+    """(Native, twin model, what the native run sees) of the case's own setting for ``engine``, or None: what
+    it sees is its twin's laws and the bodies' initial state, so that a parameter that leaves it unchanged is
+    known not to move the native run."""
+    from ..engines.mapping import twin_model
+
+    nat = registry.get(engine).case_native(case)
+    if nat is None:
+        return None
+    model = twin_model(resolve(case), nat)
+    seen = (model.normal_law, model.tangential_law, tuple(case.mass(i) for i in range(len(case.particles))),
+            tuple((p.radius, tuple(p.position), tuple(p.velocity), tuple(p.angular_velocity))
+                  for p in case.particles),
+            tuple((tuple(w.point), tuple(w.normal)) for w in case.walls), tuple(case.run.gravity))
+    return nat, model, seen
 
 
 def largest_stable(check) -> tuple[float | None, str]:
@@ -203,36 +248,62 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
                 progress=None) -> StressResult:
     """Stress one case (``read_stress``'s raw table and Case) over its parameters."""
     from ..engines import discovery
-    from ..engines.mapping import contact_mapping
+    from ..engines.builds import engine_of
+    from ..engines.mapping import contact_mapping, native_summary
 
     res = StressResult(base.name, resolve(base).describe())
     params = parameters(raw0)
     if only:
         params = {k: v for k, v in params.items() if any(o in k for o in only)}
+    engines = registry.names() if engines is None else tuple(engines)
     tick = progress or (lambda: None)
     for name, values in params.items():
+        points = []  # (value, case, t_c, {engine: _native_run}) or (value, None, why, {})
         for value, transform in values:
             try:
                 case = from_dict(transform(copy.deepcopy(raw0)))
                 t_c = characteristic_time(resolve(case))
+                natives = {e: n for e in engines if (n := _native_run(case, e)) is not None}
             except DemcheckError as exc:
-                res.limits.append(Limit(name, value, "reference-verlet", None, None, f"invalid: {exc}"))
+                points.append((value, None, f"invalid: {exc}", {}))
                 continue
-            sources = ["reference-verlet"]
-            for e in registry.names() if engines is None else engines:
-                mp = contact_mapping(case, e)
+            points.append((value, case, t_c, natives))
+            res.natives.update({e: native_summary(n[0]) for e, n in natives.items()})
+        # an engine whose native run no value of this parameter moves: left out for it and its twin
+        still = set()
+        for e in engines:
+            seen = {n[e][2] for _, c, _, n in points if c is not None and e in n}
+            if len(seen) == 1 and all(c is None or e in n for _, c, _, n in points):
+                still.add(e)
+                res.skipped[f"{e} and {e}-twin × {name}"] = (
+                    f"the case's [engine.{engine_of(e)}] setting is run, and {name} changes neither it nor the "
+                    "bodies: its stability is the same at every value")
+        for value, case, t_c, natives in points:
+            if case is None:
+                res.limits.append(Limit(name, value, "reference-verlet", None, None, t_c))
+                continue
+            runs = [("reference-verlet", lambda spc, c=case, t=t_c: _stable_reference(c, t / spc, t), t_c)]
+            for e in engines:
+                nat = natives.get(e)
+                if e in still:
+                    continue
+                if nat is not None:
+                    native, model, _ = nat
+                    t_n = characteristic_time(model)
+                    runs.append((f"{e}-twin", lambda spc, c=case, n=native, m=model, t=t_n, e=e:
+                                 _stable_twin(c, e, n, m, t / spc), t_n))
+                mp = contact_mapping(case, e, nat[0] if nat else None)
                 if mp.native is None:
                     res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
                 elif discovery.find(e) is None:
                     res.skipped[e] = discovery.missing(e)
+                elif nat is not None:
+                    runs.append((e, lambda spc, c=case, n=native, m=model, t=t_n, e=e:
+                                 _stable_engine(c, e, t / spc, t, n, m), t_n))
                 else:
-                    sources.append(e)
-            for src in sources:
-                if src == "reference-verlet":
-                    check = lambda spc, c=case, t=t_c: _stable_reference(c, t / spc, t)  # noqa: E731
-                else:
-                    check = lambda spc, c=case, t=t_c, e=src: _stable_engine(c, e, t / spc, t)  # noqa: E731
+                    runs.append((e, lambda spc, c=case, t=t_c, e=e: _stable_engine(c, e, t / spc, t), t_c))
+            for src, check, t in runs:
                 spc, why = largest_stable(check)
-                res.limits.append(Limit(name, value, src, spc, (1.0 / spc) if spc else None, why))
+                res.limits.append(Limit(name, value, src, spc, (1.0 / spc) if spc else None, why, t))
                 tick()
     return res

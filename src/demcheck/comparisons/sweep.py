@@ -1,4 +1,10 @@
-"""Parameter sweeps: metrics over any case key (``--vary KEY=START:STOP:N``, several make a grid)."""
+"""Parameter sweeps: metrics over any case key (``--vary KEY=START:STOP:N``, several make a grid), from one
+source: the reference (the seed model of ``[contact]``), an engine (its deck run for real) or an engine's twin.
+
+An engine or its twin runs the case's own setting for that engine (``[engine.NAME]``) when it has one. A
+``contact.*`` key does not change that native law (``[contact]`` is the seed model it is judged against), nor
+does a ``materials.*`` key the setting does not read (LAMMPS's ``pair_coeff`` gives its own modulus and
+restitution): such a sweep is refused before any work, rather than a table of one law repeated."""
 
 from __future__ import annotations
 
@@ -52,24 +58,105 @@ def sweep_points(case_path, overrides, varies: list[str]) -> list[tuple[dict, ob
     total = math.prod(len(vals) for _, vals in axes)
     if total > MAX_POINTS:
         raise ConfigError("--vary", " ".join(varies), f"makes a grid of {total} points; at most {MAX_POINTS}")
+    from ..engines import registry
+    from ..engines.base import case_natives
+
     raw = _read(case_path)  # the file is read once
-    from_dict(apply_overrides(raw, list(overrides)))  # the base case must be valid on its own
+    case_natives(from_dict(apply_overrides(raw, list(overrides))), registry.all_engines())  # valid on its own
     points = []
     for point in itertools.product(*[vals for _, vals in axes]):
         sets = list(overrides) + [f"{k}={_text(v)}" for k, v in zip(keys, point)]
-        points.append((dict(zip(keys, point)), from_dict(apply_overrides(raw, sets))))
+        case = from_dict(apply_overrides(raw, sets))
+        case_natives(case, registry.all_engines())  # [engine.NAME] settings read by their engines
+        points.append((dict(zip(keys, point)), case))
     return points
 
 
-def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None) -> pd.DataFrame:
-    """Solve each point (``sweep_points``); a point whose solve fails keeps its row, with the status."""
+def check_source(source: str, method=None) -> str:
+    """``source`` as a sweep runs it: reference, a registered engine (or build), or ``NAME-twin``; ``method``
+    is the reference's. Else ConfigError naming the option, before any work."""
+    from ..engines import registry
+
+    names = [n for n in registry.names() if "@" not in n]  # a build's label is a source too, once registered
+    engine = source.removesuffix("-twin")
+    if source != "reference" and engine not in registry.names():
+        raise ConfigError("--engine", source, "must be reference, an engine (" + ", ".join(names) + ") or an "
+                          "engine's twin (" + ", ".join(f"{n}-twin" for n in names) + ")")
+    if source != "reference" and method is not None:
+        raise ConfigError("--method", method, "is the reference's (adaptive or verlet); an engine and its twin "
+                                               "run velocity Verlet at --dt")
+    return source
+
+
+def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str = "--vary ") -> None:
+    """Refuse, before any work, a key that cannot move what ``source`` runs: with the case's own setting for the
+    source's engine (``[engine.NAME]``), a ``contact.*`` key (the seed model's, not the native law's), or a
+    ``materials.*`` key that leaves the native law and the masses unchanged at every point. The error's key is
+    ``where`` + the case key (``--vary contact.kn``; the API's ``vary.contact.kn``)."""
+    from ..engines import registry
+    from ..engines.builds import engine_of
+    from ..engines.mapping import twin_model
+    from ..reference.model import resolve
+
+    if source == "reference" or not points:
+        return
+    engine = registry.get(source.removesuffix("-twin"))
+    base = points[0][1]
+    if engine.case_native(base) is None:
+        return
+    table = f"[engine.{engine_of(source.removesuffix('-twin'))}]"
+    for key in points[0][0]:
+        values = list(dict.fromkeys(_plain(v[key]) for v, _ in points))
+        if key == "contact" or key.startswith("contact."):
+            raise ConfigError(f"{where}{key}", values, f"{source} runs the case's {table} setting, which {key} "
+                              "does not change ([contact] is the seed model it is judged against): vary an "
+                              f"impact, particle or {table[1:-1]}.* key, or sweep the reference")
+        if key.startswith("materials."):
+            seen = set()
+            for _, case in points:
+                model = twin_model(resolve(case), engine.case_native(case))
+                seen.add((model.normal_law, model.tangential_law,
+                          tuple(case.mass(i) for i in range(len(case.particles)))))
+            if len(seen) == 1:
+                raise ConfigError(f"{where}{key}", values, f"{source} runs the case's {table} setting, and {key} "
+                                  "changes neither that law nor the masses at any point (the setting gives its "
+                                  f"own): vary {table[1:-1]}.* instead")
+
+
+def _plain(v):
+    return v.item() if hasattr(v, "item") else v
+
+
+def _run(case, source: str, method, dt):
+    """One point's Result from ``source`` (check_source)."""
+    if source == "reference":
+        return collide(case, method=method, dt=dt)
+    from ..case import run_length
+    from ..engines import registry
+    from ..engines.collide import collide as run_engine, twin_states
+
+    engine = source.removesuffix("-twin")
+    native = registry.get(engine).case_native(case)
+    if source.endswith("-twin"):
+        return twin_states(case, engine, dt or run_length(case)[0], native=native)
+    return run_engine(case, engine, dt=dt, native=native)
+
+
+def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
+              source: str = "reference") -> pd.DataFrame:
+    """Solve each point (``sweep_points``) from ``source`` (``check_source``); a point whose solve fails keeps its
+    row, with the status."""
+    from ..errors import EngineInterrupted
+
     rows = []
     for values, case in points:
         row = dict(values)
         try:
-            result = collide(case, method=method, dt=dt)
+            result = _run(case, source, method, dt)
             row.update(result.metrics())
             row["status"] = result.status
+        except EngineInterrupted:
+            raise
         except DemcheckError as exc:
             row["status"] = f"error: {exc}"
         rows.append(row)
