@@ -168,30 +168,60 @@ def cli():
 @click.argument("model_id", metavar="[ID]", required=False)
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--engine", "engine", default=None,
-              help="reverse lookup: ID is an engine's native setting, e.g. --engine lammps \"hertz/material …\"")
-def models(model_id, as_json, engine):
+              help="reverse lookup: ID is an engine's native setting — lammps: a pair_coeff's arguments "
+                   "(\"hertz/material 63e9 0.6 0.24 damping tsuji tangential mindlin NULL 1.0 0.5\"); liggghts: "
+                   "the pair_style gran arguments and the property/global values as NAME=VALUE (\"model hertz "
+                   "tangential history coefficientRestitution=0.6 coefficientFriction=0.5 youngsModulus=63e9 "
+                   "poissonsRatio=0.24\")")
+@click.option("--radius", type=Number(lo=0, lo_open=True, unit="m"), default=None,
+              help="reverse lookup: the like pair's radius (default 1e-3 m)")
+@click.option("--density", type=Number(lo=0, lo_open=True, unit="kg/m³"), default=None,
+              help="reverse lookup: the like pair's density (default 2500 kg/m³)")
+@click.option("--speed", type=Number(lo=0, lo_open=True, hi=1e4, unit="m/s"), default=None,
+              help="reverse lookup: the impact speed of the fidelity probes (default 1 m/s)")
+def models(model_id, as_json, engine, radius, density, speed):
     """Registered models: one line each (id, seed name, each engine's fidelity); `demcheck models ID` shows one
     model in full (formula, source, parameters, each engine's configuration and reason); `demcheck models
     --engine E "SETTING"` looks a native setting up (seed model, fidelity, implied parameters, traps)."""
+    if engine is None:
+        for key, value in (("--radius", radius), ("--density", density), ("--speed", speed)):
+            if value is not None:
+                raise ConfigError(key, value, "applies to a reverse lookup (--engine E \"SETTING\")")
     if engine is not None:
         from .comparisons.audit import reverse
 
         if model_id is None:
             raise ConfigError("SETTING", None, "--engine needs the native setting to look up")
-        r = reverse(engine, model_id)
+        r = reverse(engine, model_id, radius or 1e-3, density or 2500.0, speed or 1.0)
         if as_json:
             emit_json(r)
             return
-        s = r["seed"]
+        pair = r["pair"]
         click.echo(f"{engine}: {r['native']}")
-        click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']}"
-                   + (f" ({'; '.join(s['reasons'])})" if s["reasons"] else ""))
-        click.echo("  implied (like pair, R = 1 mm, ρ = 2500): "
-                   + ", ".join(f"{k} {v:.6g}" if isinstance(v, float) else f"{k} {v}" for k, v in r["implied"].items()))
+        s = r["seed"]
+        if s is None:
+            click.echo("  nearest seed model: none (demcheck has no twin of this law); fidelity none")
+        else:
+            click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — {r['fidelity']}"
+                       f" (largest gap {r['gap']:.3g} between its converged contact and the seed model's at "
+                       f"{pair['speed']:g} m/s, " + ", ".join(f"{p['angle']:g}°" for p in r["probes"]) + ")"
+                       + (f"; {'; '.join(s['reasons'])}" if s["reasons"] else ""))
+        if r["asked"]:
+            click.echo("  asks for: " + ", ".join(f"{k} {v:g}" for k, v in r["asked"].items()))
+        if r["implied"]:
+            click.echo(f"  implied (like pair, R = {pair['radius']:g} m, ρ = {pair['density']:g} kg/m³): "
+                       + ", ".join(f"{k} {v:.6g}" if isinstance(v, float) else f"{k} {v}"
+                                   for k, v in r["implied"].items()))
+        for p in r.get("probes", []):
+            tw, sd = p["twin"], p["seed"]
+            click.echo(f"  {p['angle']:>3g}°: e {tw['restitution']:.4f} (seed {sd['restitution']:.4f})"
+                       + (f", et {tw['tangential_restitution']:.4f} (seed {sd['tangential_restitution']:.4f})"
+                          if math.isfinite(tw["tangential_restitution"]) else "")
+                       + f", tc {tw['contact_time']:.4g} s (seed {sd['contact_time']:.4g} s)")
         for n in r["notes"]:
             click.echo(f"  note: {n}")
         for f in r["findings"]:
-            click.echo(f"  TRAP [{f['code']}]: {f['text']}")
+            click.echo(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
         click.echo("  `demcheck audit DECK` measures each trap in the engine (docs/audit.md)")
         return
     from .engines import mapping, registry as engine_registry

@@ -455,17 +455,42 @@ def _f(x) -> str:
     return number(x, ".4g")
 
 
-def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.0) -> dict:
-    """The reverse lookup of one native setting (``demcheck models --engine E "…"``): its nearest seed model,
-    fidelity and implied parameters for a like pair (``radius``, ``density``), and its static traps."""
+def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.0, speed: float = 1.0) -> dict:
+    """The reverse lookup of one native setting (``demcheck models --engine E "…"``): its nearest seed model
+    and implied parameters for a like pair (``radius``, ``density``), its fidelity — the head-on probe, and the
+    oblique ones at 30° and 60° with friction, at ``speed``: the twin's converged contact against the seed
+    model's, *exact* within 1e-6 (scaled) — and its static traps. No engine runs; ``demcheck audit`` measures
+    the traps in the engine. A setting the engine's reader cannot read is a ConfigError naming it."""
+    from .bench import native_law
+
     found = readers()
     reader = found.get(engine)
     if reader is None or not hasattr(reader, "reverse"):
-        raise ConfigError("--engine", engine, "the reverse lookup reads " + ", ".join(
-            n for n, r in found.items() if hasattr(r, "reverse")) + " settings")
-    ps = reader.reverse(line)
+        known = {n: r for n, r in found.items() if hasattr(r, "reverse")}
+        raise ConfigError("--engine", engine, "has no reverse lookup; it reads " + "; ".join(
+            f"{n}: {getattr(r, 'REVERSE_SYNTAX', 'its setting')}" for n, r in known.items()))
+    for key, value in (("--radius", radius), ("--density", density), ("--speed", speed)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ConfigError(key, value, "must be a finite number > 0")
+    setup = deck_script.Setup(engine)
+    try:
+        ps = reader.reverse(line, setup)
+    except deck_script.ScriptError as exc:
+        raise ConfigError("SETTING", line, str(exc).split(": ", 2)[-1]) from None
+    body = setup.bodies.setdefault(ps.i, deck_script.Body(ps.i))
+    body.radius, body.density = radius, density
     m = density * 4.0 / 3.0 * math.pi * radius ** 3
-    nl, tl = registry.get(engine).twin(ps.native, m / 2.0, radius / 2.0)
+    findings = [_finding(f) for f in [*setup.findings, *ps.findings]]
+    out = {"engine": engine, "setting": line, "native": native_summary(ps.native), "asked": ps.asked,
+           "pair": {"radius": radius, "density": density, "speed": speed}, "findings": findings,
+           "notes": list(ps.notes)}
+    if not ps.probe:  # a law demcheck has no twin of: listed, with its traps
+        return {**out, "seed": None, "fidelity": "none", "gap": math.nan, "implied": {}}
+    eng = registry.get(engine)
+    try:
+        nl, tl = eng.twin(ps.native, m / 2.0, radius / 2.0)
+    except ValueError as exc:
+        raise ConfigError("SETTING", line, f"no twin: {exc}") from None
     normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)
     implied = {"normal_force": f"{nl.k:.6g} δ^{nl.a:g}", "damping": f"{nl.eta:.6g} δ^{nl.b:g} (N·s/m at δ^b)",
                "limit": nl.limit}
@@ -473,7 +498,27 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
         implied["E*"] = nl.k / (4.0 / 3.0 * math.sqrt(radius / 2.0))
     if tl.family == SPRING:
         implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if tl.kt_sqrt else "")
-    return {"engine": engine, "setting": line, "native": native_summary(ps.native), "seed": {
-        "normal": normal, "tangential": tangential, "params": params, "reasons": reasons},
-        "asked": ps.asked, "implied": implied, "pair": {"radius": radius, "density": density},
-        "findings": [_finding(f) for f in ps.findings], "notes": ps.notes}
+    # fidelity: the twin's converged contact against the seed model's, at the like pair and ``speed``
+    setup.dt = nl.characteristic_time(m / 2.0, speed) / 1000.0  # the probe case's run.dt (no run uses it)
+    gap, probes = 0.0, []
+    scales = {"impact_energy": 0.25 * m * speed ** 2, "spin": speed / radius}
+    for angle in (ANGLES if ps.asked.get("friction", 0.0) > 0 else ANGLES[:1]):
+        case = probe_case(setup, ps, speed, angle, nl, tl, seed_of(nl, tl, ps.asked))
+        twin = native_law(case, engine, ps.native)
+        seed = collision3d.collide(case, resolve(case), "adaptive")
+        g = _worst(_metrics_of(twin.converged), _metrics(seed), [k for k in METRICS if k != "peak_force"], scales)
+        probes.append({"angle": angle, "twin": _metrics_of(twin.converged), "twin_by": twin.how,
+                       "seed": _metrics(seed), "gap": g})
+        gap = max(gap, g)
+    e_asked, e_real = ps.asked.get("restitution"), probes[0]["twin"]["restitution"]
+    for f in findings:  # the traps that miss the asked e, with the head-on probe's converged e
+        if f["code"] in ("tsuji", "limit") and e_asked is not None and math.isfinite(e_real):
+            f["size"].update(asked=e_asked, realised=e_real, difference=e_real - e_asked)
+            f["text"] += (f": e = {e_asked:g} asked, {e_real:.4f} realised (head-on at {speed:g} m/s, converged; "
+                          "the engine's own step adds its time-step error)")
+    return {**out, "seed": {"normal": normal, "tangential": tangential, "params": params, "reasons": reasons},
+            "fidelity": _fidelity(gap, reasons), "gap": gap, "probes": probes, "implied": implied}
+
+
+def _metrics_of(m: dict) -> dict:
+    return {k: m.get(k, math.nan) for k in METRICS}

@@ -347,10 +347,17 @@ def _walls(setup: Setup, types: list[int], explicit: dict, walls: list) -> None:
             setup.pairs.append(ps)
 
 
-def reverse(line: str) -> PairSetting:
+REVERSE_SYNTAX = ("a pair_style granular pair_coeff's arguments after the types: \"hertz/material 63e9 0.6 0.24 "
+                  "damping tsuji tangential mindlin NULL 1.0 0.5\"")
+
+
+def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     """One ``pair_coeff`` argument list (after the types) as the pair setting it defines, with its static traps
-    (``demcheck models --engine lammps "…"``)."""
+    (``demcheck models --engine lammps "…"``); leading types (``* *``, ``1 1``) are read and dropped.
+    ``setup`` (the lookup's, shared with other readers) takes nothing from a pair_coeff."""
     words = line.split()
+    if len(words) > 2 and all(_is_type(w) for w in words[:2]):
+        words = words[2:]
     cmd = Command(["pair_coeff", "1", "1", *words], "models", 1, line)
     spec = parse_granular(cmd, cmd.words, 3)
     if spec["rest"] != len(cmd.words):

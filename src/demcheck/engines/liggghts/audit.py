@@ -241,9 +241,93 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         notes.append(f"model {model} / tangential {tang}: listed, not probed (no twin of it in demcheck)")
     if spec["rolling"] != "off":
         notes.append(f"rolling_friction {spec['rolling']}: not part of the probes (the twin has none)")
+    if not flags.get("tangential_damping", True) and tang != "off":
+        notes.append("tangential_damping off: no tangential dashpot (the seed's TTIt has one); the probes run "
+                     "without it")
     if limit and "restitution" in asked and model in ("hertz", "hooke"):
         findings.append(Finding("trap", "limit", "limitForce on: the normal force is held ≥ 0, which raises the "
                                 "restitution above coefficientRestitution", where))
+    return ps
+
+
+# ----------------------------------------------------------------------------- reverse lookup
+
+REVERSE_PROPERTIES = ("youngsModulus", "poissonsRatio", "coefficientRestitution", "coefficientFriction",
+                      "characteristicVelocity", "kn", "kt", "gamman", "gammat")
+REVERSE_SWITCHES = ("hard_particles", "soft_particles")
+# what LIGGGHTS 3.8.0 stops without, per model (its property/global lookups), and per tangential model
+NEEDS = {"hertz": ("youngsModulus", "poissonsRatio", "coefficientRestitution"),
+         "hooke": ("youngsModulus", "poissonsRatio", "coefficientRestitution", "characteristicVelocity"),
+         "hooke/stiffness": ("kn", "kt", "gamman", "gammat"), "hertz/stiffness": ("kn", "kt", "gamman", "gammat")}
+REVERSE_SYNTAX = ("the pair_style gran arguments, then the property/global values of a like pair as NAME=VALUE: "
+                  "\"model hertz tangential history coefficientRestitution=0.6 coefficientFriction=0.5 "
+                  "youngsModulus=63e9 poissonsRatio=0.24 hard_particles=yes\"")
+
+
+def reverse(line: str, setup: Setup | None = None) -> PairSetting:
+    """``[pair_style] [gran] model M tangential T [flag on|off …] NAME=VALUE …`` — the ``pair_style gran``
+    arguments, then the ``fix property/global`` values of a like pair (one number each: youngsModulus,
+    poissonsRatio, coefficientRestitution, coefficientFriction, characteristicVelocity, kn, kt, gamman,
+    gammat) and ``hard_particles=yes|no``, ``soft_particles=yes|no`` — as the pair setting of two bodies of
+    one type, with its static traps (``demcheck models --engine liggghts "…"``). ``setup`` receives the type's
+    moduli and the deck-wide findings (hard-particles). What LIGGGHTS would stop without is one ScriptError."""
+    setup = setup if setup is not None else Setup("liggghts")
+    words = line.split()
+    words = words[1:] if words[:1] == ["pair_style"] else words
+    words = words[1:] if words[:1] == ["gran"] else words
+    style = [w for w in words if "=" not in w]
+    cmd = Command(["pair_style", "gran", *style], "models", 1, line)
+    spec, k = parse_style(cmd, cmd.words, 2)
+    if k != len(cmd.words):
+        raise _bad(cmd, f"{cmd.words[k]!r} is not a keyword of pair_style gran (a property is NAME=VALUE)")
+    props: dict = {}
+    switches = {"hard_particles": False, "soft_particles": False}
+    for w in words:
+        if "=" not in w:
+            continue
+        name, _, text = w.partition("=")
+        if name in REVERSE_SWITCHES:
+            if text not in ("yes", "no", "on", "off"):
+                raise _bad(cmd, f"{name}={text}: takes yes or no")
+            switches[name] = text in ("yes", "on")
+            continue
+        if name not in REVERSE_PROPERTIES:
+            raise _bad(cmd, f"{name}: not a property read here ({', '.join(REVERSE_PROPERTIES + REVERSE_SWITCHES)})")
+        if name in props:
+            raise _bad(cmd, f"{name} is given twice")
+        c = Command(["fix", "p", "all", "property/global", name, "scalar", text], "models", 1, w)
+        value = _num(c, 6, name)
+        if not math.isfinite(value):
+            raise _bad(cmd, f"{name}={text}: must be a finite number")
+        props[name] = ("scalar", [value], "models")
+    if spec["model"] in MODELS:
+        missing = [n for n in NEEDS[spec["model"]] if n not in props]
+        if spec["tangential"] != "off" and "coefficientFriction" not in props:
+            missing.append("coefficientFriction")
+        if missing:
+            raise _bad(cmd, f"model {spec['model']} tangential {spec['tangential']} needs "
+                            + ", ".join(f"{n}=…" for n in missing) + " (LIGGGHTS stops without them)")
+    for name in ("youngsModulus", "poissonsRatio"):  # one type: per-type values
+        if name in props:
+            props[name] = ("peratomtype", props[name][1], "models")
+    if "poissonsRatio" in props and not -1.0 < props["poissonsRatio"][1][0] < 0.5:
+        raise _bad(cmd, f"poissonsRatio={props['poissonsRatio'][1][0]:g}: must be in (-1, 0.5)")
+    for name in ("youngsModulus", "characteristicVelocity"):
+        if name in props and not props[name][1][0] > 0:
+            raise _bad(cmd, f"{name}={props[name][1][0]:g}: must be > 0")
+    if "coefficientRestitution" in props and not 0.0 < props["coefficientRestitution"][1][0] <= 1.0:
+        raise _bad(cmd, f"coefficientRestitution={props['coefficientRestitution'][1][0]:g}: must be in (0, 1]")
+    setup.bodies.setdefault(1, Body(1))
+    _moduli(setup, props, switches["hard_particles"], switches["soft_particles"])
+    for f in setup.findings:
+        f.where = "models"
+    ps = _pair(setup, spec, "models", props, 1, 1, "1-1")
+    for key in ("rolling", "cohesion"):
+        if spec[key] != "off":
+            ps.notes.append(f"{key} {spec[key]}: not part of the lookup (the twin has none)")
+    for flag in spec["flags"]:
+        if flag not in CASE_FLAGS:
+            ps.notes.append(f"{flag}: not part of the lookup (the twin reads {', '.join(CASE_FLAGS)})")
     return ps
 
 
