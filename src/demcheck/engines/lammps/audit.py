@@ -310,12 +310,18 @@ def _pairs(setup: Setup, types: list[int], explicit: dict) -> None:
                                       "LAMMPS cannot mix different sub-models; write pair_coeff for the pair")
             where = f"mixed from {wa} and {wb}"
             nat, intended, notes = mixed(sa, sb, where)
+            # what the pair asks for is what LAMMPS's mixing rule gives it: the geometric means of e and μ
             asked = _asked(sa)
+            if "restitution" in asked:
+                asked["restitution"] = nat.damping_coeff
+            if "friction" in asked:
+                asked["friction"] = nat.tangential_args[-1]
             ps = PairSetting(f"{a}-{b}", a, b, nat, where, asked, intended=intended, notes=notes)
             _static(ps, sa, where)
             if sa["normal_coeffs"] != sb["normal_coeffs"] or sa["tangential_coeffs"] != sb["tangential_coeffs"]:
                 ps.notes.append("auto-mixed coefficients: E* as Hertz mixes it, every other one by its geometric "
-                                "mean (write pair_coeff for the pair to choose them)")
+                                "mean (write pair_coeff for the pair to choose them)"
+                                + "".join(f"; {k} {v:.6g}" for k, v in asked.items()))
             if intended is not None:
                 ps.findings.append(Finding("trap", "mixing", f"type pair {a} {b} auto-mixed with mindlin NULL: "
                                            "LAMMPS's tangential stiffness is wrong (write pair_coeff "
