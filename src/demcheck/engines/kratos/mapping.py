@@ -73,6 +73,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         fid = APPROXIMATE
         reasons.append("Kratos holds the total normal force at ≥ 0 (its dashpot is cut where it would pull); "
                        f"the seed's '{nid}' without limit_force lets it pull at the end of the contact")
+    keywords = {r: law for r in reasons}  # the discontinuum law's own clamp
     nat = Native("kratos", normal=law, normal_args=(young_eff,), damping="gamma", damping_coeff=gamma,
                  tangential="none", limit=True,
                  props={"young_eff": young_eff, "gamma": gamma, "wall": pair.wall},
@@ -80,7 +81,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                            f"DAMPING_GAMMA γ = {gamma:.17g} (the seed's η = 2γ√(m̄Kn)), set on the contact's "
                            "properties after Kratos' own e → γ",
                            "STATIC_FRICTION = DYNAMIC_FRICTION = 0, no rolling friction, no global damping"])
-    return Mapping("kratos", fid, reasons, nat)
+    return Mapping("kratos", fid, reasons, nat, keywords)
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:

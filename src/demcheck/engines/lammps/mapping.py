@@ -21,6 +21,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nl, tl, pair = model.normal_law, model.tangential_law, model.pair
     m, r = pair.m_eff, pair.r_eff
     reasons: list[str] = []
+    keywords: dict[str, str] = {}  # an approximate reason → the pair_coeff keyword it is about
     comments: list[str] = []
     nid = model.normal.id
     if nl.family == HYSTERETIC:
@@ -73,6 +74,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                                   "(nearest: mindlin_rescale/force, a different law)")
     else:
         mu, f_mu = mu_of(model, reasons)
+        mu_reason = reasons[-1] if f_mu == APPROXIMATE else None
         fid = worst(fid, f_mu)
         if family == SLIDING:
             if nl.eta == 0.0:
@@ -82,6 +84,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             fid = worst(fid, APPROXIMATE)
             reasons.append(f"simple sliding friction as linear_nohistory with x_t = {SLIDING_XT:g}: "
                            "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
+            keywords[reasons[-1]] = "tangential linear_nohistory"
         elif family in (VISCOUS, VISCOUS_SLIDING):
             if tl.eta_normal or not eta_n_const:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
@@ -92,6 +95,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append("with limit_damping the Coulomb cap μ|Fn| is 0 wherever the normal force is held "
                                "at 0, so the viscous force vanishes there too")
+                keywords[reasons[-1]] = "limit_damping"
             nat.tangential = "linear_nohistory"
             nat.tangential_args = (x_t, HUGE_MU if family == VISCOUS else mu)
             comments.append(f"linear_nohistory x_t = ηt/ηn = {x_t:.10g}"
@@ -119,10 +123,13 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 name = {TRUNC_CAP: "force", TRUNC_SPRING: "spring"}[tl.truncation]
                 reasons.append(f"LAMMPS limits the history after Maw (truncation = overlap: ξ such that |Kt ξ + "
                                f"ηt v_t| = μ|Fn|); the case asks for truncation = {name}")
+                keywords[reasons[-1]] = f"tangential {nat.tangential}"
         else:
             return refused("lammps", f"no LAMMPS equivalent of tangential '{tid}'")
+        if mu_reason is not None:
+            keywords[mu_reason] = f"tangential {nat.tangential} mu"
     nat.comments = comments
-    return Mapping("lammps", fid, reasons, nat)
+    return Mapping("lammps", fid, reasons, nat, keywords)
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:

@@ -20,6 +20,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nl, tl, pair = model.normal_law, model.tangential_law, model.pair
     m, r = pair.m_eff, pair.r_eff
     reasons: list[str] = []
+    keywords: dict[str, str] = {}  # an approximate reason → the pair_style gran keyword it is about
     comments: list[str] = []
     nid = model.normal.id
     nat = Native("liggghts", normal="", limit=model.limit_force)
@@ -77,6 +78,8 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
     else:
         mu, f_mu = mu_of(model, reasons)
+        if f_mu == APPROXIMATE:
+            keywords[reasons[-1]] = "coefficientFriction"
         fid = worst(fid, f_mu)
         p["friction"] = mu
         if family in (SLIDING, VISCOUS, VISCOUS_SLIDING):
@@ -89,6 +92,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append(f"simple sliding friction as no_history with gammat = {p['gammat']:.4g} 1/s: a "
                                "regularised slider near v_t = 0")
+                keywords[reasons[-1]] = "tangential no_history"
             else:
                 p["gammat"] = tl.eta / m
                 if family == VISCOUS:
@@ -97,6 +101,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                         fid = worst(fid, APPROXIMATE)
                         reasons.append("with limitForce the Coulomb cap μ|Fn| is 0 wherever the normal force is "
                                        "held at 0, so the viscous force vanishes there too")
+                        keywords[reasons[-1]] = "limitForce on"
                 comments.append(f"no_history gammat = ηt/m̄ = {p['gammat']:.10g} 1/s"
                                 + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if family == VISCOUS
                                    else ""))
@@ -110,6 +115,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
                 reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
                                "the dashpot lies outside the Coulomb cap (spring-only truncation)")
+                keywords[reasons[-1]] = "model hertz tangential history"
             elif tl.kt_sqrt:  # DDt on hertz/stiffness
                 if nat.normal != "hertz/stiffness":
                     return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
@@ -123,6 +129,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                     reasons.append("LIGGGHTS truncates the spring at μ|Fn|; the case's truncation = force is the "
                                    "seed's min() cap, which keeps the spring's extension (they part after a slip "
                                    "that reverses)")
+                    keywords[reasons[-1]] = "tangential history"
                 comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
             else:
                 if not stiff:
@@ -138,10 +145,11 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                     reasons.append("LIGGGHTS caps the spring only (truncation = spring: the dashpot is added "
                                    f"uncapped while sticking and dropped while slipping); the case asks for "
                                    f"truncation = {name}")
+                    keywords[reasons[-1]] = "tangential history"
         else:
             return refused("liggghts", f"no LIGGGHTS equivalent of tangential '{tid}'")
     nat.comments = comments
-    return Mapping("liggghts", fid, reasons, nat)
+    return Mapping("liggghts", fid, reasons, nat, keywords)
 
 
 def luding_limit(props: dict, r: float) -> float:

@@ -31,6 +31,7 @@ from ..mapping import mu_of
 
 VISCEL = "ViscElPhys"
 MINDLIN = "MindlinPhys"
+LAW2 = {VISCEL: "Law2_ScGeom_ViscElPhys_Basic", MINDLIN: "Law2_ScGeom_MindlinPhys_Mindlin"}  # each physics' law
 CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashpot's attraction at the end of "
          "the contact); the case has limit_force = false")
 
@@ -39,6 +40,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nl, tl, pair = model.normal_law, model.tangential_law, model.pair
     m, r = pair.m_eff, pair.r_eff
     reasons: list[str] = []
+    keywords: dict[str, str] = {}  # an approximate reason → the Yade class or attribute it is about
     comments: list[str] = []
     fid = EXACT
     if nl.family == HYSTERETIC:
@@ -64,12 +66,15 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     if nat.limit and nl.eta > 0.0 and not model.limit_force:
         fid = APPROXIMATE
         reasons.append(CLAMP.format(law=nat.normal))
+        keywords[reasons[-1]] = LAW2[nat.normal]
     p = nat.props
     family = tl.family
     if family == NONE:
         nat.tangential = "none"
     else:
         mu, f_mu = mu_of(model, reasons)
+        if f_mu == APPROXIMATE:
+            keywords[reasons[-1]] = "frictionAngle"
         fid = worst(fid, f_mu)
         p["mu"] = mu
         if nat.normal == VISCEL and family == VISCOUS:
@@ -85,10 +90,12 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append("Yade caps the spring only (the dashpot is added uncapped while sticking, dropped "
                                "while slipping); the case asks for another truncation")
+                keywords[reasons[-1]] = LAW2[VISCEL]
             fid = worst(fid, APPROXIMATE)
             reasons.append("oblique impacts: on a wall Yade's slip velocity and torque use the arm R − δ (the "
                            "contact point on the wall's plane), and it turns the history with ScGeom's first-order "
                            "rotation")
+            keywords[reasons[-1]] = "ScGeom (Ig2_Wall_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom)"
         elif nat.normal == MINDLIN and family == SPRING and tl.kt_sqrt:
             # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
             # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
@@ -99,7 +106,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             return refused("yade", f"no Yade law pairs tangential '{model.tangential.id}' with the normal law "
                                    f"mapped here ({nat.normal})")
     nat.comments = comments
-    return Mapping("yade", fid, reasons, nat)
+    return Mapping("yade", fid, reasons, nat, keywords)
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
