@@ -86,6 +86,8 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     tol = opts.tolerances
     entry = {"case": case.name, "file": str(file), "case_hash": case.hash, "kind": case.kind,
              "sources": {}, "comparisons": [], "curves": {}, "series": []}
+    entry["walls"] = len(case.walls)  # a wall impact or a pair: the report's panels say which
+    entry["variant"] = variant_labels(case.name, file)
     if case.kind == "packing":
         from .packing_suite import run_packing
 
@@ -156,13 +158,46 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         for metric in ref:
             comps.append(verdicts.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
                                         twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons), scales, tol,
-                                        opts.expected))
+                                        opts.expected, setting=verdicts.mapping_setting(mp)))
     entry["series"] = [s for s in entry["series"] if s]
     entry["comparisons"] = [c.as_dict() for c in comps]
     worst = verdicts.worst(c.verdict for c in comps)
     entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
     entry["verdict"] = worst
     return entry
+
+
+def variant_labels(name: str, file) -> list[list[str]]:
+    """A variant's labels, [[label key, text], …] in the order of its file's ``[variants]`` table (case.expand
+    names a variant ``base[key=text,…,GROUP=label]``, a key by its last part, a group by its name); [] for a file
+    without variants, or a name that does not read that way. The report's panels keep cases whose other
+    labels differ on lines of their own."""
+    import tomllib
+
+    try:
+        raw = tomllib.loads(Path(file).read_text())
+    except (OSError, ValueError):
+        return []
+    variants, base = raw.get("variants"), raw.get("name")
+    if not (isinstance(variants, dict) and variants and isinstance(base, str)):
+        return []
+    keys = [k if isinstance(v, dict) else k.rsplit(".", 1)[-1] for k, v in variants.items()]
+    if not (name.startswith(base + "[") and name.endswith("]")):
+        return []
+    text, out = name[len(base) + 1:-1], []
+    for i, key in enumerate(keys):
+        if not text.startswith(key + "="):
+            return []
+        text = text[len(key) + 1:]
+        if i + 1 == len(keys):
+            out.append([key, text])
+            break
+        end = text.find("," + keys[i + 1] + "=")  # the next key's label starts after this one's text
+        if end < 0:
+            return []
+        out.append([key, text[:end]])
+        text = text[end + 1:]
+    return out
 
 
 def _incidence(case: Case) -> dict:

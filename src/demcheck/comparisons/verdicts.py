@@ -11,9 +11,10 @@ an engine the difference is split in two (docs/verify.md):
   behaviour (``data/expected_differences.toml``, matched by engine version).
 
 Each "differs as expected" carries the engine setting that causes it (``Comparison.setting``): an
-expected-differences entry's ``setting``, or, for an approximate mapping, the native configuration the
-mapping chose (recorded per case by :func:`unavailable` in ``entry["settings"]``). The report's traps
-section names them.
+expected-differences entry's ``setting``, or, for an approximate mapping, the native keyword each of the
+mapping's reasons is about (:func:`mapping_setting`, from ``Mapping.keywords``). The report's traps section
+names them. The whole native configuration the mapping chose is recorded per case too (:func:`unavailable`,
+``entry["settings"]``).
 
 Verdicts: agree, differs as expected, differs unexpectedly, not expressible, engine missing, failed.
 Only "differs unexpectedly" and "failed" fail a run.
@@ -58,8 +59,8 @@ class ExpectedDifference:
     engine: str
     versions: tuple[str, ...]
     reason: str
-    normal: str = "*"
-    tangential: str = "*"
+    normal: str | tuple[str, ...] = "*"  # a model id pattern, or a list of them
+    tangential: str | tuple[str, ...] = "*"
     metrics: tuple[str, ...] = ("*",)
     source: str = ""
     setting: str = ""  # the engine's own setting (keyword, class, law) that causes the difference
@@ -67,9 +68,13 @@ class ExpectedDifference:
     def matches(self, engine: str, version: str | None, model: dict, metric: str) -> bool:
         return (fnmatch.fnmatchcase(engine, self.engine)
                 and version is not None and any(fnmatch.fnmatchcase(version, v) for v in self.versions)
-                and fnmatch.fnmatchcase(model.get("normal", ""), self.normal)
-                and fnmatch.fnmatchcase(model.get("tangential", ""), self.tangential)
+                and _any_match(model.get("normal", ""), self.normal)
+                and _any_match(model.get("tangential", ""), self.tangential)
                 and any(fnmatch.fnmatchcase(metric, m) for m in self.metrics))
+
+
+def _any_match(value: str, patterns) -> bool:
+    return any(fnmatch.fnmatchcase(value, p) for p in ((patterns,) if isinstance(patterns, str) else patterns))
 
 
 def load_expected(path: str | Path | None = None) -> list[ExpectedDifference]:
@@ -91,14 +96,23 @@ def load_expected(path: str | Path | None = None) -> list[ExpectedDifference]:
         unknown = set(d) - {"engine", "versions", "reason", "normal", "tangential", "metrics", "source", "setting"}
         if unknown:
             raise ConfigError(f"{where}.{sorted(unknown)[0]}", d[sorted(unknown)[0]], "unknown key")
+        for key in ("normal", "tangential"):
+            v = d.get(key, "*")
+            if not (isinstance(v, str) or isinstance(v, list) and v and all(isinstance(x, str) for x in v)):
+                raise ConfigError(f"{where}.{key}", v, "must be a model id pattern or a non-empty list of them")
         if "setting" in d and not (isinstance(d["setting"], str) and d["setting"].strip()):
             raise ConfigError(f"{where}.setting", d["setting"], "must be a non-empty string: the engine's own "
                                                               "setting (keyword, class or law) that causes the difference")
         out.append(ExpectedDifference(engine=d["engine"], versions=tuple(d["versions"]), reason=d["reason"],
-                                      normal=d.get("normal", "*"), tangential=d.get("tangential", "*"),
+                                      normal=_patterns(d.get("normal", "*")),
+                                      tangential=_patterns(d.get("tangential", "*")),
                                       metrics=tuple(d.get("metrics", ["*"])), source=d.get("source", ""),
                                       setting=d.get("setting", "")))
     return out
+
+
+def _patterns(v):
+    return v if isinstance(v, str) else tuple(v)
 
 
 def scale(metric: str, ref: float, case_scales: dict) -> float:
@@ -160,7 +174,8 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
     """One metric of an engine run against the seed model. A run whose ``status`` is not "ok" (the
     reference's rules, reference/health.py) is FAILED whatever its values; so is a value that is not finite
     where the reference or the twin has one (a broken run is never "agree" or "differs as expected").
-    ``setting``: the native configuration the mapping chose, named on an approximate mapping's difference."""
+    ``setting``: the native keyword(s) the approximate mapping's reasons are about (:func:`mapping_setting`),
+    named on its difference."""
     diff = scaled(value, reference, metric, case_scales)
     impl = scaled(value, twin, metric, case_scales)
     step = scaled(seed_verlet, reference, metric, case_scales)
@@ -260,6 +275,19 @@ def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
         comps.append(status_comparison(engine, MISSING, why))
         return True
     return False
+
+
+def mapping_setting(mp) -> str:
+    """The native setting an approximate mapping's difference is about: the keyword of each of its reasons
+    (``Mapping.keywords``, the engine's own words), once each, joined by "; "; the whole native configuration
+    for a reason that names none. Empty for a mapping without reasons."""
+    keywords = getattr(mp, "keywords", None) or {}
+    out = []
+    for r in mp.reasons:
+        k = keywords.get(r) or (native_setting(mp.native) if mp.native is not None else "")
+        if k and k not in out:
+            out.append(k)
+    return "; ".join(out)
 
 
 def native_setting(native) -> str:
