@@ -2,7 +2,10 @@
 offset tick labels, one line per case file, no empty packing panel and no P(f) from a handful of contacts, no
 overlapping titles, markdown rendered (and raw HTML never let through), the matrix coloured by verdict, and a
 traps section naming the engine setting behind each expected difference — checked on the figures themselves,
-and on the page as headless Chromium lays it out (layout, not pixels)."""
+and on the page as headless Chromium lays it out (layout, not pixels). Review findings: a ``$…$`` in a file's
+name never reaches mathtext and a plot that fails never loses the page; a case name is never a link or
+emphasis; an approximate mapping's difference carries its keyword (the real path, suite → results.json); one
+trap per setting; pair or wall by the case's walls; a line per value of a file's other variant labels."""
 
 import html as htmllib
 import json
@@ -16,6 +19,7 @@ import numpy as np
 import pytest
 
 from demcheck.comparisons import packing_metrics, plots, report, suite, verdicts as V
+from demcheck.engines.base import APPROXIMATE
 from demcheck.comparisons.styles import style
 from demcheck.engines.cache import Cache
 from demcheck.errors import ConfigError
@@ -37,9 +41,11 @@ def _summary(cases, engines=ENGINES):
 
 
 def _collision(case, file, values, model=("hertz", "none"), speed=1.0, angle=None, spin=0.0, e_in=0.8,
-               metric="restitution", comparisons=()):
-    """A collision entry as suite.run_case writes it: ``values`` {source: value of ``metric``}."""
-    return {"case": case, "file": file, "kind": "collision", "status": "ok",
+               metric="restitution", comparisons=(), walls=1, variant=None):
+    """A collision entry as suite.run_case writes it: ``values`` {source: value of ``metric``}; ``variant``
+    its labels [[key, text], …]."""
+    return {"case": case, "file": file, "kind": "collision", "status": "ok", "walls": walls,
+            "variant": [list(x) for x in variant or []],
             "model": {"normal": model[0], "tangential": model[1], "limit_force": False},
             "impact": {"speed": speed, "restitution_input": e_in, "angle": angle, "spin": spin},
             "sources": {s: {"status": "ok", "metrics": {metric: v}} for s, v in values.items()},
@@ -55,7 +61,7 @@ def _packing(forces_n=None, profile=True, absent=None):
     and ``forces_n[source]`` contact forces; ``absent`` {source: status} sources that did not run."""
     forces_n = forces_n or {"reference": 400, "lammps": 400}
     prof = {"z": [1e-3 * k for k in range(1, 11)], "solid_fraction": [0.5 + 0.01 * k for k in range(10)]}
-    data = {s: {"ke": [(0.01 * k, 10.0 ** -k) for k in range(8)], "forces": _forces(n, seed=k) if n else {"x": [], "p": []},
+    data = {s: {"ke": [(0.01 * k, 10.0 ** -k) for k in range(8)], "forces": _forces(n, seed=k),
                 "profile": prof if profile else None} for k, (s, n) in enumerate(forces_n.items())}
     sources = {s: {"status": "ok", "metrics": {}} for s in data}
     sources.update({s: {"status": st} for s, st in (absent or {}).items()})
@@ -161,12 +167,17 @@ def test_y_axes_carry_no_offset_and_a_tiny_spread_stays_small(values):
     plt.close(fig)
 
 
-@pytest.mark.parametrize("n", [4, 16, 49, 50, 400, 1234])
-def test_the_contact_count_is_read_off_a_histogram(n):
-    # the histogram of n forces holds n of them (a recorded count wins)
-    assert report.force_count(_forces(n, seed=n)) == n
-    assert report.force_count({**_forces(n), "n": 7}) == 7
-    assert report.force_count({"x": [], "p": []}) == 0
+def test_the_contact_count_is_the_recorded_one_and_unknown_without_it():
+    assert report.force_count(_forces(400)) == 400 and report.force_count(_forces(0)) == 0
+    # a results.json from before force_distribution recorded n: the count is unknown, and nothing is drawn
+    assert report.force_count({k: v for k, v in _forces(400).items() if k != "n"}) is None
+    pack = _packing({"reference": 400, "lammps": 400})
+    del pack["packing"]["lammps"]["forces"]["n"]
+    fig = report.packing_figure(pack)
+    a2 = fig.axes[1]
+    assert [ln.get_label() for ln in a2.get_lines()] == ["reference"]
+    assert "lammps: count unknown" in " ".join(t.get_text().replace("\n", " ") for t in a2.texts)
+    plt.close(fig)
 
 
 def test_p_of_f_is_drawn_only_from_enough_contacts():
@@ -271,35 +282,164 @@ def _parse(page: str) -> _Text:
     return p
 
 
+# a name the case-name rule lets through (letters, spaces, [ ] ( ) : / _ .) that markdown would read as a link
+# and emphasis
+HOSTILE = "[click me](https://evil.example/x) _em_ wall"
+
+
 def _all_verdicts_summary():
     """One model, every verdict: lammps agrees on e, differs as expected on et, unexpectedly on E;
-    liggghts is missing; a hostile case name and reason (from a user's case file)."""
-    hostile = '<script>alert("x")</script>'
+    liggghts is missing; a hostile case name and reason (from a user's case file, an engine's message)."""
     comps = [V.Comparison("lammps", "restitution", 0.8, 0.8, 0, 0, 1e-6, V.AGREE).as_dict(),
              V.Comparison("lammps", "tangential_restitution", 0.5, 0.49, 0.01, 0.01, 1e-6, V.EXPECTED,
-                          "approximate mapping: a **regularised** slider <b>bold</b>").as_dict(),
-             V.Comparison("lammps", "energy_dissipated", 1, 2, 1, 1, 1e-6, V.UNEXPECTED, "no documented difference").as_dict(),
+                          "approximate mapping: a **regularised** slider <b>bold</b>", setting="tangential linear_nohistory").as_dict(),
+             V.Comparison("lammps", "energy_dissipated", 1, 2, 1, 1, 1e-6, V.UNEXPECTED, f"no documented difference in {HOSTILE}").as_dict(),
              V.status_comparison("liggghts", V.MISSING, "liggghts is not installed").as_dict()]
-    c = _collision(hostile, "x.toml", {"reference": 0.8, "lammps": 0.8}, model=("lsd", "sliding"), comparisons=comps)
+    c = _collision(HOSTILE, "x.toml", {"reference": 0.8, "lammps": 0.8}, model=("lsd", "sliding"), comparisons=comps)
     c["settings"] = {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     c["status"] = "unexpected"
     n_e = _collision("other", "y.toml", {"reference": 0.8}, model=("kk", "none"),
                      comparisons=[V.status_comparison("lammps", V.NOT_EXPRESSIBLE, "no law").as_dict(),
                                   V.status_comparison("liggghts", V.FAILED, "crashed").as_dict()])
-    s = _summary([c, n_e])
+    pack = _packing()
+    pack["case"] = HOSTILE + " pack"  # in the packings table's cells too
+    s = _summary([c, n_e, pack])
     s["failed"] = 2
     return s
 
 
+def _rendered_text(md: str) -> tuple[str, str]:
+    """report.md as a markdown viewer shows it: (its HTML, its visible text)."""
+    from markdown_it import MarkdownIt
+
+    page = MarkdownIt("commonmark").enable("table").render(md)
+    return page, "".join(_parse(page).text)
+
+
 def test_markdown_is_rendered_and_raw_html_never_let_through():
     page = report.render_html(_all_verdicts_summary())
-    assert page.count("<script>") == 1  # the page's own (plots-ok), not the case name's
-    assert "&lt;script&gt;alert(&quot;x&quot;)&lt;/script&gt;" in page and "<b>bold</b>" not in page
+    assert page.count("<script>") == 1  # the page's own (plots-ok)
+    assert "<b>bold</b>" not in page and "&lt;b&gt;bold&lt;/b&gt;" in page
+    assert "<strong>differs unexpectedly</strong>" in page  # the report's own markdown is rendered
+    # a reason is text, not markdown: shown as written
+    assert "<strong>regularised</strong>" not in page and "a **regularised** slider" in "".join(_parse(page).text)
+    assert "<h2>Traps</h2>" in page and "<code>tangential linear_nohistory</code>" in page
+
+
+def test_a_case_name_is_never_a_link_or_emphasis():
+    """Review finding: the name rule allows [ ] ( ) : / _, and the traps' and disagreements' case lists and the
+    tables' cells put names into markdown unescaped — the name became <a href> and <em> in report.html."""
+    from demcheck.case import check_name
+
+    assert check_name("name", HOSTILE) == HOSTILE  # the real route: a case file may carry this name
+    s = _all_verdicts_summary()
+    page = report.render_html(s)
+    assert "<a " not in page and "<em>" not in page and "evil.example/x" in page
     text = "".join(_parse(page).text)
-    assert "**" not in text
-    assert '<script>alert("x")</script>' in text  # shown as text
-    assert "<strong>differs unexpectedly</strong>" in page and "<strong>regularised</strong>" in page
-    assert "<h2>Traps</h2>" in page and "<code>hooke damping coeff_restitution tangential linear_nohistory</code>" in page
+    assert text.count(HOSTILE) >= 3  # traps, disagreements (markdown), cases (HTML), each literally
+    md = report.render_markdown(s)
+    html_md, text_md = _rendered_text(md)
+    assert "<a " not in html_md and "<em>" not in html_md
+    # literally in the traps' and disagreements' case lists, a reason, the cases' and the packings' table cells
+    assert text_md.count(HOSTILE) >= 5, text_md
+    assert "no documented difference in " + HOSTILE in text_md
+
+
+def test_a_case_name_in_the_baseline_section_is_never_a_link():
+    s = _all_verdicts_summary()
+    s["baseline"] = {"path": "/tmp/_b_/x.json", "old": {"run_id": "r"}, "checked": 1, "unchanged": 0,
+                     "regressions": 1, "counts": {"worse": 1, "moved": 0, "removed": 0, "better": 0},
+                     "engines": {"lammps": {"old": "22 Jul 2025", "new": "[v](https://evil.example/y)"}},
+                     "rows": [{"case": HOSTILE, "source": "lammps", "metric": "restitution", "old": 0.8, "new": 0.7,
+                               "moved": 0.1, "tolerance": 1e-6, "old_verdict": "agree",
+                               "new_verdict": "differs unexpectedly", "regression": True}]}
+    html_md, text_md = _rendered_text(report.render_markdown(s))
+    assert "<a " not in html_md and "<em>" not in html_md
+    assert HOSTILE in text_md and "/tmp/_b_/x.json" in text_md and "[v](https://evil.example/y)" in text_md
+    assert "<a " not in report.render_html(s)
+
+
+@pytest.fixture(scope="module")
+def hostile_run(tmp_path_factory):
+    """A real verify run (the reference alone) of normal-hertz-wall.toml saved as ``a$\frac$b.toml`` under the
+    hostile name: the review reproduced a ParseSyntaxException with it, exit 1 and no report.html."""
+    tmp = tmp_path_factory.mktemp("hostile")
+    text = (CASES / "suite" / "normal-hertz-wall.toml").read_text()
+    text = re.sub(r'(?m)^name = ".*"$', f'name = "{HOSTILE}"', text, count=1)
+    case = tmp / "a$\\frac$b.toml"
+    case.write_text(text)
+    s = suite.run_suite([case], tmp / "reports", suite.Options(engines=()), quiet=True, argv=["demcheck", "verify"])
+    return s, Path(s["report"])
+
+
+def test_a_dollar_in_a_file_name_is_drawn_as_text_and_the_report_is_written(hostile_run):
+    s, out = hostile_run
+    assert len(s["cases"]) == 3 and (out / "report.html").exists()
+    assert (out.parent / "latest").resolve() == out.resolve()
+    page = (out / "report.html").read_text()
+    assert "class='plot-error'" not in page and page.count('<img class="plot"') >= 2  # the speed panel, the curves
+    titles = [t for t, _ in report.suite_figures(s)]
+    assert titles == ["restitution in vs out", "restitution against impact speed"]
+    # the panel's title carries the file's name as it is
+    panels = report.speed_panels([c for c in s["cases"] if c.get("impact")])
+    assert list(panels) == ["hertz / none wall (a$\\frac$b)"]
+    fig = report.panel_grid(panels, ["reference"], "speed", "restitution", "v", "e", log_x=True)
+    fig.canvas.draw()
+    assert fig.axes[0].title.get_text().replace("\n", " ") == "hertz / none wall (a\\$\\frac\\$b)"  # no mathtext
+    plt.close(fig)
+
+
+def test_a_real_name_is_never_a_link_or_emphasis(hostile_run):
+    _, out = hostile_run
+    page = (out / "report.html").read_text()
+    assert "<a " not in page and "<em>" not in page
+    assert HOSTILE in "".join(_parse(page).text)
+    html_md, text_md = _rendered_text((out / "report.md").read_text())
+    assert "<a " not in html_md and "<em>" not in html_md and HOSTILE in text_md
+
+
+@pytest.mark.parametrize("text", ["a$\\frac$b", "$x$", "cost $5 and $", "a\\$b$c"])
+def test_user_text_never_reaches_mathtext(text):
+    series = [{"source": "reference", "t": [0, 1e-6, 2e-6], "delta": [0, 1e-6, 0], "fn": [0, 1.0, 0]}]
+    fig = report.case_figure(text, series)
+    plots.note(fig.axes[0], f"no data from {text}")  # a wrapped text
+    plots.note(fig.axes[1], text, centre=False)
+    fig.canvas.draw()  # mathtext would raise here (or draw $x$ as an italic x)
+    for t in (fig._suptitle, *fig.axes[0].texts, *fig.axes[1].texts):
+        assert t._preprocess_math(t.get_text()) == (t.get_text().replace("\\$", "$"), False)  # drawn as text
+        assert text in t.get_text().replace("\\$", "$").replace("\n", " ")
+    plt.close(fig)
+
+
+def test_a_plot_that_fails_leaves_a_note_and_the_report(tmp_path, monkeypatch):
+    def broken(*a, **k):
+        raise ValueError("Expected \\frac{num}{den}")
+
+    s = _summary([_collision(f"c[speed={v}]", "c.toml", {"reference": 0.8 + v / 100}, speed=v) for v in (0.1, 1.0)])
+    s["cases"][0]["series"] = [{"source": "reference", "t": [0, 1e-6], "delta": [0, 1e-6], "fn": [0, 1.0]}]
+    monkeypatch.setattr(report, "case_figure", broken)
+    page = report.render_html(s)
+    assert "the force curves of c[speed=0.1] could not be drawn (ValueError: Expected \\frac{num}{den})" in page
+    assert page.count('<img class="plot"') == 2  # the suite plots still drawn
+    monkeypatch.setattr(report, "suite_figures", broken)
+    s["cache"] = {"dir": str(tmp_path / "cache"), "hits": 0, "misses": 0}
+    report.write_all(s, tmp_path / "run", tmp_path)
+    page = (tmp_path / "run" / "report.html").read_text()
+    assert "the suite plots could not be drawn" in page and (tmp_path / "latest").resolve() == tmp_path / "run"
+    assert not list((tmp_path / "cache" / "plots").glob("*"))  # a failure is never cached
+
+
+def test_an_interrupt_while_drawing_still_writes_the_page(tmp_path, monkeypatch):
+    def interrupted(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(report, "suite_figures", interrupted)
+    s = _summary([_collision(f"c[speed={v}]", "c.toml", {"reference": 0.8}, speed=v) for v in (0.1, 1.0)])
+    with pytest.raises(KeyboardInterrupt):
+        report.write_all(s, tmp_path / "run", tmp_path)
+    page = (tmp_path / "run" / "report.html").read_text()
+    assert "No plots in this page: the run was interrupted" in page and "<h2>Cases</h2>" in page
+    assert (tmp_path / "latest").resolve() == tmp_path / "run"
 
 
 def test_matrix_cells_carry_their_verdicts_class():
@@ -316,37 +456,132 @@ def test_matrix_cells_carry_their_verdicts_class():
     assert all(f"class='{c}'" in legend[:legend.index("</p>")] for c in want.values())
 
 
+def _engine_words(engine: str) -> str:
+    return "".join(p.read_text() for p in (ROOT / "src" / "demcheck" / "engines" / engine).glob("*.py"))
+
+
 def test_traps_name_the_setting_of_each_expected_difference():
     entries = V.load_expected()
     assert entries and all(e.setting for e in entries)
     # each setting names what demcheck's own decks for that engine write (identifiers: words with _ or /)
     for e in entries:
-        package = "".join(p.read_text() for p in (ROOT / "src" / "demcheck" / "engines" / e.engine).glob("*.py"))
         words = re.findall(r"[A-Za-z0-9]+(?:[_/][A-Za-z0-9]+)+", e.setting)
         assert words, e.setting
         for w in words:
-            assert w in package, (e.engine, w)
+            assert w in _engine_words(e.engine), (e.engine, w)
     # the shipped lammps entry, on a comparison of a results.json written before comparisons carried a setting
     lam = next(e for e in entries if e.engine == "lammps")
     old = V.Comparison("lammps", "tangential_restitution", 0.5, 0.49, 0.01, 0.01, 1e-6, V.EXPECTED,
                        f"{lam.reason} ({lam.source})").as_dict()
     del old["setting"]
-    kratos = [V.Comparison("kratos", m, 1, 1.1, 0.1, 0.1, 1e-6, V.EXPECTED,
-                           "approximate mapping: the force is held at >= 0").as_dict()
-              for m in ("restitution", "contact_time")]
     poured = V.Comparison("lammps", "solid_fraction (range)", 0.5, 0.55, 0, 0, 0.09, V.EXPECTED,
                           "outside the physical range").as_dict()
-    c1 = _collision("k1", "k.toml", {}, comparisons=kratos)
-    c1["settings"] = {"kratos": "DEM_D_Linear_viscous_Coulomb E*=1.80578e+09 DAMPING_GAMMA=0.0335184 no friction"}
-    c2 = _collision("k2", "k.toml", {}, comparisons=kratos + [old, poured])
-    c2["settings"] = {"kratos": "DEM_D_Linear_viscous_Coulomb E*=3.2e+10 DAMPING_GAMMA=0.1 no friction"}
-    found = report.traps(_summary([c1, c2]))
-    assert [(t["engine"], t["comparisons"], len(t["cases"])) for t in found] == [("kratos", 4, 2), ("lammps", 1, 1)]
-    assert found[0]["settings"] == ["DEM_D_Linear_viscous_Coulomb E*=… DAMPING_GAMMA=… no friction"]
-    assert found[1]["settings"] == [lam.setting] and found[1]["source"] == lam.source
-    md = report.render_markdown(_summary([c1, c2]))
+    c = _collision("k", "k.toml", {}, comparisons=[old, poured])
+    found = report.traps(_summary([c]))
+    assert [(t["engine"], t["settings"], t["source"]) for t in found] == [("lammps", [lam.setting], lam.source)]
+    md = report.render_markdown(_summary([c]))
     traps = md[md.index("## Traps"):md.index("## Disagreements")]
     assert f"`{lam.setting}`" in traps and "physical range" not in traps
+
+
+def _approximate(engine, metric, reason, setting):
+    return V.Comparison(engine, metric, 1, 1.1, 0.1, 0.1, 1e-6, V.EXPECTED, "approximate mapping: " + reason,
+                        setting=setting).as_dict()
+
+
+def test_one_trap_per_setting_whatever_the_cases_numbers():
+    """Review finding: a trap named the whole native configuration and was keyed by a reason carrying the
+    case's numbers (gammat = 5.038e+08), so one setting was listed once per mass in a large suite."""
+    why = "simple sliding friction as no_history with gammat = {:.4g} 1/s: a regularised slider near v_t = 0"
+    cases = []
+    for k, gammat in enumerate((5.038e8, 2.1e7, 9.9e9)):
+        comps = [_approximate("liggghts", m, why.format(gammat), "tangential no_history")
+                 for m in ("tangential_restitution", "rebound_angular_velocity")]
+        comps.append(_approximate("liggghts", "energy_dissipated", f"hertz + history: ηt = {0.9 + k / 100:.4f} ηn",
+                                  "model hertz tangential history"))
+        comps.append(_approximate("lammps", "tangential_restitution", why.format(gammat), "tangential linear_nohistory"))
+        c = _collision(f"s{k}", f"s{k}.toml", {}, comparisons=comps)
+        c["settings"] = {"liggghts": f"model hooke/stiffness tangential no_history gammat={gammat}"}
+        cases.append(c)
+    found = report.traps(_summary(cases))
+    assert [(t["engine"], t["settings"], t["comparisons"], len(t["cases"])) for t in found] == [
+        ("liggghts", ["tangential no_history"], 6, 3),
+        ("lammps", ["tangential linear_nohistory"], 3, 3),
+        ("liggghts", ["model hertz tangential history"], 3, 3)]
+    assert found[0]["reason"] == why.replace("{:.4g}", "…")
+    assert found[2]["reason"] == "hertz + history: ηt = … ηn"
+    md = report.render_markdown(_summary(cases))
+    traps = md[md.index("## Traps"):md.index("## Disagreements")]
+    assert traps.count("`tangential no_history`") == 1 and "5.038e+08" not in traps
+    # a comparison whose mapping has two reasons names both keywords
+    two = _approximate("lammps", "tangential_restitution", "limit_damping …; one friction coefficient only",
+                       "limit_damping; tangential linear_nohistory mu")
+    assert report.traps(_summary([_collision("t", "t.toml", {}, comparisons=[two])]))[0]["settings"] == [
+        "limit_damping", "tangential linear_nohistory mu"]
+    # a results.json from before comparisons carried a setting: the case's native configuration, numbers out
+    old = _approximate("liggghts", "tangential_restitution", why.format(1e8), "")
+    del old["setting"]
+    c = _collision("o", "o.toml", {}, comparisons=[old])
+    c["settings"] = {"liggghts": "model hooke/stiffness tangential no_history gammat=1e+08"}
+    assert report.traps(_summary([c]))[0]["settings"] == ["model hooke/stiffness tangential no_history gammat=…"]
+
+
+def _mappings():
+    """Every mapping of the cases under cases/, and of every registered normal and tangential law on the mapping
+    table's glass pair (docs/models.md), with μk = μs and μk ≠ μs: (engine, Mapping)."""
+    import copy
+    import tomllib
+
+    from demcheck.case import apply_overrides, expand, from_dict
+    from demcheck.engines import mapping, registry
+    from demcheck.reference import normal, tangential
+    from demcheck.reference.model import resolve
+
+    out = []
+    for f in sorted(CASES.rglob("*.toml")):
+        if "optin" in f.parts:
+            continue
+        try:
+            cases = expand(f)
+        except ConfigError:
+            continue
+        for case in cases:
+            if case.kind != "packing":
+                out += [(e, mapping.contact_mapping(case, e)) for e in registry.names()]
+    for nid in normal.REGISTRY:
+        for tid in tangential.REGISTRY:
+            for extra in ({}, {"friction_kinetic": 0.2}):
+                params = {**normal.REGISTRY[nid].example, **tangential.REGISTRY[tid].example, **extra}
+                params.pop("friction", None)
+                sets = [f"contact.normal={nid}", f"contact.tangential={tid}"]
+                sets += [f"contact.{k}={mapping._toml(v)}" for k, v in params.items()]
+                try:
+                    case = from_dict(apply_overrides(copy.deepcopy(tomllib.loads(mapping._TABLE_CASE)), sets))
+                    model = resolve(case)
+                except ConfigError:
+                    continue
+                out += [(e, mapping.map_model(model, e, case.contact.params)) for e in registry.names()]
+    return out
+
+
+def test_every_approximate_reason_names_its_native_keyword():
+    """Each reason of an approximate mapping names the setting it is about, in its engine's own words (what the
+    traps show): never a reason without one, never a word the engine's package does not use."""
+    seen = set()
+    for engine, mp in _mappings():
+        if mp.fidelity != APPROXIMATE:
+            continue
+        for r in mp.reasons:
+            assert mp.keywords.get(r), (engine, r)
+            seen.add((engine, mp.keywords[r]))
+        assert V.mapping_setting(mp) == "; ".join(dict.fromkeys(mp.keywords[r] for r in mp.reasons))
+    for engine, keyword in seen:
+        for w in re.findall(r"[A-Za-z0-9_/]+", keyword):
+            assert w in _engine_words(engine), (engine, w)
+    assert {("lammps", "tangential linear_nohistory"), ("liggghts", "tangential no_history"),
+            ("liggghts", "model hertz tangential history"), ("liggghts", "coefficientFriction"),
+            ("lammps", "tangential linear_history mu"), ("kratos", "DEM_D_Hertz_viscous_Coulomb"),
+            ("yade", "Law2_ScGeom_ViscElPhys_Basic")} <= seen
 
 
 @pytest.mark.parametrize("value,message", [(3, "setting = 3: must be a non-empty string"),
@@ -357,6 +592,31 @@ def test_a_bad_setting_in_the_expected_differences_is_one_clear_line(tmp_path, v
     with pytest.raises(ConfigError) as exc:
         V.load_expected(path)
     assert message in str(exc.value) and len(str(exc.value).splitlines()) == 1
+
+
+@pytest.mark.parametrize("value", ["[]", "[1]", "3"])
+def test_a_bad_model_pattern_in_the_expected_differences_is_one_clear_line(tmp_path, value):
+    path = tmp_path / "expected.toml"
+    path.write_text(f'[[difference]]\nengine = "lammps"\nversions = ["*"]\nreason = "x"\ntangential = {value}\n')
+    with pytest.raises(ConfigError) as exc:
+        V.load_expected(path)
+    assert "tangential" in str(exc.value) and len(str(exc.value).splitlines()) == 1
+
+
+def test_the_expected_differences_fit_their_settings():
+    """Review finding: the LIGGGHTS entry ("with tangential history") matched every tangential law, simple
+    sliding's no_history too; Yade's kinematic entry named ViscElPhys's law alone, though it matches MindlinPhys."""
+    from demcheck.engines import mapping
+
+    lig = next(e for e in V.load_expected() if e.engine == "liggghts")
+    history = {r["tangential"] for r in mapping.table() if "tangential history" in r["liggghts_config"]}
+    assert history == {"spring_sliding", "lsd_sliding", "ddt", "tti"} and set(lig.tangential) == history
+    for tid, want in (("tti", True), ("lsd_sliding", True), ("sliding", False), ("viscous_sliding", False)):
+        model = {"normal": "lsd", "tangential": tid}
+        assert lig.matches("liggghts", "LIGGGHTS-PUBLIC 3.8.0", model, "tangential_restitution") is want, tid
+    yade = next(e for e in V.load_expected() if e.engine == "yade" and "ScGeom" in e.setting)
+    assert "Law2_ScGeom_ViscElPhys_Basic" in yade.setting and "Law2_ScGeom_MindlinPhys_Mindlin" in yade.setting
+    assert yade.tangential == "*" and yade.normal == "*"
 
 
 def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
@@ -374,18 +634,83 @@ def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
 
     c = judge(0.52, "exact", [rule])
     assert (c.verdict, c.setting) == (V.EXPECTED, "pair_style granular") and c.as_dict()["setting"] == c.setting
-    c = judge(0.52, "approximate", setting="mindlin")
-    assert (c.verdict, c.setting) == (V.EXPECTED, "mindlin")
     c = judge(0.5, "approximate", setting="mindlin")
     assert (c.verdict, c.setting) == (V.AGREE, "")  # an agreement names no trap
-    # the mapping's native configuration, as docs/models.md's table gives it for lsd / sliding
+    # what the suite passes for oblique-sliding: the keyword of the mapping's reason, not its whole configuration
     case = expand(CASES / "suite" / "oblique-sliding.toml")[0]
+    mp = contact_mapping(case, "lammps")
+    c = judge(0.52, mp.fidelity, setting=V.mapping_setting(mp))
+    assert (c.verdict, c.setting) == (V.EXPECTED, "tangential linear_nohistory")
     entry, comps = {"sources": {}}, []
     found = {e: {"found": True} for e in ("lammps", "yade")}
     for e in ("lammps", "yade"):
         V.unavailable(entry, comps, e, contact_mapping(case, e), found)
     assert entry["settings"] == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     assert entry["sources"]["yade"]["status"] == "not expressible"
+
+
+# ----------------------------------------------------------------------------- panels: pair or wall, lines
+
+
+def test_pair_or_wall_is_the_cases_walls_not_its_name():
+    cases = [_collision(f"wallace-pair[speed={v}]", "wallace-pair.toml", {"reference": 0.8}, speed=v, walls=0)
+             for v in (0.1, 1.0)]
+    cases += [_collision(f"x[speed={v}]", "x.toml", {"reference": 0.8}, speed=v, walls=1) for v in (0.1, 1.0)]
+    old = [_collision(f"o[speed={v}]", "o.toml", {"reference": 0.8}, speed=v) for v in (0.1, 1.0)]
+    for c in old:
+        del c["walls"]  # a results.json from before entries carried it: neither said
+    assert sorted(report.speed_panels(cases + old)) == ["hertz / none (o)", "hertz / none pair (wallace-pair)",
+                                                        "hertz / none wall (x)"]
+
+
+def test_a_line_per_value_of_a_files_other_variant_labels():
+    """Review finding: the panels grouped by file alone, so a file varying a second key joined its values in
+    one line. normal-tti-wall varies the speed and limit_force; a file may vary a restitution with the speed."""
+    cases = []
+    for e_in in (0.5, 0.9):
+        for v in (0.1, 1.0, 10.0):
+            cases.append(_collision(f"f[speed={v:g},restitution={e_in:g}]", "f.toml", {"reference": e_in}, speed=v,
+                                    e_in=e_in, variant=[("speed", f"{v:g}"), ("restitution", f"{e_in:g}")]))
+    panels = report.speed_panels(cases)
+    assert sorted(panels) == ["hertz / none wall (f, restitution=0.5)", "hertz / none wall (f, restitution=0.9)"]
+    assert all(len({c["impact"]["restitution_input"] for c in cs}) == 1 and len(cs) == 3 for cs in panels.values())
+    # a label that sets x itself (a velocity setting the angle; a group zipping angle and spin) is the line
+    vel = [_collision(f"g[velocity=[{a}]]", "g.toml", {"reference": 0.5}, model=("lsd", "tti"), angle=a, speed=5 + a,
+                      variant=[("velocity", f"[{a}, 0.0, -5.0]")]) for a in (5.0, 30.0, 60.0)]
+    zipped = [_collision(f"h[g={k}]", "h.toml", {"reference": 0.5}, model=("lsd", "tti"), angle=a, spin=10.0 * k,
+                         variant=[("g", str(k))]) for k, a in enumerate((5.0, 30.0, 60.0))]
+    both = [_collision(f"o[angle={a:g},spin={w:g}]", "o.toml", {"reference": 0.5}, model=("lsd", "tti"), angle=a,
+                       spin=w, variant=[("angle", f"{a:g}"), ("spin", f"{w:g}")]) for a in (5.0, 30.0) for w in (0.0, 1500.0)]
+    panels = report.angle_panels(vel + zipped + both)
+    assert sorted((t, len(cs)) for t, cs in panels.items()) == [
+        ("lsd / tti (g)", 3), ("lsd / tti (h)", 3), ("lsd / tti (o, spin=0)", 2), ("lsd / tti (o, spin=1500)", 2)]
+
+
+def test_the_suite_records_walls_and_variant_labels():
+    from demcheck.case import expand
+
+    f = CASES / "suite" / "normal-tti-wall.toml"
+    names = [c.name for c in expand(f)]
+    assert suite.variant_labels(names[1], f) == [["speed", "0.1"], ["limit_force", "true"]]
+    g = next(CASES.rglob("chung-ooi-7-copper-tti.toml"))  # a [variants.GROUP]
+    assert [suite.variant_labels(c.name, g) for c in expand(g)] == [[["spin", "1"]], [["spin", "10"]]]
+    assert suite.variant_labels("glass", CASES / "glass-pair.toml") == []
+
+
+def test_the_packing_panels_carry_no_second_title_and_the_table_its_fabric():
+    fig = report.packing_figure(_packing())
+    assert fig._suptitle is None  # report.html heads the plot with an h3 of its own
+    plt.close(fig)
+    pack = _packing()
+    for src, phi in (("reference", 0.3312), ("lammps", 0.3345)):
+        pack["sources"][src]["metrics"]["fabric_zz"] = phi
+    pack["comparisons"] = [V.Comparison("lammps", "fabric_zz", 0.3345, 0.3312, 0.0021, 0.0021, 0.021, V.AGREE).as_dict()]
+    md = "\n".join(report._md_packings(_summary([pack])))
+    assert "φ_zz" in md.splitlines()[4]
+    rows = {line.split(" | ")[1]: line for line in md.splitlines() if line.startswith("| pack |")}
+    assert "| 0.3312 |" in rows["reference"] and "| 0.3345; 0.0021 (0.0210) agree |" in rows["lammps"]
+    page = report.render_html(_summary([pack]))
+    assert page.count("<h3>packing pack</h3>") == 1
 
 
 # ----------------------------------------------------------------------------- with the engines, in a browser
@@ -415,6 +740,8 @@ window.addEventListener('load', function () {
   var h = [].filter.call(document.querySelectorAll('h2'), function (e) { return e.textContent === 'Traps'; })[0];
   for (var e = h && h.nextElementSibling; e && e.tagName !== 'H2'; e = e.nextElementSibling)
     [].forEach.call(e.querySelectorAll('code'), function (c) { out.traps.push(c.textContent); });
+  out.plots = +document.body.getAttribute('data-plots');
+  out.plots_ok = +document.body.getAttribute('data-plots-ok');
   document.body.setAttribute('data-layout', JSON.stringify(out));
 });
 </script>
@@ -484,18 +811,31 @@ def engine_report(tmp_path_factory):
 @pytest.mark.engine("lammps")
 @pytest.mark.engine("liggghts")
 def test_a_real_run_names_its_traps(engine_report):
+    """The real path (review finding: the suite never passed a setting, so the traps read only the case's
+    whole native configuration): run_case → judge_engine(setting=the mapping's keywords) → results.json."""
     s, out = engine_report
     assert s["failed"] == 0
     md = (out / "report.md").read_text()
     traps = md[md.index("## Traps"):md.index("## Disagreements")]
     lam = next(e for e in V.load_expected() if e.engine == "lammps")
     assert f"**lammps** — `{lam.setting}` (expected difference)" in traps  # oblique-spring-sliding
-    # the approximate mappings of simple sliding, by the setting each engine runs (docs/models.md's table)
-    assert "**lammps** — `hooke damping coeff_restitution tangential linear_nohistory` (approximate mapping)" in traps
-    assert "**liggghts** — `model hooke/stiffness tangential no_history` (approximate mapping)" in traps
-    data = json.loads((out / "results.json").read_text())  # the settings are kept for demcheck diff and others
+    # simple sliding's approximate mappings, by the keyword each is about — once each
+    assert traps.count("**liggghts** — `tangential no_history` (approximate mapping)") == 1
+    assert "hooke/stiffness" not in traps and "coeff_restitution" not in traps  # not the whole configuration
+    data = json.loads((out / "results.json").read_text())
     sliding = next(c for c in data["cases"] if c["case"].startswith("suite-sliding"))
-    assert set(sliding["settings"]) == {"lammps", "liggghts"}
+    assert set(sliding["settings"]) == {"lammps", "liggghts"}  # the whole configurations are kept too
+    documented = {f"{e.reason} ({e.source})": e.setting for e in V.load_expected()}
+    seen = set()
+    for c in data["cases"]:
+        for k in c["comparisons"]:
+            if k["verdict"] != V.EXPECTED or k["source"] not in ("lammps", "liggghts"):
+                continue
+            if k["reason"].startswith(report.APPROXIMATE):
+                seen.add((k["source"], k["setting"]))
+            else:
+                assert k["setting"] == documented[k["reason"]], k
+    assert seen == {("lammps", "tangential linear_nohistory"), ("liggghts", "tangential no_history")}
 
 
 @pytest.mark.browser
@@ -522,11 +862,6 @@ def test_the_report_lays_out_in_headless_chromium(engine_report, tmp_path):
     assert {"v-agree", "v-expected", "v-not-expressible"} <= set(cells)  # HLS in LAMMPS: not expressible
     assert len(set(cells.values())) == len(cells)  # each verdict its own background
     assert "**" not in lay["text"]
-    assert any("pair_style granular" in t for t in lay["traps"]) and any("linear_nohistory" in t for t in lay["traps"])
-    # and a screenshot at the window's size: the page renders (its pixels are not compared)
-    shot = tmp_path / "report.png"
-    subprocess.run([_chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1400,3000",
-                    f"--screenshot={shot}", page.as_uri()], capture_output=True, timeout=180)
-    head = shot.read_bytes()[:24]
-    assert head[:8] == b"\x89PNG\r\n\x1a\n" and int.from_bytes(head[16:20], "big") == 1400
-    assert int.from_bytes(head[20:24], "big") == 3000
+    assert any("pair_style granular" in t for t in lay["traps"]) and "tangential no_history" in lay["traps"]
+    # every plot decoded (the page's own script sets data-plots-ok once they have)
+    assert lay["plots_ok"] == lay["plots"] == len(imgs)

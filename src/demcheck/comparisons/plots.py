@@ -10,6 +10,8 @@ every plot of the reports follows:
 * a y range of at least ``MIN_REL_SPAN`` of the panel's largest |value| (:func:`min_span`);
 * titles wrapped (:func:`wrap_title`) and every figure laid out by matplotlib's constrained layout, so that
   no title, suptitle or legend overlaps another;
+* text from outside demcheck's own words (a case's name, a file's, a source's) drawn as it is, never read as
+  mathtext (:func:`literal`: a ``$…$`` in a file name once stopped the report);
 * a panel with nothing to draw says why in the panel (:func:`note`), never left empty.
 """
 
@@ -95,20 +97,39 @@ def min_span(ax, values, rel: float = MIN_REL_SPAN) -> None:
         ax.set_ylim(mid - 0.55 * need, mid + 0.55 * need)
 
 
+def literal(text) -> str:
+    """Text that matplotlib draws as it is: every ``$`` escaped (``\\$``), so that no ``$…$`` in it is parsed
+    as mathtext (an unbalanced one raised, and the report was lost). For every text that is not demcheck's own
+    words: titles (:func:`wrap_title`), notes (:func:`note`), axis labels taken from data. (Escaping, not
+    ``parse_math=False``: a wrapped text is measured as mathtext whatever its parse_math says, matplotlib 3.11.)"""
+    return str(text).replace("$", "\\$")
+
+
 def wrap_title(text: str, width: int = 34) -> str:
-    return textwrap.fill(str(text), width=width, break_long_words=True, break_on_hyphens=False)
+    """A title wrapped at ``width`` characters, drawn literally (:func:`literal`)."""
+    return literal(textwrap.fill(str(text), width=width, break_long_words=True, break_on_hyphens=False))
 
 
 def note(ax, text: str, centre: bool = True) -> None:
-    """A note in a panel: in its middle when the panel has nothing else to show, else along its bottom."""
+    """A note in a panel: in its middle when the panel has nothing else to show, else along its bottom; drawn
+    literally (it names sources and their statuses)."""
     kw = {"transform": ax.transAxes, "fontsize": 7, "color": "0.25", "wrap": True}
     if centre:
         ax.set_xticks([])
         ax.set_yticks([])
-        ax.text(0.5, 0.5, textwrap.fill(text, 40), ha="center", va="center", **kw)
+        ax.text(0.5, 0.5, literal(textwrap.fill(text, 40)), ha="center", va="center", **kw)
     else:
-        ax.text(0.03, 0.03, textwrap.fill(text, 48), ha="left", va="bottom",
+        ax.text(0.03, 0.03, literal(textwrap.fill(text, 48)), ha="left", va="bottom",
                 bbox={"facecolor": "white", "edgecolor": "0.8", "alpha": 0.85, "pad": 2}, **kw)
+
+
+def legend(where, *args, **kw):
+    """``where.legend(…)`` (an Axes or a Figure) with its labels — source names, a build's label — drawn
+    literally, never as mathtext."""
+    leg = where.legend(*args, **kw)
+    for t in leg.get_texts():
+        t.set_parse_math(False)
+    return leg
 
 
 def _label(result) -> str:
@@ -138,7 +159,7 @@ def collision_panels(results, path) -> None:
         ax.grid(alpha=0.3)
         plain_ticks(ax)
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=8)
+            legend(ax, fontsize=8)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)

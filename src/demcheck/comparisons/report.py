@@ -34,7 +34,13 @@ def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = Non
     write_text(out_dir / "junit.xml", junit_text)
     if junit is not None:
         write_text(junit, junit_text)
-    write_text(out_dir / "report.html", render_html(summary))
+    try:
+        page = render_html(summary)
+    except KeyboardInterrupt:  # interrupted while drawing: the page without its plots, then stop
+        write_text(out_dir / "report.html", render_html(summary, draw=False))
+        link_latest(root, out_dir, link)
+        raise
+    write_text(out_dir / "report.html", page)
     link_latest(root, out_dir, link)
 
 
@@ -69,14 +75,30 @@ def _model(c: dict) -> str:
 def _engine_text(summary: dict) -> str:
     parts = []
     for name, e in summary["engines"].items():
-        parts.append(f"{name} {e['version']}" if e["found"] else f"{name}: missing ({e['how_to_install']})")
+        parts.append(f"{_md(name)} {_md(e['version'])}" if e["found"] else
+                     f"{_md(name)}: missing ({_md(e['how_to_install'])})")
     return "; ".join(parts) if parts else "none selected (reference only)"
 
 
+# the ASCII punctuation markdown may read in running text (CommonMark, and GitHub's autolinks, tables and
+# strikethrough): every character but - , = + ' " ; % ? ( ) /, which mean nothing in the middle of a line
+# once [ ] < > : . & are escaped (no link, autolink or entity can form; no line starts with user text)
+_MD_PUNCTUATION = re.compile("([" + re.escape("".join(sorted(set(map(chr, range(33, 127))) - set(
+    map(chr, [*range(48, 58), *range(65, 91), *range(97, 123)])) - set("-,=+'\";%?()/")))) + "])")
+
+
+def _md(text) -> str:
+    """Text as markdown that renders as itself: its markdown punctuation backslash-escaped (CommonMark lets
+    any ASCII punctuation be; :data:`_MD_PUNCTUATION`), a line break a space. Everything a report takes from
+    outside its own words goes through it — case names and files (a name may hold ``[ ] ( ) : / _``:
+    ``[x](https://…) _y_`` would be a link and emphasis), sources, reasons and messages — so that none is read
+    as a link, emphasis, code or a table's ``|``, in report.md or in report.html."""
+    return _MD_PUNCTUATION.sub(r"\\\1", str(text).replace("\r", " ").replace("\n", " "))
+
+
 def _cell(text) -> str:
-    """Text for a markdown table cell: a ``|`` (in a case name or a reason, from a user's case file) would end
-    the cell, a line break the row."""
-    return str(text).replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+    """Text for a markdown table cell (:func:`_md`: a ``|`` would end the cell, a line break the row)."""
+    return _md(text)
 
 
 def matrix(summary: dict) -> dict:
@@ -126,7 +148,7 @@ def _md_header(summary: dict) -> list[str]:
               f"{summary.get('wall_time', 0):.1f} s", "", f"Engines: {_engine_text(summary)}", ""]
     if "cache" in summary:
         lines += [f"Engine-run cache: {summary['cache']['hits']} hits, {summary['cache']['misses']} misses "
-                  f"({summary['cache']['dir']})", ""]
+                  f"({_md(summary['cache']['dir'])})", ""]
     counts: dict = defaultdict(int)
     for c in summary["cases"]:
         for k in c.get("comparisons", []):
@@ -137,8 +159,18 @@ def _md_header(summary: dict) -> list[str]:
     if "baseline" in summary:
         from .diff import baseline_markdown
 
-        lines += baseline_markdown(summary["baseline"])
+        lines += baseline_markdown(_escaped_baseline(summary["baseline"]))
     return lines
+
+
+def _escaped_baseline(b: dict) -> dict:
+    """The baseline check with its outside texts — the baseline's path, case names, sources, metrics, engine
+    versions — escaped (:func:`_md`) for diff.baseline_markdown, which writes them into markdown as they are."""
+    rows = [{**r, **{k: _md(r[k]) for k in ("case", "source", "metric") if isinstance(r.get(k), str)}}
+            for r in b.get("rows", [])]
+    engines = {_md(k): {side: _md(x) if isinstance(x, str) else x for side, x in v.items()}
+               for k, v in (b.get("engines") or {}).items()}
+    return {**b, "path": _md(b.get("path", "")), "rows": rows, "engines": engines}
 
 
 def _md_matrix(summary: dict) -> list[str]:
@@ -151,7 +183,7 @@ def _md_matrix(summary: dict) -> list[str]:
              "unexpectedly, n/e not expressible, missing (engine not installed), FAIL (a run failed), · not "
              "compared. Columns: " + ", ".join(name for _, _, name in MATRIX_METRICS) + ".", ""]
     marks = " · ".join(mark for _, mark, _ in MATRIX_METRICS)
-    lines += ["| model | " + " | ".join(f"{s}: {marks}" for s in sources) + " |",
+    lines += ["| model | " + " | ".join(f"{_cell(s)}: {marks}" for s in sources) + " |",
               "|---|" + "---|" * len(sources)]
     for m in models:
         cells = []
@@ -178,10 +210,10 @@ def _md_disagreements(summary: dict) -> list[str]:
         worst = max((h[2] for h in hits if h[2] is not None and math.isfinite(h[2])), default=None)
         cases = sorted({h[0] for h in hits})
         metrics = sorted({h[1] for h in hits})
-        lines += [f"* **{verdict}** — {source}: {reason}",
-                  f"  {len(hits)} comparison(s) in {len(cases)} case(s); metrics {', '.join(metrics)}"
+        lines += [f"* **{verdict}** — {_md(source)}: {_md(reason)}",
+                  f"  {len(hits)} comparison(s) in {len(cases)} case(s); metrics {_md(', '.join(metrics))}"
                   + (f"; largest scaled difference {worst:.3g}" if worst is not None else "")
-                  + f". Cases: {', '.join(cases[:6])}{' …' if len(cases) > 6 else ''}"]
+                  + f". Cases: {_md(', '.join(cases[:6]))}{' …' if len(cases) > 6 else ''}"]
     return lines + [""]
 
 
@@ -189,17 +221,19 @@ APPROXIMATE = "approximate mapping: "
 MAPPING_DOC = "docs/models.md (the mapping table: each engine's configuration and why it is approximate)"
 
 
-def _generic_setting(text: str) -> str:
-    """A native configuration with its numbers left out (``E*=7.1e+10`` → ``E*=…``): the setting, whatever
-    the case's values, so that one trap is named once."""
-    return re.sub(r"=\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?", "=…", text)
+def _generic(text: str) -> str:
+    """A setting or reason with the case's numbers left out (``gammat = 5.038e+08`` → ``gammat = …``,
+    ``E*=7.1e+10`` → ``E*=…``): the same trap whatever the case's values, so that it is named once."""
+    # a number after "=" and not part of a word ("Kt = 8G*" stays); "= 0" stays (not the case's)
+    return re.sub(r"(=\s*)(?!0(?![\w.]))[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(?![\w.])", r"\1…", text)
 
 
 def traps(summary: dict) -> list[dict]:
-    """Every expected difference of an engine met in the run, with the engine setting that causes it: an
-    entry of data/expected_differences.toml (its ``setting`` and ``source``), or an approximate mapping (the
-    native configuration the mapping chose for those cases, ``entry["settings"]``; documented in the mapping
-    table). Most comparisons first."""
+    """Every expected difference of an engine met in the run, grouped by (engine, setting, reason with its
+    numbers left out), the setting being what causes it: an entry of data/expected_differences.toml (its
+    ``setting`` and ``source``), or an approximate mapping (the native keyword each of its reasons is about,
+    ``Comparison.setting`` from ``Mapping.keywords``; documented in the mapping table). Most comparisons
+    first."""
     # the shipped entries by the reason a comparison carries (judge_engine's words): their source, and the
     # setting of a comparison from a results.json written before comparisons carried it
     documented = {f"{e.reason} ({e.source})" if e.source else e.reason: e for e in verdicts.load_expected()}
@@ -210,27 +244,29 @@ def traps(summary: dict) -> list[dict]:
                 continue
             reason = k["reason"]
             entry = documented.get(reason)
-            if not (reason.startswith(APPROXIMATE) or entry is not None or k.get("setting")):
+            approximate = reason.startswith(APPROXIMATE)
+            if not (approximate or entry is not None or k.get("setting")):
                 continue  # not an engine setting's doing (a poured packing outside its physical range)
-            if reason.startswith(APPROXIMATE):
-                setting = k.get("setting") or (c.get("settings") or {}).get(k["source"], "")
-                g = groups.setdefault((k["source"], reason), {
-                    "engine": k["source"], "reason": reason[len(APPROXIMATE):], "kind": "approximate mapping",
-                    "settings": set(), "source": MAPPING_DOC, "cases": set(), "metrics": set(), "comparisons": 0})
+            if approximate:
+                # the keywords, "; "-joined; a results.json from before comparisons carried them: the whole
+                # native configuration the case recorded
+                setting = k.get("setting") or _generic((c.get("settings") or {}).get(k["source"], ""))
+                settings = [x for x in setting.split("; ") if x]
+                text, kind, source = reason[len(APPROXIMATE):], "approximate mapping", MAPPING_DOC
             else:
                 setting = k.get("setting") or (entry.setting if entry else "")
-                g = groups.setdefault((k["source"], reason), {
-                    "engine": k["source"], "reason": entry.reason if entry else reason,
-                    "kind": "expected difference", "settings": set(),
-                    "source": entry.source if entry else "", "cases": set(), "metrics": set(), "comparisons": 0})
-            if setting:
-                g["settings"].add(_generic_setting(setting))
+                settings = [setting] if setting else []
+                text, kind = (entry.reason if entry else reason), "expected difference"
+                source = entry.source if entry else ""
+            text = _generic(text)
+            g = groups.setdefault((k["source"], setting, text, kind), {
+                "engine": k["source"], "settings": settings, "reason": text, "kind": kind, "source": source,
+                "cases": set(), "metrics": set(), "comparisons": 0})
             g["cases"].add(c["case"])
             g["metrics"].add(k["metric"])
             g["comparisons"] += 1
-    out = [{**g, "settings": sorted(g["settings"]), "cases": sorted(g["cases"]), "metrics": sorted(g["metrics"])}
-           for g in groups.values()]
-    return sorted(out, key=lambda g: (-g["comparisons"], g["engine"], g["reason"]))
+    out = [{**g, "cases": sorted(g["cases"]), "metrics": sorted(g["metrics"])} for g in groups.values()]
+    return sorted(out, key=lambda g: (-g["comparisons"], g["engine"], g["settings"], g["reason"]))
 
 
 def _code(text: str) -> str:
@@ -242,17 +278,17 @@ def _md_traps(summary: dict) -> list[str]:
     """The traps: for each expected difference met, the engine setting a user's own deck would meet it with."""
     lines = ["## Traps", "",
              "Each expected difference met in this run, by the engine setting that causes it: the setting to look "
-             "for in a deck of your own, why it differs from the seed model, how much of this run it touched, "
-             "and where it is documented.", ""]
+             "for in a deck of your own, why it differs from the seed model (the case's numbers shown as …), how "
+             "much of this run it touched, and where it is documented.", ""]
     found = traps(summary)
     if not found:
         return lines + ["None met in this run.", ""]
     for t in found:
         settings = ", ".join(_code(s) for s in t["settings"]) or "(the setting was not recorded)"
-        cases = ", ".join(t["cases"][:6]) + (" …" if len(t["cases"]) > 6 else "")
-        lines += [f"* **{t['engine']}** — {settings} ({t['kind']}): {t['reason']}",
+        cases = _md(", ".join(t["cases"][:6])) + (" …" if len(t["cases"]) > 6 else "")
+        lines += [f"* **{_md(t['engine'])}** — {settings} ({t['kind']}): {_md(t['reason'])}",
                   f"  {t['comparisons']} comparison(s) in {len(t['cases'])} case(s); metrics "
-                  f"{', '.join(t['metrics'])}. Documented in {t['source'] or '—'}. Cases: {cases}"]
+                  f"{_md(', '.join(t['metrics']))}. Documented in {_md(t['source']) or '—'}. Cases: {cases}"]
     return lines + [""]
 
 
@@ -263,8 +299,9 @@ def _md_packings(summary: dict) -> list[str]:
     lines = ["## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
              "within statistical tolerances; column and layer against their static closed form).", "",
              "| case | source | solid fraction | coordination | bed height (m) | mean contact force (N) | "
-             "force distribution: KS distance to the reference (critical) | max overlap / d | static closed form |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "force distribution: KS distance to the reference (critical) | φ_zz; distance to the reference (critical) | "
+             "max overlap / d | static closed form |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for c in packings:
         for src, v in c["sources"].items():
             m = v.get("metrics") or {}
@@ -272,14 +309,24 @@ def _md_packings(summary: dict) -> list[str]:
             def comp(metric, src=src, c=c):
                 return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
 
-            cf, ks = comp("static_overlap"), comp("force_distribution_ks")
-            lines.append(f"| {_cell(c['case'])} | {src} | {number(m.get('solid_fraction'), '.4f')} | "
+            cf, ks, fz = comp("static_overlap"), comp("force_distribution_ks"), comp("fabric_zz")
+            lines.append(f"| {_cell(c['case'])} | {_cell(src)} | {number(m.get('solid_fraction'), '.4f')} | "
                          f"{number(m.get('coordination_number'), '.3f')} | {number(m.get('bed_height'), '.5g')} | "
                          f"{number(m.get('mean_contact_force'), '.4g')} | "
                          f"{number(ks['value'], '.3f') + ' (' + number(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
+                         f"{_fabric_cell(m, fz)} | "
                          f"{number(m.get('max_overlap_ratio'), '.3g')} | "
                          f"{number(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
     return lines + [""]
+
+
+def _fabric_cell(metrics: dict, comp: dict | None) -> str:
+    """A source's φ_zz (the contact fabric's vertical component) and, where verify compares it (a poured
+    packing's engines), its distance to the reference's against the critical one and the verdict."""
+    text = number(metrics.get("fabric_zz"), ".4f")
+    if comp:
+        text += f"; {number(comp['rel_diff'], '.4f')} ({number(comp['tolerance'], '.4f')}) {comp['verdict']}"
+    return text
 
 
 def _md_cases(summary: dict) -> list[str]:
@@ -288,7 +335,8 @@ def _md_cases(summary: dict) -> list[str]:
     for c in summary["cases"]:
         srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
         worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
-        lines.append(f"| {_cell(c['case'])} | {_model(c)} | {c['status']} | {srcs} | {number(worst_curve, '.3g')} |")
+        lines.append(f"| {_cell(c['case'])} | {_cell(_model(c))} | {_cell(c['status'])} | {_cell(srcs)} | "
+                     f"{number(worst_curve, '.3g')} |")
     return lines
 
 
@@ -305,10 +353,12 @@ def validation_markdown(summary: dict) -> list[str]:
              "| case file | source | quantity | expected | largest deviation | at | tolerance | verdict |",
              "|---|---|---|---|---|---|---|---|"]
     for c in val["checks"]:
-        lines.append(f"| {c['file']} | {c['source']} | {c['quantity']} | {c['kind']}: {c['expected']} | "
+        lines.append(f"| {_cell(c['file'])} | {_cell(c['source'])} | {_cell(c['quantity'])} | "
+                     f"{_cell(c['kind'])}: {_cell(c['expected'])} | "
                      f"{number(c['deviation'], '.3g')} | {number(c['at'], '.3g')} | {number(c['tolerance'], '.3g')} | "
-                     f"{c['verdict']} |")
-    lines += ["", "Tolerances:", ""] + sorted({f"* {c['quantity']} ({c['kind']}): {c['why']}" for c in val["checks"]})
+                     f"{_cell(c['verdict'])} |")
+    lines += ["", "Tolerances:", ""] + sorted({f"* {_md(c['quantity'])} ({_md(c['kind'])}): {_md(c['why'])}"
+                                                for c in val["checks"]})
     return lines
 
 
@@ -336,14 +386,14 @@ def validation_plots(summary: dict) -> list[tuple[str, str]]:
         if line["paper"]:
             ax.plot([p[0] for p in line["paper"]], [p[1] for p in line["paper"]], "k*", ms=7, label="paper")
             ys += [p[1] for p in line["paper"]]
-        ax.set(xlabel=line["x_label"], ylabel=line["label"],
+        ax.set(xlabel=plots.literal(line["x_label"]), ylabel=plots.literal(line["label"]),
                title=plots.wrap_title(f"{line['file']}: {line['quantity']}", 50))
         ax.title.set_fontsize(9)
         ax.grid(alpha=0.3)
         plots.plain_ticks(ax)
         plots.min_span(ax, ys)
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7)
+            plots.legend(ax, fontsize=7)
         out.append((f"{line['file']} {line['quantity']}", _png(fig)))
     return out
 
@@ -409,7 +459,7 @@ table.matrix td.mark{text-align:center;min-width:1.4em}table.matrix th.src{borde
 table.matrix td.first{border-left:2px solid #888}
 .legend span{display:inline-block;padding:1px 8px;margin:0 4px 4px 0;border:1px solid #bbb}
 .status-ok{color:#1a7f37}.status-unexpected,.status-failed{color:#cf222e;font-weight:bold}
-.partial{background:#fff3cd;padding:.5em;border:1px solid #e0c060}img{max-width:100%;border:1px solid #ddd;margin:4px 0}
+.partial,.plot-error{background:#fff3cd;padding:.5em;border:1px solid #e0c060}img{max-width:100%;border:1px solid #ddd;margin:4px 0}
 details{margin:.4em 0}summary{cursor:pointer}code{background:#f3f3f3;padding:0 3px}
 """
 _SCRIPT = """
@@ -423,7 +473,7 @@ window.addEventListener('load', function () {
 </script>
 """
 # what a plot draws, in every plot-cache key: raise it when a plot changes, so that no stale PNG is reused
-PLOT_VERSION = 2
+PLOT_VERSION = 3
 # P(f/⟨f⟩) is drawn for a source with at least this many contact forces: a histogram of a handful (a column
 # of five spheres has four) shows the few forces' values, not a distribution
 MIN_CONTACTS = 50
@@ -431,14 +481,10 @@ MIN_CONTACTS = 50
 
 def _markdown_html(lines: list[str]) -> str:
     """Markdown rendered by markdown-it (CommonMark and tables). Raw HTML is not let through: case names and
-    reasons come from users' case files, so ``<script>`` in one is shown as text, never run. A line break is
-    kept (a list item's second line, its counts, starts a line of its own)."""
+    reasons come from users' case files and engines, so raw HTML in one would be shown as text, never run; and
+    every such text is escaped (:func:`_md`) before it reaches markdown, so that none is read as a link or
+    emphasis either. A line break is kept (a list item's second line, its counts, starts a line of its own)."""
     return _markdown().render("\n".join(lines))
-
-
-def _inline(text: str) -> str:
-    """One line of markdown (a reason in a table cell) rendered inline, raw HTML escaped."""
-    return _markdown().renderInline(str(text))
 
 
 @functools.lru_cache(maxsize=1)
@@ -548,7 +594,7 @@ def case_figure(name, series):
         a.grid(alpha=0.3)
         a.axhline(0, color="0.6", lw=0.5)
         plots.plain_ticks(a)
-    a1.legend(fontsize=7)
+    plots.legend(a1, fontsize=7)
     fig.suptitle(plots.wrap_title(name, 90), fontsize=9)
     return fig
 
@@ -563,7 +609,7 @@ def suite_plots(summary: dict) -> list[tuple[str, str]]:
     against incidence angle — each per model and source."""
     import json
 
-    key = [(c["case"], c.get("file"), _model(c), c.get("impact"),
+    key = [(c["case"], c.get("file"), _model(c), c.get("impact"), c.get("walls"), c.get("variant"),
             {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()}) for c in summary["cases"]]
     text = _cached({"suite": key, "v": PLOT_VERSION}, lambda: json.dumps(_suite_plots(summary)), _plot_list_ok)
     return [tuple(x) for x in json.loads(text)]
@@ -573,26 +619,67 @@ def _suite_plots(summary: dict) -> list[tuple[str, str]]:
     return [(title, _png(fig)) for title, fig in suite_figures(summary)]
 
 
-def speed_panels(cases: list[dict]) -> dict:
-    """The panels of "restitution against impact speed": one per case file (its variants over speed), titled
-    by the model, pair or wall, and the file — a line never joins the cases of two files."""
-    groups = defaultdict(list)
+def _kind(c: dict) -> str:
+    """A wall impact or a pair, by the case's number of walls (never its name); "" when the entry does not say
+    (a results.json from before entries carried it)."""
+    walls = c.get("walls")
+    return "" if walls is None else "wall" if walls else "pair"
+
+
+def _lines(cases: list[dict], x_key: str) -> dict:
+    """The cases of each file split into lines along ``x_key``: a file's variant labels (``entry["variant"]``)
+    other than those that set x keep cases apart — a file varying the speed and limit_force draws a line per
+    limit_force. A label sets x when, within the file, its texts and the x values go one to one (``speed``
+    for impact.speed, ``velocity`` for a particle's velocity that sets the incidence angle, a group zipping
+    x with other keys). {(file, ((key, text), …)): cases}; the labels are None for a file whose entries carry
+    none (a file without variants, a results.json from before entries carried them)."""
+    by_file = defaultdict(list)
     for c in cases:
-        if c["impact"].get("speed") is None:
-            continue
-        kind = "wall" if "wall" in c["case"] else "pair"
-        groups[(_model(c), kind, c.get("file") or c["case"])].append(c)
-    return {f"{model} {kind} ({Path(file).stem})": cs for (model, kind, file), cs in groups.items()
-            if len({c["impact"]["speed"] for c in cs}) > 1}
+        by_file[c.get("file") or c["case"]].append(c)
+    out = {}
+    for file, cs in by_file.items():
+        keys = [k for k, _ in cs[0].get("variant") or []]
+        labelled = bool(keys) and all([k for k, _ in c.get("variant") or []] == keys for c in cs)
+        keep = []
+        for i in range(len(keys) if labelled else 0):
+            pairs = {(c["variant"][i][1], round(float(c["impact"][x_key]), 9)) for c in cs}
+            if not len(pairs) == len({t for t, _ in pairs}) == len({x for _, x in pairs}):
+                keep.append(i)  # not x's own label: its values are lines of their own
+        for c in cs:
+            labels = tuple((keys[i], c["variant"][i][1]) for i in keep) if labelled else None
+            out.setdefault((file, labels), []).append(c)
+    return out
+
+
+def _label_text(labels) -> str:
+    return "".join(f", {k}={v}" for k, v in labels or ())
+
+
+def speed_panels(cases: list[dict]) -> dict:
+    """The panels of "restitution against impact speed": one per case file (its variants over speed) and
+    value of its other variant labels (:func:`_lines`), titled by the model, pair or wall, the file and those
+    labels — a line never joins the cases of two files, nor two values of another key."""
+    groups = defaultdict(list)
+    with_speed = [c for c in cases if c["impact"].get("speed") is not None]
+    for (file, labels), cs in _lines(with_speed, "speed").items():
+        for c in cs:
+            groups[(_model(c), _kind(c), file, labels)].append(c)
+    return {" ".join(x for x in (model, kind) if x) + f" ({Path(file).stem}{_label_text(labels)})": cs
+            for (model, kind, file, labels), cs in groups.items() if len({c["impact"]["speed"] for c in cs}) > 1}
 
 
 def angle_panels(cases: list[dict]) -> dict:
-    """The panels against incidence angle: one per case file and initial spin."""
+    """The panels against incidence angle: one per case file and value of its other variant labels
+    (:func:`_lines`: the initial spin's among them, titled by them); a file whose entries carry no labels, one
+    per initial spin (titled by it)."""
     groups = defaultdict(list)
-    for c in cases:
-        groups[(c.get("file") or c["case"], round(c["impact"].get("spin") or 0.0, 6))].append(c)
-    return {f"{_model(cs[0])}, spin {spin:g} ({Path(file).stem})": cs for (file, spin), cs in groups.items()
-            if len(cs) > 1}
+    with_angle = [c for c in cases if c["impact"].get("angle") is not None]
+    for (file, labels), cs in _lines(with_angle, "angle").items():
+        for c in cs:
+            spin = round(c["impact"].get("spin") or 0.0, 6) if labels is None else None
+            groups[(file, labels, spin)].append(c)
+    return {f"{_model(cs[0])}{'' if spin is None else f', spin {spin:g}'} ({Path(file).stem}{_label_text(labels)})": cs
+            for (file, labels, spin), cs in groups.items() if len(cs) > 1}
 
 
 def suite_figures(summary: dict) -> list[tuple[str, object]]:
@@ -617,7 +704,7 @@ def suite_figures(summary: dict) -> list[tuple[str, object]]:
                 plots.source_line(ax, *zip(*pts), src, line=False)
         ax.plot([0, 1], [0, 1], color="0.5", lw=0.8)
         ax.set(xlabel="input restitution", ylabel="measured restitution", title="restitution: in vs out")
-        ax.legend(fontsize=7)
+        plots.legend(ax, fontsize=7)
         ax.grid(alpha=0.3)
         plots.plain_ticks(ax)
         out.append(("restitution in vs out", fig))
@@ -672,7 +759,7 @@ def panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_l
     for ax in axes.ravel()[n:]:
         ax.axis("off")
     if handles:
-        fig.legend(list(handles.values()), list(handles), loc="outside upper center", ncol=len(handles),
+        plots.legend(fig, list(handles.values()), list(handles), loc="outside upper center", ncol=len(handles),
                    fontsize=7, frameon=False)
     fig.supxlabel(x_label, fontsize=8)
     fig.supylabel(y_label, fontsize=8)
@@ -683,32 +770,18 @@ def packing_plots(entry: dict) -> str:
     return _png(packing_figure(entry))
 
 
-def force_count(forces: dict) -> int:
-    """How many contact forces a P(f/⟨f⟩) histogram holds: its ``n`` when recorded, else read off the
-    densities — bin k holds p_k·w·n forces (w the bin width), a whole number, so n is the least N making every
-    p_k·w·N whole (to 1e-6). That is n divided by the common factor of the bins' counts: a lower bound, equal
-    to n whenever one bin holds a count prime to the others (a single force in a tail bin, as in any real
-    distribution)."""
-    import numpy as np
-
-    if forces.get("n") is not None:
-        return int(forces["n"])
-    x, p = np.asarray(forces.get("x") or [], float), np.asarray(forces.get("p") or [], float)
-    if len(x) < 2 or not (p > 0).any():
-        return 0
-    share = p[p > 0] * (x[1] - x[0])  # each nonzero bin's fraction of the forces
-    for lo in range(1, 100_001, 5000):
-        n = np.arange(lo, lo + 5000)[:, None]
-        whole = np.all(np.abs(share * n - np.round(share * n)) <= 1e-6 * np.maximum(1.0, share * n), axis=1)
-        if whole.any():
-            return int(n[np.argmax(whole), 0])
-    return 100_000
+def force_count(forces: dict) -> int | None:
+    """How many contact forces a P(f/⟨f⟩) histogram holds: its ``n`` (packing_metrics.force_distribution
+    records it); None — unknown — for one without (a results.json from before it was recorded)."""
+    n = forces.get("n")
+    return None if n is None else int(n)
 
 
 def packing_figure(entry: dict):
     """Solid fraction against height, P(f/⟨f⟩) and kinetic energy against time, per source. What a panel
     cannot draw is said in it: a source without that output (or one that did not run), a packing without a
-    periodic box (no profile), a source with fewer than MIN_CONTACTS contact forces (no distribution)."""
+    periodic box (no profile), a source with fewer than MIN_CONTACTS contact forces or an unknown count (no
+    distribution). No title of its own: report.html heads it with the packing's name."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -736,9 +809,11 @@ def packing_figure(entry: dict):
             notes[a3].append(src)
         forces = d.get("forces") or {}
         n = force_count(forces)
-        if n >= MIN_CONTACTS:
+        if n is not None and n >= MIN_CONTACTS:
             pts = [(x, p) for x, p in zip(forces["x"], forces["p"]) if p > 0]  # log axis: the empty bins left out
             plots.source_line(a2, [q[0] for q in pts], [q[1] for q in pts], src)
+        elif n is None:
+            notes[a2].append(f"{src}: count unknown" if forces.get("p") else f"{src}: no contact forces")
         else:
             notes[a2].append(f"{src}: {n} contact force(s)" if n else f"{src}: no contact forces")
     a3.set_yscale("log")
@@ -752,7 +827,7 @@ def packing_figure(entry: dict):
         a.title.set_fontsize(9)
         plots.plain_ticks(a)
         if a.get_legend_handles_labels()[0]:
-            a.legend(fontsize=7)
+            plots.legend(a, fontsize=7)
     said = {a1: [], a2: [], a3: []}
     if notes[a1]:
         said[a1].append("no solid-fraction profile: the packing has no periodic box" if not a1.get_lines()
@@ -767,7 +842,6 @@ def packing_figure(entry: dict):
             said[a].append("no data from " + ", ".join(absent))
         if said[a]:
             plots.note(a, ". ".join(said[a]), centre=not a.get_lines())
-    fig.suptitle(plots.wrap_title(f"packing {entry['case']}", 100), fontsize=9)
     return fig
 
 
@@ -807,7 +881,28 @@ def _matrix_html(summary: dict) -> str:
     return "\n".join(out)
 
 
-def render_html(summary: dict) -> str:
+def _plot(what: str, render, draw: bool = True):
+    """A plot (``render()``: its PNG, or a list of them) and the HTML said in its place: "" when drawn; a note
+    when drawing it raised — the report is never lost to a plot (the numbers are in its tables) — and nothing
+    when ``draw`` is off (the page says once that no plot was drawn)."""
+    if not draw:
+        return None, ""
+    try:
+        return render(), ""
+    except Exception as exc:  # noqa: BLE001 — any plotting failure: the page is written without that plot
+        import matplotlib.pyplot as plt
+
+        plt.close("all")
+        first = (str(exc).strip().splitlines() or [""])[0][:300]
+        logging.getLogger("demcheck.report").warning("demcheck: report.html: %s could not be drawn: %s: %s",
+                                                     what, type(exc).__name__, first)
+        return None, (f"<p class='plot-error'>{html.escape(what)} could not be drawn "
+                      f"({html.escape(type(exc).__name__)}: {html.escape(first)}); the numbers are in the tables.</p>")
+
+
+def render_html(summary: dict, draw: bool = True) -> str:
+    """report.html. ``draw`` off: no plot is drawn (write_all's page when the run was interrupted while they
+    were), and the page says so."""
     from . import plots
 
     esc = html.escape
@@ -827,17 +922,25 @@ def render_html(summary: dict) -> str:
                  "larger for the sources drawn first, so that sources that agree show one inside the other). A "
                  f"y axis spans at least {100 * plots.MIN_REL_SPAN:g} % of its panel's largest value: smaller differences "
                  "are read in the tables, not the plots.</p>")
-    for title, b64 in suite_plots(summary):
+    if not draw:
+        parts.append("<p class='plot-error'>No plots in this page: the run was interrupted while they were drawn. "
+                     "The numbers are in the tables.</p>")
+    items, note = _plot("the suite plots", lambda: suite_plots(summary), draw)
+    parts.append(note)
+    for title, b64 in items or []:
         parts.append(f"<h3>{esc(title)}</h3>{_img(b64, title)}")
     packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
     if packings:
         parts.append(_markdown_html(_md_packings(summary)))
         for c in packings:
             if c.get("packing"):
-                parts.append(f"<h3>packing {esc(c['case'])}</h3>" + _img(packing_plots(c), f"packing {c['case']}"))
+                b64, note = _plot(f"the packing panels of {c['case']}", lambda c=c: packing_plots(c), draw)
+                parts.append(f"<h3>packing {esc(c['case'])}</h3>" + (_img(b64, f"packing {c['case']}") if b64 else note))
     if summary.get("validation"):
         parts.append(_markdown_html(validation_markdown(summary)))
-        parts += [f"<h3>{esc(title)}</h3>{_img(b64, title)}" for title, b64 in validation_plots(summary)]
+        items, note = _plot("the validation plots", lambda: validation_plots(summary), draw)
+        parts.append(note)
+        parts += [f"<h3>{esc(title)}</h3>{_img(b64, title)}" for title, b64 in items or []]
     parts.append("<h2>Cases</h2>")
     # one plot per case file (its first variant), every case's numbers in a table
     shown = set()
@@ -846,9 +949,11 @@ def render_html(summary: dict) -> str:
         parts.append(f"<details><summary><span class='{cls}'>{esc(c['status'])}</span> {esc(c['case'])} — "
                      f"{esc(_model(c))}</summary>")
         if c.get("kind") != "packing" and c["file"] not in shown:
-            b64 = case_panels(c)
+            b64, note = _plot(f"the force curves of {c['case']}", lambda c=c: case_panels(c), draw)
             if b64:
                 parts.append(_img(b64, f"force curves of {c['case']}"))
+            if b64 or note:
+                parts.append(note)
                 shown.add(c["file"])
         parts.append("<table><tr><th>source</th><th>metric</th><th>value</th><th>reference</th><th>scaled diff"
                      "</th><th>tolerance</th><th>verdict</th><th>reason</th></tr>")
@@ -857,8 +962,7 @@ def render_html(summary: dict) -> str:
                          f"<td>{number(k['reference'])}</td><td>{number(k['rel_diff'], '.3g')}</td>"
                          f"<td>{number(k['tolerance'], '.3g')}</td>"
                          f"<td class='{VERDICT_CLASS.get(k['verdict'], '')}'>{esc(k['verdict'])}</td>"
-                         f"<td>{_inline(k['reason'])}</td></tr>")
+                         f"<td>{esc(k['reason'])}</td></tr>")
         parts.append("</table></details>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"
-
