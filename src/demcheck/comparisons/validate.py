@@ -14,7 +14,8 @@ against two independent kinds of expected values:
   slip at the contact, no tangential force);
 * the papers' digitised curves (data/benchmarks/*.dat, each file naming its source): the largest deviation
   of the source's curve from the paper's points, in the quantity's own units, against a tolerance that says
-  what it stands for.
+  what it stands for — judged apart past the gross-sliding threshold (the rigid body) and below it (the
+  papers' codes' tangential elastic response).
 
 A source that misses a published curve is a finding (the report says which models meet the paper); the
 reference missing an exact limit, or a run that failed, fails the command (exit 1).
