@@ -109,7 +109,7 @@ def test_a_worse_verdict_exits_1_and_a_better_one_does_not(runs, tmp_path):
         ("peak_force", "agree", "differs unexpectedly", "worse")]
     # the other way round: the verdict improved, nothing regressed
     p = demcheck("diff", worse, a)
-    assert p.returncode == 0 and "| hertz-wall | reference-verlet | peak_force | differs unexpectedly | agree | better |" \
+    assert p.returncode == 0 and "| hertz-wall | reference-verlet | peak\\_force | differs unexpectedly | agree | better |" \
         in p.stdout
 
 
@@ -123,7 +123,7 @@ def test_a_gone_source_or_case_is_a_regression(runs, tmp_path):
     data["cases"] = [c for c in data["cases"] if c["case"] != "kk-wall"]
     (tmp_path / "c.json").write_text(json.dumps(data))
     p = demcheck("diff", a, tmp_path / "c.json")
-    assert p.returncode == 1 and "kk-wall · *: case not in NEW" in p.stdout
+    assert p.returncode == 1 and "kk-wall · \\*: case not in NEW" in p.stdout
     assert demcheck("diff", tmp_path / "c.json", a).returncode == 0  # a case added is news, not a regression
 
 
@@ -136,7 +136,7 @@ def test_a_metric_new_in_NEW_is_news_and_one_gone_from_NEW_a_regression(runs, tm
     assert d["regressions"] == 0 and not d["rows"]
     assert {"case": "kk-wall", "source": "reference", "what": "metric fabric_zz not in OLD"} in d["added"]
     p = demcheck("diff", a, more)
-    assert p.returncode == 0 and "metric fabric_zz not in OLD" in p.stdout
+    assert p.returncode == 0 and "metric fabric\\_zz not in OLD" in p.stdout  # markdown-escaped (a name is text, never markup)
     d = D.compare(D.load(more), D.load(a))  # the other way round: gone from NEW
     assert d["regressions"] == 1 and d["rows"][0]["metric"] == "fabric_zz"
 
@@ -186,3 +186,21 @@ def test_a_rerun_of_lammps_is_clean_and_a_planted_engine_change_is_caught(tmp_pa
     (r,) = [r for r in json.loads(p.stdout)["rows"] if r["beyond"]]
     assert (r["source"], r["metric"]) == ("lammps", "peak_force") and r["moved"] == pytest.approx(0.02, rel=1e-9)
     assert r["old_version"] == r["new_version"] and r["old_version"].startswith("22 Jul 2025")
+
+
+def test_a_case_name_is_text_in_the_diff_report_never_a_link(runs, tmp_path):
+    """A case name may hold [ ] ( ) : / _ (the name rule): in diff.md it is escaped, so rendered markdown shows
+    it as text — no link, no emphasis."""
+    from markdown_it import MarkdownIt
+
+    _, a, b = runs
+    name = "[click](https://evil.example/x) _em_ wall"
+
+    def rename(c):
+        c[name] = c.pop("kk-wall")
+        c[name]["case"] = name
+
+    old = plant(a, tmp_path / "o.json", rename)
+    new = plant(b, tmp_path / "n.json", lambda c: c.pop("kk-wall"))  # gone from NEW: listed by name
+    html = MarkdownIt("commonmark", {"html": False}).enable("table").render(D.render_markdown(D.compare(D.load(old), D.load(new))))
+    assert "<a " not in html and "<em>" not in html and "[click](https://evil.example/x) _em_ wall" in html

@@ -6,6 +6,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import secrets
 from pathlib import Path
 
@@ -66,3 +67,19 @@ def number(v, spec: str = ".6g") -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
     return format(v, spec) if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+
+
+# the ASCII punctuation markdown may read in running text (CommonMark, and GitHub's autolinks, tables and
+# strikethrough): every character but - , = + ' " ; % ? ( ) /, which mean nothing in the middle of a line
+# once [ ] < > : . & are escaped (no link, autolink or entity can form; no line starts with user text)
+MD_PUNCTUATION = re.compile("([" + re.escape("".join(sorted(set(map(chr, range(33, 127))) - set(
+    map(chr, [*range(48, 58), *range(65, 91), *range(97, 123)])) - set("-,=+'\";%?()/")))) + "])")
+
+
+def md_text(text) -> str:
+    """Text as markdown that renders as itself: its markdown punctuation backslash-escaped (CommonMark lets
+    any ASCII punctuation be; :data:`MD_PUNCTUATION`), a line break a space. Everything a report takes from
+    outside its own words goes through it — case names and files (a name may hold ``[ ] ( ) : / _``:
+    ``[x](https://…) _y_`` would be a link and emphasis), sources, reasons and messages — so that none is read
+    as a link, emphasis, code or a table's ``|``, in report.md or in report.html."""
+    return MD_PUNCTUATION.sub(r"\\\1", str(text).replace("\r", " ").replace("\n", " "))

@@ -25,6 +25,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from ..errors import ConfigError
+from ..io import md_text as _t
 from ..io import number, plain
 from . import verdicts
 
@@ -252,16 +253,16 @@ def _v(verdict) -> str:
 def render_markdown(d: dict) -> str:
     o, n = d["old"], d["new"]
     lines = ["# demcheck diff", "",
-             f"OLD: {o['path']} (run {o['run_id'] or '—'}, {o['started'] or '—'}, demcheck {o['demcheck'] or '—'})"
+             f"OLD: {_t(o['path'])} (run {_t(o['run_id'] or '—')}, {_t(o['started'] or '—')}, demcheck {_t(o['demcheck'] or '—')})"
              + (" PARTIAL" if o["partial"] else ""),
-             f"NEW: {n['path']} (run {n['run_id'] or '—'}, {n['started'] or '—'}, demcheck {n['demcheck'] or '—'})"
+             f"NEW: {_t(n['path'])} (run {_t(n['run_id'] or '—')}, {_t(n['started'] or '—')}, demcheck {_t(n['demcheck'] or '—')})"
              + (" PARTIAL" if n["partial"] else ""), ""]
     if d["rename"]:
-        lines += ["Sources compared under another name: " + ", ".join(f"OLD {a} → NEW {b}" for a, b in
+        lines += ["Sources compared under another name: " + ", ".join(f"OLD {_t(a)} → NEW {_t(b)}" for a, b in
                                                                       d["rename"].items()), ""]
     if d["engines"]:
         lines += ["| engine | OLD version | NEW version |", "|---|---|---|"]
-        lines += [f"| {k} | {_v(v['old']) if v['old'] else 'missing'} | {_v(v['new']) if v['new'] else 'missing'} |"
+        lines += [f"| {_t(k)} | {_t(v['old']) if v['old'] else 'missing'} | {_t(v['new']) if v['new'] else 'missing'} |"
                   + (" changed" if v["old"] != v["new"] else "") for k, v in d["engines"].items()]
         lines.append("")
     c = d["counts"]
@@ -272,11 +273,11 @@ def render_markdown(d: dict) -> str:
               f"better. {d['checked']} quantities compared, {d['unchanged']} identical; moves in units of each "
               f"metric's scale ({tol}).", ""]
     if d["changed_cases"]:
-        lines += ["Case files changed between the runs (their hash differs): " + ", ".join(d["changed_cases"]), ""]
+        lines += ["Case files changed between the runs (their hash differs): " + ", ".join(map(_t, d["changed_cases"])), ""]
     changed = [r for r in d["rows"] if r["old_verdict"] != r["new_verdict"]]
     if changed:
         lines += ["## Verdicts that changed", "", "| case | source | metric | OLD | NEW | |", "|---|---|---|---|---|---|"]
-        lines += [f"| {r['case']} | {r['source']} | {r['metric']} | {_v(r['old_verdict'])} | {_v(r['new_verdict'])} | "
+        lines += [f"| {_t(r['case'])} | {_t(r['source'])} | {_t(r['metric'])} | {_v(r['old_verdict'])} | {_v(r['new_verdict'])} | "
                   f"{'**worse**' if r['change'] == 'worse' else r['change']} |" for r in changed]
         lines.append("")
     moved = [r for r in d["rows"] if r["beyond"]]
@@ -285,8 +286,8 @@ def render_markdown(d: dict) -> str:
                   "| case | source | metric | OLD | NEW | moved (scaled) | tolerance | versions |",
                   "|---|---|---|---|---|---|---|---|"]
         for r in sorted(moved, key=lambda r: -(r["moved"] if math.isfinite(r["moved"]) else math.inf)):
-            ver = "" if r["old_version"] == r["new_version"] else f"{_v(r['old_version'])} → {_v(r['new_version'])}"
-            lines.append(f"| {r['case']} | {r['source']} | {r['metric']} | {number(r['old'], '.10g')} | "
+            ver = "" if r["old_version"] == r["new_version"] else f"{_t(_v(r['old_version']))} → {_t(_v(r['new_version']))}"
+            lines.append(f"| {_t(r['case'])} | {_t(r['source'])} | {_t(r['metric'])} | {number(r['old'], '.10g')} | "
                          f"{number(r['new'], '.10g')} | {_moved(r['moved'])} | {r['tolerance']:.3g} | {ver} |")
         lines.append("")
     small = [r for r in d["rows"] if not r["beyond"] and r["old_verdict"] == r["new_verdict"]]
@@ -295,7 +296,7 @@ def render_markdown(d: dict) -> str:
                   f"{d['largest_below_tolerance']:.3g}, scaled).", ""]
     for title, items in (("Gone from NEW", d["removed"]), ("New in NEW", d["added"])):
         if items:
-            lines += [f"## {title}", ""] + [f"- {i['case']} · {i['source']}: {i['what']}" for i in items] + [""]
+            lines += [f"## {title}", ""] + [f"- {_t(i['case'])} · {_t(i['source'])}: {_t(i['what'])}" for i in items] + [""]
     if not d["regressions"] and not d["rows"] and not d["added"]:
         lines += ["Nothing moved: every value and verdict is identical.", ""]
     return "\n".join(lines)
@@ -385,19 +386,19 @@ def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) ->
 def baseline_markdown(b: dict) -> list[str]:
     """report.md's section on the baseline check."""
     c = b["counts"]
-    lines = ["## Baseline", "", f"Against {b['path']} (run {b['old']['run_id'] or '—'}): {b['checked']} quantities "
+    lines = ["## Baseline", "", f"Against {_t(b['path'])} (run {_t(b['old']['run_id'] or '—')}): {b['checked']} quantities "
              f"compared, {b['unchanged']} identical; **{b['regressions']} regression(s)** ({c['worse']} verdict(s) "
              f"worse, {c['moved']} value(s) moved beyond their tolerance, {c['removed']} source(s) gone); "
              f"{c['better']} verdict(s) better.", ""]
     changed = {k: v for k, v in b["engines"].items() if v["old"] != v["new"]}
     if changed:
-        lines += ["Engine versions changed: " + "; ".join(f"{k} {_v(v['old'])} → {_v(v['new'])}"
+        lines += ["Engine versions changed: " + "; ".join(f"{_t(k)} {_t(_v(v['old']))} → {_t(_v(v['new']))}"
                                                           for k, v in changed.items()), ""]
     bad = [r for r in b["rows"] if r["regression"]]
     if bad:
         lines += ["| case | source | metric | baseline | now | moved (scaled) | tolerance | verdict |",
                   "|---|---|---|---|---|---|---|---|"]
-        lines += [f"| {r['case']} | {r['source']} | {r['metric']} | {number(r['old'], '.10g')} | "
+        lines += [f"| {_t(r['case'])} | {_t(r['source'])} | {_t(r['metric'])} | {number(r['old'], '.10g')} | "
                   f"{number(r['new'], '.10g')} | {_moved(r['moved'])} | {r['tolerance']:.3g} | "
                   f"{_v(r['old_verdict'])} → {_v(r['new_verdict'])} |" for r in bad]
         lines.append("")

@@ -19,7 +19,7 @@ import xml.etree.ElementTree as ET
 from collections import defaultdict
 from pathlib import Path
 
-from ..io import number, plain, write_json, write_text
+from ..io import md_text, number, plain, write_json, write_text
 from . import verdicts
 from .styles import engine_sources
 
@@ -80,20 +80,7 @@ def _engine_text(summary: dict) -> str:
     return "; ".join(parts) if parts else "none selected (reference only)"
 
 
-# the ASCII punctuation markdown may read in running text (CommonMark, and GitHub's autolinks, tables and
-# strikethrough): every character but - , = + ' " ; % ? ( ) /, which mean nothing in the middle of a line
-# once [ ] < > : . & are escaped (no link, autolink or entity can form; no line starts with user text)
-_MD_PUNCTUATION = re.compile("([" + re.escape("".join(sorted(set(map(chr, range(33, 127))) - set(
-    map(chr, [*range(48, 58), *range(65, 91), *range(97, 123)])) - set("-,=+'\";%?()/")))) + "])")
-
-
-def _md(text) -> str:
-    """Text as markdown that renders as itself: its markdown punctuation backslash-escaped (CommonMark lets
-    any ASCII punctuation be; :data:`_MD_PUNCTUATION`), a line break a space. Everything a report takes from
-    outside its own words goes through it — case names and files (a name may hold ``[ ] ( ) : / _``:
-    ``[x](https://…) _y_`` would be a link and emphasis), sources, reasons and messages — so that none is read
-    as a link, emphasis, code or a table's ``|``, in report.md or in report.html."""
-    return _MD_PUNCTUATION.sub(r"\\\1", str(text).replace("\r", " ").replace("\n", " "))
+_md = md_text
 
 
 def _cell(text) -> str:
@@ -159,18 +146,8 @@ def _md_header(summary: dict) -> list[str]:
     if "baseline" in summary:
         from .diff import baseline_markdown
 
-        lines += baseline_markdown(_escaped_baseline(summary["baseline"]))
+        lines += baseline_markdown(summary["baseline"])
     return lines
-
-
-def _escaped_baseline(b: dict) -> dict:
-    """The baseline check with its outside texts — the baseline's path, case names, sources, metrics, engine
-    versions — escaped (:func:`_md`) for diff.baseline_markdown, which writes them into markdown as they are."""
-    rows = [{**r, **{k: _md(r[k]) for k in ("case", "source", "metric") if isinstance(r.get(k), str)}}
-            for r in b.get("rows", [])]
-    engines = {_md(k): {side: _md(x) if isinstance(x, str) else x for side, x in v.items()}
-               for k, v in (b.get("engines") or {}).items()}
-    return {**b, "path": _md(b.get("path", "")), "rows": rows, "engines": engines}
 
 
 def _md_matrix(summary: dict) -> list[str]:
