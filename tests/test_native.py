@@ -187,19 +187,3 @@ def test_deck_is_written_from_parsed_numbers():
     case = demcheck.load(_case({"lammps": {"pair_coeff": TSUJI.replace("63e9", "6.30e+10")}}))
     text = deck(case, "lammps", native=registry.get("lammps").case_native(case)).text
     assert "6.30e+10" not in text and "hertz/material 63000000000 " in text
-
-
-@pytest.mark.parametrize("command", [["bench"], ["stress"], ["dt"], ["sweep", "--vary", "impact.speed=0.5:1:2"]])
-def test_commands_that_run_the_seed_mapping_refuse_native_settings(tmp_path, command):
-    """bench, stress, dt and sweep run the seed model's mapping in every engine: a case with [engine.NAME]
-    settings is refused in one line (exit 2) rather than silently run as something else than it asks for."""
-    import subprocess
-    import sys
-
-    f = tmp_path / "tsuji.toml"
-    f.write_text(to_toml(_case({"lammps": {"pair_coeff": TSUJI}})))
-    extra = ["--report", str(tmp_path / "r")] if command[0] in ("bench", "stress") else []
-    p = subprocess.run([sys.executable, "-m", "demcheck", command[0], str(f), *command[1:], *extra],
-                       capture_output=True, text=True, timeout=300)
-    assert p.returncode == 2, p.stderr
-    assert p.stderr.strip().count("\n") == 0 and "engine.lammps" in p.stderr and command[0] in p.stderr

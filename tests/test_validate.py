@@ -512,3 +512,15 @@ def test_validate_exits_1_when_the_reference_misses_an_exact_limit(tmp_path, mon
                                                             ("chung-ooi-1-limestone", "contact_time")}
     assert all(c["deviation"] == pytest.approx(0.01 / 1.01, rel=1e-6) for c in failed)  # |t − 1.01 t|/(1.01 t)
     assert out["failed"] == 2
+
+
+def test_validate_quick_runs_one_case_file_per_benchmark(tmp_path):
+    """demcheck validate --quick: each benchmark's quick file alone (validate.QUICK), every benchmark once."""
+    import json
+
+    r = subprocess.run([sys.executable, "-m", "demcheck", "validate", "--quick", "--engines", "none", "--report",
+                        str(tmp_path), "--json"], capture_output=True, text=True, timeout=900,
+                       env={**os.environ, "DEMCHECK_CACHE": str(tmp_path / "cache")})
+    assert r.returncode in (0, 1), r.stderr[-2000:]
+    files = {c["file"] for c in json.loads(r.stdout)["validation"]["checks"]}
+    assert files == set(VA.QUICK) and len(VA.QUICK) == len(VA.BENCHMARKS)

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from . import case as _case
-from .errors import ConfigError, DemcheckError
+from .errors import ConfigError
 from .result import Result as _Result
 
 __all__ = ["load", "collide", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result", "ConfigError"]
@@ -160,9 +160,7 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     setting, which a ``contact.*`` key (the seed model's) does not change, nor a ``materials.*`` key the
     setting does not read: such a sweep is a ConfigError. Every point is validated before any is solved; a
     point whose solve fails keeps its row with the error as its status."""
-    import pandas as pd
-
-    from .comparisons.sweep import native_vary_rule
+    from .comparisons.sweep import native_vary_rule, run_sweep
 
     known = sources()
     if source not in known:
@@ -186,19 +184,13 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
         values = {k: (v.item() if hasattr(v, "item") else v) for (k, _), v in zip(axes, combo)}
         points.append((values, _build(case, [*pairs, *values.items()])))
     native_vary_rule(points, source, "vary.")  # a key that cannot move the native law: refused before any solve
-    rows = []
-    for values, c in points:
-        row = dict(values)
-        try:
-            res = collide(c, source=source, method=method, dt=dt)
-            row.update(res.metrics())
-            row["status"] = res.status
-        except ConfigError:
-            raise
-        except DemcheckError as exc:
-            row["status"] = f"error: {exc}"
-        rows.append(row)
-    return pd.DataFrame(rows)
+    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        raise ConfigError("dt", dt, "must be a number > 0 (s)")
+    if source != "reference" and method is not None:
+        raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
+                                            "velocity Verlet at dt")
+    # the command's own loop: an engine's points run in its long-lived worker where it has one
+    return run_sweep(points, method, dt, source=source)
 
 
 def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path | None = None, jobs: int = 1,

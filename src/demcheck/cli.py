@@ -650,7 +650,8 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again")
 @click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="per engine run (s)")
-def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout):
+@click.option("--quick", is_flag=True, help="one case file per benchmark (68 of the 614 cases): a first look in minutes")
+def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout, quick):
     """Run the published benchmarks (cases/benchmarks/: Chung & Ooi's eight tests, Thornton's oblique
     impacts; NAME one of them, e.g. chung-ooi-4) in the reference and every engine, and judge each source
     against the exact limits and the papers' curves (docs/benchmarks.md). Exit 1 when the reference misses an
@@ -666,7 +667,7 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout)
     opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout)
     try:
         summary = run(name, CASES_DIR / "benchmarks", Path(report_dir), opts, quiet=as_json,
-                      junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]])
+                      junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]], quick=quick)
     except KeyboardInterrupt as exc:
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
                    f"report {Path(report_dir) / 'latest-validate'}", err=True)
@@ -706,8 +707,8 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout)
                    "tangential_force, overlap, i, j; wall contacts are not drawn)")
 @click.option("--xyz", "xyz_file", type=PACK_XYZ_FILE, default=None,
               help="write the settled state as one extended XYZ frame (ase; OVITO reads it): Lattice and pbc from "
-                   "the box (x, y periodic), per particle id, species_id, radius, mass, velo, omega, and force from "
-                   "an engine only; ase writes eight decimals, so SI values to 5e-9 (--vtk keeps float64)")
+                   "the box (x, y periodic), per particle id, species_id, radius, velo, omega; ase writes eight "
+                   "decimals, so SI values to 5e-9 — masses and forces are in --vtk (float64) only")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 def pack(case_path, engine, duration, mpi, timeout, csv_dir, vtk_dir, xyz_file, overrides, as_json):

@@ -139,7 +139,8 @@ def _run(case, source: str, method, dt):
     native = registry.get(engine).case_native(case)
     if source.endswith("-twin"):
         return twin_states(case, engine, dt or run_length(case)[0], native=native)
-    return run_engine(case, engine, dt=dt, native=native)
+    # a sweep runs one engine many times: in its long-lived worker where it has one (no start-up per point)
+    return run_engine(case, engine, dt=dt, native=native, worker=True)
 
 
 def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
