@@ -4,7 +4,8 @@ A collision deck is a Python script generated from a fixed template with only nu
 (:mod:`.deck`), checked before every run by :func:`.deck.check_script` (parsed with ``ast``: only the
 template's names, attributes, calls and numeric constants). It steps Yade's leap-frog NewtonIntegrator one
 step at a time and writes the bodies' states as a LAMMPS-style ``dump custom`` (float64, %.17g), so the rest
-of demcheck reads Yade as it reads the other engines.
+of demcheck reads Yade as it reads the other engines. A packing script (:mod:`.packing`) comes from a second fixed
+template with its own guard; :meth:`Yade.check_deck` picks the guard by the script's first line.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ import shutil
 import subprocess
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 from .. import registry
 from ..base import Native, PackageEngine, Style
@@ -117,9 +120,21 @@ class Yade(PackageEngine):
         return [executable, "-x", "-n", str(LAUNCHER), deck]
 
     def check_deck(self, text: str, files: dict | None = None) -> None:
-        from .deck import check_script
+        """The guard of the template the script opens as: a packing script's (its first line), else the
+        collision script's; both refuse anything their template does not write."""
+        from . import deck, packing
 
-        check_script(text, files)
+        (packing.check_script if packing.is_packing_script(text) else deck.check_script)(text, files)
+
+    def read_contacts(self, v, i, j, radius, x=None, box=None):
+        """A packing script's contact dump (packing.CONTACT_COLUMNS): id1 id2, penetrationDepth, the normal
+        force on the second body (3), the stored shear force (3), the contact normal from the first to the
+        second (3). Fn = normalForce · normal (repulsive > 0), |Ft| = |shearForce|; the overlap is Yade's
+        penetrationDepth (across a periodic boundary too: Yade computes it with the cell shift)."""
+        overlap = v[:, 2]
+        fn = np.einsum("ij,ij->i", v[:, 3:6], v[:, 9:12])
+        ft = np.linalg.norm(v[:, 6:9], axis=1)
+        return overlap, fn, ft
 
     def summary(self, native: Native) -> str:
         return f"{native.normal} + {native.tangential}"

@@ -49,6 +49,13 @@ def check_script(text: str, files: dict | None = None) -> None:
     """The final guard before Yade runs a script: it parses, and holds only the template's names, attributes,
     calls and constants (numbers, and the template's own strings); its first two lines name no encoding; it
     reads no other file. Raises DemcheckError otherwise."""
+    guard(text, files, NAMES, ATTRIBUTES, KEYWORDS, STRINGS, NODES)
+
+
+def guard(text: str, files, names, attributes, keywords, strings, nodes, flags=False) -> None:
+    """:func:`check_script` with a template's allow-lists (names, attributes, keywords, strings, ast node
+    types; ``flags``: the constant True is allowed too): the collision template's here, the packing template's
+    in :mod:`.packing`."""
     def refuse(why: str):
         raise DemcheckError(f"refusing to run a Yade script: {why}")
 
@@ -66,15 +73,15 @@ def check_script(text: str, files: dict | None = None) -> None:
     except SyntaxError as exc:
         refuse(f"it does not parse (line {exc.lineno}: {exc.msg})")
     for node in ast.walk(tree):
-        if not isinstance(node, NODES):
+        if not isinstance(node, nodes):
             refuse(f"line {getattr(node, 'lineno', '?')}: {type(node).__name__} is not in the template")
-        if isinstance(node, ast.Name) and node.id not in NAMES:
+        if isinstance(node, ast.Name) and node.id not in names:
             refuse(f"line {node.lineno}: name {node.id!r} is not in the template")
-        if isinstance(node, ast.Attribute) and node.attr not in ATTRIBUTES:
+        if isinstance(node, ast.Attribute) and node.attr not in attributes:
             refuse(f"line {node.lineno}: attribute {node.attr!r} is not in the template")
         if isinstance(node, ast.keyword) and node.arg is None:
             refuse(f"line {node.lineno}: ** arguments are not in the template")
-        if isinstance(node, ast.keyword) and node.arg not in KEYWORDS:
+        if isinstance(node, ast.keyword) and node.arg not in keywords:
             refuse(f"line {node.lineno}: keyword {node.arg!r} is not in the template")
         if isinstance(node, ast.ImportFrom) and (node.module != "yade" or [a.name for a in node.names] != ["utils"]
                                                  or node.names[0].asname or node.level != 0):
@@ -82,8 +89,10 @@ def check_script(text: str, files: dict | None = None) -> None:
         if isinstance(node, ast.Constant):
             v = node.value
             if isinstance(v, str):
-                if v not in STRINGS:
+                if v not in strings:
                     refuse(f"line {node.lineno}: string {v[:40]!r} is not one of the template's")
+            elif v is True and flags:
+                continue
             elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 refuse(f"line {node.lineno}: constant {v!r} is not a finite number")
 
