@@ -444,6 +444,25 @@ def test_a_bad_group_of_variants_is_one_clear_line(tmp_path, group, key, words):
     assert info.value.key == key and words in info.value.rule, (info.value.key, info.value.rule)
 
 
+@pytest.mark.parametrize("extra,key,words", [
+    # the same key in a plain variant and in a group: the last would win under both labels
+    ('"impact.spin" = [2.0]\n[variants.spin2]\n"impact.spin" = [1.0, 3.0]', "variants.impact.spin",
+     "is varied twice"),
+    # a group named as another dimension's label
+    ('"impact.speed" = [1.0]\n[variants.speed]\n"impact.angle" = [0.0, 10.0]', "variants", "labels two dimensions"),
+    # an unquoted dotted key inside a group
+    ('[variants.g]\nimpact.speed = [1.0, 2.0]', "variants.g.impact", '"impact.speed" = ['),
+])
+def test_variants_that_would_mislabel_a_case_are_refused(tmp_path, extra, key, words):
+    from .conftest import CASES
+
+    path = tmp_path / "z.toml"
+    path.write_text((CASES / "glass-pair.toml").read_text() + "\n[variants]\n" + extra + "\n")
+    with pytest.raises(ConfigError) as info:
+        C.expand(path)
+    assert info.value.key == key and words in info.value.rule, (info.value.key, info.value.rule)
+
+
 def test_an_unquoted_dotted_variant_key_is_named_with_the_fix(tmp_path):
     """impact.speed = [...] without quotes is a TOML table: said in one line, not read as a group."""
     from .conftest import CASES

@@ -181,6 +181,18 @@ def expand(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> lis
             if _name_problem(_label(v)):
                 raise ConfigError(where, v, f"labels its variant, so its text {NAME_RULE}")
         dims.append((label_key, [(_label(v), {key: v}) for v in values]))
+    seen: dict = {}  # a key set by two dimensions would run the last one's value under both labels
+    for label_key, members in dims:
+        for key in members[0][1]:
+            if key in seen:
+                raise ConfigError(f"variants.{_key_text(key)}", key, f"is varied twice (in {seen[key]} and in "
+                                  f"{label_key}): a key belongs to one dimension of the variants")
+            seen[key] = label_key
+    labels = [label_key for label_key, _ in dims]
+    twice = sorted({k for k in labels if labels.count(k) > 1})
+    if twice:
+        raise ConfigError("variants", twice[0], "labels two dimensions of the variants (each names its variants: "
+                          "give one key's group another name)")
     cases = []
     for combo in itertools.product(*(members for _, members in dims)):
         r = copy.deepcopy(raw)
@@ -205,6 +217,9 @@ def _zipped(where: str, group: dict) -> list[tuple[str, dict]]:
         raise ConfigError(where, {}, "a group of variants needs at least one dotted key with a list of values")
     lengths = set()
     for key, values in group.items():
+        if isinstance(values, dict):  # impact.speed = [...] unquoted inside the group: TOML made it a table
+            raise ConfigError(f"{where}.{_key_text(key)}", values, f"a variant's key is quoted, \"{key}."
+                              f"{next(iter(values), 'x')}\" = […]")
         if not isinstance(values, list) or not values:
             raise ConfigError(f"{where}.{_key_text(key)}", values, "must be a non-empty list of values")
         lengths.add(len(values))
