@@ -170,3 +170,86 @@ def test_models_reverse_lookup():
     assert [f["code"] for f in r["findings"]] == ["tsuji"]
     bad = demcheck("models", "--engine", "lammps", "hertz/material 63e9 0.6 damping")
     assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+
+
+# ----------------------------------------------------------------------------- every normal family's seed probe
+
+LIGGGHTS_HEAD = HEAD.format(n=1).replace("atom_style sphere", "atom_style granular\ncommunicate single vel yes")
+# (pair_coeff or LIGGGHTS's material lines, the seed normal and tangential models it is nearest to, its traps)
+PLAIN = {
+    "lammps-default-damping": ("pair_style granular\npair_coeff * * hertz/material 63e9 0.6 0.24 tangential mindlin "
+                               "NULL 1.0 0.5\n", ("kk", "ddt"), set()),
+    "lammps-undamped": ("pair_style granular\npair_coeff * * hertz/material 63e9 0 0.24 tangential mindlin NULL 1.0 "
+                        "0.5\n", ("hertz", "ddt"), set()),
+    "lammps-coeff-restitution": ("pair_style granular\npair_coeff * * hertz/material 63e9 0.6 0.24 damping "
+                                 "coeff_restitution tangential mindlin NULL 1.0 0.5\n", ("tti", "tti"),
+                                 # mindlin's Maw history at contact onset has no limit as dt → 0 (docs/benchmarks.md)
+                                 {"dt-coarse"}),
+    "lammps-hooke-mindlin": ("pair_style granular\npair_coeff * * hooke 1e7 0.5 tangential mindlin 1e9 1.0 0.5\n",
+                             ("lsd", "ddt"), set()),
+    "liggghts-hertz-e1": ("fix m1 all property/global youngsModulus peratomtype 5e8\n"
+                          "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
+                          "fix m3 all property/global coefficientRestitution peratomtypepair 1 1.0\n"
+                          "fix m4 all property/global coefficientFriction peratomtypepair 1 0.5\n"
+                          "pair_style gran model hertz tangential history\npair_coeff * *\n", ("hertz", "ddt"),
+                          set()),
+    "liggghts-hertz-stiffness": ("fix m1 all property/global kn peratomtypepair 1 4e10\n"
+                                 "fix m2 all property/global kt peratomtypepair 1 5e10\n"
+                                 "fix m3 all property/global gamman peratomtypepair 1 1e3\n"
+                                 "fix m4 all property/global gammat peratomtypepair 1 1e3\n"
+                                 "fix m5 all property/global coefficientFriction peratomtypepair 1 0.5\n"
+                                 "pair_style gran model hertz/stiffness tangential history\npair_coeff * *\n",
+                                 ("kk", "ddt"), set()),
+}
+
+
+@pytest.mark.parametrize("name", list(PLAIN))
+def test_a_plain_deck_of_every_normal_family_probes_clean(tmp_path, name):
+    """The seed probe of each normal family (Hertz undamped, KK's δ^½ dashpot, TTIn's δ^¼, a linear spring) with a
+    δ½-stiffness tangential spring: DDt takes no truncation (Maw's is its only one), TTIt does; every probe runs and
+    a deck without a trap reports none (the twin here; the engine in the next test)."""
+    text, (normal, tangential), traps = PLAIN[name]
+    deck = _deck(tmp_path, (LIGGGHTS_HEAD if name.startswith("liggghts") else HEAD.format(n=1)) + text)
+    r = A.audit(deck, run_engine=False)
+    (entry,) = r["pairs"]
+    assert [p.get("error") for p in entry["probes"]] == [None] * 3, entry["probes"]
+    assert (entry["seed"]["normal"], entry["seed"]["tangential"]) == (normal, tangential)
+    assert {f["code"] for f in entry["findings"] if f["kind"] == "trap"} == traps, entry["findings"]
+    assert r["status"] == ("traps" if traps else "clean")
+
+
+@pytest.mark.engine("lammps")
+def test_audit_of_a_plain_deck_with_default_damping_exits_0(tmp_path):
+    """The review's deck: hertz/material with LAMMPS's default damping and mindlin NULL, run in LAMMPS."""
+    deck = _deck(tmp_path, HEAD.format(n=1) + PLAIN["lammps-default-damping"][0])
+    out = demcheck("audit", str(deck), "--json")
+    assert out.returncode == 0, out.stdout[-2000:] + out.stderr
+    r = json.loads(out.stdout)
+    assert r["status"] == "clean"
+    assert all(p["engine_vs_twin"] <= 1e-9 and p["engine"]["status"] == "ok" for p in r["pairs"][0]["probes"])
+
+
+@pytest.mark.engine("liggghts")
+def test_audit_of_liggghts_hertz_and_hertz_stiffness_decks_in_the_engine(tmp_path):
+    for name in ("liggghts-hertz-e1", "liggghts-hertz-stiffness"):
+        r = A.audit(_deck(tmp_path, LIGGGHTS_HEAD + PLAIN[name][0], name=f"{name}.deck"))
+        assert r["status"] == "clean", (name, r["pairs"][0]["findings"])
+        assert all(p["engine_vs_twin"] <= 1e-9 for p in r["pairs"][0]["probes"]), name
+
+
+@pytest.mark.parametrize("engine, line, seed", [
+    ("lammps", "hertz/material 63e9 0.6 0.24 tangential mindlin NULL 1.0 0.5", ("kk", "ddt")),
+    ("lammps", "hertz/material 63e9 0.6 0.24 damping coeff_restitution tangential mindlin NULL 1.0 0.5", ("tti", "tti")),
+    ("lammps", "* * hertz 1e9 0 tangential mindlin 1e9 1.0 0.5", ("hertz", "ddt")),
+    ("lammps", "hertz 1e9 0.5 tangential mindlin 1e9 1.0 0.5", ("kk", "ddt")),
+    ("lammps", "hooke 1e5 0.5 tangential mindlin 1e5 1.0 0.5", ("lsd", "ddt")),
+    ("liggghts", "model hertz tangential history coefficientRestitution=1 coefficientFriction=0.5 "
+                 "youngsModulus=63e9 poissonsRatio=0.24 hard_particles=yes", ("hertz", "ddt")),
+    ("liggghts", "model hertz/stiffness tangential history kn=1e5 kt=1e5 gamman=1 gammat=1 coefficientFriction=0.5",
+     ("kk", "ddt")),
+])
+def test_reverse_lookup_of_every_normal_family(engine, line, seed):
+    r = A.reverse(engine, line)
+    assert (r["seed"]["normal"], r["seed"]["tangential"]) == seed
+    assert ("truncation" in r["seed"]["params"]) == (seed[1] == "tti")
+    assert len(r["probes"]) == 3 and all(math.isfinite(p["gap"]) for p in r["probes"])

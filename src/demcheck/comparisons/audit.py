@@ -144,7 +144,8 @@ def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
         tangential = "none"
     elif tl.family == SPRING and tl.kt_sqrt:
         tangential = "tti" if normal == "tti" else "ddt"
-        params["truncation"] = "overlap"
+        if tangential == "tti":  # TTIt takes a truncation rule (the engines' Maw history); DDt has Maw's only
+            params["truncation"] = "overlap"
     elif tl.family == SPRING:
         tangential = "spring_sliding"
         params["kt"] = tl.kt
