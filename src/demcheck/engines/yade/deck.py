@@ -35,8 +35,8 @@ NAMES = frozenset({
     "DT", "STEPS", "G", "ids", "mass", "inertia", "radius", "out", "k", "n", "i", "s", "x", "v", "w", "f", "t", "a",
     "b", "b0", "b1"})
 # keyword arguments of the template's calls (Yade's own constructor keywords)
-KEYWORDS = frozenset({"axis", "betan", "betas", "cn", "cs", "damping", "density", "en", "frictionAngle", "gravity",
-                      "kn", "ks", "material", "poisson", "sense", "young", "dt"})
+KEYWORDS = frozenset({"axis", "betan", "betas", "cn", "cs", "damping", "density", "en", "et", "frictionAngle",
+                      "gravity", "kn", "ks", "material", "poisson", "sense", "tc", "young", "dt"})
 ATTRIBUTES = frozenset({"materials", "bodies", "append", "sphere", "wall", "state", "mass", "inertia", "pos", "vel",
                         "angVel", "engines", "dt", "step", "forces", "f", "t", "write", "close"})
 NODES = (ast.Module, ast.Expr, ast.Assign, ast.Call, ast.Name, ast.Load, ast.Store, ast.Attribute, ast.Constant,
@@ -115,6 +115,10 @@ def materials(nat, case: Case, sc) -> tuple[str, str]:
     p = nat.props
     phi = math.atan(p.get("mu", 0.0))
     if nat.normal == VISCEL:
+        if p.get("tc") is not None:  # Yade's own calibration input (never mapped: docs/yade.md's trap)
+            body = (f"ViscElMat(tc={_num(p['tc'])}, en={_num(p['en'])}, et={_num(p.get('et', 1.0))}, "
+                    f"frictionAngle={_num(phi)}, density=1.0)")
+            return body, body
         # in series: 1/(1/a + 1/b) = a/2 for equal values; a wall's material takes the same values
         body = (f"ViscElMat(kn={_num(2.0 * p['kn'])}, cn={_num(2.0 * p['cn'])}, ks={_num(2.0 * p['ks'])}, "
                 f"cs={_num(2.0 * p['cs'])}, frictionAngle={_num(phi)}, density=1.0)")
