@@ -378,3 +378,18 @@ def test_viscelmat_tc_en_calibrates_a_wall_with_half_the_mass(path, en):
         assert a["restitution"] - en >= 0.025 and a["contact_time"] / tc >= 1.39
     else:
         assert a["contact_time"] / tc == pytest.approx(1.0, abs=6e-3)
+
+
+def test_free_text_stays_in_ascii_comments(tmp_path):
+    """A case name that tries to end its comment line, and a material name outside ASCII (both in comments), change
+    no code line of the script; it still passes its guard."""
+    import dataclasses
+
+    text = (CASES / "packing" / "column-lsd.toml").read_text().replace("glass", "gl\u00e4ss")
+    case = C.loads(text.replace("[materials.gl\u00e4ss]", '[materials."gl\u00e4ss"]'))
+    benign = script(C.load(CASES / "packing" / "column-lsd.toml"))
+    for name in ("x\nimport os #", "x\r\nexec('1') #", "x \\", "x\u2028O.run(1) #"):
+        bad = script(dataclasses.replace(case, name=name))
+        YP.check_script(bad)
+        code = [line for line in bad.split("\n") if not line.startswith("#")]
+        assert code == [line for line in benign.split("\n") if not line.startswith("#")]

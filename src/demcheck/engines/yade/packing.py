@@ -351,7 +351,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
                            "(every particle pair in contact)"),
             common.comment("run by hand: yade -x -n <this file> (it writes both files in the working directory and "
                            "prints 'step ke atoms' lines)")]
-    lines = [ascii_comment(x) for x in head]
+    lines = list(head)
     lines += ["from yade import utils", "",
               common.comment(f"the run: dt (s), steps, gravity (m/s^2), the steps whose translational kinetic energy "
                              f"is printed (every {every} and the last)"),
@@ -373,7 +373,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
         who = ", ".join(str(a + 1) for a, gg in enumerate(laws.group_of) if gg == g_)
         lines += [common.comment(f"the floor of species {who}: the wall's values of the case in series with the "
                                  "species' material"), _material(laws, w)]
-    lines += [ascii_comment(c) for c in PD.law_comments(
+    lines += [c for c in PD.law_comments(
         [*((f"species {a + 1} with {b + 1}", mp) for (a, b), mp in pairs.items()),
          *((f"species {a + 1} with the walls", mp) for a, mp in enumerate(walls))])]
     lines += [common.comment("every particle: material (its species), radius (m), mass (kg), moment of inertia "
@@ -460,4 +460,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
               f"    out.write({CONTACT_ROW!r} % (c.id1 + 1, c.id2 + 1, c.geom.penetrationDepth, f[0], f[1], f[2], "
               "t[0], t[1], t[2], a[0], a[1], a[2]))",
               "out.close()", ""]
-    return common.Deck("yade", "\n".join(lines), {}, dt=lay.dt, check=check_script)
+    # free text (the case's and materials' names, the mapping's words) reaches the script only in comments, each
+    # an ASCII line (Yade reads a script in the locale's encoding when it is run by hand)
+    text = "\n".join(ascii_comment(x) if x.startswith("#") else x for x in lines)
+    return common.Deck("yade", text, {}, dt=lay.dt, check=check_script)
