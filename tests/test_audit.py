@@ -13,6 +13,8 @@ from demcheck.comparisons import audit as A
 from demcheck.engines.collide import collide
 from demcheck.engines.lammps.audit import mixed
 from demcheck.engines.base import Native
+from demcheck.errors import ConfigError
+from demcheck.inputs.script import ScriptError
 
 from .conftest import ROOT
 from .helpers import glass_case
@@ -141,7 +143,9 @@ def test_a_plain_deck_passes_and_shell_lines_are_not_run(tmp_path):
 @pytest.mark.parametrize("line,what", [
     ("pair_coeff * * hertz/material 63e9 0.6 0.24 damping tsuji tangential bogus 1 2", "tangential bogus"),
     ("pair_coeff * * hertz/material 63e9 x 0.24 tangential linear_nohistory 0 0", "'x' is not a number"),
-    ("jump SELF a", "control flow"), ("include ../../etc/passwd", "outside the deck's directory")])
+    ("jump SELF a", "control flow"), ("include ../../etc/passwd", "outside the deck's directory"),
+    ("pair_coeff * * hertz/material 0 0.6 0.24 tangential mindlin NULL 1.0 0.5", "hertz/material E = 0: must be > 0"),
+    ("pair_coeff * * hooke 1e5 0.5 tangential mindlin NULL 1.0 0.5", "mindlin NULL: k_t from E and ν needs a material")])
 def test_bad_lines_exit_2_with_one_line(tmp_path, line, what):
     deck = _deck(tmp_path, HEAD.format(n=1) + "pair_style granular\n" + line + "\n")
     out = demcheck("audit", str(deck))
@@ -253,3 +257,63 @@ def test_reverse_lookup_of_every_normal_family(engine, line, seed):
     assert (r["seed"]["normal"], r["seed"]["tangential"]) == seed
     assert ("truncation" in r["seed"]["params"]) == (seed[1] == "tti")
     assert len(r["probes"]) == 3 and all(math.isfinite(p["gap"]) for p in r["probes"])
+
+
+# ----------------------------------------------------------------------------- numbers out of range
+
+
+@pytest.mark.parametrize("line, words", [
+    ("hertz/material 0 0.6 0.24 tangential mindlin NULL 1.0 0.5", "hertz/material E = 0: must be > 0"),
+    ("hooke 0 0.5 tangential linear_history 1e5 1 0.5", "hooke k_n = 0: must be > 0"),
+    ("hooke -1e5 0.5 tangential linear_history 1e5 1 0.5", "hooke k_n = -100000: must be > 0"),
+    ("hooke 1e5 -1 tangential linear_history 1e5 1 0.5", "damping viscoelastic η_n0 (the 2nd hooke coefficient) = -1"),
+    ("hertz/material 63e9 0 0.24 damping coeff_restitution tangential mindlin NULL 1.0 0.5",
+     "damping coeff_restitution e (the 2nd hertz/material coefficient) = 0: must be in (0, 1]"),
+    ("hertz/material 63e9 0.6 0.5 damping tsuji tangential mindlin NULL 1.0 0.5", "hertz/material ν = 0.5"),
+    ("hertz/material 63e9 0.6 0.24 tangential mindlin NULL -1 0.5", "tangential mindlin x_γ,t = -1: must be >= 0"),
+    ("hertz/material 63e9 0.6 0.24 tangential mindlin NULL 1 -0.5", "tangential mindlin μ_s = -0.5: must be >= 0"),
+    ("hooke 1e5 0.5 tangential linear_history 0 1 0.5", "tangential linear_history k_t = 0: must be > 0"),
+])
+def test_lammps_numbers_out_of_range_are_refused_by_their_names(line, words):
+    """What would divide by zero or make a law without meaning (a stiffness ≤ 0, a damping or friction < 0, an e
+    outside (0, 1], ν outside (−1, 0.5)) is one ConfigError naming LAMMPS's own coefficient and value."""
+    with pytest.raises(ConfigError) as err:
+        A.reverse("lammps", line)
+    assert words in err.value.rule, err.value.rule
+
+
+def test_lammps_classic_style_numbers_out_of_range(tmp_path):
+    text = HEAD.format(n=1) + "pair_style gran/hooke/history 0 NULL 50 NULL 0.5 1\npair_coeff * *\n"
+    with pytest.raises(ScriptError, match=r"in.deck:10: .*gran/hooke/history Kn = 0: must be > 0"):
+        A.read(_deck(tmp_path, text))
+    text = HEAD.format(n=1) + "pair_style gran/hooke 2e5 0 50 NULL 0.5 2\npair_coeff * *\n"
+    with pytest.raises(ScriptError, match="dampflag = 2: must be 0 or 1"):
+        A.read(_deck(tmp_path, text))
+    text = HEAD.format(n=1) + "pair_style gran/hooke 2e5 0 50 NULL 0.5 1\npair_coeff * *\n"  # Kt unread: fine
+    assert A.read(_deck(tmp_path, text)).pairs[0].probe
+
+
+LIGGGHTS_MATERIALS = ("fix m1 all property/global youngsModulus peratomtype 5e8\n"
+                      "fix m2 all property/global poissonsRatio peratomtype 0.25\n"
+                      "fix m3 all property/global coefficientRestitution peratomtypepair 1 0.5\n"
+                      "fix m4 all property/global coefficientFriction peratomtypepair 1 {mu}\n"
+                      "pair_style gran model {model} tangential history\npair_coeff * *\n")
+
+
+def test_liggghts_deck_numbers_out_of_range_name_the_property_line(tmp_path):
+    deck = _deck(tmp_path, LIGGGHTS_HEAD + LIGGGHTS_MATERIALS.format(mu=-0.5, model="hertz"))
+    out = demcheck("audit", str(deck))
+    assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1, out.stderr
+    assert "in.deck:14" in out.stderr and "coefficientFriction=-0.5 (types 1 1): must be >= 0" in out.stderr
+    # a */stiffness model without its kn, kt, gamman, gammat: LIGGGHTS stops; so does the reader (no silent 0)
+    deck = _deck(tmp_path, LIGGGHTS_HEAD + "fix m1 all property/global kn peratomtypepair 1 1e5\n"
+                 + LIGGGHTS_MATERIALS.split("\n", 3)[3].format(mu=0.5, model="hooke/stiffness"))
+    with pytest.raises(ScriptError, match="model hooke/stiffness needs kt, gamman, gammat"):
+        A.read(deck)
+    deck = _deck(tmp_path, LIGGGHTS_HEAD + "fix m1 all property/global kn peratomtypepair 1 1e5\n"
+                 "fix m2 all property/global kt peratomtypepair 1 1e5\nfix m3 all property/global gamman "
+                 "peratomtypepair 1 0\nfix m4 all property/global gammat peratomtypepair 1 1\n"
+                 "fix m5 all property/global coefficientFriction peratomtypepair 1 0.5\n"
+                 "pair_style gran model hertz/stiffness tangential history\npair_coeff * *\n")
+    r = A.audit(deck, run_engine=False)  # gammat > 0 with gamman = 0: no twin; listed, not probed
+    assert r["pairs"][0]["probes"] == [] and "no twin" in " ".join(r["pairs"][0]["notes"])

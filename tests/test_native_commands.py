@@ -305,6 +305,38 @@ def test_cli_sweep_of_a_liggghts_native_property():
         assert row["restitution"] == pytest.approx(e_in, abs=2e-3)  # the twin at the case's dt
 
 
+STIFF = {"pair_style": "gran model hooke/stiffness tangential history", "kn": "1e5", "kt": "1e5", "gamman": "1",
+         "gammat": "1"}
+
+
+@pytest.mark.parametrize("table, key, words", [
+    ({**STIFF, "kn": "0"}, "engine.liggghts.kn", "must be > 0"),
+    ({**STIFF, "kn": "-1e5"}, "engine.liggghts.kn", "must be > 0"),
+    ({**STIFF, "gamman": "-1"}, "engine.liggghts.gamman", "must be >= 0"),
+    ({**STIFF, "coefficientFriction": "-0.5"}, "engine.liggghts.coefficientFriction", "must be >= 0"),
+    ({k: v for k, v in STIFF.items() if k != "gammat"}, "engine.liggghts.gammat",
+     "model hooke/stiffness needs kn, kt, gamman, gammat"),
+    ({k: v for k, v in STIFF.items() if k not in ("kn", "kt")}, "engine.liggghts.kn", "needs kn, kt"),
+    ({**STIFF, "pair_style": "gran model hertz/stiffness tangential history", "gamman": "0"}, "engine.liggghts",
+     "no twin"),
+])
+def test_case_native_numbers_out_of_range_name_their_key(table, key, words):
+    """A case's [engine.liggghts] property out of range, or a */stiffness model's missing (never a silent 0), is a
+    ConfigError naming its key before any work."""
+    with pytest.raises(ConfigError) as err:
+        demcheck.load(_case({"liggghts": table}))
+    assert err.value.key == key and words in err.value.rule, (err.value.key, err.value.rule)
+
+
+def test_case_native_numbers_out_of_range_in_a_sweep_are_one_line(tmp_path):
+    f = _native_file(tmp_path, {"liggghts": {**STIFF, "kn": "0"}})
+    _one_line_exit_2(demcheck_cli("sweep", f, "--engine", "liggghts-twin", "--vary", "impact.speed=1,2"),
+                     "engine.liggghts.kn = '0': must be > 0")
+    f = _native_file(tmp_path, {"lammps": {"pair_coeff": TSUJI.replace("63e9", "0")}}, name="e0.toml")
+    _one_line_exit_2(demcheck_cli("sweep", f, "--engine", "lammps-twin", "--vary", "impact.speed=1,2"),
+                     "engine.lammps.pair_coeff", "hertz/material E = 0: must be > 0")
+
+
 @pytest.mark.engine("lammps")
 def test_cli_sweep_runs_the_native_law_in_lammps(tmp_path):
     f = _native_file(tmp_path)
@@ -353,6 +385,11 @@ def test_liggghts_reverse_lookup_flags_limitforce_with_its_number():
     assert f["size"]["realised"] > 0.62 and "0.6323 realised" in f["text"]
 
 
+def test_liggghts_reverse_lookup_notes_rolling_friction_and_cohesion_once():
+    r = A.reverse("liggghts", LIGGGHTS_LINE.replace("history", "history rolling_friction epsd2 cohesion sjkr"))
+    assert [n.split()[0] for n in r["notes"]] == ["rolling_friction", "cohesion"], r["notes"]
+
+
 @pytest.mark.parametrize("line, words", [
     ("model hertz tangential history coefficientRestitution=0.6 youngsModulus=63e9 poissonsRatio=0.24",
      "needs coefficientFriction"),
@@ -362,6 +399,19 @@ def test_liggghts_reverse_lookup_flags_limitforce_with_its_number():
     ("model hertz tangential off colour=red", "colour: not a property read here"),
     ("model hertz tangential off coefficientRestitution=1.5 youngsModulus=63e9 poissonsRatio=0.24", "(0, 1]"),
     ("model hertzz", "not a LIGGGHTS 3.8.0 normal model"),
+    # numbers out of range: one line naming the property and its value (never a traceback or an internal key)
+    ("model hooke/stiffness tangential history kn=0 kt=1e5 gamman=1 gammat=1 coefficientFriction=0.5",
+     "kn=0: must be > 0"),
+    ("model hooke/stiffness tangential history kn=-1e5 kt=1e5 gamman=1 gammat=1 coefficientFriction=0.5",
+     "kn=-100000: must be > 0"),
+    ("model hertz/stiffness tangential history kn=1e5 kt=0 gamman=1 gammat=1 coefficientFriction=0.5",
+     "kt=0: must be > 0"),
+    ("model hooke/stiffness tangential history kn=1e5 kt=1e5 gamman=-1 gammat=1 coefficientFriction=0.5",
+     "gamman=-1: must be >= 0"),
+    ("model hooke/stiffness tangential history kn=1e5 kt=1e5 gamman=1 gammat=-1 coefficientFriction=0.5",
+     "gammat=-1: must be >= 0"),
+    (LIGGGHTS_LINE.replace("coefficientFriction=0.5", "coefficientFriction=-0.5"), "coefficientFriction=-0.5: must be"),
+    ("model hertz/stiffness tangential history kn=1e5 kt=1e5 gamman=0 gammat=1 coefficientFriction=0.5", "no twin"),
 ])
 def test_bad_liggghts_reverse_lookups_are_one_line(line, words):
     _one_line_exit_2(demcheck_cli("models", "--engine", "liggghts", line), "SETTING = ", words)
@@ -372,7 +422,9 @@ def test_reverse_lookups_of_other_engines_and_untwinned_laws():
                      "lammps:", "liggghts:")
     _one_line_exit_2(demcheck_cli("models", "--radius", "1e-3"), "--radius", "reverse lookup")
     _one_line_exit_2(demcheck_cli("models", "--engine", "lammps", "hooke 1e5 0.5 tangential mindlin NULL 1 0.5"),
-                     "no twin")
+                     "mindlin NULL: k_t from E and ν needs a material normal model")
+    _one_line_exit_2(demcheck_cli("models", "--engine", "lammps", "hertz/material 0 0.6 0.24 tangential mindlin "
+                                  "NULL 1.0 0.5"), "hertz/material E = 0: must be > 0")
     jkr = demcheck_cli("models", "--engine", "lammps", "--json", "jkr 1e9 0.5 0.3 0.1 tangential mindlin NULL 1 0.5")
     assert jkr.returncode == 0, jkr.stderr
     r = json.loads(jkr.stdout)

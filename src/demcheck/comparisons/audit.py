@@ -291,9 +291,14 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
         from ..errors import EngineNotFound
 
         raise EngineNotFound(discovery.missing(setup.engine))
-    for ps in setup.pairs:  # every body the probes need, before any run
+    eng = registry.get(setup.engine)
+    for ps in setup.pairs:  # every body the probes need, and a twin of every probed law, before any run
         if ps.probe:
-            _effective(setup, ps)
+            try:
+                eng.twin(ps.native, *_effective(setup, ps))
+            except (ValueError, ArithmeticError) as exc:
+                ps.probe = False
+                ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
     pairs = []
     findings = list(setup.findings)
     for ps in setup.pairs:
@@ -490,7 +495,7 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
     eng = registry.get(engine)
     try:
         nl, tl = eng.twin(ps.native, m / 2.0, radius / 2.0)
-    except ValueError as exc:
+    except (ValueError, ArithmeticError) as exc:
         raise ConfigError("SETTING", line, f"no twin: {exc}") from None
     normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)
     implied = {"normal_force": f"{nl.k:.6g} δ^{nl.a:g}", "damping": f"{nl.eta:.6g} δ^{nl.b:g} (N·s/m at δ^b)",

@@ -81,10 +81,51 @@ def parse_granular(cmd: Command, words: list[str], k: int) -> dict:
             out["extras"].append(f"cutoff {words[k + 1]}")
             k += 2
         else:
-            return {**out, "rest": k}
-    if "tangential" not in out:
+            break
+    if k == len(words) and "tangential" not in out:
         raise _bad(cmd, "pair granular needs a tangential model")
+    _ranges(cmd, out)
     return {**out, "rest": k}
+
+
+POSITIVE, NON_NEGATIVE, RESTITUTION = ("must be > 0", lambda x: x > 0), ("must be >= 0", lambda x: x >= 0), \
+    ("must be in (0, 1]", lambda x: 0 < x <= 1)
+POISSON = ("must be in (-1, 0.5)", lambda x: -1 < x < 0.5)
+MATERIAL_NORMALS = ("hertz/material", "dmt", "jkr", "mdr")  # where mindlin's k_t may be NULL (from E and ν)
+
+
+def _ranges(cmd: Command, spec: dict) -> None:
+    """The coefficients of the laws demcheck twins within their ranges, each refused by its LAMMPS name and
+    value: k_n, E > 0, ν in (−1, 0.5), the damping coefficient η_n0 ≥ 0 or e in (0, 1] (tsuji,
+    coeff_restitution), k_t > 0 (or NULL with a material normal model), x_γ,t ≥ 0, μ_s ≥ 0."""
+    def check(what, value, rule):
+        text, ok = rule
+        if value is not None and not ok(value):
+            raise _bad(cmd, f"{what} = {value:g}: {text}")
+
+    normal, c = spec["normal"], spec["normal_coeffs"]
+    if normal in PROBED_NORMALS:
+        check(f"{normal} {'E' if normal == 'hertz/material' else 'k_n'}", c[0], POSITIVE)
+        if spec["damping"] in ("tsuji", "coeff_restitution"):
+            check(f"damping {spec['damping']} e (the 2nd {normal} coefficient)", c[1], RESTITUTION)
+        else:
+            check(f"damping {spec['damping']} η_n0 (the 2nd {normal} coefficient)", c[1], NON_NEGATIVE)
+        if normal == "hertz/material":
+            check("hertz/material ν", c[2], POISSON)
+    tang, tc = spec.get("tangential"), spec.get("tangential_coeffs") or ()
+    if tang is None or not tc:
+        return
+    if tang == "linear_nohistory":
+        check(f"tangential {tang} x_γ,t", tc[0], NON_NEGATIVE)
+    else:
+        if tc[0] is None and tang.startswith("mindlin") and normal not in MATERIAL_NORMALS:
+            raise _bad(cmd, f"tangential {tang} NULL: k_t from E and ν needs a material normal model "
+                            f"({', '.join(MATERIAL_NORMALS)}), not {normal}")
+        if tc[0] is None and not tang.startswith("mindlin"):
+            raise _bad(cmd, f"tangential {tang}: k_t must be a number (NULL is mindlin's)")
+        check(f"tangential {tang} k_t", tc[0], POSITIVE)
+        check(f"tangential {tang} x_γ,t", tc[1], NON_NEGATIVE)
+    check(f"tangential {tang} μ_s", tc[-1], NON_NEGATIVE)
 
 
 def native_of(spec: dict) -> Native:
@@ -107,6 +148,12 @@ def classic(cmd: Command, style: str, words: list[str], k: int) -> tuple[dict, l
     gt = 0.5 * gn if words[k + 3:k + 4] == ["NULL"] else _num(cmd, k + 3, "gamma_t")
     mu = _num(cmd, k + 4, "xmu")
     flag = _num(cmd, k + 5, "dampflag")
+    for what, value, (text, ok) in (("Kn", kn, POSITIVE), ("Kt", kt, POSITIVE), ("gamma_n", gn, NON_NEGATIVE),
+                                    ("gamma_t", gt, NON_NEGATIVE), ("xmu", mu, NON_NEGATIVE)):
+        if not ok(value) and (what != "Kt" or style != "gran/hooke"):  # gran/hooke has no spring: Kt unread
+            raise _bad(cmd, f"{style} {what} = {value:g}: {text}")
+    if flag not in (0, 1):
+        raise _bad(cmd, f"{style} dampflag = {flag:g}: must be 0 or 1")
     if flag == 0:
         gt = 0.0
     xt = gt / gn if gn > 0 else (0.0 if gt == 0 else math.inf)

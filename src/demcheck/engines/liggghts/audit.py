@@ -39,6 +39,34 @@ def _bad(cmd: Command, why: str):
     return ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {why}")
 
 
+# the range of each property a law reads: (rule, test); a value outside it is refused with its own name
+RANGES = {"youngsModulus": ("must be > 0", lambda x: x > 0),
+          "poissonsRatio": ("must be in (-1, 0.5)", lambda x: -1.0 < x < 0.5),
+          "coefficientRestitution": ("must be in (0, 1]", lambda x: 0.0 < x <= 1.0),
+          "coefficientFriction": ("must be >= 0", lambda x: x >= 0.0),
+          "characteristicVelocity": ("must be > 0", lambda x: x > 0),
+          "kn": ("must be > 0", lambda x: x > 0), "kt": ("must be > 0", lambda x: x > 0),
+          "gamman": ("must be >= 0", lambda x: x >= 0.0), "gammat": ("must be >= 0", lambda x: x >= 0.0)}
+STIFFNESS = ("kn", "kt", "gamman", "gammat")  # what the */stiffness models read (LIGGGHTS stops without them)
+
+
+class RangeError(ScriptError):
+    """A property outside its range (RANGES), with its LIGGGHTS name, value and rule."""
+
+    def __init__(self, where: str, name: str, value: float, rule: str, types: str = ""):
+        super().__init__(f"{where}: {name}={value:g}{types}: {rule}")
+        self.name, self.value, self.rule = name, value, rule
+
+
+def _checked(props: dict, name: str, value: float, types: str) -> float:
+    rule, ok = RANGES[name]
+    if not (math.isfinite(value) and ok(value)):
+        where = props[name][2] if name in props else "models"
+        kind = props[name][0] if name in props else "scalar"
+        raise RangeError(where, name, value, rule, f" ({types})" if kind != "scalar" and where != "models" else "")
+    return value
+
+
 def parse_style(cmd: Command, w: list[str], k: int) -> tuple[dict, int]:
     """``model M tangential T [rolling_friction R] [cohesion C] [surface S] [flag on|off]…`` from w[k]."""
     spec = {"model": None, "tangential": "off", "rolling": "off", "cohesion": "off", "flags": {}}
@@ -206,6 +234,7 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
     limit = flags.get("limitForce", model in ("luding", "edinburgh"))
     p = {}
     notes, findings, asked = [], [], {}
+    pair = f"types {a} {b}"
     for pname, key in PER_PAIR.items():
         v = _pair_value(props, pname, a, b)
         if v is not None:
@@ -215,23 +244,33 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         na, nb = _per_type(props, "poissonsRatio", a), _per_type(props, "poissonsRatio", b)
         if None in (ea, eb, na, nb):
             raise ScriptError(f"{where}: model {model} needs youngsModulus and poissonsRatio for types {a} and {b}")
+        for name, t, v in (("youngsModulus", a, ea), ("youngsModulus", b, eb), ("poissonsRatio", a, na),
+                           ("poissonsRatio", b, nb)):
+            _checked(props, name, v, f"type {t}")
         p["youngs_eff"] = 1.0 / ((1 - na * na) / ea + (1 - nb * nb) / eb)
         p["shear_eff"] = 1.0 / (2 * (2 - na) * (1 + na) / ea + 2 * (2 - nb) * (1 + nb) / eb)
         if "restitution" not in p:
             raise ScriptError(f"{where}: model {model} needs coefficientRestitution")
-        asked["restitution"] = p["restitution"]
+        asked["restitution"] = _checked(props, "coefficientRestitution", p["restitution"], pair)
         if model == "hooke":
             if "characteristicVelocity" not in props:
                 raise ScriptError(f"{where}: model hooke needs characteristicVelocity")
-            p["characteristic_velocity"] = props["characteristicVelocity"][1][0]
+            p["characteristic_velocity"] = _checked(props, "characteristicVelocity",
+                                                    props["characteristicVelocity"][1][0], pair)
             notes.append("model hooke: kn is set by characteristicVelocity, m̄ and R̄ (not directly), kt = kn")
+    elif model in ("hooke/stiffness", "hertz/stiffness"):
+        missing = [n for n in STIFFNESS if n not in p]
+        if missing:
+            raise ScriptError(f"{where}: model {model} needs {', '.join(missing)} (LIGGGHTS stops without them)")
+        for name in STIFFNESS:
+            _checked(props, name, p[name], pair)
     if tang != "off":
         if "friction" not in p:
             raise ScriptError(f"{where}: tangential {tang} needs coefficientFriction")
-        asked["friction"] = p["friction"]
+        asked["friction"] = _checked(props, "coefficientFriction", p["friction"], pair)
     else:
         notes.append("tangential off (LIGGGHTS's default): no friction at all")
-    for key in ("kn", "kt", "gamman", "gammat"):
+    for key in STIFFNESS:  # read by the */stiffness models only
         p.setdefault(key, 0.0)
     nat = Native("liggghts", model, limit=limit, tangential=tang, props=p,
                  tangential_damping=flags.get("tangential_damping", True))
@@ -241,6 +280,8 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         notes.append(f"model {model} / tangential {tang}: listed, not probed (no twin of it in demcheck)")
     if spec["rolling"] != "off":
         notes.append(f"rolling_friction {spec['rolling']}: not part of the probes (the twin has none)")
+    if spec["cohesion"] != "off":
+        notes.append(f"cohesion {spec['cohesion']}: not part of the probes (the twin has none)")
     if not flags.get("tangential_damping", True) and tang != "off":
         notes.append("tangential_damping off: no tangential dashpot (the seed's TTIt has one); the probes run "
                      "without it")
@@ -321,10 +362,10 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     _moduli(setup, props, switches["hard_particles"], switches["soft_particles"])
     for f in setup.findings:
         f.where = "models"
-    ps = _pair(setup, spec, "models", props, 1, 1, "1-1")
-    for key in ("rolling", "cohesion"):
-        if spec[key] != "off":
-            ps.notes.append(f"{key} {spec[key]}: not part of the lookup (the twin has none)")
+    try:
+        ps = _pair(setup, spec, "models", props, 1, 1, "1-1")  # its notes name rolling friction and cohesion
+    except ScriptError as exc:
+        raise _bad(cmd, str(exc).removeprefix("models: ")) from None
     for flag in spec["flags"]:
         if flag not in CASE_FLAGS:
             ps.notes.append(f"{flag}: not part of the lookup (the twin reads {', '.join(CASE_FLAGS)})")
@@ -410,12 +451,28 @@ def native_from_case(table: dict, case) -> Native:
             ratios.append(case.materials[w.material].poisson_ratio)
     props["youngsModulus"] = ("peratomtype", moduli, "materials")
     props["poissonsRatio"] = ("peratomtype", ratios, "materials")
+    if spec["model"] in ("hooke/stiffness", "hertz/stiffness"):
+        missing = [n for n in STIFFNESS if n not in table]
+        if missing:
+            raise ConfigError(f"engine.liggghts.{missing[0]}", None, f"model {spec['model']} needs "
+                              f"{', '.join(STIFFNESS)} (LIGGGHTS stops without them)")
     try:
         ps = _pair(Setup("liggghts"), spec, "engine.liggghts", props, 1, 2, "contact")
+    except RangeError as exc:
+        if exc.name in table:
+            raise ConfigError(f"engine.liggghts.{exc.name}", table[exc.name], exc.rule) from None
+        raise ConfigError(f"engine.liggghts.{exc.name}", None, f"{exc.rule}: {props[exc.name][2]} gives "
+                          f"{exc.value:g}; give {exc.name} here") from None
     except ScriptError as exc:
         raise ConfigError("engine.liggghts", sorted(table), str(exc).split(": ", 1)[-1]) from None
     if not ps.probe:
         raise ConfigError("engine.liggghts.pair_style", text, f"model {spec['model']} / tangential "
                           f"{spec['tangential']}: demcheck has no twin of it (it runs {', '.join(MODELS)})")
+    from .mapping import twin
+
+    try:
+        twin(ps.native, 1.0, 1.0)
+    except (ValueError, ArithmeticError) as exc:
+        raise ConfigError("engine.liggghts", sorted(table), f"no twin: {exc}") from None
     ps.native.comments.append("the case's own native setting ([engine.liggghts])")
     return ps.native
