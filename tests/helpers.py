@@ -55,3 +55,11 @@ def oblique_case(tangential, params=None, *, normal="lsd", normal_params=None, w
     text = text.replace("restitution = ", f"friction = {friction}\nrestitution = ", 1)
     sets = [f"contact.{k}={_toml(v)}" for k, v in {**nparams, **tparams}.items()]
     return C.loads(text, sets + [f"contact.tangential={tangential}"] + list(overrides))
+
+
+def md_plain(md: str) -> str:
+    """Markdown with its backslash escapes undone (CommonMark: a backslash before ASCII punctuation): the text a
+    reader sees, for tests that look for a phrase in report.md (names, versions and sources are escaped there)."""
+    import re
+
+    return re.sub(r"\\([!-/:-@\[-`{-~])", r"\1", md)

@@ -88,7 +88,9 @@ def test_two_builds_of_the_toy_engine_side_by_side(tmp_path):
     p = _demcheck("verify", CASES / "hertz-wall.toml", "--engines", f"toy,toy@v2={toy2}", "--report", "r",
                   tmp_path=tmp_path)
     assert p.returncode == 0, p.stderr
-    md = (tmp_path / "r" / "latest" / "report.md").read_text()
+    from .helpers import md_plain
+
+    md = md_plain((tmp_path / "r" / "latest" / "report.md").read_text())  # the text as rendered (names escaped)
     assert "Engines: toy 1.0; toy@v2 2.0" in md and "| toy@v2: e · t · δ · F · E · et · ω |" in md
     res = json.loads((tmp_path / "r" / "latest" / "results.json").read_text())
     (case,) = res["cases"]
