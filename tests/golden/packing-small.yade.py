@@ -18,9 +18,9 @@ DT = 3.735347976579279e-07
 STEPS = 267713
 G = Vector3(0.0, 0.0, -9.81)
 SAMPLES = [0, 5354, 10708, 16062, 21416, 26770, 32124, 37478, 42832, 48186, 53540, 58894, 64248, 69602, 74956, 80310, 85664, 91018, 96372, 101726, 107080, 112434, 117788, 123142, 128496, 133850, 139204, 144558, 149912, 155266, 160620, 165974, 171328, 176682, 182036, 187390, 192744, 198098, 203452, 208806, 214160, 219514, 224868, 230222, 235576, 240930, 246284, 251638, 256992, 262346, 267700, 267713]
-# Yade's periodic cell (periodic in x, y and z): x and y the case's box, z twice the box's height, so nothing reaches across it
+# Yade's periodic cell (periodic in x, y and z): x and y the case's box, z twice the height of the box and the floor, so nothing reaches across it
 O.periodic = True
-O.cell.setBox(0.011, 0.011, 0.016969401154727747)
+O.cell.setBox(0.011, 0.011, 0.024781901154727747)
 LX = 0.011
 LY = 0.011
 # material k: species k + 1 (it carries twice its like pair's values: Yade combines two materials in series); after them the floor's (one per group of species, each group masked to its own floor)

@@ -17,7 +17,9 @@ What the script does, and why:
   a thousand box widths wide (Ig2_Box_Sphere_ScGeom: the same overlap and normal on its face; its contact point
   is midway into the overlap, arm R − δ/2, where a Wall's is on the plane, R − δ).
 * **The periodic cell.** Yade's cell is periodic in x, y and z: x and y are the case's box, z a period twice
-  the box's height (nothing reaches across it). ``allowBiggerThanPeriod`` lets the floor span the cell.
+  the height of the box and the floor (nothing reaches across it). ``allowBiggerThanPeriod`` lets the floor span
+  the cell; ``sortAxis=2`` makes the collider's first search walk z, where the floor's bound is its own (along x
+  a box far wider than the cell wraps to an arbitrary arc, and the spheres it misses fall through it).
 * **Masses** are the case's (state.mass set, inertia 0.4 m r²), not Yade's from a density.
 * **Leap-frog.** Yade's NewtonIntegrator (damping 0) keeps v_{k−½}; the script starts from v_{−½} = v0 − ½dt g,
   so that velocity Verlet's v0 (no contact at t = 0: the layouts start apart) is the full-step velocity at
@@ -358,9 +360,12 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
               f"DT = {_num(lay.dt)}", f"STEPS = {int(lay.steps)}", f"G = {_vec(g)}",
               f"SAMPLES = [{', '.join(str(int(s)) for s in samples)}]"]
     if periodic:
-        lz = 2.0 * hi[2]
+        # Yade's cell is periodic in z too: twice the height from the lowest floor box to the top of the box
+        half = _half_thickness(lay)
+        zs = [float(w.point[2]) for w in case.walls]
+        lz = 2.0 * (max([hi[2], *(z + 2.0 * half for z in zs)]) - min([lo[2], *(z - 2.0 * half for z in zs)]))
         lines += [common.comment("Yade's periodic cell (periodic in x, y and z): x and y the case's box, z twice the "
-                                 "box's height, so nothing reaches across it"),
+                                 "height of the box and the floor, so nothing reaches across it"),
                   "O.periodic = True", f"O.cell.setBox({_num(hi[0])}, {_num(hi[1])}, {_num(lz)})",
                   f"LX = {_num(hi[0])}", f"LY = {_num(hi[1])}"]
     lines.append(common.comment("material k: species k + 1 (it carries twice its like pair's values: Yade combines "
