@@ -65,3 +65,27 @@ def test_float64_and_float128_differ_by_round_off_dt_and_half_dt_by_scheme_error
     assert max(round_off.values()) <= 1e-12, round_off
     for k in METRICS:
         assert scheme[k] >= 1e-5 and scheme[k] >= 1e6 * max(round_off[k], 1e-16), (k, scheme, round_off)
+
+
+@pytest.mark.engine("yade")
+def test_precision_option_runs_yades_float128_build():
+    """demcheck collide --engine yade --precision float128: Yade's float128 program, as the build yade@float128
+    (its version read from it), beside the reference; --precision where no listed engine has that build is one
+    line, exit 2, before any run."""
+    import json
+    import subprocess
+    import sys
+
+    def demcheck(*args):
+        return subprocess.run([sys.executable, "-m", "demcheck", *map(str, args)], capture_output=True, text=True,
+                              timeout=600)
+
+    p = demcheck("collide", CASES / "hertz-wall.toml", "--engine", "reference,yade", "--precision", "float128",
+                 "--json")
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert set(out) == {"reference", "yade@float128"} and out["yade@float128"]["engine_version"] == "2023.02a"
+    assert out["yade@float128"]["metrics"]["restitution"] == pytest.approx(1.0, abs=1e-5)  # elastic Hertz, O(dt)
+    for engines in ("lammps", "reference"):
+        bad = demcheck("collide", CASES / "hertz-wall.toml", "--engine", engines, "--precision", "float128")
+        assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0 and "--precision" in bad.stderr, bad.stderr

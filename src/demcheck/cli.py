@@ -305,11 +305,17 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
 @click.option("--csv", "csv_path", type=OUT_FILE, default=None,
               help="write the contact time series (of the first source)")
 @click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="engine run timeout (s)")
-def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout):
+@click.option("--precision", "precision", type=click.Choice(["float128", "mpfr150"]), default=None,
+              help="run each engine that has one as its build in this floating-point precision (Yade: "
+                   "yade-float128, yade-mpfr150), e.g. to show a difference is the scheme's and not round-off")
+def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout, precision):
     """Solve one collision case and print its metrics (per source, side by side)."""
     from .errors import EngineNotFound, UnsupportedByEngine
     from .reference.collision import collide as run
 
+    if engine == "all" and precision:
+        raise ConfigError("--precision", precision, "names the builds of engines given by name (--engine yade), "
+                          "not all")
     if engine == "all":
         sources = ["reference", *ENGINE_NAMES]
     else:  # the reference and engines or builds (engines/builds.py), each checked before any work
@@ -318,7 +324,12 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         specs = [s.strip() for s in engine.split(",") if s.strip()]
         if not specs:
             raise ConfigError("--engine", engine, "must name a source: reference, an engine, a build or all")
+        from .engines.builds import with_precision
+
         rest = [s for s in specs if s != "reference"]
+        if precision and not rest:
+            raise ConfigError("--precision", precision, "applies to an engine (--engine yade)")
+        rest = with_precision(",".join(rest), precision).split(",") if rest else []
         labels = iter(discovery.resolve(",".join(rest), "--engine") if rest else [])
         sources = ["reference" if s == "reference" else next(labels) for s in specs]
         if len(sources) == 1:
@@ -562,7 +573,9 @@ def warmup():
                    "directory): a worse verdict or a value moved beyond its tolerance differs unexpectedly")
 @click.option("--write-baseline", "write_baseline", type=OUT_FILE, default=None, metavar="PATH",
               help="store this run as a baseline (metrics, verdicts, engine versions, per-quantity tolerances)")
-def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, baseline, write_baseline):
+@click.option("--precision", "precision", type=click.Choice(["float128", "mpfr150"]), default=None,
+              help="run each listed engine that has one as its build in this floating-point precision (Yade)")
+def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, baseline, write_baseline, precision):
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
@@ -573,6 +586,7 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, 
     from .comparisons import diff, verdicts
     from .engines import builds, discovery
 
+    engines = builds.with_precision(engines, precision) if precision else engines  # yade → yade@float128=…
     names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)

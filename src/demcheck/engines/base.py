@@ -114,6 +114,8 @@ class Engine(ABC):
     banner: re.Pattern  # group 1 of a match on the output of ``<exe> -h`` is the version
     rules: dict  # kinematic rules of its scheme for the twin (reference/collision3d.SEED_RULES's keys)
     style: Style
+    # builds of the same code in another floating-point precision: precision → program (``--precision``)
+    precisions: dict = {}
 
     # ------------------------------------------------------------------ discovery and launch
 

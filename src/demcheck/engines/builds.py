@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -89,6 +90,30 @@ def parse_list(text: str, key: str = "--engines") -> list[Build]:
             raise ConfigError(key, spec, f"names the source {b.label} twice")
         out.append(b)
     return out
+
+
+def with_precision(text: str, precision: str | None, key: str = "--precision") -> str:
+    """The list ``text`` with each engine that has a build of ``precision`` (``Engine.precisions``: Yade's
+    float128 and mpfr150) named as that build, ``yade`` → ``yade@float128=/usr/bin/yade-float128`` (found on
+    PATH); other entries as they are. ConfigError naming ``key`` when no engine of the list has that precision
+    or its program is not installed."""
+    if not precision:
+        return text
+    out, found = [], False
+    for spec in filter(None, (s.strip() for s in text.split(","))):
+        programs = getattr(registry.get(spec), "precisions", {}) if spec in _engines() else {}
+        if precision in programs:
+            path = shutil.which(programs[precision])
+            if path is None:
+                raise ConfigError(key, precision, f"needs {programs[precision]}, which is not installed "
+                                                  f"(apt-get install {programs[precision]})")
+            spec, found = f"{spec}@{precision}={path}", True
+        out.append(spec)
+    if not found:
+        have = {n: sorted(registry.get(n).precisions) for n in _engines() if getattr(registry.get(n), "precisions", {})}
+        raise ConfigError(key, precision, "is a build of no engine in the list (" + "; ".join(
+            f"{n}: {', '.join(p)}" for n, p in have.items()) + ")")
+    return ",".join(out)
 
 
 def _engines() -> list[str]:

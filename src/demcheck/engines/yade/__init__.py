@@ -102,6 +102,8 @@ class Yade(PackageEngine):
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "surface", "rotation": "project",
              "wall_slip_arm": "surface"}
     style = Style(colour="#e377c2", marker="X", linestyle=":")
+    # Debian's builds of the same 2023.02a code in extended precision (docs/yade.md)
+    precisions = {"float128": "yade-float128", "mpfr150": "yade-mpfr150"}
 
     def executables(self) -> tuple[str, ...]:
         return ("yade",)
