@@ -421,8 +421,9 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
 @click.option("--dt", type=DT, default=None, help="time step (s); default: the case's")
 @_set_option
 def deck(case_path, engine, output, dt, overrides):
-    """Write the engine's input deck of a collision or packing case (runnable by hand: lmp -in / liggghts
-    -in; a packing's deck reads data.lmp, its initial state, written beside it)."""
+    """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
+    (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
+    reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
     from .engines.collide import deck as make_deck
 
     case = _load(case_path, overrides)
