@@ -124,7 +124,8 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     ``source``: ``"reference"`` (``method`` adaptive — converged — or verlet at ``dt``), an engine's name (its
     deck run for real at ``dt``, default the case's), or ``"NAME-twin"`` (the reference computing that
     engine's formulas with its scheme at ``dt``). A case's ``[engine.NAME]`` native settings are used by that
-    engine and its twin. Overrides as :func:`load` takes them."""
+    engine and its twin, by default at the native law's own step (run.dt, else its twin's elastic contact time
+    over run.steps_per_contact). Overrides as :func:`load` takes them."""
     c = load(case, overrides, **keyword)
     if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ConfigError("dt", dt, "must be a number > 0 (s)")
@@ -142,6 +143,10 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
 
     engine = source.removesuffix("-twin")
     native = registry.get(engine).case_native(c)
+    if native is not None:  # the native law's own step (its twin's contact time / run.steps_per_contact)
+        from .comparisons.bench import native_step
+
+        dt = native_step(c, native, dt)
     if source.endswith("-twin"):
         from .engines.collide import twin_states
 
@@ -157,14 +162,17 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     """Metrics over a grid of case keys → a DataFrame: one row per point (its values, every metric, and its
     status). ``vary`` maps dotted keys to their values (``{"impact.angle": [0, 30, 60]}``); several keys make a
     grid. ``source`` as :func:`collide` takes it: an engine and its twin run the case's ``[engine.NAME]``
-    setting, which a ``contact.*`` key (the seed model's) does not change, nor a ``materials.*`` key the
-    setting does not read: such a sweep is a ConfigError. Every point is validated before any is solved; a
-    point whose solve fails keeps its row with the error as its status."""
-    from .comparisons.sweep import native_vary_rule, run_sweep
+    setting — by default at its own step (run.dt, else its twin's elastic contact time over
+    run.steps_per_contact) —, which a ``contact.*`` key (the seed model's), varied or overridden, does not
+    change, nor a ``materials.*`` key the setting does not read: such a sweep is a ConfigError. Every point is
+    validated before any is solved; a point whose solve fails keeps its row with the error as its status. An
+    engine's points run in its long-lived worker, which stays (idle) until the interpreter exits or
+    ``demcheck.engines.run.shutdown_workers()`` ends it."""
+    from .comparisons.sweep import Points, check_source, native_vary_rule, run_sweep
 
-    known = sources()
-    if source not in known:
-        raise ConfigError("source", source, f"must be one of {', '.join(known)}")
+    check_source(source, method, ("source", "method", "dt"))  # the command's checks, with the API's names
+    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        raise ConfigError("dt", dt, "must be a number > 0 (s)")
     if not isinstance(vary, Mapping) or not vary:
         raise ConfigError("vary", vary, "must be a dict of dotted case keys to lists of values")
     axes = []
@@ -179,16 +187,12 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
                                                                  f"{MAX_POINTS}")
     pairs = _overrides(overrides, keyword)
     _build(case, pairs)  # the base case must be valid on its own
-    points = []
+    points = Points(overrides=pairs)
     for combo in itertools.product(*(v for _, v in axes)):
         values = {k: (v.item() if hasattr(v, "item") else v) for (k, _), v in zip(axes, combo)}
         points.append((values, _build(case, [*pairs, *values.items()])))
-    native_vary_rule(points, source, "vary.")  # a key that cannot move the native law: refused before any solve
-    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ConfigError("dt", dt, "must be a number > 0 (s)")
-    if source != "reference" and method is not None:
-        raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
-                                            "velocity Verlet at dt")
+    # a key that cannot move the native law, varied or set: refused before any solve
+    native_vary_rule(points, source, "vary.", "overrides.")
     # the command's own loop: an engine's points run in its long-lived worker where it has one
     return run_sweep(points, method, dt, source=source)
 

@@ -41,8 +41,11 @@ ADAPTIVE_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
 TARGETS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 BATCH = 16
 # a native law whose twin has no adaptive solve (a force history): its converged answer is the twin at t_c over
-# this many steps, four times finer than the finest default grid point
-CONVERGED_STEPS = 20_000
+# this many steps, 16 times finer than the finest grid point (DT_STEPS' 10 000). An incremental force history
+# makes velocity Verlet first order (measured: Yade's Mindlin twin at 30°, every error halves as the steps double
+# from 5 000 to 80 000), so the error of a point n steps per contact is understated by n/CONVERGED_STEPS: 6% at
+# 10 000 (at 20 000 steps it was 50%). Cost, measured: 0.2 s at 80 000 steps, 0.8 s at 160 000, once per case.
+CONVERGED_STEPS = 160_000
 
 
 @dataclass
@@ -220,25 +223,50 @@ def native_sources(case: Case, engines) -> dict:
     return out
 
 
+def native_contact(case: Case, native) -> tuple[object, float]:
+    """(the twin's ResolvedModel, its elastic contact time) of a native law for the case: the time a native
+    law's grid of steps (bench, dt, stress) and its default step (``native_step``) are counted in."""
+    from ..engines.mapping import twin_model
+
+    model = twin_model(resolve(case), native)
+    return model, characteristic_time(model)
+
+
+def native_seen(case: Case, model) -> tuple:
+    """What a native run sees (``model``: its twin's, ``native_contact``): the twin's laws and the bodies'
+    initial state — masses, radii, positions, velocities, spins —, the walls and gravity. Two cases with the same
+    are the same native run: a swept or stressed parameter that leaves it unchanged does not move that run."""
+    return (model.normal_law, model.tangential_law, tuple(case.mass(i) for i in range(len(case.particles))),
+            tuple((p.radius, tuple(p.position), tuple(p.velocity), tuple(p.angular_velocity))
+                  for p in case.particles),
+            tuple((tuple(w.point), tuple(w.normal)) for w in case.walls), tuple(case.run.gravity))
+
+
+def native_step(case: Case, native, dt: float | None = None) -> float:
+    """The step a native law runs at: ``dt`` (--dt), else the case's run.dt, else — as ``dt = auto`` is for the
+    seed model — its twin's elastic contact time over the case's run.steps_per_contact (the seed model's
+    contact time would leave a stiffer native law unresolved)."""
+    return dt or case.run.dt or native_contact(case, native)[1] / case.run.steps_per_contact
+
+
 def native_law(case: Case, engine: str, native, seed: dict | None = None) -> NativeLaw:
     """The native law of ``engine`` for the case and its converged answer: the twin solved by the adaptive
     method with the engine's kinematic rules, or — a twin with a force history has no adaptive solve — by its
     own scheme at t_c/CONVERGED_STEPS. ``seed``: the seed model's converged metrics, for ``seed_gap``."""
     from ..engines import states
-    from ..engines.mapping import twin_model
     from ..reference import collision3d
     from ..reference.health import impact_scales
 
-    model = twin_model(resolve(case), native)
-    t_c = characteristic_time(model)
+    model, t_c = native_contact(case, native)
     rules = registry.get(engine).rules
-    try:
-        conv = collision3d.collide(case, model, "adaptive", rules=rules)
-        how = f"adaptive, rtol {conv.rtol:g}"
-    except ConfigError:  # a force history is defined for the engines' scheme only
+    tl = model.tangential_law
+    if tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
         conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),
                               case)
         how = f"verlet at t_c/{CONVERGED_STEPS}: a force history has no adaptive solve"
+    else:
+        conv = collision3d.collide(case, model, "adaptive", rules=rules)
+        how = f"adaptive, rtol {conv.rtol:g}"
     m = conv.metrics()
     # the solver's note on a tangential history concerns a contact that slides: none in a head-on impact
     note = conv.message if _defined(m.get("tangential_restitution")) or conv.status != "ok" else ""
@@ -248,7 +276,7 @@ def native_law(case: Case, engine: str, native, seed: dict | None = None) -> Nat
     return law
 
 
-def _native_errors(case: Case, law: NativeLaw, metrics: dict, scales) -> dict:
+def _native_errors(law: NativeLaw, metrics: dict, scales) -> dict:
     """A native run's errors against its twin's converged answer: every metric the scene produces (a head-on
     impact's tangential restitution, undefined on both sides, is left out)."""
     return _errors(metrics, law.converged, METRICS + OBLIQUE_METRICS, scales)
@@ -312,7 +340,7 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
                 tick()
                 continue
             # an engine result carries the reference's own checks (reference/health.py)
-            errors = (_native_errors(case, law, one.metrics(), scales) if law
+            errors = (_native_errors(law, one.metrics(), scales) if law
                       else _errors(one.metrics(), ref, metrics, scales))
             res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
                                     many.meta["engine_wall_time"] / batch if many is not None else math.nan,
@@ -423,7 +451,7 @@ def _twin_points(case: Case, engine: str, law: NativeLaw, steps, repeat: int = 1
                              "failed", str(exc).splitlines()[0]))
         else:
             pts.append(Point(f"{engine}-twin", spc, dt, None, wall, None,
-                             _native_errors(case, law, r.metrics(), scales), r.status, r.message))
+                             _native_errors(law, r.metrics(), scales), r.status, r.message))
         if tick:
             tick()
     return pts

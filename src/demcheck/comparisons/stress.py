@@ -194,17 +194,13 @@ def _native_run(case: Case, engine: str):
     """(Native, twin model, what the native run sees) of the case's own setting for ``engine``, or None: what
     it sees is its twin's laws and the bodies' initial state, so that a parameter that leaves it unchanged is
     known not to move the native run."""
-    from ..engines.mapping import twin_model
+    from .bench import native_contact, native_seen
 
     nat = registry.get(engine).case_native(case)
     if nat is None:
         return None
-    model = twin_model(resolve(case), nat)
-    seen = (model.normal_law, model.tangential_law, tuple(case.mass(i) for i in range(len(case.particles))),
-            tuple((p.radius, tuple(p.position), tuple(p.velocity), tuple(p.angular_velocity))
-                  for p in case.particles),
-            tuple((tuple(w.point), tuple(w.normal)) for w in case.walls), tuple(case.run.gravity))
-    return nat, model, seen
+    model, _ = native_contact(case, nat)
+    return nat, model, native_seen(case, model)
 
 
 def largest_stable(check) -> tuple[float | None, str]:

@@ -1,10 +1,11 @@
 """Parameter sweeps: metrics over any case key (``--vary KEY=START:STOP:N``, several make a grid), from one
 source: the reference (the seed model of ``[contact]``), an engine (its deck run for real) or an engine's twin.
 
-An engine or its twin runs the case's own setting for that engine (``[engine.NAME]``) when it has one. A
-``contact.*`` key does not change that native law (``[contact]`` is the seed model it is judged against), nor
-does a ``materials.*`` key the setting does not read (LAMMPS's ``pair_coeff`` gives its own modulus and
-restitution): such a sweep is refused before any work, rather than a table of one law repeated."""
+An engine or its twin runs the case's own setting for that engine (``[engine.NAME]``) when it has one, by
+default at that law's own step (bench.native_step: its twin's contact time over run.steps_per_contact). A
+``contact.*`` key, varied or set, does not change that native law (``[contact]`` is the seed model it is judged
+against), nor does a ``materials.*`` key the setting does not read (LAMMPS's ``pair_coeff`` gives its own modulus
+and restitution): such a sweep is refused before any work, rather than a table of one law repeated."""
 
 from __future__ import annotations
 
@@ -50,7 +51,16 @@ def parse_vary(text: str) -> tuple[str, list]:
     return key, values
 
 
-def sweep_points(case_path, overrides, varies: list[str]) -> list[tuple[dict, object]]:
+class Points(list):
+    """A sweep's grid: [(its values by key, its Case)], with the overrides (``--set``: ``KEY=VALUE`` texts, or the
+    API's (key, value) pairs) every point was built with, for ``native_vary_rule``."""
+
+    def __init__(self, points=(), overrides=()):
+        super().__init__(points)
+        self.overrides = list(overrides)
+
+
+def sweep_points(case_path, overrides, varies: list[str]) -> Points:
     """Every point of the grid as (its values by key, its Case), all loaded and validated before any is
     solved: a bad key or value is one ConfigError (exit 2), not a row of errors."""
     axes = [parse_vary(v) for v in varies]
@@ -69,34 +79,41 @@ def sweep_points(case_path, overrides, varies: list[str]) -> list[tuple[dict, ob
         case = from_dict(apply_overrides(raw, sets))
         case_natives(case, registry.all_engines())  # [engine.NAME] settings read by their engines
         points.append((dict(zip(keys, point)), case))
-    return points
+    return Points(points, overrides)
 
 
-def check_source(source: str, method=None) -> str:
+def check_source(source: str, method=None, keys: tuple[str, str, str] = ("--engine", "--method", "--dt")) -> str:
     """``source`` as a sweep runs it: reference, a registered engine (or build), or ``NAME-twin``; ``method``
-    is the reference's. Else ConfigError naming the option, before any work."""
+    is the reference's. Else ConfigError naming the option, before any work: ``keys`` are the names of the
+    source, the method and the step (the command's options; the API's ``source``, ``method``, ``dt``)."""
     from ..engines import registry
 
     names = [n for n in registry.names() if "@" not in n]  # a build's label is a source too, once registered
-    engine = source.removesuffix("-twin")
+    engine = source.removesuffix("-twin") if isinstance(source, str) else None
     if source != "reference" and engine not in registry.names():
-        raise ConfigError("--engine", source, "must be reference, an engine (" + ", ".join(names) + ") or an "
+        raise ConfigError(keys[0], source, "must be reference, an engine (" + ", ".join(names) + ") or an "
                           "engine's twin (" + ", ".join(f"{n}-twin" for n in names) + ")")
     if source != "reference" and method is not None:
-        raise ConfigError("--method", method, "is the reference's (adaptive or verlet); an engine and its twin "
-                                               "run velocity Verlet at --dt")
+        raise ConfigError(keys[1], method, "is the reference's (adaptive or verlet); an engine and its twin "
+                                           f"run velocity Verlet at {keys[2]}")
     return source
 
 
-def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str = "--vary ") -> None:
+def _contact_key(key: str) -> bool:
+    return key == "contact" or key.startswith("contact.")
+
+
+def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str = "--vary ",
+                     set_where: str = "--set ") -> None:
     """Refuse, before any work, a key that cannot move what ``source`` runs: with the case's own setting for the
-    source's engine (``[engine.NAME]``), a ``contact.*`` key (the seed model's, not the native law's), or a
-    ``materials.*`` key that leaves the native law and the masses unchanged at every point. The error's key is
-    ``where`` + the case key (``--vary contact.kn``; the API's ``vary.contact.kn``)."""
+    source's engine (``[engine.NAME]``), a ``contact.*`` key (the seed model's, not the native law's) varied or
+    set (``points.overrides``, sweep_points' Points), or a ``materials.*`` key that leaves what the native run
+    sees (bench.native_seen: its law, the masses, …) unchanged at every point. The error's key is ``where`` +
+    the case key (``--vary contact.kn``; the API's ``vary.contact.kn``), or ``set_where`` + it for an override
+    (``--set contact.kn``; the API's ``overrides.contact.kn``)."""
     from ..engines import registry
     from ..engines.builds import engine_of
-    from ..engines.mapping import twin_model
-    from ..reference.model import resolve
+    from .bench import native_contact, native_seen
 
     if source == "reference" or not points:
         return
@@ -105,18 +122,20 @@ def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str 
     if engine.case_native(base) is None:
         return
     table = f"[engine.{engine_of(source.removesuffix('-twin'))}]"
+    why = (f"{source} runs the case's {table} setting, which {{key}} does not change ([contact] is the seed "
+           f"model it is judged against)")
+    for item in getattr(points, "overrides", ()):
+        key, value = item.partition("=")[::2] if isinstance(item, str) else item
+        if _contact_key(key.strip()):
+            raise ConfigError(f"{set_where}{key.strip()}", _plain(value), why.format(key=key.strip()) + ": leave it "
+                              f"out, set a {table[1:-1]}.* key, or sweep the reference")
     for key in points[0][0]:
         values = list(dict.fromkeys(_plain(v[key]) for v, _ in points))
-        if key == "contact" or key.startswith("contact."):
-            raise ConfigError(f"{where}{key}", values, f"{source} runs the case's {table} setting, which {key} "
-                              "does not change ([contact] is the seed model it is judged against): vary an "
-                              f"impact, particle or {table[1:-1]}.* key, or sweep the reference")
+        if _contact_key(key):
+            raise ConfigError(f"{where}{key}", values, why.format(key=key) + ": vary an impact, particle or "
+                              f"{table[1:-1]}.* key, or sweep the reference")
         if key.startswith("materials."):
-            seen = set()
-            for _, case in points:
-                model = twin_model(resolve(case), engine.case_native(case))
-                seen.add((model.normal_law, model.tangential_law,
-                          tuple(case.mass(i) for i in range(len(case.particles)))))
+            seen = {native_seen(case, native_contact(case, engine.case_native(case))[0]) for _, case in points}
             if len(seen) == 1:
                 raise ConfigError(f"{where}{key}", values, f"{source} runs the case's {table} setting, and {key} "
                                   "changes neither that law nor the masses at any point (the setting gives its "
@@ -134,9 +153,12 @@ def _run(case, source: str, method, dt):
     from ..case import run_length
     from ..engines import registry
     from ..engines.collide import collide as run_engine, twin_states
+    from .bench import native_step
 
     engine = source.removesuffix("-twin")
     native = registry.get(engine).case_native(case)
+    if native is not None:  # the native law's own step, not the seed model's (bench and dt count in it too)
+        dt = native_step(case, native, dt)
     if source.endswith("-twin"):
         return twin_states(case, engine, dt or run_length(case)[0], native=native)
     # a sweep runs one engine many times: in its long-lived worker where it has one (no start-up per point)
