@@ -349,7 +349,12 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
 
             # [engine.NAME] (a build reads its engine's table)
             native = registry.get(src).case_native(case) if engine_of(src) in ENGINE_NAMES else None
-            results[src] = run_engine(case, src, dt=dt, timeout=timeout, native=native)
+            step = dt
+            if native is not None:  # a native law runs at its own step, as in the API, sweep and bench
+                from .comparisons.bench import native_step
+
+                step = native_step(case, native, dt)
+            results[src] = run_engine(case, src, dt=step, timeout=timeout, native=native)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
                 raise
