@@ -26,9 +26,9 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -47,13 +47,18 @@ class Impact:
     material: str  # particle 0's material: the paper's curve for it
     radius: float  # particle 0's radius (m)
     e: float  # the restitution the case gives (nominal)
-    mu: float
+    mu: float  # the friction coefficient of a slipping contact: the resolved pair's kinetic μ (else its static μ)
     vn: float  # normal approach speed (m/s)
     vt: float  # tangential speed of the centres (m/s)
     spin: float  # |ω0| of particle 0 (rad/s)
     angle: float  # incidence from the normal (degrees)
     normal: str = ""  # the case's normal law (its id in reference/normal.py): which exact limit applies
     tangential: str = ""  # the case's tangential law (its id in reference/tangential.py)
+    # the share of μ∫|F_n|dt by which the law itself holds its force below the Coulomb cap in this case (viscous
+    # sliding where η_t|v_t| < μ|F_n|: law_shortfall, on the reference's adaptive run); a contact short of it by more
+    # than SHORTFALL_MAX does not slide, whatever a source's run does
+    law_short: float = 0.0
+    pair: Any = field(default=None, compare=False, repr=False)  # the case's resolved Pair (Hertz's m̄, R̄, Ē, v)
 
     @property
     def key(self) -> str:
@@ -62,34 +67,48 @@ class Impact:
 
 
 def impact_of(case) -> Impact:
+    """The case's Impact; its μ is the resolved pair's kinetic friction (contact.friction_kinetic, contact.friction,
+    the materials' mixed), the same μ the force history measures the Coulomb cap with."""
     from ..case import incidence
-    from ..reference.model import models_of
+    from ..reference.model import models_of, resolve
 
     p0 = case.particles[0]
     vn, vt = incidence(case)
     mat = case.materials[p0.material]
+    pair = resolve(case).pair
     return Impact(material=p0.material, radius=p0.radius, e=float(mat.restitution if mat.restitution is not None
                                                                  else 1.0),
-                  mu=float(mat.friction or 0.0), vn=abs(vn), vt=vt,
+                  mu=_coulomb_mu(pair), vn=abs(vn), vt=vt,
                   spin=float(np.linalg.norm(p0.angular_velocity)), angle=math.degrees(math.atan2(vt, abs(vn))),
-                  normal=str(case.contact.normal), tangential=models_of(case)[1].id)
+                  normal=str(case.contact.normal), tangential=models_of(case)[1].id, pair=pair)
+
+
+def _coulomb_mu(pair) -> float:
+    """The friction coefficient of a slipping contact (kinetic, else static)."""
+    return float(pair.friction_kinetic if pair.friction_kinetic is not None else pair.friction or 0.0)
 
 
 # ----------------------------------------------------------------------------- a source's own force history
 # Coulomb's gross sliding gives a tangential impulse of μ ∫|F_n| dt, and the seed's dissipative laws pull at the
 # end of contact (F_n < 0: the dashpot outlasts the spring), so ∫|F_n| dt exceeds the normal impulse
-# ∫F_n dt = m̄ v_n (1 + e′). Two numbers off each source's own contact table say what its law gives:
+# ∫F_n dt = m̄ v_n (1 + e′). Numbers off each source's own contact table say what its law gives:
 # * pull — ∫_{F_n<0} |F_n| dt in units of m̄ v_n, from the normal velocity the pull takes back (m̄ dδ̇/dt = −F_n,
 #   so the pull's impulse is m̄ times the separation speed lost while it acts: exact at the adaptive method's
 #   events, interpolated between an engine's steps); the normal impulse's magnitude is m̄ v_n (1 + e′ + 2 pull);
-# * shortfall — how far the tangential force stays below its Coulomb cap, ∫(μ|F_n| − |F_t|)₊ dt, as a share
-#   of μ ∫|F_n| dt: 0 for a contact that slides throughout; a spring law sticks at first (its force builds up
-#   from zero behind the normal force's jump at contact start), a viscous one may never reach the cap. A force
-#   that opposes the slip, as sliding friction does, gives a tangential impulse of (1 − shortfall) μ ∫|F_n| dt;
-#   one above the cap, or along the slip, is no part of it: the judging says how much of the force was
-#   (above_cap: ∫(|F_t| − μ|F_n|)₊ dt, along_slip: ∫|F_t| dt where F_t·v_t > 0, both shares of μ ∫|F_n| dt).
+# * stick — how far the tangential force stays below its Coulomb cap, ∫(μ|F_n| − |F_t|)₊ dt as a share of
+#   μ ∫|F_n| dt, from contact start until the force first reaches the cap (|F_t| ≥ (1 − REACH) μ|F_n| > 0, by
+#   the normal force's peak): a spring law sticks at first, its force building up from zero behind the normal
+#   force's jump at contact start.
+#   That force opposes the slip and gives a tangential impulse of (1 − stick) μ ∫|F_n| dt: the limit allows it.
+#   A force below the cap after it has reached it, or one that never reaches it (a cap below μ|F_n|), is no
+#   allowance: it is what the limit is there to catch (below_cap: its share, the rest of ∫(μ|F_n| − |F_t|)₊ dt);
+#   so is a force above the cap or along the slip (above_cap: ∫(|F_t| − μ|F_n|)₊ dt, along_slip: ∫|F_t| dt where
+#   F_t·v_t > 0). The check names the shares of its worst variant.
+# Whether a contact slides at all is the law's answer, not a source's run: law_shortfall (below) is the share by
+# which the law itself holds its force below the cap, on the reference's adaptive run of the same variant.
 
-SHORTFALL_MAX = 0.05  # a contact short of its Coulomb cap by more than this share does not slide: no sliding limit
+SHORTFALL_MAX = 0.05  # a law short of its Coulomb cap by more than this share does not slide: no sliding limit
+REACH = 1e-3  # a force within this share of μ|F_n| has reached its cap (an engine's output, its round-off)
 
 
 def _window(c: dict, events) -> tuple[int, int]:
@@ -111,14 +130,24 @@ def _window(c: dict, events) -> tuple[int, int]:
     return max(ks - 1, 0), ks + int(after[0])
 
 
+def _integral(t, y) -> float:
+    """Trapezoid over a contact's rows."""
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def _norm3(contact: dict, prefix: str, rows: slice) -> np.ndarray:
+    return np.sqrt(sum(np.asarray(contact[prefix + k], float)[rows] ** 2 for k in "xyz"))
+
+
 def force_history(contact: dict, events, mu: float) -> dict:
-    """``pull``, ``shortfall``, ``above_cap`` and ``along_slip`` (above) of a contact table (Result.table("contact"): t, delta, delta_dot, fn,
-    ft*) with friction coefficient ``mu``."""
+    """``pull``, ``stick``, ``below_cap``, ``above_cap`` and ``along_slip`` (above) of a contact table
+    (Result.table("contact"): t, delta, delta_dot, fn, ft*, vt*) with friction coefficient ``mu``."""
     k0, k1 = _window(contact, events)
-    t = np.asarray(contact["t"], float)[k0:k1 + 1]
-    fn = np.asarray(contact["fn"], float)[k0:k1 + 1]
-    rate = np.asarray(contact["delta_dot"], float)[k0:k1 + 1]
-    ft = np.sqrt(sum(np.asarray(contact[k], float)[k0:k1 + 1] ** 2 for k in ("ftx", "fty", "ftz")))
+    rows = slice(k0, k1 + 1)
+    t = np.asarray(contact["t"], float)[rows]
+    fn = np.asarray(contact["fn"], float)[rows]
+    rate = np.asarray(contact["delta_dot"], float)[rows]
+    ft = _norm3(contact, "ft", rows)
     v_in = rate[0]
     # the pull: each run of rows with F_n < 0, from the sign change that opens it (linear in t between the two
     # rows) to the one that closes it, or the contact's end; the separation speed it takes back
@@ -134,17 +163,42 @@ def force_history(contact: dict, events, mu: float) -> dict:
     if opened is not None:
         pull += abs(rate[-1] - opened)
     cap = mu * np.abs(fn)
-    dt = np.diff(t)
-
-    def integral(y) -> float:  # trapezoid over the contact's rows
-        return float(np.sum(0.5 * (y[1:] + y[:-1]) * dt))
-
-    total = integral(cap)
-    share = (lambda y: integral(y) / total) if total > 0 else (lambda y: math.nan)
-    along = sum(np.asarray(contact[f], float)[k0:k1 + 1] * np.asarray(contact[v], float)[k0:k1 + 1]
+    total = _integral(t, cap)
+    share = (lambda y: _integral(t, y) / total) if total > 0 else (lambda y: math.nan)
+    short = np.maximum(cap - ft, 0.0)
+    # the first stick: until the first row at the cap, while the cap still rises (none: the force never reaches it
+    # before the normal force's peak — a force that meets the cap only as the cap falls away at the end of contact
+    # was below it all along — and nothing is allowed)
+    reached = np.flatnonzero((cap > 0) & (ft >= (1 - REACH) * cap))
+    k = int(reached[0]) + 1 if reached.size and reached[0] <= int(np.argmax(cap)) else 0
+    stick = share(np.where(np.arange(len(t)) < k, short, 0.0))
+    along = sum(np.asarray(contact[f], float)[rows] * np.asarray(contact[v], float)[rows]
                 for f, v in (("ftx", "vtx"), ("fty", "vty"), ("ftz", "vtz"))) > 0 if "vtx" in contact else 0.0
-    return {"pull": float(pull / v_in), "shortfall": share(np.maximum(cap - ft, 0.0)),
+    return {"pull": float(pull / v_in), "stick": stick, "below_cap": share(short) - stick,
             "above_cap": share(np.maximum(ft - cap, 0.0)), "along_slip": share(ft * along)}
+
+
+def law_shortfall(model, contact: dict, events) -> float:
+    """The share of μ∫|F_n|dt by which the case's tangential law itself holds its force below the Coulomb cap,
+    from the law's parameters on a run's kinematics (the reference's adaptive run of the variant: F_n, δ and the
+    slip velocity; never its tangential force): viscous damping with sliding friction gives min(η_t|v_t|, μ|F_n|),
+    short of the cap where η_t|v_t| < μ|F_n|. Every other Coulomb law's force reaches the cap under a sustained
+    slip (0: its first stick is the stick a source's force history measures). ``model``: the case's
+    ResolvedModel."""
+    from ..reference.kernels3d import eta_of
+    from ..reference.tangential import VISCOUS_SLIDING
+
+    law = model.tangential_law
+    if law.family != VISCOUS_SLIDING:
+        return 0.0
+    k0, k1 = _window(contact, events)
+    rows = slice(k0, k1 + 1)
+    t = np.asarray(contact["t"], float)[rows]
+    cap = law.mu_k * np.abs(np.asarray(contact["fn"], float)[rows])
+    tl, nl = law.array(), model.normal_law.array()
+    eta = np.array([eta_of(tl, nl, float(d)) for d in np.asarray(contact["delta"], float)[rows]])
+    total = _integral(t, cap)
+    return _integral(t, np.maximum(cap - eta * _norm3(contact, "vt", rows), 0.0)) / total if total > 0 else math.nan
 
 
 # ----------------------------------------------------------------------------- quantities
@@ -209,13 +263,15 @@ class Curve:
 
 @dataclass(frozen=True)
 class Limit:
-    """An exact value of ``quantity`` for a case where ``applies`` (a function of the Impact and the source's
-    measured restitution e'), judged relative to ``scale`` (a function of the Impact), with the reference's
-    tolerance and the engines' (their time step and lever-arm rules)."""
+    """An exact value of ``quantity`` for a case where ``applies`` (a function of the Impact), judged relative to
+    ``scale`` (a function of the Impact and the value), with the reference's tolerance and the engines' (their time
+    step and lever-arm rules). ``value(impact, metrics, s=0)``: the source's metrics (its restitution e′, its
+    force history); a gross-sliding value at (1 − s) J, where the source's force forgoes a share s of Coulomb's
+    impulse by law (the judging's allowance; 0: the value itself)."""
 
     quantity: str
     name: str
-    value: Callable[[Impact, dict], float]
+    value: Callable[..., float]
     applies: Callable[[Impact], bool]
     scale: Callable[[Impact, float], float]
     tol_reference: float
@@ -224,15 +280,15 @@ class Limit:
     # the size of the limit's spin part in its scale's units (0: no spin in it): the seed's torque arm R − δ/2
     # departs from the rigid body's R, which moves a spin by up to δ_max/(2R) of it (0.39 δ_max/R measured)
     arm: Callable[[Impact, dict], float] | None = None
-    # gross sliding: the limit reads the source's force history (pull, shortfall) and applies where it slides
+    # gross sliding: the limit reads the source's force history (pull, stick) and applies where the law slides
     sliding: bool = False
 
 
 def _hertz(metric: str):
     from ..reference import analytic
 
-    def value(c: Impact, m: dict) -> float:
-        p = m["_pair"]
+    def value(c: Impact, m: dict, s: float = 0.0) -> float:
+        p = c.pair  # the case's resolved pair
         args = (p.m_eff, p.r_eff, p.e_eff, p.impact_speed)
         return {"contact_time": analytic.hertz_duration, "max_overlap": analytic.hertz_max_overlap,
                 "peak_force": analytic.hertz_peak_force}[metric](*args)
@@ -256,9 +312,9 @@ def _sliding(c: Impact) -> bool:
 # Gross sliding: Coulomb's law gives a tangential impulse of μ times the normal impulse's magnitude, μ m̄ v_n J with
 # J = ∫|F_n| dt/(m̄ v_n) = 1 + e′ + 2 pull from the source's own force history (e′ its own restitution; pull the
 # attractive end's impulse, force_history above): the rigid-body values with 1 + e′ in place of 1 + e where no
-# force pulls, and the law's own where one does. (_short: the judging's bound for a force short of its cap.)
-def _J(m: dict) -> float:
-    return (1 + m["restitution"] + 2 * m["pull"]) * (1 - m.get("_short", 0.0))
+# force pulls, and the law's own where one does; at (1 − s) J with s the share a force short of its cap forgoes.
+def _J(m: dict, s: float = 0.0) -> float:
+    return (1 + m["restitution"] + 2 * m["pull"]) * (1 - s)
 
 
 def _WHOLE(c, m) -> float:
@@ -268,26 +324,30 @@ def _WHOLE(c, m) -> float:
 _SLIDE_WHY = ("gross sliding: a tangential impulse of μ∫|F_n|dt = μ m̄ v_n J, J = 1 + e' + 2·pull from the source's "
               "own force history (its restitution e', and the impulse of its attractive end, on which friction "
               "μ|F_n| acts too); reference 1e-4, engines 1e-2 (their time step); spins also δ_max/R of their "
-              "part (torque arm R − δ/2, not R); a tangential force short of its Coulomb cap μ|F_n| (a spring "
-              "sticks at first) by a share s of μ∫|F_n|dt also the value at (1 − s) J on that side; where s > "
-              f"{SHORTFALL_MAX:g} the contact does not slide and the limit does not apply")
-SLIDE_ET = Limit("et", "gross sliding e_t = 1 − μJ/tanθ", lambda c, m: 1 - c.mu * _J(m) * c.vn / c.vt, _sliding,
-                 lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY, sliding=True)
+              "part (torque arm R − δ/2, not R); also the value at (1 − s) J on that side, s the share of "
+              "μ∫|F_n|dt the force forgoes by law: its first stick until it reaches the Coulomb cap μ|F_n| (a "
+              "spring builds up from zero), at most "
+              f"{SHORTFALL_MAX:g}, and what the law holds below the cap (viscous sliding, η_t|v_t| < μ|F_n|, on "
+              "the reference's run) — a force below the cap after reaching it, or never reaching it, is not "
+              f"allowed; where the law falls short by more than {SHORTFALL_MAX:g} the contact does not slide and "
+              "the limit does not apply")
+SLIDE_ET = Limit("et", "gross sliding e_t = 1 − μJ/tanθ", lambda c, m, s=0.0: 1 - c.mu * _J(m, s) * c.vn / c.vt,
+                 _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY, sliding=True)
 SLIDE_SPIN = Limit("spin_paper", "gross sliding ω' = −2.5 μJ v_n/R",
-                   lambda c, m: -2.5 * c.mu * _J(m) * c.vn / c.radius, _sliding,
+                   lambda c, m, s=0.0: -2.5 * c.mu * _J(m, s) * c.vn / c.radius, _sliding,
                    lambda c, v: abs(v), 1e-4, 1e-2, _SLIDE_WHY, arm=_WHOLE, sliding=True)
 T5_ANGLE = Limit("t5_angle", "gross sliding v'_c/(μ v'_n) = (ψ − 3.5J)/e'",
-                 lambda c, m: (c.vt / (c.mu * c.vn) - 3.5 * _J(m)) / m["restitution"], _sliding,
+                 lambda c, m, s=0.0: (c.vt / (c.mu * c.vn) - 3.5 * _J(m, s)) / m["restitution"], _sliding,
                  lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; the contact point's velocity carries R ω'",
                  arm=lambda c, m: 2.5 * _J(m) / m["restitution"], sliding=True)
-T5_SPIN = Limit("t5_spin", "gross sliding R ω'/(μ v_n) = −2.5J", lambda c, m: -2.5 * _J(m),
+T5_SPIN = Limit("t5_spin", "gross sliding R ω'/(μ v_n) = −2.5J", lambda c, m, s=0.0: -2.5 * _J(m, s),
                 _sliding, lambda c, v: 2.5 * (1 + c.e), 1e-4, 1e-2, _SLIDE_WHY,
                 arm=lambda c, m: _J(m) / (1 + c.e), sliding=True)
 PSI2 = Limit("psi2", "Ψ2 = Ψ1 − 7J/(1+e)",
-             lambda c, m: 2 * c.vt / (c.mu * (1 + c.e) * c.vn) - 7 * _J(m) / (1 + c.e),
+             lambda c, m, s=0.0: 2 * c.vt / (c.mu * (1 + c.e) * c.vn) - 7 * _J(m, s) / (1 + c.e),
              _sliding, lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; Ψ2 = Ψ1 − 7 when J = 1 + e; Ψ2 carries Ω",
              arm=lambda c, m: 5 * _J(m) / (1 + c.e), sliding=True)
-OMEGA = Limit("omega", "Ω = −5J/(1+e)", lambda c, m: -5 * _J(m) / (1 + c.e), _sliding,
+OMEGA = Limit("omega", "Ω = −5J/(1+e)", lambda c, m, s=0.0: -5 * _J(m, s) / (1 + c.e), _sliding,
               lambda c, v: 5.0, 1e-4, 1e-2, _SLIDE_WHY + "; |Ω| = 5 when J = 1 + e",
               arm=lambda c, m: _J(m) / (1 + c.e), sliding=True)
 
@@ -298,7 +358,7 @@ def _spin_slide(c: Impact) -> bool:
 
 
 BETA = Limit("beta", "gross sliding β = 3.5μJ v_n/(Rω0) − 1",
-             lambda c, m: 3.5 * c.mu * _J(m) * c.vn / (c.radius * c.spin) - 1, _spin_slide,
+             lambda c, m, s=0.0: 3.5 * c.mu * _J(m, s) * c.vn / (c.radius * c.spin) - 1, _spin_slide,
              lambda c, v: 1.0, 1e-4, 1e-2, _SLIDE_WHY + "; β carries 1.4 ω'/ω0",
              arm=lambda c, m: 1.4 * abs(m["rebound_angular_velocity"]) / c.spin, sliding=True)
 GIVEN_E = Limit("restitution", "e' = the given e", lambda c, m: c.e, lambda c: c.normal != "tti", lambda c, v: 1.0,
@@ -522,6 +582,16 @@ def _value(fn, m, imp):
     return v if v is not None and math.isfinite(v) else None
 
 
+def _allowance(imp: Impact, m: dict) -> float:
+    """The share s of μ∫|F_n|dt a source's tangential force forgoes by law: its first stick (force_history's stick,
+    at most SHORTFALL_MAX) and what the law itself holds below the cap (Impact.law_short)."""
+    law = imp.law_short if math.isfinite(imp.law_short) else 0.0
+    return min(max(m["stick"], 0.0), SHORTFALL_MAX) + law
+
+
+_BREACHES = ("below_cap", "above_cap", "along_slip")  # shares of a force off its cap that no law excuses
+
+
 def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     fn = QUANTITIES[lim.quantity][1]
     tol = lim.tol_reference if src == "reference" else lim.tol_engine
@@ -529,21 +599,20 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     for imp, ms in rows:
         if src not in ms or not lim.applies(imp):
             continue
+        if lim.sliding and imp.law_short > SHORTFALL_MAX:
+            stuck += 1  # the law holds its force short of the Coulomb cap: the contact does not slide
+            continue
         m = ms[src]  # None: the run failed, which never meets a limit
         y = _value(fn, m, imp)
-        short, short_value = 0.0, None
+        short_value = None
         try:
             exact = lim.value(imp, m) if m is not None else None
             if lim.sliding and m is not None:
-                short = m["shortfall"]
-                short_value = lim.value(imp, {**m, "_short": short})  # the limit's value at (1 − s) J
-        except (KeyError, ZeroDivisionError, TypeError):
+                short_value = lim.value(imp, m, s=_allowance(imp, m))  # the limit's value at (1 − s) J
+        except (KeyError, ZeroDivisionError, TypeError, AttributeError):
             exact = None
-        if lim.sliding and short > SHORTFALL_MAX:
-            stuck += 1  # its force stays short of the Coulomb cap: the contact does not slide
-            continue
         n += 1
-        if y is None or exact is None or not math.isfinite(exact) or not math.isfinite(short):
+        if y is None or exact is None or not math.isfinite(exact) or (lim.sliding and not math.isfinite(short_value)):
             worst, at = math.inf, X_AXES[bench.x][1](imp)  # a NaN is never an agreement
             break
         scale = max(lim.scale(imp, exact), 1e-300)
@@ -553,15 +622,15 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
             allowed += abs(short_value - exact) / scale  # on the side a force short of its cap moves it to
         if worst is None or d / allowed > worst / tol_at:
             worst, at, tol_at = d, X_AXES[bench.x][1](imp), allowed
-            breach = {k: m.get(k, 0.0) for k in ("above_cap", "along_slip")} if lim.sliding else {}
+            breach = {k: m.get(k, 0.0) for k in _BREACHES} if lim.sliding else {}
     verdict = NO_DATA if n == 0 else (MEETS if worst <= tol_at else MISSES)
     why = lim.why
     said = [f"{k.replace('_', ' ')} {v:.2g}" for k, v in breach.items() if v > 1e-3]
-    if said:  # where the worst variant's tangential force broke Coulomb's cap or pushed along the slip
+    if said:  # where the worst variant's tangential force fell below or broke Coulomb's cap, or pushed along the slip
         why += f" (its tangential force, as shares of μ∫|F_n|dt: {', '.join(said)})"
     if stuck:
-        why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold short of the cap by "
-                f"more than {SHORTFALL_MAX:g}: not judged)")
+        why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold where the law holds its "
+                f"force short of the cap by more than {SHORTFALL_MAX:g}: not judged)")
     return {"benchmark": bench.name, "file": file, "source": src, "kind": "limit", "quantity": lim.quantity,
             "expected": lim.name, "deviation": worst, "at": at, "tolerance": tol_at, "why": why,
             "verdict": verdict, "points": n}
@@ -644,20 +713,32 @@ def _final_spin_ratio(case, res) -> float | None:
     return float(w @ w0 / (w0 @ w0))
 
 
-def _coulomb_mu(pair) -> float:
-    """The friction coefficient of a slipping contact (kinetic, else static)."""
-    return float(pair.friction_kinetic if pair.friction_kinetic is not None else pair.friction or 0.0)
-
-
 def _needs_history(bench: Benchmark, imp: Impact) -> bool:
     return any(lim.sliding and lim.applies(imp) for lim in bench.limits)
+
+
+def _law_short(case, run_of) -> float:
+    """law_shortfall of the case's law on the reference's adaptive run (run only for a law that can fall short of
+    its cap: viscous sliding); NaN without a run to read."""
+    from ..reference.model import resolve
+    from ..reference.tangential import VISCOUS_SLIDING
+
+    model = resolve(case)
+    if model.tangential_law.family != VISCOUS_SLIDING:
+        return 0.0
+    res = run_of("reference")
+    if not res.ok:
+        return math.nan
+    try:
+        return law_shortfall(model, res.table("contact"), res.table("events"))
+    except ValueError:  # no contact, or no end
+        return math.nan
 
 
 def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path]], opts,
              root: Path = DATA) -> dict:
     """The validation of a finished suite run (its cases' entries): checks and series per benchmark."""
     from ..case import expand
-    from ..reference.model import resolve
 
     entries = {c["case"]: c for c in summary["cases"]}
     out = {"benchmarks": [], "checks": [], "series": []}
@@ -669,22 +750,30 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
                 if entry is None:
                     continue
                 imp = impact_of(case)
+                runs: dict = {}  # each source's own Result, run (or read from the run cache) once per case
+
+                def run_of(src: str, case=case, runs=runs):
+                    if src not in runs:
+                        runs[src] = _result(case, src, opts)
+                    return runs[src]
+
+                needs_history = _needs_history(bench, imp)
+                if needs_history:  # whether the law slides: its answer on the reference's adaptive run
+                    imp = replace(imp, law_short=_law_short(case, run_of))
                 ms = {}
                 for src, got in entry.get("sources", {}).items():
                     if src == "reference-verlet" or got.get("status") in _NOT_A_SOURCE:
                         continue  # an engine that cannot express the model is no source here (a failed run is)
                     m = _source_metrics(entry, src)
                     if m is not None:
-                        m["_pair"] = pair = resolve(case).pair
-                        history = _needs_history(bench, imp) and not {"pull", "shortfall"} <= m.keys()
+                        history = needs_history and not {"pull", "stick"} <= m.keys()
                         if bench.final_spin or history:
-                            res = _result(case, src, opts)
+                            res = run_of(src)
                             if bench.final_spin:
                                 m["spin_ratio"] = _final_spin_ratio(case, res)
                             if history and res.ok:
                                 with contextlib.suppress(ValueError):  # no contact, or no end: no history
-                                    m.update(force_history(res.table("contact"), res.table("events"),
-                                                           _coulomb_mu(pair)))
+                                    m.update(force_history(res.table("contact"), res.table("events"), imp.mu))
                     ms[src] = m
                 groups.setdefault(Path(f).stem, []).append((imp, ms))
         checks, series = judge(bench, groups, root)
