@@ -5,9 +5,10 @@ The script builds the two bodies (spheres, or a sphere and an axis-aligned ``Wal
 the engines (``NewtonIntegrator(damping=0, gravity=…)``: Yade's default Cundall damping is 0.2 in many
 examples), then steps one step at a time. Yade's NewtonIntegrator is a leap-frog: a step computes the forces
 F_k at the positions x_k with the velocities v_{k−½}, then v_{k+½} = v_{k−½} + dt F_k/m and x_{k+1} = x_k +
-dt v_{k+½}. The dump's row of step k holds x_k, F_k (plus the weight, as the LAMMPS-family engines write a
+dt v_{k+½}. The dump's row of step k holds x_k, F_k (the weight included, as the LAMMPS-family engines write a
 body's force) and the full-step velocity v_k = v_{k−½} + ½dt F_k/m: exactly the rows velocity Verlet writes,
-whose force at step k reads the same x_k and v_{k−½}.
+whose force at step k reads the same x_k and v_{k−½}. The script starts from v_{−½} = v_0 − ½dt g (no contact
+at the start, so the weight is F_0), so that its first row's velocity is the case's.
 """
 
 from __future__ import annotations
@@ -184,7 +185,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         inertias.append(_num(inertia))
         lines += [f"O.bodies[b{i}].state.mass = {_num(m)}",
                   f"O.bodies[b{i}].state.inertia = {_vec([inertia] * 3)}",
-                  f"O.bodies[b{i}].state.vel = {_vec(part.velocity)}",
+                  # leap-frog starts from v_{-1/2} = v_0 − ½dt F_0/m: no contact at the start, the weight alone
+                  f"O.bodies[b{i}].state.vel = {_vec([v - 0.5 * sc.dt * gk for v, gk in zip(part.velocity, g)])}",
                   f"O.bodies[b{i}].state.angVel = {_vec(part.angular_velocity)}"]
     lines += [f"mass = [{', '.join(masses)}]", f"radius = [{', '.join(_num(q.radius) for q in case.particles)}]", f"inertia = [{', '.join(inertias)}]",
               "O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),",
@@ -195,7 +197,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
               "O.dt = DT",
               f"out = open({common.DUMP_FILE!r}, 'w')",
               "n = len(ids)",
-              # step k: F_k at x_k with v_{k-1/2}; the row holds x_k, v_k = v_{k-1/2} + dt F_k/(2m), F_k + m g
+              # step k: F_k (the weight m g included: NewtonIntegrator adds it, O.forces holds the contacts') at x_k
+              # with v_{k-1/2}; the row holds x_k, v_k = v_{k-1/2} + dt F_k/(2m), F_k
               "for k in range(STEPS + 1):",
               "    x = [Vector3(O.bodies[i].state.pos) for i in ids]",
               "    v = [Vector3(O.bodies[i].state.vel) for i in ids]",
@@ -203,11 +206,10 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
               "    O.step()",
               f"    out.write({HEAD!r} % (k, n))",
               "    for s in range(n):",
-              "        f = O.forces.f(ids[s])",
+              "        f = O.forces.f(ids[s]) + G * mass[s]",
               "        t = O.forces.t(ids[s])",
               "        a = v[s] + f * (0.5 * DT / mass[s])",
               "        b = w[s] + t * (0.5 * DT / inertia[s])",
-              "        f = f + G * mass[s]",
               f"        out.write({ROW!r} % (s + 1, s + 1, radius[s], mass[s], x[s][0], x[s][1], "
               "x[s][2], a[0], a[1], a[2], b[0], b[1], b[2], f[0], f[1], f[2], t[0], t[1], t[2]))",
               "out.close()", ""]
