@@ -250,6 +250,21 @@ def test_a_worker_that_died_is_replaced(tmp_path):
     assert runner.workers() and runner.workers()[0] not in (pid, second)
 
 
+def test_a_worker_handed_out_while_dying_gives_the_run_to_a_new_one(tmp_path, monkeypatch):
+    """A worker killed while idle can still read as running (its first thread a zombie, the others exiting):
+    handed out, it never takes the run — no log, no screen — and the run goes to a new worker, with no error.
+    Forced here by a worker that reads as alive after it was killed and reaped."""
+    runner.run("lammps", _deck(), workdir=tmp_path / "a", worker=True)
+    [pid] = runner.workers()
+    os.kill(pid, signal.SIGKILL)
+    while _alive(pid):
+        time.sleep(0.01)
+    monkeypatch.setattr(runner._Worker, "alive", lambda self: self.proc.pid == pid or self.proc.poll() is None)
+    out = runner.run("lammps", _deck(), workdir=tmp_path / "b", worker=True)
+    assert "Loop time" in out.log
+    assert [w for w in runner.workers() if w != pid]
+
+
 # ----------------------------------------------------------------------------- no process left behind
 
 _SCRIPT = """

@@ -271,6 +271,7 @@ def _same_as_two_body(case, dt, rules):
 
 @pytest.mark.engine("lammps")
 @pytest.mark.engine("liggghts")
+@pytest.mark.engine("yade")
 def test_verify_runs_the_small_packings_in_every_source(tmp_path):
     from pathlib import Path
 
@@ -283,7 +284,8 @@ def test_verify_runs_the_small_packings_in_every_source(tmp_path):
     assert s["failed"] == 0 and {c["case"] for c in s["cases"]} == {"column-lsd", "layer-kk"}
     for c in s["cases"]:
         static = {k["source"]: k for k in c["comparisons"] if k["metric"] == "static_overlap"}
-        assert set(static) == {"reference", "lammps", "liggghts"}
+        # Yade pours the LSDn column; KKn's δ^½ dashpot it cannot express (layer-kk: not expressible)
+        assert set(static) == {"reference", "lammps", "liggghts"} | ({"yade"} if c["case"] == "column-lsd" else set())
         assert all(k["verdict"] == "agree" and k["value"] < 1e-6 for k in static.values())
     md = (Path(s["report"]) / "report.md").read_text()
     assert "## Packings" in md and "| column-lsd | lammps |" in md

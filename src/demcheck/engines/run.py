@@ -377,8 +377,21 @@ def workers() -> list[int]:
         return sorted(w.proc.pid for w in _WORKERS if w.alive())
 
 
+class _NotTaken(Exception):
+    """The worker ended before it took the run (no log, no screen in the work directory)."""
+
+
 def _run_in_worker(engine: str, info, argv: list[str], wd: Path, workdir, timeout: float) -> RunOutput:
-    """``in.deck`` in ``wd`` run by a worker: the subprocess path's RunOutput and errors."""
+    """``in.deck`` in ``wd`` run by a worker: the subprocess path's RunOutput and errors. A worker handed out
+    while it was dying (killed while idle: a process whose first thread is a zombie still reads as running
+    until its other threads have ended) never takes the run: it is given once more to a new worker."""
+    try:
+        return _worker_attempt(engine, info, argv, wd, workdir, timeout)
+    except _NotTaken:
+        return _worker_attempt(engine, info, argv, wd, workdir, timeout)
+
+
+def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeout: float) -> RunOutput:
     w = _checkout(engine, argv, info)
     try:
         with _LOCK:  # as a process's start: an interrupt either sees this run or stops it from starting
@@ -407,6 +420,9 @@ def _run_in_worker(engine: str, info, argv: list[str], wd: Path, workdir, timeou
         wall = time.perf_counter() - started
         log = _read_log(wd, None)
         errors = _ERROR.findall(log)
+        if answer is None and not any((wd / name).exists() for name in ("log.txt", "screen.txt")):
+            w.end(kill=True)
+            raise _NotTaken()
         if answer is None:  # the worker died during the run: the next run starts a new one
             code = w.end(kill=True)
             what = errors[0] if errors else f"its worker process ended: exit code {code}"
