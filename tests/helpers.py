@@ -63,3 +63,25 @@ def md_plain(md: str) -> str:
     import re
 
     return re.sub(r"\\([!-/:-@\[-`{-~])", r"\1", md)
+
+
+def proc_stat(pid) -> list[str] | None:
+    """/proc/<pid>/stat after the command name: [state, ppid, pgrp, ...], or None once it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+
+
+def group_alive(pgid: int) -> list[int]:
+    """The live (not zombie) processes of a process group."""
+    import os
+
+    out = []
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            st = proc_stat(d)
+            if st and st[2] == str(pgid) and st[0] != "Z":
+                out.append(int(d))
+    return out

@@ -17,6 +17,7 @@ from demcheck.engines import discovery, run as runner
 from demcheck.errors import EngineFailed, EngineInterrupted
 
 from .conftest import CASES
+from .helpers import group_alive, proc_stat
 
 # a fake LAMMPS: answers -h with a banner; a run starts a child and waits on it forever (a process group
 # of two, as an MPI launch has)
@@ -28,32 +29,12 @@ wait
 SIGNALS = [(signal.SIGINT, 130), (signal.SIGTERM, 143)]
 
 
-def _stat(pid) -> list[str] | None:
-    """/proc/<pid>/stat after the command name: [state, ppid, pgrp, ...], or None once it is gone."""
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()
-    except (FileNotFoundError, ProcessLookupError):
-        return None
-
-
 def _children(pid: int) -> list[int]:
     out = []
     for d in os.listdir("/proc"):
         if d.isdigit():
-            st = _stat(d)
+            st = proc_stat(d)
             if st and st[1] == str(pid) and st[0] != "Z":
-                out.append(int(d))
-    return out
-
-
-def _group_alive(pgid: int) -> list[int]:
-    """The live (not zombie) processes of a process group."""
-    out = []
-    for d in os.listdir("/proc"):
-        if d.isdigit():
-            st = _stat(d)
-            if st and st[2] == str(pgid) and st[0] != "Z":
                 out.append(int(d))
     return out
 
@@ -82,16 +63,16 @@ def _wait_for_engine(proc, within=240.0) -> int:
 
 def _interrupt(proc, engine: int, sig) -> tuple[int, str, str]:
     """Send ``sig`` to demcheck while its engine runs; (exit code, stdout, stderr) once it has exited."""
-    pgid = int(_stat(engine)[2])
+    pgid = int(proc_stat(engine)[2])
     assert pgid == engine, "the engine runs in a process group of its own"
-    assert _group_alive(pgid), "the engine ended before the signal: the case must run longer"
+    assert group_alive(pgid), "the engine ended before the signal: the case must run longer"
     proc.send_signal(sig)
     try:
         out, err = proc.communicate(timeout=240)
     except subprocess.TimeoutExpired:
         proc.kill()
         pytest.fail(f"demcheck did not exit within 240 s of signal {sig!r}")
-    assert _group_alive(pgid) == [], f"processes of the engine's group {pgid} survive"
+    assert group_alive(pgid) == [], f"processes of the engine's group {pgid} survive"
     return proc.returncode, out, err
 
 
@@ -187,7 +168,7 @@ def test_a_run_stopped_by_kill_all_is_interrupted_not_failed_and_no_new_run_star
     t.join(60)
     assert not t.is_alive() and len(caught) == 1
     assert isinstance(caught[0], EngineInterrupted), caught[0]  # not "failed (exit code -9)"
-    assert _group_alive(pgid) == []
+    assert group_alive(pgid) == []
     with pytest.raises(EngineInterrupted, match="not started"):  # after an interrupt, no engine starts
         runner.run("lammps", "run 1\n", workdir=tmp_path / "wd2", timeout=300)
     runner.reset()

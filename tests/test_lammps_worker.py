@@ -17,6 +17,7 @@ from demcheck.engines import collide as collisions, discovery, registry, run as 
 from demcheck.errors import EngineFailed, EngineInterrupted
 
 from .conftest import CASES
+from .helpers import group_alive, proc_stat
 
 pytestmark = pytest.mark.engine("lammps")
 
@@ -36,25 +37,8 @@ def _clean():
 
 def _alive(pid: int) -> bool:
     """Whether ``pid`` is a live process (a zombie is not)."""
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except (FileNotFoundError, ProcessLookupError):
-        return False
-
-
-def _group(pgid: int) -> list[int]:
-    out = []
-    for d in os.listdir("/proc"):
-        if d.isdigit():
-            try:
-                with open(f"/proc/{d}/stat") as fh:
-                    st = fh.read().rsplit(")", 1)[1].split()
-            except (FileNotFoundError, ProcessLookupError):
-                continue
-            if st[2] == str(pgid) and st[0] != "Z":
-                out.append(int(d))
-    return out
+    st = proc_stat(pid)
+    return st is not None and st[0] != "Z"
 
 
 def _deck(name="glass-pair.toml"):
@@ -149,7 +133,7 @@ def test_a_run_past_its_timeout_kills_the_worker_and_the_next_run_starts_another
     [pid] = runner.workers()
     with pytest.raises(runner.EngineTimeout, match="ran past its timeout of 1 s and was stopped") as err:
         runner.run("lammps", _long_deck(), workdir=tmp_path / "long", timeout=1.0, worker=True)
-    assert err.value.pid == pid and not _alive(pid) and _group(pid) == []
+    assert err.value.pid == pid and not _alive(pid) and group_alive(pid) == []
     assert str(tmp_path / "long") in str(err.value) and (tmp_path / "long" / "log.txt").exists()
     runner.run("lammps", _deck(), workdir=tmp_path / "after", worker=True)
     [new] = runner.workers()
@@ -177,7 +161,7 @@ def test_an_interrupt_stops_the_worker_and_no_run_starts_until_reset(tmp_path):
     t.join(60)
     assert not t.is_alive() and len(caught) == 1
     assert isinstance(caught[0], EngineInterrupted), caught[0]  # not "failed"
-    assert _group(pid) == [] and runner.workers() == []
+    assert group_alive(pid) == [] and runner.workers() == []
     with pytest.raises(EngineInterrupted, match="not started"):
         runner.run("lammps", _deck(), workdir=tmp_path / "refused", worker=True)
     runner.reset()
@@ -217,7 +201,7 @@ def test_ctrl_c_while_the_worker_runs_stops_it(sig, code, tmp_path):
             proc.kill()
             proc.communicate()
     assert out.strip() == f"lammps was stopped by the interrupt {code}", err[-3000:]
-    assert _group(workers[0]) == []
+    assert group_alive(workers[0]) == []
     assert (tmp_path / "wd" / "log.txt").exists()  # a work directory given by the caller is kept
 
 
