@@ -1,7 +1,8 @@
 """The N-body reference against LAMMPS (and LIGGGHTS) on the same poured packing, one core each, measured
 side by side in one run: particle-steps per second (the issue's goal: the reference at least half of
-LAMMPS's rate). The same data file, the same model (LSDn + linear spring with sliding friction, exact in
-both engines), the same dt and duration; the engines' times include their start-up (a few tenths of a
+LAMMPS's rate), and Yade beside them. The same initial state, the same model (LSDn + linear spring with
+sliding friction: exact in LAMMPS and LIGGGHTS, approximate in Yade, whose spring alone is capped), the same
+dt and duration; the engines' times include their start-up (a few tenths of a
 second), so the runs are long enough for it not to matter much.
 
 Run: .venv/bin/python benchmarks/bench_packing.py > benchmarks/results/bench_packing.txt
@@ -18,7 +19,8 @@ from demcheck.comparisons import packing_metrics as PM  # noqa: E402
 from demcheck.engines.packing import run_engine  # noqa: E402
 from demcheck.reference import packing as P  # noqa: E402
 
-CASE = Path(__file__).resolve().parents[1] / "cases" / "packing" / "poured.toml"  # the default suite's, 2000 spheres
+CASE = Path(__file__).resolve().parents[1] / "cases" / "packing" / "poured.toml"
+ENGINES = ("lammps", "liggghts", "yade")  # the engines that pour packings (Kratos writes no packing decks)  # the default suite's, 2000 spheres
 
 
 def main():
@@ -35,7 +37,7 @@ def main():
     nc = min(st.n_contacts, len(st.contacts))
     rows.append(("reference", ref_time, PM.compute(st.x, st.rad, box=case.packing.box, margin=1.0,
                                                    forces=st.contacts[:nc, 3])))
-    for engine in ("lammps", "liggghts"):
+    for engine in ENGINES:
         t = time.perf_counter()
         run = run_engine(case, engine)
         rows.append((f"{engine} ({run.version})", time.perf_counter() - t,
