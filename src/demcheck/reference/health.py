@@ -8,8 +8,10 @@ does not depend on the method). The statuses, first rule that fails wins:
 * ``unresolved``: fewer than ``min_steps`` steps inside the contact (or none, with a time step longer than
   ``1/min_steps`` of the elastic contact time): the time step is the cause, and the message names it;
 * ``no-contact``: the bodies never touched;
-* ``unstable``: the collision created energy (a law that only stores or dissipates it): the scheme is
-  unstable at this step;
+* ``unstable``: the collision created energy, with a law that only stores or dissipates it
+  (``TangentialLaw.passive``): the scheme is unstable at this step. A law that can create energy itself (a
+  spring capped with its history left alone) is not judged by this rule: its energy balance is the law's;
+  the comparison with the converged adaptive answer judges its time step;
 * ``out-of-range``: the overlap passed half the smaller radius: the contact law has left its range (small
   overlaps), whatever the method — the impact is too fast or the material too soft for the model;
 * ``no-separation``: the contact had not ended by the end of the run.
@@ -43,10 +45,11 @@ def _steps(dt: float, t_c: float) -> str:
 
 
 def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN_STEPS,
-           impact_energy: float | None = None) -> tuple[str, str]:
+           impact_energy: float | None = None, passive: bool = True) -> tuple[str, str]:
     """(status, why) of a time-stepped result (module docstring); ("ok", "") when every rule holds.
     ``radius``: the smaller radius (default: ``result.meta["radius0"]``); ``impact_energy``: the energy
-    the energy rule is measured in (default ½ m̄ v² of the normal impact)."""
+    the energy rule is measured in (default ½ m̄ v² of the normal impact); ``passive``: whether the law can
+    only store or dissipate energy (the energy rule applies only then)."""
     c = result.table("contact")  # the arrays: no DataFrame is built for the check
     dt = result.dt
     state = np.column_stack([np.asarray(c[k], dtype=float) for k in STATE_COLUMNS])
@@ -65,7 +68,7 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
     if e_in is None:
         e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
     gained = -result.metrics()["energy_dissipated"]
-    if e_in > 0 and math.isfinite(gained) and gained > ENERGY_GAIN_TOLERANCE * e_in:
+    if passive and e_in > 0 and math.isfinite(gained) and gained > ENERGY_GAIN_TOLERANCE * e_in:
         return "unstable", (f"the collision created {gained / e_in:.3g} of the impact energy ({_steps(dt, t_c)}): "
                             "the scheme is unstable at this time step")
     out = overlap_rule(float(d.max()), radius or result.meta.get("radius0"))
@@ -84,7 +87,7 @@ def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, st
 
     model = model or resolve(case)
     return health(result, characteristic_time(model), smallest_radius(case), min_steps,
-                  impact_scales(case, model)["impact_energy"])
+                  impact_scales(case, model)["impact_energy"], model.tangential_law.passive)
 
 
 def apply(result, case, model=None, min_steps: int = MIN_STEPS):

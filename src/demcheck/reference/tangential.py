@@ -72,6 +72,15 @@ class TangentialLaw:
         return self.family in (SPRING, LTH, ZZY, WALTON)
 
     @property
+    def passive(self) -> bool:
+        """Whether the law can only store or dissipate energy. A spring capped at μ|Fn| with its history left
+        alone (truncation ``force``, the seed's min()) is not: after a slip the history is far past the cap, and
+        when the slip reverses the capped force keeps pointing the old way — along the new slip — until the
+        history unwinds (Chung & Ooi Test 5 with TTIt: 6 % of the impact energy created, in the adaptive and the
+        verlet method alike; docs/models.md)."""
+        return not (self.family == SPRING and self.truncation == TRUNC_CAP)
+
+    @property
     def caps(self) -> bool:
         """Whether the law limits |Ft| by Coulomb (μ|Fn|) in its slip state."""
         return self.family in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
