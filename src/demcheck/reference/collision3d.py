@@ -12,7 +12,7 @@ from ..errors import ConfigError
 from ..result import Result
 from . import kernels, kernels3d as k3
 from .model import ResolvedModel
-from .tangential import TRUNC_MAW, WALTON
+from .tangential import WALTON
 
 # The seed's own rules: lever arms to the contact point (R − δ/2) for slip velocity and torque; in the
 # verlet method the history is rotated into the new tangent plane keeping its length. A wall's slip arm is the
@@ -119,7 +119,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
     if status_name == "too-many-steps" and method == "adaptive":
         result.message = _points_message(result, rtol, l_scale)
     tlaw = model.tangential_law
-    if tlaw.kt_sqrt and tlaw.eta > 0 and tlaw.truncation == TRUNC_MAW and not result.message:
+    if tlaw.pushes_at_onset and not result.message:
         result.message = ("truncation=overlap with a Kt that vanishes at contact onset: where the dashpot exceeds "
                           "the cap the Maw overlap grows like δ^(-1/4) and the friction can push along the slip "
                           "(docs/models.md, finding 9); truncation=force is the seed's formulation")

@@ -81,6 +81,12 @@ class TangentialLaw:
         return not (self.family == SPRING and self.truncation == TRUNC_CAP)
 
     @property
+    def pushes_at_onset(self) -> bool:
+        """Whether the friction can push along the slip at contact onset: Maw's truncation (``overlap``) with a
+        Kt ∝ √δ that vanishes there and a dashpot (TTIt, DDt with ηt; docs/models.md finding 9)."""
+        return self.family == SPRING and self.kt_sqrt and self.eta > 0 and self.truncation == TRUNC_MAW
+
+    @property
     def caps(self) -> bool:
         """Whether the law limits |Ft| by Coulomb (μ|Fn|) in its slip state."""
         return self.family in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
