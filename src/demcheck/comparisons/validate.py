@@ -18,7 +18,8 @@ against two independent kinds of expected values:
   papers' codes' tangential elastic response).
 
 A source that misses a published curve is a finding (the report says which models meet the paper); the
-reference missing an exact limit, or a run that failed, fails the command (exit 1).
+reference missing an exact limit, or a run that failed, fails the command (exit 1) — except a miss that is the
+law's own (a force pushing along the slip at contact onset where the law does so by design: reported, not failed).
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ class Impact:
 
     material: str  # particle 0's material: the paper's curve for it
     radius: float  # particle 0's radius (m)
-    e: float  # the restitution the case gives (nominal)
+    e: float  # the restitution the case gives (nominal): the resolved pair's (contact.restitution, else the materials' mixed)
     mu: float  # the friction coefficient of a slipping contact: the resolved pair's kinetic μ (else its static μ)
     vn: float  # normal approach speed (m/s)
     vt: float  # tangential speed of the centres (m/s)
@@ -58,6 +59,9 @@ class Impact:
     # sliding where η_t|v_t| < μ|F_n|: law_shortfall, on the reference's adaptive run); a contact short of it by more
     # than SHORTFALL_MAX does not slide, whatever a source's run does
     law_short: float = 0.0
+    # the law's force may push along the slip at contact onset (TangentialLaw.pushes_at_onset): the reference,
+    # solving the law, does too
+    pushes_at_onset: bool = False
     pair: Any = field(default=None, compare=False, repr=False)  # the case's resolved Pair (Hertz's m̄, R̄, Ē, v)
 
     @property
@@ -67,20 +71,22 @@ class Impact:
 
 
 def impact_of(case) -> Impact:
-    """The case's Impact; its μ is the resolved pair's kinetic friction (contact.friction_kinetic, contact.friction,
-    the materials' mixed), the same μ the force history measures the Coulomb cap with."""
+    """The case's Impact; its e and μ are the resolved pair's (``contact.restitution``, the kinetic friction
+    ``contact.friction_kinetic``, ``contact.friction``, else the materials' mixed): the e the laws are
+    calibrated to and the μ the force history measures the Coulomb cap with."""
     from ..case import incidence
     from ..reference.model import models_of, resolve
 
     p0 = case.particles[0]
     vn, vt = incidence(case)
-    mat = case.materials[p0.material]
-    pair = resolve(case).pair
-    return Impact(material=p0.material, radius=p0.radius, e=float(mat.restitution if mat.restitution is not None
+    model = resolve(case)
+    pair, tl = model.pair, model.tangential_law
+    return Impact(material=p0.material, radius=p0.radius, e=float(pair.restitution if pair.restitution is not None
                                                                  else 1.0),
                   mu=_coulomb_mu(pair), vn=abs(vn), vt=vt,
                   spin=float(np.linalg.norm(p0.angular_velocity)), angle=math.degrees(math.atan2(vt, abs(vn))),
-                  normal=str(case.contact.normal), tangential=models_of(case)[1].id, pair=pair)
+                  normal=str(case.contact.normal), tangential=models_of(case)[1].id,
+                  pushes_at_onset=tl.pushes_at_onset, pair=pair)
 
 
 def _coulomb_mu(pair) -> float:
@@ -628,12 +634,21 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     said = [f"{k.replace('_', ' ')} {v:.2g}" for k, v in breach.items() if v > 1e-3]
     if said:  # where the worst variant's tangential force fell below or broke Coulomb's cap, or pushed along the slip
         why += f" (its tangential force, as shares of μ∫|F_n|dt: {', '.join(said)})"
+    # the law's own miss: the reference solves the law, and a law whose force pushes along the slip at contact
+    # onset (Impact.pushes_at_onset) does not slide as the rigid body's limit assumes — a finding about the model
+    # (reported as a miss), not a failure of the reference
+    law_miss = (verdict == MISSES and src == "reference" and breach.get("along_slip", 0.0) > 1e-3
+                and all(imp.pushes_at_onset for imp, _ in rows))
+    if law_miss:
+        why += ("; the law's own miss: its force pushes along the slip at contact onset (Maw's truncation under "
+                "a Kt that vanishes there, docs/models.md finding 9), which the reference computes as the law "
+                "has it — not a failure of the reference")
     if stuck:
         why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold where the law holds its "
                 f"force short of the cap by more than {SHORTFALL_MAX:g}: not judged)")
     return {"benchmark": bench.name, "file": file, "source": src, "kind": "limit", "quantity": lim.quantity,
             "expected": lim.name, "deviation": worst, "at": at, "tolerance": tol_at, "why": why,
-            "verdict": verdict, "points": n}
+            "verdict": verdict, "points": n, **({"law": True} if law_miss else {})}
 
 
 # A paper's curve is two things. Where the rigid body slides throughout (past the gross-sliding threshold with
@@ -781,7 +796,7 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
         out["checks"] += checks
         out["series"] += series
     out["failed"] = [c for c in out["checks"] if c["kind"] == "limit" and c["source"] == "reference"
-                     and c["verdict"] == MISSES]
+                     and c["verdict"] == MISSES and not c.get("law")]
     return out
 
 
