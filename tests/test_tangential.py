@@ -192,6 +192,24 @@ def test_maw_truncation_at_grazing_incidence_the_adaptive_method_follows_the_law
     assert (ft <= 0.092 * np.abs(c["fn"]) * (1 + 1e-9) + 1e-300).all()
 
 
+def test_maw_truncation_a_dissipative_slip_at_onset_that_unloads_sticks():
+    """Thornton's sphere (e 0.25, TTIt with Maw's truncation) at 45°: the contact starts slipping the dissipative
+    way with a stick flow that unloads the history from its first instant (λ < 0 throughout: no crossing to
+    locate). The adaptive method went on slipping (e_t 0.853); the law sticks, swings round to push along the slip
+    and slips that way, as the verlet method shows at every step: 0.90772, 0.907945, 0.907952 at t_c/500, /5000,
+    /20000. The adaptive answer must be the last within 2e-5 (the verlet's own change from /5000 to /20000 is
+    7e-6; the old error was 0.055)."""
+    from demcheck.reference.model import characteristic_time
+
+    case = next(c for c in C.expand(CASES / "benchmarks" / "thornton-e025-tti-overlap.toml")
+                if c.name.endswith("[angle=45]"))
+    t_c = characteristic_time(resolve(case))
+    fine = collide(case, "verlet", dt=t_c / 20000).metrics()
+    m = collide(case, "adaptive").metrics()
+    assert m["tangential_restitution"] == pytest.approx(fine["tangential_restitution"], abs=2e-5)
+    assert m["rebound_angular_velocity"] == pytest.approx(fine["rebound_angular_velocity"], rel=1e-4)
+
+
 def test_a_slip_that_ends_where_the_force_does_keeps_the_force_end():
     """LSDn with a spring law at 5° on a wall: the slip ends where the normal force does (the cap collapses),
     and the two events were located within 1e-16 of a step — the slip's end taken first, the force's end went

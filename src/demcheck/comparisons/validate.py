@@ -637,12 +637,12 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     # the law's own miss: the reference solves the law, and a law whose force pushes along the slip at contact
     # onset (Impact.pushes_at_onset) does not slide as the rigid body's limit assumes — a finding about the model
     # (reported as a miss), not a failure of the reference
-    law_miss = (verdict == MISSES and src == "reference" and breach.get("along_slip", 0.0) > 1e-3
+    law_miss = (verdict == MISSES and breach.get("along_slip", 0.0) > 1e-3
                 and all(imp.pushes_at_onset for imp, _ in rows))
     if law_miss:
         why += ("; the law's own miss: its force pushes along the slip at contact onset (Maw's truncation under "
-                "a Kt that vanishes there, docs/models.md finding 9), which the reference computes as the law "
-                "has it — not a failure of the reference")
+                "a Kt that vanishes there, docs/models.md finding 9), as the reference, computing the law as it is, "
+                "shows too — not a failure of the reference")
     if stuck:
         why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold where the law holds its "
                 f"force short of the cap by more than {SHORTFALL_MAX:g}: not judged)")
