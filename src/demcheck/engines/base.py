@@ -151,8 +151,10 @@ class Engine(ABC):
 
     def worker_argv(self, executable: str) -> list[str] | None:
         """The command of a long-lived worker that runs this engine's decks case after case in one process
-        (the protocol of engines/run.py's workers), when ``executable`` is the build the worker loads; None (the
-        default): every run is a process of its own."""
+        (engines/serve.py's protocol, which engines/run.py speaks), when ``executable`` is the build the worker
+        loads; None (the default): every run is a process of its own. run.py appends ``--parent PID``. The
+        worker's runs must give a process's dumps: the engine is loaded once and put back to its state at start
+        between runs (serve.Server.reset)."""
         return None
 
     def check_deck(self, text: str, files: dict | None = None) -> None:

@@ -10,12 +10,14 @@ kills the group of every running engine (``kill_all``), starts no new one, and e
 EngineInterrupted — "interrupted", never "failed".
 
 ``run(..., worker=True)`` runs the deck in a long-lived worker process of the engine instead, when the engine
-has one for the executable discovery found (``Engine.worker_argv``; LAMMPS: engines/lammps/worker.py) and
-``mpi`` is 1; otherwise it is the subprocess above. The worker loads the engine's library once and runs deck
-after deck, each in its work directory as above, with the same timeout, interrupt and failure rules and the
-same RunOutput: a run past its timeout or stopped by an interrupt kills the worker's process group (the next
-run starts a new worker; its start is not counted in the run's timeout), an engine error is EngineFailed with
-the log's tail and leaves the worker usable, a worker that died is replaced. Each worker serves one run at a
+has one for the executable discovery found (``Engine.worker_argv``: LAMMPS, LIGGGHTS, Yade and Kratos each have
+one, ``engines/<name>/worker.py``; the worker's side of the protocol is engines/serve.py) and ``mpi`` is 1;
+otherwise it is the subprocess above. The worker loads the engine once and runs deck after deck, each in its
+work directory as above, with the same timeout, interrupt and failure rules and the same RunOutput: a run past
+its timeout or stopped by an interrupt kills the worker's process group (the next run starts a new worker; its
+start is not counted in the run's timeout), an engine error is EngineFailed with the log's tail and leaves the
+worker usable, a worker that died is replaced — also one an engine error ends (LIGGGHTS's library exits): that
+run fails with its log's ERROR line and tail, as a process's does. Each worker serves one run at a
 time: concurrent jobs take one each (a pool per engine and command). A worker runs in a session of its own,
 as a run's process does, and dies with the thread that started it (a job's, or the main thread); an
 interrupt kills the workers that are running, ``shutdown_workers`` (also run at exit) ends the idle ones.
@@ -43,6 +45,7 @@ DEFAULT_TIMEOUT = 600.0
 # the engines' own warnings, as they print them
 _WARNING = re.compile(r"^WARNING:?\s*(.*)$", re.M)
 _ERROR = re.compile(r"^(?:ERROR|ERROR on proc \d+):?\s*(.*)$", re.M)
+_LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on", re.M)
 
 
 class EngineTimeout(EngineFailed):
@@ -59,6 +62,8 @@ class RunOutput:
     log: str
     wall_time: float
     warnings: list[str] = field(default_factory=list)
+    # s of the engine's own stepping loop (``loop_time``); None where neither its log nor its worker says
+    loop_time: float | None = None
 
 
 class Terminated(KeyboardInterrupt):
@@ -124,6 +129,16 @@ def warnings_of(log: str) -> list[str]:
     return [w.strip() for w in _WARNING.findall(log)]
 
 
+def loop_time(log: str, measured: float | None = None) -> float | None:
+    """The seconds of the engine's own stepping loop in a run: the sum of its log's ``Loop time of`` lines
+    (LAMMPS, LIGGGHTS: the loop and its dump output), else what its worker measured (``measured``: Yade the
+    script, Kratos its RunSolutionLoop), else None."""
+    found = _LOOP.findall(log)
+    if found:
+        return sum(float(x) for x in found)
+    return None if measured is None else float(measured)
+
+
 def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
     """The MPI launcher of an engine's own MPI (its package knows which)."""
     return registry.get(engine).mpi_launcher(executable, ranks)
@@ -182,7 +197,7 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     if proc.returncode != 0 or errors:
         what = errors[0] if errors else f"exit code {proc.returncode}"
         raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
-    return RunOutput(engine, info.version, wd, log, wall, warnings_of(log))
+    return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log))
 
 
 def _interrupted(engine: str, wd: Path, workdir, code: int, what: str = "was stopped by the interrupt"
@@ -242,21 +257,26 @@ class _Worker:
         except (BrokenPipeError, OSError):
             return False
 
-    def receive(self, timeout: float) -> dict | None:
-        """The next answer; None when the worker ended first; TimeoutError past ``timeout`` seconds."""
+    def receive(self, timeout: float, greeting: bool = False) -> dict | None:
+        """The next answer; None when the worker ended first; TimeoutError past ``timeout`` seconds.
+        ``greeting``: the first answer; lines before it that are not a JSON object are what the engine printed as
+        it started (Yade's welcome), skipped."""
         deadline = time.monotonic() + timeout
         fd = self.proc.stdout.fileno()
-        while b"\n" not in self.buffer:
-            left = deadline - time.monotonic()
-            if left <= 0:
-                raise TimeoutError
-            ready, _, _ = select.select([fd], [], [], left)
-            if ready:
-                chunk = os.read(fd, 65536)
-                if not chunk:
-                    return None
-                self.buffer += chunk
-        line, _, self.buffer = self.buffer.partition(b"\n")
+        while True:
+            while b"\n" not in self.buffer:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise TimeoutError
+                ready, _, _ = select.select([fd], [], [], left)
+                if ready:
+                    chunk = os.read(fd, 65536)
+                    if not chunk:
+                        return None
+                    self.buffer += chunk
+            line, _, self.buffer = self.buffer.partition(b"\n")
+            if not greeting or line.lstrip().startswith(b"{"):
+                break
         try:
             return json.loads(line)
         except ValueError:
@@ -306,7 +326,7 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         if not _AT_EXIT:
             _AT_EXIT.append(atexit.register(shutdown_workers))
     try:
-        hello = w.receive(WORKER_START_TIMEOUT)
+        hello = w.receive(WORKER_START_TIMEOUT, greeting=True)
     except TimeoutError:
         w.end(kill=True)
         raise EngineFailed(f"{engine}'s worker did not start within {WORKER_START_TIMEOUT:g} s") from None
@@ -431,6 +451,6 @@ def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeo
             message = str(answer.get("error") or "").strip()
             what = errors[0] if errors else (message.splitlines()[0] if message else "no message")
             raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log or message)}")
-        return RunOutput(engine, info.version, wd, log, wall, warnings_of(log))
+        return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log, answer.get("loop")))
     finally:
         _checkin(w, argv)

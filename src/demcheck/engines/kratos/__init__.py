@@ -1,10 +1,12 @@
 """Kratos DEM 10.4.4 (PyPI KratosMultiphysics + KratosDEMApplication): DEM_D_*_viscous_Coulomb laws, driven
-by a runner script that the Python with Kratos installed executes (one subprocess a run, like the others)."""
+by a runner script that the Python with Kratos installed executes (one subprocess a run, like the others, or
+script after script in this Python's worker: worker.py)."""
 
 from __future__ import annotations
 
 import re
 import subprocess
+import sys
 
 from .. import registry
 from ..base import Native, PackageEngine, Style
@@ -38,7 +40,9 @@ class _Banner:
         m = VERSION.search(out)
         if not m:
             return None
-        return re.match(r"(.+)", f"{m.group(1)} (DEMApplication {m.group(2)})")
+        from .worker import version_words
+
+        return re.match(r"(.+)", version_words(m.group(1), m.group(2)))
 
 
 class Kratos(PackageEngine):
@@ -57,6 +61,14 @@ class Kratos(PackageEngine):
 
     def argv(self, executable: str, deck: str) -> list[str]:
         return [executable, deck]
+
+    def worker_argv(self, executable: str) -> list[str] | None:
+        """The worker (worker.py) when ``executable`` is this Python: it imports Kratos once and runs script
+        after script in one process. Another Python (``$DEMCHECK_KRATOS``, ``kratos@LABEL=PATH``) runs a process
+        per run."""
+        from . import worker
+
+        return [sys.executable, "-m", worker.MODULE] if worker.serves(executable) else None
 
     def check_deck(self, text: str, files: dict | None = None) -> None:
         from .deck import check

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,14 @@ class Liggghts(PackageEngine):
 
     def argv(self, executable: str, deck: str) -> list[str]:
         return [*super().argv(executable, deck), "-echo", "none"]
+
+    def worker_argv(self, executable: str) -> list[str] | None:
+        """The worker (worker.py) loading the LIGGGHTS library ``executable`` itself loads (Debian's
+        ``libliggghts.so.3``); None for a build that loads none (a static build: a process per run)."""
+        from . import worker
+
+        path = worker.library(executable)
+        return None if path is None else [sys.executable, "-m", worker.MODULE, "--library", path]
 
     def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
         """Debian's mpirun (Open MPI, which Debian's LIGGGHTS is built with), not the mpich wheel's."""

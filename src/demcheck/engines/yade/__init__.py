@@ -25,6 +25,7 @@ from .. import registry
 from ..base import Native, PackageEngine, Style
 
 LAUNCHER = Path(__file__).with_name("launch.py")
+WORKER = Path(__file__).with_name("worker.py")
 
 
 @functools.lru_cache(maxsize=None)
@@ -120,6 +121,10 @@ class Yade(PackageEngine):
 
     def argv(self, executable: str, deck: str) -> list[str]:
         return [executable, "-x", "-n", str(LAUNCHER), deck]
+
+    def worker_argv(self, executable: str) -> list[str] | None:
+        """The worker (worker.py) in this very executable: one Yade process, script after script."""
+        return [executable, "-x", "-n", str(WORKER)]
 
     def check_deck(self, text: str, files: dict | None = None) -> None:
         """The guard of the template the script opens as: a packing script's (its first line), else the
