@@ -44,12 +44,23 @@ def _start(args, cwd, env=None):
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def _descendants(pid: int) -> list[int]:
+    """The live processes under ``pid``: its children, theirs, …"""
+    out, todo = [], [pid]
+    while todo:
+        kids = _children(todo.pop())
+        out += kids
+        todo += kids
+    return out
+
+
 def _wait_for_engine(proc, within=240.0) -> int:
-    """The pid of the engine ``proc`` has started (its child running a deck), once there is one."""
+    """The pid of the engine ``proc`` has started (a process under it running a deck: its child, or a child of a
+    worker process of its local Dask cluster), once there is one."""
     deadline = time.monotonic() + within
     while time.monotonic() < deadline:
         assert proc.poll() is None, f"demcheck ended before its engine started: {proc.communicate()}"
-        for pid in _children(proc.pid):
+        for pid in _descendants(proc.pid):
             try:
                 cmd = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
             except FileNotFoundError:

@@ -144,6 +144,51 @@ PACK_VTK_DIR = OutputPath(directory=True, files=("particles.vtu", "contacts.vtu"
 PACK_XYZ_FILE = OutputPath()
 
 
+class SchedulerAddress(click.ParamType):
+    """A Dask scheduler's address, ``tcp://HOST:PORT`` (comparisons/dispatch.py); its form checked here, whether
+    a scheduler answers there when the command starts its campaign — both before any work."""
+
+    name = "address"
+
+    def convert(self, value, param, ctx):
+        from .comparisons.dispatch import check_address
+
+        return check_address(value, _option_name(param))
+
+
+def _campaign_options(jobs: int, runs: str, jobs_help: str | None = None):
+    """``--jobs`` (default ``jobs``) and ``--scheduler``: where a command's independent ``runs`` go
+    (comparisons/dispatch.py, docs/scaling.md)."""
+
+    def add(command):
+        command = click.option("--scheduler", "scheduler", type=SchedulerAddress(), default=None,
+                               metavar="tcp://HOST:PORT",
+                               help=f"run the {runs} on the workers of this Dask cluster (its workers set the "
+                                    "parallelism: not with --jobs; docs/scaling.md)")(command)
+        return click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=jobs,
+                            show_default=True, help=jobs_help or f"{runs} run in parallel: 1 in this process, N in a "
+                                                                 "local Dask cluster of N worker processes")(command)
+
+    return add
+
+
+def _check_jobs(jobs: int, scheduler: str | None) -> None:
+    """``--jobs`` given with ``--scheduler`` is refused: the cluster's workers set the parallelism, and the size of
+    a local cluster would be silently ignored."""
+    source = click.get_current_context().get_parameter_source("jobs")
+    if scheduler and source is not click.core.ParameterSource.DEFAULT:
+        raise ConfigError("--jobs", jobs, "sizes a local cluster; with --scheduler the cluster's workers run the "
+                                          "tasks: leave out --jobs")
+
+
+def _campaign(jobs: int, scheduler: str | None, sources=()):
+    """The dispatch.Campaign of ``--jobs`` and ``--scheduler`` (checked by ``_check_jobs``)."""
+    from .comparisons.dispatch import Campaign
+
+    _check_jobs(jobs, scheduler)
+    return Campaign(jobs, scheduler, sources=sources)
+
+
 def _load(case_path: str, overrides) -> "object":
     from . import case as case_mod
     from .engines import registry
@@ -491,7 +536,8 @@ def _print_summary(s: dict) -> None:
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--csv", "csv_path", type=OUT_FILE, default=None, help="write the table")
 @click.option("--plot", type=OUT_FILE, default=None, help="plot metrics against the first key")
-def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, plot):
+@_campaign_options(1, "points")
+def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, plot, jobs, scheduler):
     """Metrics of a collision over one or more case keys, e.g. --vary impact.angle=5:85:17, from one source.
     With the case's own setting for the source's engine ([engine.NAME]), a contact.* key (the seed model's) or
     a materials.* key the setting does not read is refused: it would not change the law that runs."""
@@ -514,9 +560,10 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     check_source(source, method)
     points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
     native_vary_rule(points, source)
-    with Progress(transient=True, disable=as_json) as progress:
+    with _campaign(jobs, scheduler, [source.removesuffix("-twin")]) as campaign, \
+            Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("sweep", total=len(points))
-        table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source)
+        table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source, campaign=campaign)
     if csv_path:
         from .io import atomic_path
 
@@ -565,8 +612,7 @@ def warmup():
               help=f"comma-separated engines to compare ({', '.join(ENGINE_NAMES)}), builds of one beside it "
                    "(ENGINE@LABEL=PATH, e.g. lammps@2024=/opt/lammps-2024/bin/lmp; ENGINE=PATH replaces its "
                    "executable), or 'none' for the reference alone")
-@click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
-              help="cases run in parallel")
+@_campaign_options(2, "cases")
 @click.option("--report", "report_dir", type=REPORT_DIR, default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest go")
 @click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
@@ -581,7 +627,8 @@ def warmup():
               help="store this run as a baseline (metrics, verdicts, engine versions, per-quantity tolerances)")
 @click.option("--precision", "precision", type=click.Choice(["float128", "mpfr150"]), default=None,
               help="run each listed engine that has one as its build in this floating-point precision (Yade)")
-def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, baseline, write_baseline, precision):
+def verify(paths, engines, jobs, scheduler, report_dir, junit, as_json, no_cache, timeout, baseline, write_baseline,
+           precision):
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
@@ -592,13 +639,14 @@ def verify(paths, engines, jobs, report_dir, junit, as_json, no_cache, timeout, 
     from .comparisons import diff, verdicts
     from .engines import builds, discovery
 
+    _check_jobs(jobs, scheduler)
     engines = builds.with_precision(engines, precision) if precision else engines  # yade → yade@float128=…
     names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     files = _case_files(paths)
     base = diff.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
-    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout, baseline=base,
-                   expected=builds.expected_for(verdicts.load_expected(), names))
+    opts = Options(engines=tuple(names), jobs=jobs, scheduler=scheduler, cache=Cache(refresh=no_cache), timeout=timeout,
+                   baseline=base, expected=builds.expected_for(verdicts.load_expected(), names))
     try:
         summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
                             argv=["demcheck", "verify", *sys.argv[2:]])
@@ -662,8 +710,7 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
 @click.argument("name", required=False, metavar="[NAME]")
 @click.option("--engines", "engines", default=",".join(ENGINE_NAMES), show_default=True, metavar="LIST",
               help=f"comma-separated engines ({', '.join(ENGINE_NAMES)}), or 'none' for the reference alone")
-@click.option("--jobs", "-j", type=Number(lo=1, hi=256, integer=True), default=2, show_default=True,
-              help="cases run in parallel")
+@_campaign_options(2, "cases")
 @click.option("--report", "report_dir", type=VALIDATE_DIR, default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest-validate go")
 @click.option("--junit", "junit", type=OUT_FILE, default=None, help="also write JUnit XML here")
@@ -671,7 +718,7 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
 @click.option("--no-cache", "no_cache", is_flag=True, help="run every engine deck again")
 @click.option("--timeout", type=TIMEOUT, default=600.0, show_default=True, help="per engine run (s)")
 @click.option("--quick", is_flag=True, help="one case file per benchmark (68 of the 614 cases): a first look in minutes")
-def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout, quick):
+def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cache, timeout, quick):
     """Run the published benchmarks (cases/benchmarks/: Chung & Ooi's eight tests, Thornton's oblique
     impacts; NAME one of them, e.g. chung-ooi-4) in the reference and every engine, and judge each source
     against the exact limits and the papers' curves (docs/benchmarks.md). Exit 1 when the reference misses an
@@ -682,9 +729,10 @@ def validate(name, engines, jobs, report_dir, junit, as_json, no_cache, timeout,
     from .engines.cache import Cache, default_dir
 
     by_name(name)  # an unknown NAME: one line, exit 2, before any work
+    _check_jobs(jobs, scheduler)
     names = _engine_list(engines)
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
-    opts = Options(engines=tuple(names), jobs=jobs, cache=Cache(refresh=no_cache), timeout=timeout)
+    opts = Options(engines=tuple(names), jobs=jobs, scheduler=scheduler, cache=Cache(refresh=no_cache), timeout=timeout)
     try:
         summary = run(name, CASES_DIR / "benchmarks", Path(report_dir), opts, quiet=as_json,
                       junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]], quick=quick)
@@ -832,7 +880,9 @@ def _engine_text(names) -> str:
               help="where reports/<run-id> and reports/latest-bench go")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @_set_option
-def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
+@_campaign_options(1, "points", "points run in parallel: 1 in this process, N in a local Dask cluster of N worker "
+                                "processes (the points are timed: side by side they share the machine)")
+def bench(paths, engines, steps, batch, report_dir, as_json, overrides, jobs, scheduler):
     """Run time against error: sweep the time step of the reference's verlet method and of each engine (one
     collision per process, and a batch of copies per process), and the adaptive method's tolerance; fit the
     order of convergence and find the cheapest step for each target error."""
@@ -859,11 +909,11 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides):
     results = []
     per_case = len(bench.ADAPTIVE_RTOLS) + len(grid) * (1 + len(names))
     twins = sum(len(bench.native_sources(c, names)) for c in cases)  # a native law's twin: one more grid
-    with Progress(transient=True, disable=as_json) as progress:
+    with _campaign(jobs, scheduler, names) as campaign, Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("bench", total=per_case * len(cases) + len(grid) * twins)
         for case in cases:
-            results.append(bench.bench_case(case, names, grid, batch=batch,
-                                        progress=lambda: progress.advance(task)).summary())
+            results.append(bench.bench_case(case, names, grid, batch=batch, progress=lambda: progress.advance(task),
+                                            campaign=campaign).summary())
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names), "batch": batch,
             "command": ["demcheck", "bench", *sys.argv[2:]], "cases": results,
             "speed_goal": bench.speed_goal_text(results)}
@@ -900,7 +950,8 @@ def _native_lines(case: str, engine: str, law: dict, seed: dict) -> None:
 @click.option("--report", "report_dir", type=STRESS_DIR, default="reports", show_default=True,
               help="where reports/<run-id> and reports/latest-stress go")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def stress(paths, engines, only, report_dir, as_json):
+@_campaign_options(2, "stability searches")
+def stress(paths, engines, only, report_dir, as_json, jobs, scheduler):
     """Numerical stability: the largest stable time step of each source against stiffness, mass ratio,
     impact speed, restitution, radius and incidence, with the failures and where the engines and the
     reference disagree."""
@@ -922,11 +973,11 @@ def stress(paths, engines, only, report_dir, as_json):
     root = Path(report_dir)
     out_dir = new_run_dir(root, "stress")
     results = []
-    with Progress(transient=True, disable=as_json) as progress:
+    with _campaign(jobs, scheduler, names) as campaign, Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("stress", total=None)
         for raw, case in cases:
-            results.append(stress_case(raw, case, names, list(only) or None,
-                                       progress=lambda: progress.advance(task)).summary())
+            results.append(stress_case(raw, case, names, list(only) or None, progress=lambda: progress.advance(task),
+                                       campaign=campaign).summary())
     data = {"run_id": out_dir.name, "report": str(out_dir), "engines": _engine_text(names),
             "command": ["demcheck", "stress", *sys.argv[2:]], "cases": results}
     write_stress(data, root)
@@ -1026,7 +1077,9 @@ def audit(deck_path, engine, speed, as_json, report_dir):
 @_set_option
 @click.option("--no-confirm", "no_confirm", is_flag=True, help="the twin only: no confirming engine run")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json):
+@_campaign_options(1, "confirming engine run", "1: the confirming engine run in this process; 2 or more: in the "
+                                               "worker of a local Dask cluster (one run: nothing runs side by side)")
+def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jobs, scheduler):
     """The native input (the coefficient of restitution or damping an engine reads, k_t, …) that realises a
     target metric in ENGINE at the run's dt: root finding on the engine's twin, confirmed by one engine run;
     prints the line to paste. Exit 0: confirmed; 1: the engine run misses the target; 2: bad input."""
@@ -1040,7 +1093,8 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json):
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
     calibrate.check_targets(wanted)  # bad input: one line, before any work
     case = _load(case_path, overrides)
-    result = calibrate.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm)
+    with _campaign(jobs, scheduler, [engine]) as campaign:
+        result = calibrate.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm, campaign=campaign)
     if as_json:
         emit_json(result)
     else:

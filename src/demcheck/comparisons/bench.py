@@ -282,71 +282,105 @@ def _native_errors(law: NativeLaw, metrics: dict, scales) -> dict:
     return _errors(metrics, law.converged, METRICS + OBLIQUE_METRICS, scales)
 
 
+@dataclass(frozen=True)
+class Basis:
+    """What every point of a case's bench is run with and measured against: the case, the converged answer of the
+    seed model (``ref``) and the metrics and scales of the errors, its elastic contact time, each engine's native
+    law (``natives``, engine → NativeLaw), and the batch size of the engines' batched runs."""
+
+    case: Case
+    ref: dict
+    metrics: tuple
+    scales: dict
+    t_contact: float
+    natives: dict
+    batch: int
+
+
 def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
-               batch: int = BATCH, cache=None, progress=None) -> BenchResult:
+               batch: int = BATCH, cache=None, progress=None, campaign=None) -> BenchResult:
     """The work–precision of each source for one collision case (module docstring). ``engines``: the engines
     and builds to time (default every registered one); an engine the case gives its own setting runs it, as
-    its twin does, both against the twin's converged answer."""
+    its twin does, both against the twin's converged answer. Each point is a task of ``campaign``
+    (dispatch.Campaign; default this process), the points in the order planned."""
     from ..engines import discovery
-    from ..engines.collide import collide as run_engine
     from ..engines.mapping import contact_mapping
+    from ..reference.health import impact_scales
+    from .dispatch import Campaign
 
     engines = registry.names() if engines is None else tuple(engines)
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
-    from ..reference.health import impact_scales
-
-    metrics, scales = metrics_of(case, model), impact_scales(case, model)
     res = BenchResult(case.name, model.describe(), t_c, ref)
     res.natives = {e: native_law(case, e, nat, ref) for e, nat in native_sources(case, engines).items()}
-    tick = progress or (lambda: None)
-    for rtol in rtols:
-        wall, r = _timed(lambda: collide(case, "adaptive", rtol=rtol))
-        errors = _errors(r.metrics(), ref, metrics, scales)
-        res.points.append(Point("reference-adaptive", None, None, rtol, wall, None, errors, r.status, r.message))
-        tick()
-    for spc in steps:
-        dt = t_c / spc
-        wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
-        errors = _errors(r.metrics(), ref, metrics, scales)
-        res.points.append(Point("reference-verlet", spc, dt, None, wall, None, errors, r.status, r.message))
-        tick()
-    for engine, law in res.natives.items():  # the native law in the reference: the engine's twin
-        res.points += _twin_points(case, engine, law, steps, repeat=3, tick=tick)
+    basis = Basis(case, ref, metrics_of(case, model), impact_scales(case, model), t_c, res.natives, batch)
+    plan = [("reference-adaptive", rtol) for rtol in rtols] + [("reference-verlet", spc) for spc in steps]
+    plan += [(f"{engine}-twin", spc) for engine in res.natives for spc in steps]  # the native law in the reference
     for engine in engines:
         law = res.natives.get(engine)
         mp = contact_mapping(case, engine, law.native if law else None)
         if mp.native is None:
             res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
-            continue
-        if discovery.find(engine) is None:
+        elif discovery.find(engine) is None:
             res.skipped[engine] = discovery.missing(engine)
-            continue
-        for spc in steps:
-            dt = (law.t_contact if law else t_c) / spc
-            native = law.native if law else None
-            try:
-                one = run_engine(case, engine, dt=dt, cache=None, native=native)
-                try:
-                    many = run_engine(case, engine, dt=dt, cache=None, copies=batch, native=native)
-                except UnsupportedByEngine:  # an engine whose decks hold one collision: no batched time
-                    many = None
-            except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
-                raise
-            except DemcheckError as exc:
-                res.points.append(Point(engine, spc, dt, None, math.nan, math.nan, {k: math.nan for k in metrics},
-                                        "failed", str(exc).splitlines()[0]))
-                tick()
-                continue
-            # an engine result carries the reference's own checks (reference/health.py)
-            errors = (_native_errors(law, one.metrics(), scales) if law
-                      else _errors(one.metrics(), ref, metrics, scales))
-            res.points.append(Point(engine, spc, dt, None, one.meta["engine_wall_time"],
-                                    many.meta["engine_wall_time"] / batch if many is not None else math.nan,
-                                    errors, one.status, one.message if not one.ok else ""))
-            tick()
+        else:
+            plan += [(engine, spc) for spc in steps]
+    tick = progress or (lambda: None)
+    done = {}
+    for i, point in (campaign or Campaign()).completed(point_task, [(i, (basis, *p)) for i, p in enumerate(plan)]):
+        done[i] = point
+        tick()
+    for i in sorted(done):
+        if isinstance(done[i], str):  # the engine is missing on the worker the point went to
+            res.skipped[plan[i][0]] = done[i]
+        else:
+            res.points.append(done[i])
     return res
+
+
+def point_task(basis: Basis, source: str, step: float, cache=None) -> Point | str:
+    """One point of a bench, where the campaign runs it (comparisons/dispatch.py): ``step`` is the adaptive
+    method's rtol for reference-adaptive, else steps per elastic contact time (a native law's own for an engine
+    with one, and its twin). A str: why it did not run (the engine is missing on the Dask worker it went to)."""
+    from ..engines.collide import collide as run_engine
+    from .dispatch import missing_here
+
+    case, ref, metrics, scales = basis.case, basis.ref, basis.metrics, basis.scales
+    if source == "reference-adaptive":
+        wall, r = _timed(lambda: collide(case, "adaptive", rtol=step))
+        return Point(source, None, None, step, wall, None, _errors(r.metrics(), ref, metrics, scales), r.status,
+                     r.message)
+    if source == "reference-verlet":
+        dt = basis.t_contact / step
+        wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
+        return Point(source, step, dt, None, wall, None, _errors(r.metrics(), ref, metrics, scales), r.status,
+                     r.message)
+    engine = source.removesuffix("-twin")
+    law = basis.natives.get(engine)
+    if source.endswith("-twin"):
+        return _twin_point(case, engine, law, step, repeat=3)
+    lacking = missing_here([engine])
+    if lacking:
+        return lacking[engine]
+    dt = (law.t_contact if law else basis.t_contact) / step
+    native = law.native if law else None
+    try:
+        one = run_engine(case, engine, dt=dt, cache=None, native=native)
+        try:
+            many = run_engine(case, engine, dt=dt, cache=None, copies=basis.batch, native=native)
+        except UnsupportedByEngine:  # an engine whose decks hold one collision: no batched time
+            many = None
+    except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
+        raise
+    except DemcheckError as exc:
+        return Point(engine, step, dt, None, math.nan, math.nan, {k: math.nan for k in metrics}, "failed",
+                     str(exc).splitlines()[0])
+    # an engine result carries the reference's own checks (reference/health.py)
+    errors = _native_errors(law, one.metrics(), scales) if law else _errors(one.metrics(), ref, metrics, scales)
+    return Point(engine, step, dt, None, one.meta["engine_wall_time"],
+                 many.meta["engine_wall_time"] / basis.batch if many is not None else math.nan,
+                 errors, one.status, one.message if not one.ok else "")
 
 
 # ----------------------------------------------------------------------------- demcheck dt
@@ -433,28 +467,26 @@ def recommend(case: Case, target: float = 1e-3, engines=None) -> dict:
     return out
 
 
-def _twin_points(case: Case, engine: str, law: NativeLaw, steps, repeat: int = 1, tick=None) -> list[Point]:
-    """The native law's twin over a grid of steps per its elastic contact time, each point's error against the
-    twin's converged answer (best wall time of ``repeat`` runs). A step the run cannot hold (too many steps) is
-    that point's failure."""
+def _twin_points(case: Case, engine: str, law: NativeLaw, steps, repeat: int = 1) -> list[Point]:
+    """The native law's twin over a grid of steps per its elastic contact time (``_twin_point``)."""
+    return [_twin_point(case, engine, law, spc, repeat) for spc in steps]
+
+
+def _twin_point(case: Case, engine: str, law: NativeLaw, spc: float, repeat: int = 1) -> Point:
+    """The native law's twin at ``spc`` steps per its elastic contact time, its error against the twin's converged
+    answer (best wall time of ``repeat`` runs). A step the run cannot hold (too many steps) is that point's
+    failure."""
     from ..engines.collide import twin_states
     from ..reference.health import impact_scales
 
-    scales = impact_scales(case, law.model)
-    pts = []
-    for spc in steps:
-        dt = law.t_contact / spc
-        try:
-            wall, r = _timed(lambda: twin_states(case, engine, dt, native=law.native), repeat)
-        except ConfigError as exc:
-            pts.append(Point(f"{engine}-twin", spc, dt, None, math.nan, None, {k: math.nan for k in METRICS},
-                             "failed", str(exc).splitlines()[0]))
-        else:
-            pts.append(Point(f"{engine}-twin", spc, dt, None, wall, None,
-                             _native_errors(law, r.metrics(), scales), r.status, r.message))
-        if tick:
-            tick()
-    return pts
+    dt = law.t_contact / spc
+    try:
+        wall, r = _timed(lambda: twin_states(case, engine, dt, native=law.native), repeat)
+    except ConfigError as exc:
+        return Point(f"{engine}-twin", spc, dt, None, math.nan, None, {k: math.nan for k in METRICS}, "failed",
+                     str(exc).splitlines()[0])
+    errors = _native_errors(law, r.metrics(), impact_scales(case, law.model))
+    return Point(f"{engine}-twin", spc, dt, None, wall, None, errors, r.status, r.message)
 
 
 def speed_goal_text(results: list[dict]) -> str:

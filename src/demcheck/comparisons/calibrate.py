@@ -41,9 +41,12 @@ def check_targets(targets: dict) -> dict:
     return out
 
 
-def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, confirm: bool = True) -> dict:
+def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, confirm: bool = True,
+              campaign=None) -> dict:
     """The calibration as a dict: per target the input found (name, from, to), the twin's realised value, and
-    the engine's on confirmation; the native configuration and the lines to paste."""
+    the engine's on confirmation; the native configuration and the lines to paste. The root finding runs here (each
+    twin run needs the one before); the confirming engine run is a task of ``campaign`` (dispatch.Campaign; default
+    this process)."""
     from scipy.optimize import brentq
 
     targets = check_targets(targets)
@@ -102,7 +105,9 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     out["lines"] = eng.native_lines(native)
     out["confirmed"] = None
     if confirm:
-        res = collide(case, engine, dt=step, native=native)
+        from .dispatch import Campaign
+
+        [(_, res)] = (campaign or Campaign()).completed(confirm_task, [(0, (case, engine, step, native))])
         if not res.ok:
             raise DemcheckError(f"the confirming {engine} run is {res.status}: {res.message}")
         m = res.metrics()
@@ -111,6 +116,18 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
         out["engine_version"] = res.engine_version
         out["confirmed"] = all(abs(e["engine"] - e["target"]) <= ROOT_TOL for e in out["inputs"].values())
     return out
+
+
+def confirm_task(case: Case, engine: str, dt: float, native, cache=None):
+    """The engine run of the calibrated ``native`` configuration, where the campaign runs it
+    (comparisons/dispatch.py); on a Dask worker without the engine, EngineNotFound naming the worker."""
+    from ..errors import EngineNotFound
+    from .dispatch import missing_here
+
+    lacking = missing_here([engine])
+    if lacking:
+        raise EngineNotFound(lacking[engine])
+    return collide(case, engine, dt=dt, native=native)
 
 
 def _oblique(case: Case) -> bool:

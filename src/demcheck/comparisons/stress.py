@@ -236,16 +236,41 @@ def read_stress(path: Path) -> tuple[dict, Case]:
 
 
 def stress_file(path: Path, engines=None, only: list[str] | None = None,
-                progress=None) -> StressResult:
-    return stress_case(*read_stress(path), engines=engines, only=only, progress=progress)
+                progress=None, campaign=None) -> StressResult:
+    return stress_case(*read_stress(path), engines=engines, only=only, progress=progress, campaign=campaign)
+
+
+def limit_task(parameter: str, value, source: str, case: Case, t_c: float, cache=None) -> Limit | str:
+    """The largest stable step of ``source`` (reference-verlet, an engine, or NAME-twin: the case's own setting
+    for an engine when it has one) at one value of a stress parameter, where the campaign runs it
+    (comparisons/dispatch.py). A str: why it did not run (the engine is missing on the Dask worker it went to)."""
+    from .dispatch import missing_here
+
+    if source == "reference-verlet":
+        spc, why = largest_stable(lambda n: _stable_reference(case, t_c / n, t_c))
+        return Limit(parameter, value, source, spc, (1.0 / spc) if spc else None, why, t_c)
+    engine = source.removesuffix("-twin")
+    nat = _native_run(case, engine)
+    native, model = (nat[0], nat[1]) if nat is not None else (None, None)
+    t = characteristic_time(model) if nat is not None else t_c
+    if source.endswith("-twin"):
+        spc, why = largest_stable(lambda n: _stable_twin(case, engine, native, model, t / n))
+    else:
+        lacking = missing_here([engine])
+        if lacking:
+            return lacking[engine]
+        spc, why = largest_stable(lambda n: _stable_engine(case, engine, t / n, t, native, model))
+    return Limit(parameter, value, source, spc, (1.0 / spc) if spc else None, why, t)
 
 
 def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = None,
-                progress=None) -> StressResult:
-    """Stress one case (``read_stress``'s raw table and Case) over its parameters."""
+                progress=None, campaign=None) -> StressResult:
+    """Stress one case (``read_stress``'s raw table and Case) over its parameters, each source's search at each
+    value a task of ``campaign`` (dispatch.Campaign; default this process); the limits in the order planned."""
     from ..engines import discovery
     from ..engines.builds import engine_of
     from ..engines.mapping import contact_mapping, native_summary
+    from .dispatch import Campaign
 
     res = StressResult(base.name, resolve(base).describe())
     params = parameters(raw0)
@@ -253,6 +278,7 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
         params = {k: v for k, v in params.items() if any(o in k for o in only)}
     engines = registry.names() if engines is None else tuple(engines)
     tick = progress or (lambda: None)
+    plan: list = []  # a Limit known without a run (an invalid value), or the arguments of a limit_task
     for name, values in params.items():
         points = []  # (value, case, t_c, {engine: _native_run}) or (value, None, why, {})
         for value, transform in values:
@@ -276,30 +302,31 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
                     "bodies: its stability is the same at every value")
         for value, case, t_c, natives in points:
             if case is None:
-                res.limits.append(Limit(name, value, "reference-verlet", None, None, t_c))
+                plan.append(Limit(name, value, "reference-verlet", None, None, t_c))
                 continue
-            runs = [("reference-verlet", lambda spc, c=case, t=t_c: _stable_reference(c, t / spc, t), t_c)]
+            plan.append((name, value, "reference-verlet", case, t_c))
             for e in engines:
                 nat = natives.get(e)
                 if e in still:
                     continue
                 if nat is not None:
-                    native, model, _ = nat
-                    t_n = characteristic_time(model)
-                    runs.append((f"{e}-twin", lambda spc, c=case, n=native, m=model, t=t_n, e=e:
-                                 _stable_twin(c, e, n, m, t / spc), t_n))
+                    plan.append((name, value, f"{e}-twin", case, t_c))
                 mp = contact_mapping(case, e, nat[0] if nat else None)
                 if mp.native is None:
                     res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
                 elif discovery.find(e) is None:
                     res.skipped[e] = discovery.missing(e)
-                elif nat is not None:
-                    runs.append((e, lambda spc, c=case, n=native, m=model, t=t_n, e=e:
-                                 _stable_engine(c, e, t / spc, t, n, m), t_n))
                 else:
-                    runs.append((e, lambda spc, c=case, t=t_c, e=e: _stable_engine(c, e, t / spc, t), t_c))
-            for src, check, t in runs:
-                spc, why = largest_stable(check)
-                res.limits.append(Limit(name, value, src, spc, (1.0 / spc) if spc else None, why, t))
-                tick()
+                    plan.append((name, value, e, case, t_c))
+    tasks = [(i, args) for i, args in enumerate(plan) if not isinstance(args, Limit)]
+    done = {}
+    for i, limit in (campaign or Campaign()).completed(limit_task, tasks):
+        done[i] = limit
+        tick()
+    for i, item in enumerate(plan):
+        item = done.get(i, item)
+        if isinstance(item, str):  # the engine is missing on the worker the search went to
+            res.skipped[plan[i][2]] = item
+        else:
+            res.limits.append(item)
     return res

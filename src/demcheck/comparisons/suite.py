@@ -15,7 +15,6 @@ interrupted run keeps every finished case and writes a report marked partial.
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import datetime as _dt
 import os
 import sys
@@ -35,7 +34,7 @@ from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..reference.model import resolve
-from . import curves, verdicts
+from . import curves, dispatch, verdicts
 
 SERIES_POINTS = 400
 
@@ -43,7 +42,8 @@ SERIES_POINTS = 400
 @dataclass
 class Options:
     engines: tuple[str, ...] = field(default_factory=lambda: registry.names())
-    jobs: int = 1
+    jobs: int = 1  # 1: in this process; N: a local Dask cluster of N worker processes (comparisons/dispatch.py)
+    scheduler: str | None = None  # tcp://HOST:PORT of an existing Dask cluster, whose workers run the cases
     cache: object | None = None  # engines.cache.Cache
     timeout: float = 600.0
     tolerances: verdicts.Tolerances = field(default_factory=verdicts.Tolerances.load)
@@ -252,50 +252,52 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
     entries: dict[int, dict] = {}
     interrupted: KeyboardInterrupt | None = None  # SIGINT, or SIGTERM (engines.run.Terminated)
     runner.reset()
-    try:
-        with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                      console=console, transient=True) as progress:
-            task = progress.add_task("verify", total=len(cases))
-            with cf.ThreadPoolExecutor(max_workers=max(1, opts.jobs)) as pool:
+    shipped = replace(opts, cache=None, baseline=None)  # what a task needs of the options (its cache is its own)
+    with dispatch.Campaign(opts.jobs, opts.scheduler, cache=opts.cache, sources=opts.engines) as campaign:
+        try:
+            with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                          console=console, transient=True) as progress:
+                task = progress.add_task("verify", total=len(cases))
                 # the packings first: the longest jobs, so that the collisions fill the other workers meanwhile
                 order = sorted(range(len(cases)), key=lambda i: cases[i][1].kind != "packing")
-                futures = {pool.submit(_safe_case, cases[i][1], cases[i][0], opts, found): i for i in order}
-                try:
-                    for fut in cf.as_completed(futures):
-                        i = futures[fut]
-                        entries[i] = fut.result()
-                        progress.update(task, advance=1, description=cases[i][1].name[:50])
-                except KeyboardInterrupt as exc:
-                    interrupted = exc
-                    for f in futures:
-                        f.cancel()
-                    # the engines stopped, and none starts: the cases running finish without them (raising
-                    # EngineInterrupted: left out) or, needing none, finish and are reported
-                    runner.kill_all()
-                    pool.shutdown(wait=True, cancel_futures=True)
-                    runner.reset()  # every worker has stopped: engines may run again in this process
-                    for f, i in futures.items():
-                        if f.done() and not f.cancelled() and i not in entries and f.exception() is None:
-                            entries[i] = f.result()
-    except KeyboardInterrupt as exc:  # outside the wait (or a second one during the shutdown)
-        interrupted = interrupted or exc
-        runner.kill_all()
-    finally:
-        summary["cases"] = [entries[i] for i in sorted(entries)]
-        summary["failed"] = sum(e["status"] in ("failed", "unexpected") for e in summary["cases"])
-        summary["wall_time"] = time.perf_counter() - started
-        summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
-        if opts.cache is not None:
-            summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
-        if opts.baseline is not None:
-            from .diff import apply_baseline
+                tasks = [(i, (cases[i][1], str(cases[i][0]), shipped, found)) for i in order]
+                # an interrupt: the engines stopped and none starts; the cases running finish without them (raising
+                # EngineInterrupted: left out) or, needing none, finish and are reported (dispatch.Campaign)
+                for i, entry in campaign.completed(case_task, tasks):
+                    if "variant" in entry:  # read here, where the case files are
+                        entry["variant"] = variant_labels(entry["case"], cases[i][0])
+                    entries[i] = entry
+                    progress.update(task, advance=1, description=cases[i][1].name[:50])
+        except KeyboardInterrupt as exc:
+            interrupted = exc
+            runner.kill_all()
+        except EngineInterrupted as exc:  # in this process (--jobs 1): an engine the interrupt stopped
+            interrupted = exc.__cause__ if isinstance(exc.__cause__, KeyboardInterrupt) else KeyboardInterrupt()
+            runner.kill_all()
+        finally:
+            summary["cases"] = [entries[i] for i in sorted(entries)]
+            summary["failed"] = sum(e["status"] in ("failed", "unexpected") for e in summary["cases"])
+            summary["wall_time"] = time.perf_counter() - started
+            summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
+            if opts.cache is not None:
+                summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
+            if opts.baseline is not None:
+                from .diff import apply_baseline
 
-            apply_baseline(summary, opts.baseline)
-        report.write_all(summary, out_dir, report_root, junit=junit, link=link)
+                apply_baseline(summary, opts.baseline)
+            report.write_all(summary, out_dir, report_root, junit=junit, link=link)
     _print(console, summary)
     if interrupted is not None:
         raise interrupted
     return summary
+
+
+def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> dict:
+    """One case's entry, where the campaign runs it (comparisons/dispatch.py) with ``cache`` as its run cache. On a
+    Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named."""
+    lacking = dispatch.missing_here(e for e in opts.engines if found[e]["found"])
+    found = {**found, **{e: {**found[e], "found": False, "why": why} for e, why in lacking.items()}}
+    return _safe_case(case, Path(file), replace(opts, cache=cache), found)
 
 
 def _safe_case(case, path, opts, found) -> dict:

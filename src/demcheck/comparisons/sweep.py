@@ -153,7 +153,9 @@ def _run(case, source: str, method, dt):
     from ..case import run_length
     from ..engines import registry
     from ..engines.collide import collide as run_engine, twin_states
+    from ..errors import EngineNotFound
     from .bench import native_step
+    from .dispatch import missing_here
 
     engine = source.removesuffix("-twin")
     native = registry.get(engine).case_native(case)
@@ -161,31 +163,43 @@ def _run(case, source: str, method, dt):
         dt = native_step(case, native, dt)
     if source.endswith("-twin"):
         return twin_states(case, engine, dt or run_length(case)[0], native=native)
+    lacking = missing_here([engine])  # on a Dask worker without the engine: this point's error names the worker
+    if lacking:
+        raise EngineNotFound(lacking[engine])
     # a sweep runs one engine many times: in its long-lived worker where it has one (no start-up per point)
     return run_engine(case, engine, dt=dt, native=native, worker=True)
 
 
-def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
-              source: str = "reference") -> pd.DataFrame:
-    """Solve each point (``sweep_points``) from ``source`` (``check_source``); a point whose solve fails keeps its
-    row, with the status."""
+def point_task(values: dict, case, source: str, method, dt, cache=None) -> dict:
+    """One point's row (its values, metrics and status), where the campaign runs it (comparisons/dispatch.py); a
+    solve that fails keeps its row, with the status."""
     from ..errors import EngineInterrupted
 
-    rows = []
-    for values, case in points:
-        row = dict(values)
-        try:
-            result = _run(case, source, method, dt)
-            row.update(result.metrics())
-            row["status"] = result.status
-        except EngineInterrupted:
-            raise
-        except DemcheckError as exc:
-            row["status"] = f"error: {exc}"
-        rows.append(row)
+    row = dict(values)
+    try:
+        result = _run(case, source, method, dt)
+        row.update(result.metrics())
+        row["status"] = result.status
+    except EngineInterrupted:
+        raise
+    except DemcheckError as exc:
+        row["status"] = f"error: {exc}"
+    return row
+
+
+def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
+              source: str = "reference", campaign=None) -> pd.DataFrame:
+    """Solve each point (``sweep_points``) from ``source`` (``check_source``), in ``campaign``
+    (dispatch.Campaign; default this process), the rows in the points' order."""
+    from .dispatch import Campaign
+
+    rows = {}
+    tasks = [(i, (values, case, source, method, dt)) for i, (values, case) in enumerate(points)]
+    for i, row in (campaign or Campaign()).completed(point_task, tasks):
+        rows[i] = row
         if progress:
             progress()
-    return pd.DataFrame(rows)
+    return pd.DataFrame([rows[i] for i in sorted(rows)])
 
 
 def _text(v) -> str:
