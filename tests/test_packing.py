@@ -2,6 +2,7 @@
 packing metrics on lattices whose values are known exactly."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -293,12 +294,16 @@ def test_verify_runs_the_small_packings_in_every_source(tmp_path):
 
 
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
-def test_engines_run_packings_under_mpi(engine):
-    """Two MPI ranks (each engine's own launcher and domain decomposition): the same settled column."""
+def test_engines_run_packings_under_mpi(engine, tmp_path):
+    """Two MPI ranks (each engine's own launcher and domain decomposition): the same settled column, the box cut
+    across x (the deck's `processors * * 1`; cut along the height, as the engines choose for a tall box, the bed
+    would sit in one rank's half). The grid is read from the engine's own log."""
     from demcheck.engines.packing import run_engine
 
     case = C.loads(COLUMN)
-    run = run_engine(case, engine, mpi=2)
+    run = run_engine(case, engine, mpi=2, workdir=tmp_path)
+    grid = re.search(r"(\d+) by (\d+) by (\d+) MPI processor grid", (tmp_path / "log.txt").read_text())
+    assert grid is not None and grid.groups() in {("2", "1", "1"), ("1", "2", "1")}
     table = run.table
     assert len(run.contacts) == 4  # each contact once, also across the ranks' boundary
     z, r = table["z"].to_numpy(), 1e-3

@@ -763,6 +763,11 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
 @click.option("--mpi", "mpi", type=Number(lo=1, hi=256, integer=True, unit="MPI ranks"), default=1,
               show_default=True,
               help="run the engine on this many MPI ranks (its own domain decomposition)")
+@click.option("--threads", "threads", type=Number(lo=1, integer=True, unit="threads"), default=1,
+              show_default=True,
+              help="run the reference's force loop on this many threads (numba's; at most NUMBA_NUM_THREADS, by "
+                   "default the machine's cores): the same physics, summed in another order, so the same result to "
+                   "round-off, not bit for bit (docs/packing.md)")
 @click.option("--timeout", type=TIMEOUT, default=3600.0, show_default=True, help="engine run timeout (s)")
 @click.option("--csv", "csv_dir", type=PACK_CSV_DIR, default=None,
               help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "
@@ -779,7 +784,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
                    "decimals, so SI values to 5e-9 — masses and forces are in --vtk (float64) only")
 @_set_option
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
-def pack(case_path, engine, duration, mpi, timeout, csv_dir, vtk_dir, xyz_file, overrides, as_json):
+def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, xyz_file, overrides, as_json):
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics (with the contact network's fabric
     tensor); --csv, --vtk and --xyz write the settled state."""
@@ -791,20 +796,24 @@ def pack(case_path, engine, duration, mpi, timeout, csv_dir, vtk_dir, xyz_file, 
     if case.kind != "packing":
         raise ConfigError("kind", case.kind, "demcheck pack runs packing cases (kind = \"packing\")")
     if mpi > 1 and engine == "reference":
-        raise ConfigError("--mpi", mpi, f"applies to an engine (--engine {'|'.join(ENGINE_NAMES)}); the reference runs on one "
-                          "core")
+        raise ConfigError("--mpi", mpi, f"applies to an engine (--engine {'|'.join(ENGINE_NAMES)}); the reference "
+                          "runs on threads (--threads)")
+    if threads > 1 and engine != "reference":
+        raise ConfigError("--threads", threads, "applies to the reference (--engine reference); an engine runs on MPI "
+                          "ranks (--mpi)")
+    threads = packing.check_threads(threads)  # no more than numba may start here
     box = case.packing.box if case.packing else None
     import pandas as pd
 
     from .inputs.packing_decks import CONTACT_COLUMNS
 
     if engine == "reference":
-        st = packing.simulate(case, duration=duration)
+        st = packing.simulate(case, duration=duration, threads=threads)
         nc = min(st.n_contacts, len(st.contacts))
         m = packing_metrics.compute(st.x, st.rad, box=box, forces=st.contacts[:nc, 3], overlaps=st.contacts[:nc, 2],
                        ke=[e for _, e in st.ke])
-        out = {"case": case.name, "source": "reference", "particles": len(case.particles), "time": st.time,
-               "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
+        out = {"case": case.name, "source": "reference", "threads": threads, "particles": len(case.particles),
+               "time": st.time, "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
         x, rad = st.x, st.rad
         contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
         settled = packing_output.from_reference(case, st)

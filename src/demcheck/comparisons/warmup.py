@@ -4,7 +4,8 @@ The reference's kernels are numba functions compiled on first use and cached on 
 "Compiled kernels"); a cold cache makes the first suite pay for the compilation. Numba compiles one
 specialisation per set of argument types, so the warm-up runs the suite's own call sites — the 1-D and 3-D
 collision solvers, adaptive and verlet, at a wall and between a pair, and the packing solver with a floor,
-its periodic box and one with side walls — on tiny scenes: what it compiles is exactly what the suite would.
+its periodic box and one with side walls, on one thread and on two — on tiny scenes: what it compiles is exactly
+what the suite (and a threaded `pack`) would.
 It needs no engine and writes nothing but numba's cache.
 """
 
@@ -81,10 +82,15 @@ def scenes() -> list[tuple[str, callable]]:
 
 
 def _packing():
+    import numba
+
     from ..case import loads
     from ..reference import packing
 
-    packing.simulate(loads(_PACKING), rest=0.0)
+    case = loads(_PACKING)
+    packing.simulate(case, rest=0.0)
+    if numba.config.NUMBA_NUM_THREADS >= 2:  # the threaded loop (threads > 1), where numba may run it
+        packing.simulate(case, rest=0.0, threads=2)
 
 
 def warm(progress=None) -> list[tuple[str, float]]:

@@ -138,10 +138,10 @@ def notes(texts) -> list[str]:
 
 # every command demcheck writes, and of those that take a style the word's position and the styles it writes
 COMMANDS = frozenset({
-    "units", "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "region", "create_box",
-    "create_atoms", "set", "read_data", "neighbor", "neigh_modify", "pair_style", "pair_coeff", "fix", "compute",
-    "timestep", "dump", "dump_modify", "undump", "write_dump", "thermo_style", "thermo_modify", "thermo", "run",
-    "hard_particles", "soft_particles"})
+    "units", "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "processors", "region",
+    "create_box", "create_atoms", "set", "read_data", "neighbor", "neigh_modify", "pair_style", "pair_coeff", "fix",
+    "compute", "timestep", "dump", "dump_modify", "undump", "write_dump", "thermo_style", "thermo_modify", "thermo",
+    "run", "hard_particles", "soft_particles"})
 STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/sphere"})),
           "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local"})),
           "dump": (3, frozenset({"custom", "local"})), "pair_style": (1, frozenset({"granular", "gran"})),

@@ -179,6 +179,9 @@ def head(case: Case, engine: str, note: str, hand: str, lay: Layout, mappings, a
              common.comment("a pair across a periodic or process boundary is computed on both sides, and ghost "
                             "particles carry their velocities (the dashpots use them)"),
              "newton off", comm,
+             common.comment("on several MPI ranks (mpirun -np N), cut the box across x and y only: the bed gathers at "
+                            "the bottom, and ranks cut along the height would leave it to one rank"),
+             "processors * * 1",
              common.comment("the initial state: every particle's type, diameter, density, position and velocity"),
              f"read_data {DATA_FILE}"]
     for s in lay.table:

@@ -4,9 +4,10 @@ The engines' scheme (velocity Verlet of fix nve/sphere, I = 0.4 m R²), Verlet n
 compressed rows built from linked cells with a skin (rebuilt once a particle has moved half of it; O(N),
 memory linear in N), each listed pair's contact state (history, largest overlap) stored beside it in the
 list and carried over at a rebuild (as LAMMPS's fix neigh/history), and one state per particle–wall
-contact. The contact laws are the reference's compiled laws (kernels.py's normal force, kernels3d.py's
-tangential laws), one law per pair of particle species, so any normal × tangential model — engine twins
-included — runs here as in the two-body solvers. Tangential laws with a
+contact. One thread (:func:`run`) or several (:func:`run_threaded`: numba threads over shares of the list's
+rows, the same arithmetic per contact; docs/packing.md). The contact laws are the reference's compiled laws
+(kernels.py's normal force, kernels3d.py's tangential laws), one law per pair of particle species, so any
+normal × tangential model — engine twins included — runs here as in the two-body solvers. Tangential laws with a
 displacement history (spring families, LTH, ZZYt), Walton's incrementally slipping friction (with its
 reversal state per contact) and the history-free ones run; the LAMMPS twins' force-history variants
 (mindlin/force, mindlin_rescale) do not (no deck uses them in a packing): ``resolve_laws`` says so.
@@ -21,9 +22,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from .kernels import normal_force
+from .kernels import L_LIMIT, normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
                         kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
                         turn_history, wall_arm, walton_reverses, walton_stiffness)
@@ -37,21 +39,32 @@ HIST_WIDTH, SLIP_HIST_WIDTH, WALTON_HIST_WIDTH = 3, 4, 9
 
 @njit(cache=True)
 def _cells(x, box_lo, box_hi, cell, periodic):
-    """Linked cells: (head, nxt, dims), cells at least the largest contact distance wide. A periodic axis
-    with fewer than three cells is one cell, so that no neighbour cell is visited twice."""
+    """Linked cells at least ``cell`` (the largest contact distance) wide — a periodic axis with fewer than three
+    cells is one cell, so that no neighbour cell is visited twice — as the particles sorted by cell: (dims, the
+    cell of each particle, order, first), cell c holding order[first[c]:first[c + 1]] in descending index. Cells
+    are numbered z fastest, so a column of neighbour cells is one range of ``order``."""
+    n = x.shape[0]
     dims = np.empty(3, np.int64)
     for k in range(3):
         dims[k] = max(1, int((box_hi[k] - box_lo[k]) / cell))
         if k < 2 and periodic[k] and dims[k] < 3:
             dims[k] = 1
-    ncell = dims[0] * dims[1] * dims[2]
-    head = -np.ones(ncell, np.int64)
-    nxt = -np.ones(x.shape[0], np.int64)
-    for i in range(x.shape[0]):
-        idx = _cell_index(x[i], box_lo, box_hi, dims, periodic)
-        nxt[i] = head[idx]
-        head[idx] = i
-    return head, nxt, dims
+    which = np.empty(n, np.int64)
+    first = np.zeros(dims[0] * dims[1] * dims[2] + 1, np.int64)
+    for i in range(n):
+        c0 = _cell_of(x[i, 0], box_lo[0], box_hi[0], dims[0], periodic[0])
+        c1 = _cell_of(x[i, 1], box_lo[1], box_hi[1], dims[1], periodic[1])
+        c2 = _cell_of(x[i, 2], box_lo[2], box_hi[2], dims[2], False)
+        which[i] = (c0 * dims[1] + c1) * dims[2] + c2
+        first[which[i] + 1] += 1
+    for c in range(first.shape[0] - 1):
+        first[c + 1] += first[c]
+    fill = first[1:].copy()
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        fill[which[i]] -= 1
+        order[fill[which[i]]] = i
+    return dims, which, order, first
 
 
 @njit(cache=True, inline="always")
@@ -62,118 +75,160 @@ def _cell_of(xk, lo, hi, dim, per):
     return min(dim - 1, max(0, int(s * dim)))
 
 
-@njit(cache=True)
-def _cell_index(xi, box_lo, box_hi, dims, periodic):
-    c0 = _cell_of(xi[0], box_lo[0], box_hi[0], dims[0], periodic[0])
-    c1 = _cell_of(xi[1], box_lo[1], box_hi[1], dims[1], periodic[1])
-    c2 = _cell_of(xi[2], box_lo[2], box_hi[2], dims[2], False)
-    return (c0 * dims[1] + c1) * dims[2] + c2
+@njit(cache=True, inline="always")
+def _separation(x, i, j, period):
+    """x_j − x_i, by minimum image along the periodic axes: ``period`` = (lx, ly), 0 along an axis that is not
+    periodic (a tuple, so that the force loop passes no array per pair: :func:`_law`)."""
+    return (_image(x[j, 0] - x[i, 0], period[0]), _image(x[j, 1] - x[i, 1], period[1]), x[j, 2] - x[i, 2])
 
 
 @njit(cache=True, inline="always")
-def _separation(x, i, j, box, periodic):
-    """x_j − x_i, by minimum image along the periodic axes."""
-    d0 = x[j, 0] - x[i, 0]
-    d1 = x[j, 1] - x[i, 1]
-    d2 = x[j, 2] - x[i, 2]
-    if periodic[0]:
-        d0 -= box[0] * math.floor(d0 / box[0] + 0.5)
-    if periodic[1]:
-        d1 -= box[1] * math.floor(d1 / box[1] + 0.5)
-    return d0, d1, d2
+def _image(d, length):
+    """The minimum image d − L·floor(d/L + ½) of a separation d along an axis of period L (none if L = 0).
+    Where |d| ≤ 0.49 L the floor is 0 whatever the rounding, and d is returned without the division: most
+    pairs, and the same bits."""
+    if length != 0.0 and abs(d) > 0.49 * length:
+        return d - length * math.floor(d / length + 0.5)
+    return d
+
+
+@njit(cache=True)
+def _period(box_lo, box_hi, periodic):
+    """(lx, ly) of the periodic box for :func:`_separation`, 0 along an axis that is not periodic."""
+    return (box_hi[0] - box_lo[0] if periodic[0] else 0.0, box_hi[1] - box_lo[1] if periodic[1] else 0.0)
 
 
 NB_PER_PARTICLE = 8  # the neighbour list's first capacity per particle (pairs j > i); grown when short
 
 
 @njit(cache=True)
-def _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, start, nbj):
-    """Verlet list in compressed rows: for each i, the j > i within r_i + r_j + skin (linked cells of that
-    width) in nbj[start[i]:start[i+1]]. Returns the number of entries needed; when it exceeds len(nbj) the
-    list is incomplete and the caller grows nbj and builds again."""
-    cell = 2.0 * rad.max() + skin
-    head, nxt, dims = _cells(x, box_lo, box_hi, cell, periodic)
-    box = box_hi - box_lo
+def _neighbour_rows(lo, hi, x, rad, skin, periodic, period, cells, start, nbj):
+    """Rows lo…hi−1 of the Verlet list in compressed rows — for each i, the j > i within r_i + r_j + skin —
+    from nbj[0] on (start[i]: where row i begins), as far as nbj has room; returns the entries needed (more
+    than len(nbj): the rows are incomplete, and the caller builds them again in a longer array). The neighbour
+    cells column by column, each cell's particles in descending index: the order of the linked cells this
+    replaced, which is the order in which the force loop adds up a particle's contacts."""
+    dims, which, order, first = cells
     rx = 1 if dims[0] >= 3 or not periodic[0] else 0
     ry = 1 if dims[1] >= 3 or not periodic[1] else 0
     count = 0
-    for i in range(x.shape[0]):
+    for i in range(lo, hi):
         start[i] = count
-        c0 = _cell_of(x[i, 0], box_lo[0], box_hi[0], dims[0], periodic[0])
-        c1 = _cell_of(x[i, 1], box_lo[1], box_hi[1], dims[1], periodic[1])
-        c2 = _cell_of(x[i, 2], box_lo[2], box_hi[2], dims[2], False)
+        c0 = which[i] // (dims[1] * dims[2])
+        c1 = which[i] // dims[2] % dims[1]
+        c2 = which[i] % dims[2]
         for dx in range(-rx, rx + 1):
             for dy in range(-ry, ry + 1):
-                for dz in range(-1, 2):
-                    cx, cy, cz = c0 + dx, c1 + dy, c2 + dz
-                    if cx < 0 or cx >= dims[0]:
-                        if not periodic[0]:
-                            continue
-                        cx %= dims[0]
-                    if cy < 0 or cy >= dims[1]:
-                        if not periodic[1]:
-                            continue
-                        cy %= dims[1]
-                    if cz < 0 or cz >= dims[2]:
+                cx, cy = c0 + dx, c1 + dy
+                if cx < 0 or cx >= dims[0]:
+                    if not periodic[0]:
                         continue
-                    j = head[(cx * dims[1] + cy) * dims[2] + cz]
-                    while j >= 0:
-                        if j > i:
-                            d0, d1, d2 = _separation(x, i, j, box, periodic)
-                            reach = rad[i] + rad[j] + skin
-                            if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                                if count < nbj.shape[0]:
-                                    nbj[count] = j
-                                count += 1
-                        j = nxt[j]
-    start[x.shape[0]] = count
+                    cx %= dims[0]
+                if cy < 0 or cy >= dims[1]:
+                    if not periodic[1]:
+                        continue
+                    cy %= dims[1]
+                column = (cx * dims[1] + cy) * dims[2]  # cells c2 − 1 … c2 + 1 of this column, one range
+                for k in range(first[column + max(c2 - 1, 0)], first[column + min(c2 + 1, dims[2] - 1) + 1]):
+                    j = order[k]
+                    d0, d1, d2 = _separation(x, i, j, period)
+                    reach = rad[i] + rad[j] + skin
+                    # the distance first, for every j: mostly apart, a branch predicted right (j > i is a coin)
+                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach and j > i:
+                        if count < nbj.shape[0]:
+                            nbj[count] = j
+                        count += 1
     return count
 
 
 @njit(cache=True)
-def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax):
-    """A new Verlet list, each pair's contact state (history, largest overlap) carried over from the old
-    list where the pair was already listed (as LAMMPS's fix neigh/history). Returns the new arrays."""
-    n = x.shape[0]
-    new_start = np.empty(n + 1, np.int64)
-    new_j = np.empty(max(nbj.shape[0], NB_PER_PARTICLE * n), np.int64)
-    need = _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, new_start, new_j)
-    if need > new_j.shape[0]:
-        new_j = np.empty(need + need // 4, np.int64)
-        _build_neighbours(x, rad, box_lo, box_hi, periodic, skin, new_start, new_j)
-    new_hist = np.zeros((new_j.shape[0], hist.shape[1]))
-    new_dmax = np.zeros(new_j.shape[0])
-    for i in range(n):
+def _carry_states(lo, hi, new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base):
+    """Rows lo…hi−1 of a new Verlet list take each pair's contact state (history, largest overlap) from the old
+    list where the pair was listed (as LAMMPS's fix neigh/history); the walls' states (the first ``base``
+    rows) are the caller's to copy."""
+    for i in range(lo, hi):
         for q in range(new_start[i], new_start[i + 1]):
             j = new_j[q]
             for p in range(start[i], start[i + 1]):
                 if nbj[p] == j:
-                    if dmax[p] != 0.0:
-                        new_hist[q, :] = hist[p, :]
-                        new_dmax[q] = dmax[p]
+                    if dmax[base + p] != 0.0:
+                        new_hist[base + q, :] = hist[base + p, :]
+                        new_dmax[base + q] = dmax[base + p]
                     break
+
+
+@njit(cache=True)
+def _new_states(hist, dmax, base, entries):
+    """Contact-state arrays for a new list of ``entries`` entries, the walls' rows (the first ``base``) kept."""
+    new_hist = np.zeros((base + entries, hist.shape[1]))
+    new_dmax = np.zeros(base + entries)
+    new_hist[:base] = hist[:base]
+    new_dmax[:base] = dmax[:base]
+    return new_hist, new_dmax
+
+
+@njit(cache=True)
+def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, base):
+    """A new Verlet list for positions x, each pair's contact state carried over (:func:`_carry_states`); the
+    walls' contact states (the first ``base`` rows) stay as they are. Returns the new arrays."""
+    n = x.shape[0]
+    cells = _cells(x, box_lo, box_hi, 2.0 * rad.max() + skin, periodic)
+    period = _period(box_lo, box_hi, periodic)
+    new_start = np.empty(n + 1, np.int64)
+    new_j = np.empty(max(nbj.shape[0], NB_PER_PARTICLE * n), np.int64)
+    need = _neighbour_rows(0, n, x, rad, skin, periodic, period, cells, new_start, new_j)
+    if need > new_j.shape[0]:
+        new_j = np.empty(need + need // 4, np.int64)
+        _neighbour_rows(0, n, x, rad, skin, periodic, period, cells, new_start, new_j)
+    new_start[n] = need
+    new_hist, new_dmax = _new_states(hist, dmax, base, new_j.shape[0])
+    _carry_states(0, n, new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base)
     return new_start, new_j, new_hist, new_dmax
 
 
-@njit(cache=True, inline="always")
-def _contact_force(nl, tl, delta, rate, n, vt, hist2, row, dmax_in, dt, update, ft, rot):
-    """Normal force (+ repulsive) of one contact, and its tangential force into ``ft``, updating its history
-    (row ``row`` of ``hist2``) in place by the verlet rules of kernels3d.verlet_3d: rotate-rescale, increment,
-    truncate; ``update`` False at setup, where the engines compute forces without touching histories.
-    Returns (Fn, δ_max). Inlined into the force loop with the spring family's scalar law (every deck's law):
-    a call per contact, with its dozen array arguments, cost the loop 40 % (0.80 against 0.48 ms per step on
-    the 2000-sphere packing; docs/packing.md). The laws that build arrays (kernels3d's functions) stay in
-    :func:`_other_tangential`, called."""
-    dmax = max(dmax_in, delta)
-    fn = normal_force(nl, delta, rate, dmax)
-    family = tl[T_FAMILY]
-    ft[0] = ft[1] = ft[2] = 0.0
-    if family == NONE:
-        return fn, dmax
-    if family == SPRING and update:
-        return _spring(nl, tl, delta, n, vt, hist2, row, abs(fn), dt, ft, fn, dmax, rot)
-    _other_tangential(nl, tl, delta, n, vt, hist2[row], abs(fn), dt, update, ft, rot)
-    return fn, dmax
+@njit(cache=True, parallel=True)
+def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, base, chunks):
+    """:func:`_rebuild` on threads, a share of the rows each (``chunks``): the same list and states. Each share
+    builds its rows into its own array (room: its rows' last entries and a quarter more), then they are laid end
+    to end; a share that ran out of room makes the whole rebuild the serial one."""
+    n = x.shape[0]
+    m = chunks.shape[0] - 1
+    cells = _cells(x, box_lo, box_hi, 2.0 * rad.max() + skin, periodic)
+    period = _period(box_lo, box_hi, periodic)
+    room = NB_PER_PARTICLE
+    for c in range(m):
+        room = max(room, (start[chunks[c + 1]] - start[chunks[c]]) * 5 // 4 + NB_PER_PARTICLE)
+    rows = np.empty((m, room), np.int64)
+    ends = np.empty(m, np.int64)
+    new_start = np.empty(n + 1, np.int64)
+    for c in prange(m):
+        ends[c] = _neighbour_rows(chunks[c], chunks[c + 1], x, rad, skin, periodic, period, cells, new_start, rows[c])
+    if ends.max() > room:
+        return _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, base)
+    at = np.zeros(m + 1, np.int64)
+    for c in range(m):
+        at[c + 1] = at[c] + ends[c]
+    new_j = np.empty(max(nbj.shape[0], at[m], NB_PER_PARTICLE * n), np.int64)
+    for c in prange(m):
+        for i in range(chunks[c], chunks[c + 1]):
+            new_start[i] += at[c]
+        new_j[at[c]:at[c + 1]] = rows[c, :ends[c]]
+    new_start[n] = at[m]
+    new_hist, new_dmax = _new_states(hist, dmax, base, new_j.shape[0])
+    for c in prange(m):
+        _carry_states(chunks[c], chunks[c + 1], new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base)
+    return new_start, new_j, new_hist, new_dmax
+
+
+NL_SIZE = L_LIMIT + 1  # the length of a normal law's array (kernels.py)
+
+
+@njit(cache=True)
+def _law(laws_n, laws_t, p):
+    """Law ``p``'s normal and tangential arrays as tuples. The force loop hands its laws and vectors to the
+    compiled laws by value: every array it passed (a law's row, a buffer) cost a reference count per contact
+    — atomic operations that took 80 % of the loop (docs/packing.md)."""
+    return to_fixed_tuple(laws_n[p], NL_SIZE), to_fixed_tuple(laws_t[p], T_SIZE)
 
 
 @njit(cache=True)
@@ -219,57 +274,91 @@ ZERO3 = np.zeros(3)
 
 
 @njit(cache=True, inline="always")
-def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
-    """The spring family with scalars only, for the packing solver's inner loop, by the verlet rules of
-    kernels3d (turn_history, the increment, project_history, spring_slip — as verlet_3d). A slip goes on while
-    the force exceeds μk|Fn|: where μk < μs the contact's slip state is kept in hist[row, 3]."""
+def _spring_law(nl, tl, delta, n, vt, xi0, xi1, xi2, slipping, fabs, dt, rot):
+    """The spring family with scalars only (laws and vectors as tuples), for the packing solver's inner loop,
+    by the verlet rules of kernels3d (turn_history, the increment, project_history, spring_slip — as
+    verlet_3d), from the history (xi0, xi1, xi2). A slip goes on while the force exceeds μk|Fn| (``slipping``:
+    the contact slipped at the last step; kept where μk < μs). Returns (history, force, sliding)."""
     kt = kt_of(tl, delta)
-    xi0, xi1, xi2 = turn_history(hist[row, 0], hist[row, 1], hist[row, 2], n, rot, kt, tl[T_MU_K], fabs)
+    xi0, xi1, xi2 = turn_history(xi0, xi1, xi2, n, rot, kt, tl[T_MU_K], fabs)
     xi0, xi1, xi2 = project_history(xi0 + vt[0] * dt, xi1 + vt[1] * dt, xi2 + vt[2] * dt, n, rot)
+    mu = tl[T_MU_K] if slipping else tl[T_MU_S]
+    return spring_slip(xi0, xi1, xi2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC], mu, tl[T_MU_K], fabs)
+
+
+@njit(cache=True)
+def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
+    """:func:`_spring_law` on row ``row`` of ``hist`` (updated in place; its slip state in hist[row, 3] where
+    μk < μs), the force into ``ft``: one contact's spring as the loop runs it, with array arguments (a test
+    drives the law through it). Returns (fn, dmax)."""
     two_mu = tl[T_MU_K] != tl[T_MU_S]
-    mu = tl[T_MU_K] if two_mu and hist[row, 3] != 0.0 else tl[T_MU_S]
-    xi0, xi1, xi2, ft[0], ft[1], ft[2], sliding = spring_slip(xi0, xi1, xi2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC],
-                                                           mu, tl[T_MU_K], fabs)
+    xi0, xi1, xi2, ft[0], ft[1], ft[2], sliding = _spring_law(nl, tl, delta, n, vt, hist[row, 0], hist[row, 1],
+                                                              hist[row, 2], two_mu and hist[row, 3] != 0.0, fabs,
+                                                              dt, rot)
     hist[row, 0], hist[row, 1], hist[row, 2] = xi0, xi1, xi2
     if two_mu:
         hist[row, 3] = 1.0 if sliding else 0.0
     return fn, dmax
 
 
+@njit(cache=True, inline="always")
+def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
+    """The reaction on particle j of a pair's force (f0, f1, f2) on i, and its torque b (t0, t1, t2)."""
+    f[j, 0] -= f0
+    f[j, 1] -= f1
+    f[j, 2] -= f2
+    tq[j, 0] += b * t0
+    tq[j, 1] += b * t1
+    tq[j, 2] += b * t2
+
+
 @njit(cache=True)
-def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
-            hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, update, rules):
-    """Forces and torques of every contact; contact records (i, j, δ, Fn, |Ft|) into ``contacts``. A pair's
-    contact state (history, largest overlap) lives beside it in the Verlet list (``hist``, ``dmax``), a
-    particle–wall contact's in row i·n_walls + k of ``w_hist``, ``w_dmax``; a contact that has ended is
-    forgotten (its state zeroed) when next seen apart."""
-    n_p = x.shape[0]
+def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
+                    hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules):
+    """Forces and torques of the contacts of particles lo…hi−1 (their pairs in the Verlet list, j > i, and
+    their walls), added into ``f`` and ``tq`` — for a particle j ≥ hi into ``f_far`` and ``tq_far`` instead (the
+    same arrays when lo…hi−1 are all the rows). A contact's state (history, largest overlap) is row r of
+    ``hist``, ``dmax``: particle i's with wall k at i·n_walls + k, a listed pair's beside it, at n·n_walls + its
+    list entry; a contact that has ended is forgotten (its state zeroed) when next seen apart. Laws: row
+    si·n_species + sj of ``laws_n``/``laws_t`` for a pair of species si, sj, row n_species² + si for the walls.
+    ``records`` (one row per list entry, or none): each touching pair's (δ, Fn, |Ft|).
+
+    A row's contacts are computed, and their states updated, by whoever computes the row: the rows lo…hi−1 may
+    be one thread's share, writing f and tq only for its own particles, its far buffers for the others'
+    (:func:`run_threaded`)."""
     n_w = walls.shape[0]
-    f[:, :] = 0.0
-    tq[:, :] = 0.0
-    nbuf = np.empty(3)
+    base = x.shape[0] * n_w
+    nbuf = np.empty(3)  # the laws that take arrays (all but the updated spring family)
     vtbuf = np.empty(3)
-    ft = np.empty(3)
+    ftbuf = np.empty(3)
     rot = rules[R_ROTATION]
-    box = box_hi - box_lo
-    nc = 0
-    nl, tl, law_i, law_j = laws_n[0, 0], laws_t[0, 0], 0, 0
-    wnl, wtl, wall_i = wall_n[0], wall_t[0], 0
-    for i in range(n_p):
-        for q in range(start[i], start[i + 1]):
-            j = nbj[q]
-            d0, d1, d2 = _separation(x, i, j, box, periodic)  # scalars: no allocation on the hot path
-            touch = rad[i] + rad[j]
-            dist2 = d0 * d0 + d1 * d1 + d2 * d2
-            if dist2 < touch * touch:
+    slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
+    torque_radius = rules[R_TORQUE_ARM] == ARM_RADIUS
+    record = records.shape[0] > 0
+    law = 0
+    nl, tl = _law(laws_n, laws_t, law)
+    for i in range(lo, hi):
+        end = start[i + 1]
+        for e in range(start[i], end + n_w):
+            if e < end:  # the listed pair (i, j)
+                j = nbj[e]
+                r = base + e
+                d0, d1, d2 = _separation(x, i, j, period)  # scalars: no allocation on the hot path
+                touch = rad[i] + rad[j]
+                dist2 = d0 * d0 + d1 * d1 + d2 * d2
+                if not dist2 < touch * touch:
+                    if dmax[r] != 0.0:  # the contact has ended: forget it
+                        dmax[r] = 0.0
+                        hist[r, :] = 0.0
+                    continue
                 dist = math.sqrt(dist2)
                 delta = touch - dist
                 n0, n1, n2 = d0 / dist, d1 / dist, d2 / dist
                 # lever arms by rule (kernels3d): the contact point R − δ/2, or the full radius
-                ai = rad[i] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
-                aj = rad[j] if rules[R_SLIP_ARM] == ARM_RADIUS else rad[j] - 0.5 * delta
-                bi = rad[i] if rules[R_TORQUE_ARM] == ARM_RADIUS else rad[i] - 0.5 * delta
-                bj = rad[j] if rules[R_TORQUE_ARM] == ARM_RADIUS else rad[j] - 0.5 * delta
+                ai = rad[i] if slip_radius else rad[i] - 0.5 * delta
+                aj = rad[j] if slip_radius else rad[j] - 0.5 * delta
+                bi = rad[i] if torque_radius else rad[i] - 0.5 * delta
+                bj = rad[j] if torque_radius else rad[j] - 0.5 * delta
                 vr0, vr1, vr2 = v[i, 0] - v[j, 0], v[i, 1] - v[j, 1], v[i, 2] - v[j, 2]
                 rate = vr0 * n0 + vr1 * n1 + vr2 * n2
                 # ω_i × (a_i n) + ω_j × (a_j n)
@@ -279,138 +368,305 @@ def _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo
                 u0 = vr0 + o1 * n2 - o2 * n1
                 u1 = vr1 + o2 * n0 - o0 * n2
                 u2 = vr2 + o0 * n1 - o1 * n0
-                vn = u0 * n0 + u1 * n1 + u2 * n2
-                nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
-                vtbuf[0], vtbuf[1], vtbuf[2] = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-                si, sj = species[i], species[j]
-                if si != law_i or sj != law_j:  # a new species pair: its law views (once, not per contact)
-                    nl, tl = laws_n[si, sj], laws_t[si, sj]
-                    law_i, law_j = si, sj
-                fn, dm = _contact_force(nl, tl, delta, rate, nbuf, vtbuf, hist, q, dmax[q], dt, update, ft, rot)
-                dmax[q] = dm
-                f0, f1, f2 = -fn * n0 + ft[0], -fn * n1 + ft[1], -fn * n2 + ft[2]
-                f[i, 0] += f0
-                f[i, 1] += f1
-                f[i, 2] += f2
-                f[j, 0] -= f0
-                f[j, 1] -= f1
-                f[j, 2] -= f2
-                # torques (a n) × F_t
-                t0 = n1 * ft[2] - n2 * ft[1]
-                t1 = n2 * ft[0] - n0 * ft[2]
-                t2 = n0 * ft[1] - n1 * ft[0]
-                tq[i, 0] += bi * t0
-                tq[i, 1] += bi * t1
-                tq[i, 2] += bi * t2
-                tq[j, 0] += bj * t0
-                tq[j, 1] += bj * t1
-                tq[j, 2] += bj * t2
-                if nc < contacts.shape[0]:
-                    contacts[nc, 0], contacts[nc, 1] = i, j
-                    contacts[nc, 2], contacts[nc, 3] = delta, fn
-                    contacts[nc, 4] = math.sqrt(ft[0] ** 2 + ft[1] ** 2 + ft[2] ** 2)
-                nc += 1
-            elif dmax[q] != 0.0:  # the contact has ended: forget it
-                dmax[q] = 0.0
-                hist[q, :] = 0.0
-        # walls: plane through p with normal nw into the domain
-        for k in range(walls.shape[0]):
-            dist = (x[i, 0] - walls[k, 0]) * walls[k, 3] + (x[i, 1] - walls[k, 1]) * walls[k, 4] \
-                + (x[i, 2] - walls[k, 2]) * walls[k, 5]
-            delta = rad[i] - dist
-            if delta > 0.0:
+                p = species[i] * n_species + species[j]
+            else:  # wall k: a plane through p with normal nw into the domain
+                k = e - end
+                j, bj = -1, 0.0
+                r = i * n_w + k
+                delta = rad[i] - ((x[i, 0] - walls[k, 0]) * walls[k, 3] + (x[i, 1] - walls[k, 1]) * walls[k, 4]
+                                  + (x[i, 2] - walls[k, 2]) * walls[k, 5])
+                if not delta > 0.0:
+                    if dmax[r] != 0.0:
+                        dmax[r] = 0.0
+                        hist[r, :] = 0.0
+                    continue
                 n0, n1, n2 = -walls[k, 3], -walls[k, 4], -walls[k, 5]  # from the particle into the wall
                 ai = wall_arm(rules[R_WALL_SLIP_ARM], rad[i], delta)
                 bi = wall_arm(rules[R_WALL_TORQUE_ARM], rad[i], delta)
                 rate = v[i, 0] * n0 + v[i, 1] * n1 + v[i, 2] * n2
-                # the contact point's velocity v + ω × (a n), scalars: no allocation on the hot path
+                # the contact point's velocity v + ω × (a n)
                 u0 = v[i, 0] + ai * (w[i, 1] * n2 - w[i, 2] * n1)
                 u1 = v[i, 1] + ai * (w[i, 2] * n0 - w[i, 0] * n2)
                 u2 = v[i, 2] + ai * (w[i, 0] * n1 - w[i, 1] * n0)
-                vn = u0 * n0 + u1 * n1 + u2 * n2
+                p = n_species * n_species + species[i]
+            vn = u0 * n0 + u1 * n1 + u2 * n2
+            vt0, vt1, vt2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+            if p != law:  # another law: its tuples (once per change, not per contact)
+                nl, tl = _law(laws_n, laws_t, p)
+                law = p
+            dm = max(dmax[r], delta)
+            dmax[r] = dm
+            fn = normal_force(nl, delta, rate, dm)
+            family = tl[T_FAMILY]
+            if family == SPRING and update:  # every deck's law: scalars only
+                two_mu = tl[T_MU_K] != tl[T_MU_S]
+                xi0, xi1, xi2, ft0, ft1, ft2, sliding = _spring_law(nl, tl, delta, (n0, n1, n2), (vt0, vt1, vt2),
+                                                                    hist[r, 0], hist[r, 1], hist[r, 2],
+                                                                    two_mu and hist[r, 3] != 0.0, abs(fn), dt, rot)
+                hist[r, 0], hist[r, 1], hist[r, 2] = xi0, xi1, xi2
+                if two_mu:
+                    hist[r, 3] = 1.0 if sliding else 0.0
+            elif family == NONE:
+                ft0 = ft1 = ft2 = 0.0
+            else:
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
-                vtbuf[0], vtbuf[1], vtbuf[2] = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-                row = i * n_w + k
-                if species[i] != wall_i:
-                    wnl, wtl = wall_n[species[i]], wall_t[species[i]]
-                    wall_i = species[i]
-                fn, dm = _contact_force(wnl, wtl, delta, rate, nbuf, vtbuf, w_hist, row, w_dmax[row], dt, update, ft,
-                                        rot)
-                w_dmax[row] = dm
-                f[i, 0] += -fn * n0 + ft[0]
-                f[i, 1] += -fn * n1 + ft[1]
-                f[i, 2] += -fn * n2 + ft[2]
-                # torque (b n) × F_t
-                tq[i, 0] += bi * (n1 * ft[2] - n2 * ft[1])
-                tq[i, 1] += bi * (n2 * ft[0] - n0 * ft[2])
-                tq[i, 2] += bi * (n0 * ft[1] - n1 * ft[0])
-            elif w_dmax[i * n_w + k] != 0.0:
-                w_dmax[i * n_w + k] = 0.0
-                w_hist[i * n_w + k, :] = 0.0
-    nc_out[0] = nc
+                vtbuf[0], vtbuf[1], vtbuf[2] = vt0, vt1, vt2
+                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r], abs(fn), dt, update, ftbuf, rot)
+                ft0, ft1, ft2 = ftbuf[0], ftbuf[1], ftbuf[2]
+            f0, f1, f2 = -fn * n0 + ft0, -fn * n1 + ft1, -fn * n2 + ft2
+            # torques (b n) × F_t
+            t0 = n1 * ft2 - n2 * ft1
+            t1 = n2 * ft0 - n0 * ft2
+            t2 = n0 * ft1 - n1 * ft0
+            f[i, 0] += f0
+            f[i, 1] += f1
+            f[i, 2] += f2
+            tq[i, 0] += bi * t0
+            tq[i, 1] += bi * t1
+            tq[i, 2] += bi * t2
+            if j >= 0:
+                if j < hi:
+                    _react(f, tq, j, f0, f1, f2, bj, t0, t1, t2)
+                else:  # another share's particle
+                    _react(f_far, tq_far, j, f0, f1, f2, bj, t0, t1, t2)
+                if record:
+                    records[e, 0], records[e, 1] = delta, fn
+                    records[e, 2] = math.sqrt(ft0 ** 2 + ft1 ** 2 + ft2 ** 2)
+
+
+@njit(cache=True)
+def _new_records(start):
+    """One record row per list entry, δ = −1 until the entry is seen touching."""
+    return np.full((start[start.shape[0] - 1], 3), -1.0)
+
+
+@njit(cache=True)
+def _contact_table(start, nbj, records, contacts):
+    """The touching pairs' records as rows (i, j, δ, Fn, |Ft|) of ``contacts``, in list order (as many as fit);
+    returns their number."""
+    nc = 0
+    for i in range(start.shape[0] - 1):
+        for e in range(start[i], start[i + 1]):
+            if records[e, 0] >= 0.0:
+                if nc < contacts.shape[0]:
+                    contacts[nc, 0], contacts[nc, 1] = i, nbj[e]
+                    contacts[nc, 2], contacts[nc, 3], contacts[nc, 4] = records[e, 0], records[e, 1], records[e, 2]
+                nc += 1
+    return nc
+
+
+@njit(cache=True, inline="always")
+def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref):
+    """The first half kick and the drift of particles lo…hi−1, wrapped into the periodic box; returns the
+    largest squared displacement since the last rebuild."""
+    moved = 0.0
+    for i in range(lo, hi):
+        for k in range(3):
+            v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
+            x[i, k] += dt * v[i, k]
+            w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
+        for k in range(2):
+            if periodic[k]:
+                L = box_hi[k] - box_lo[k]
+                if x[i, k] < box_lo[k]:
+                    x[i, k] += L
+                elif x[i, k] >= box_hi[k]:
+                    x[i, k] -= L
+        dd = (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
+        if dd > moved:
+            moved = dd
+    return moved
+
+
+@njit(cache=True, inline="always")
+def _kick(lo, hi, v, w, f, tq, mass, inertia, gravity, dt):
+    """The second half kick of particles lo…hi−1; returns their translational and rotational kinetic energy."""
+    e = 0.0
+    e_rot = 0.0
+    for i in range(lo, hi):
+        for k in range(3):
+            v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
+            w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
+        e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+        e_rot += 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
+    return e, e_rot
+
+
+@njit(cache=True)
+def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps,
+           ke_every, start, nbj, hist, dmax, rules):
+    """What a run starts from: a new Verlet list (its pair states carried over) and the forces of the initial
+    state, computed without touching histories (as the engines do). Returns (inertia, period, skin, the kinetic
+    energy series and the flags to fill, the positions at the rebuild, f, tq, the list and its states, the
+    contact records)."""
+    n_p = x.shape[0]
+    skin = 0.3 * rad.max()
+    start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
+                                      n_p * walls.shape[0])
+    f = np.zeros((n_p, 3))
+    tq = np.zeros((n_p, 3))
+    period = _period(box_lo, box_hi, periodic)
+    records = _new_records(start) if steps == 0 else np.zeros((0, 3))  # records at the last step only
+    _contact_forces(0, n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj, hist, dmax,
+                    f, tq, f, tq, records, dt, False, rules)
+    return (0.4 * mass * rad * rad, period, skin, np.zeros(steps // ke_every + 1), np.zeros(2, np.int64), x.copy(),
+            f, tq, start, nbj, hist, dmax, records)
+
+
+@njit(cache=True, inline="always")
+def _energy(ke, flags, step, ke_every, e, e_rot):
+    """Keeps the translational kinetic energy e every ke_every steps; False, flagged, once e + e_rot is not
+    finite (the run stops)."""
+    if step % ke_every == 0:
+        ke[step // ke_every] = e
+    if math.isfinite(e + e_rot):
+        return True
+    flags[1] = 1
+    return False
 
 
 @njit(cache=True, nogil=True)
-def run(x, v, w, rad, mass, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, gravity,
-        dt, steps, ke_every, start, nbj, hist, dmax, w_hist, w_dmax, contacts, rules):
-    """Velocity Verlet for ``steps`` steps from the given state (x, v, w, the wall contact states modified in
-    place; the pair contact states travel with the Verlet list, rebuilt here). Returns (translational kinetic
-    energy every ke_every steps, number of pair contacts at the end, flags [unused, non-finite], and the
-    Verlet list with its pair states: start, nbj, hist, dmax). The kinetic energy is translational, as the
-    engines' thermo `ke`: these laws have no rolling or twisting resistance, so a sphere rolling or spinning
-    about its contact normal keeps its rotational energy in every source."""
+def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt, steps,
+        ke_every, start, nbj, hist, dmax, contacts, rules):
+    """Velocity Verlet for ``steps`` steps from the given state (x, v, w modified in place; the contact states
+    travel with the Verlet list, rebuilt here, the walls' first). Returns (translational kinetic energy every
+    ke_every steps, number of pair contacts at the end (their records in ``contacts``), flags [unused,
+    non-finite], and the Verlet list with its contact states: start, nbj, hist, dmax). The kinetic energy is
+    translational, as the engines' thermo `ke`: these laws have no rolling or twisting resistance, so a
+    sphere rolling or spinning about its contact normal keeps its rotational energy in every source. One
+    thread; :func:`run_threaded` is the same on several."""
     n_p = x.shape[0]
-    inertia = 0.4 * mass * rad * rad
-    f = np.zeros((n_p, 3))
-    tq = np.zeros((n_p, 3))
-    nc_out = np.zeros(2, np.int64)
-    skin = 0.3 * rad.max()
-    x_ref = x.copy()
-    ke = np.zeros(steps // ke_every + 1)
-    flags = np.zeros(2, np.int64)
-    start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax)
-    # setup: forces of the initial state without touching histories (as the engines do)
-    _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
-            hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, False, rules)
+    inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
+        x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
+        start, nbj, hist, dmax, rules)
     for step in range(1, steps + 1):
-        for i in range(n_p):
-            for k in range(3):
-                v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
-                x[i, k] += dt * v[i, k]
-                w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
-        for i in range(n_p):  # periodic wrap of positions
-            for k in range(2):
-                if periodic[k]:
-                    L = box_hi[k] - box_lo[k]
-                    if x[i, k] < box_lo[k]:
-                        x[i, k] += L
-                    elif x[i, k] >= box_hi[k]:
-                        x[i, k] -= L
+        moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
         # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
-        moved = 0.0
-        for i in range(n_p):
-            dd = (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
-            if dd > moved:
-                moved = dd
         if moved > (0.5 * skin) ** 2:
-            start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax)
+            start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
+                                              n_p * walls.shape[0])
             x_ref[:, :] = x
-        _forces(x, v, w, rad, species, laws_n, laws_t, wall_n, wall_t, walls, box_lo, box_hi, periodic, start, nbj,
-                hist, dmax, w_hist, w_dmax, f, tq, contacts, nc_out, dt, True, rules)
-        e = 0.0  # translational, as the engines' thermo `ke`
-        e_rot = 0.0
-        for i in range(n_p):
-            for k in range(3):
-                v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
-                w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
-            e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-            e_rot += 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
-        if step % ke_every == 0:
-            ke[step // ke_every] = e
-        if not math.isfinite(e + e_rot):
-            flags[1] = 1
+        if step == steps:
+            records = _new_records(start)
+        f[:, :] = 0.0
+        tq[:, :] = 0.0
+        _contact_forces(0, n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj, hist,
+                        dmax, f, tq, f, tq, records, dt, True, rules)
+        e, e_rot = _kick(0, n_p, v, w, f, tq, mass, inertia, gravity, dt)
+        if not _energy(ke, flags, step, ke_every, e, e_rot):
             break
-    return ke, nc_out[0], flags, start, nbj, hist, dmax
+    return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
+
+
+CONTACT_COST = 8  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
+
+
+@njit(cache=True)
+def _balance(start, n_walls, dmax, chunks):
+    """Row bounds ``chunks`` (len = shares + 1) that give each share about the same work: each row costs one,
+    each of its list entries and walls one more, and each contact (a nonzero largest overlap) CONTACT_COST
+    more — the contacts of a pour gather in the bed while the rows above are falling apart."""
+    n = start.shape[0] - 1
+    m = chunks.shape[0] - 1
+    base = n * n_walls
+    cost = np.empty(n + 1)
+    cost[0] = 0.0
+    for i in range(n):
+        c = 1.0 + n_walls + (start[i + 1] - start[i])
+        for k in range(n_walls):
+            if dmax[i * n_walls + k] != 0.0:
+                c += CONTACT_COST
+        for e in range(start[i], start[i + 1]):
+            if dmax[base + e] != 0.0:
+                c += CONTACT_COST
+        cost[i + 1] = cost[i] + c
+    chunks[0] = 0
+    i = 0
+    for c in range(1, m):
+        while i < n and cost[i] * m < cost[n] * c:
+            i += 1
+        chunks[c] = i
+    chunks[m] = n
+
+
+@njit(cache=True, inline="always")
+def _zero_rows(a, lo, hi):
+    for i in range(lo, hi):
+        a[i, 0] = a[i, 1] = a[i, 2] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _gather(lo, hi, share, f_far, tq_far, f, tq):
+    """Into f and tq of particles lo…hi−1 (share ``share``'s), what the shares before it added for them into
+    their far buffers; each row read is zeroed for the next step."""
+    for c in range(share):
+        for i in range(lo, hi):
+            for k in range(3):
+                f[i, k] += f_far[c, i, k]
+                tq[i, k] += tq_far[c, i, k]
+                f_far[c, i, k] = tq_far[c, i, k] = 0.0
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt,
+                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, threads):
+    """:func:`run` on ``threads`` threads (numba's, prange). The particles, and with them the rows of the
+    Verlet list, are cut into as many shares of about equal work (:func:`_balance`, again at each rebuild, which
+    is threaded too). A share's contacts are computed by one thread, which alone updates their states (a pair's
+    sits beside its entry, a wall contact's in its particle's row) and writes the forces and torques of its own
+    particles; what it adds for another share's particle (a pair across the cut, j > i) goes into its far
+    buffer, which that share's thread adds in after the loop (:func:`_gather`) and then kicks and drifts its
+    particles. Race-free, and no locks: two parallel regions a step. The same arithmetic per contact as
+    :func:`run`: with one thread the same bits; with more, a particle's force is summed in another order
+    (round-off)."""
+    n_p = x.shape[0]
+    n_w = walls.shape[0]
+    inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
+        x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
+        start, nbj, hist, dmax, rules)
+    chunks = np.empty(threads + 1, np.int64)  # each share's rows of the list, and its particles
+    _balance(start, n_w, dmax, chunks)
+    f_far = np.zeros((threads, n_p, 3))  # per share: what it adds for particles of the shares after it
+    tq_far = np.zeros((threads, n_p, 3))
+    moved = np.zeros(threads)
+    e_share = np.zeros(threads)
+    e_rot_share = np.zeros(threads)
+    # two parallel regions a step, the fewest velocity Verlet allows (a region's launch and its barrier are the
+    # threads' overhead): the forces, then the second half kick fused with the next step's first and its drift
+    if steps > 0:
+        for b in prange(threads):
+            moved[b] = _kick_drift(chunks[b], chunks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
+                                   box_hi, periodic, x_ref)
+    for step in range(1, steps + 1):
+        most = 0.0
+        for b in range(threads):
+            most = max(most, moved[b])
+        if most > (0.5 * skin) ** 2:
+            start, nbj, hist, dmax = _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist,
+                                                       dmax, n_p * n_w, chunks)
+            x_ref[:, :] = x
+            _balance(start, n_w, dmax, chunks)
+        if step == steps:
+            records = _new_records(start)
+        for c in prange(threads):
+            _zero_rows(f, chunks[c], chunks[c + 1])
+            _zero_rows(tq, chunks[c], chunks[c + 1])
+            _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
+                            start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, True, rules)
+        for b in prange(threads):
+            _gather(chunks[b], chunks[b + 1], b, f_far, tq_far, f, tq)
+            e_share[b], e_rot_share[b] = _kick(chunks[b], chunks[b + 1], v, w, f, tq, mass, inertia, gravity, dt)
+            if step < steps:
+                moved[b] = _kick_drift(chunks[b], chunks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
+                                       box_hi, periodic, x_ref)
+        e = 0.0
+        e_rot = 0.0
+        for b in range(threads):
+            e += e_share[b]
+            e_rot += e_rot_share[b]
+        if not _energy(ke, flags, step, ke_every, e, e_rot):
+            break
+    return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
 
 
 # ----------------------------------------------------------------------------- Python side
@@ -503,14 +759,12 @@ class PackState:
         walton = any_law(lambda t: t[..., T_FAMILY] == WALTON)
         two_mu = any_law(lambda t: (t[..., T_FAMILY] == SPRING) & (t[..., T_MU_K] != t[..., T_MU_S]))
         width = WALTON_HIST_WIDTH if walton else SLIP_HIST_WIDTH if two_mu else HIST_WIDTH
-        # the Verlet list (compressed rows) and, beside each listed pair, its contact state; built by run()
+        # the contact states (history, largest overlap): particle i's with wall k in row i·n_walls + k, then
+        # each pair of the Verlet list (compressed rows; built by run()) beside its entry
         self.start = np.zeros(n + 1, np.int64)
         self.nbj = np.zeros(0, np.int64)
-        self.hist = np.zeros((0, width))
-        self.dmax = np.zeros(0)
-        # particle–wall contact states: row i·n_walls + k
-        self.w_hist = np.zeros((n * len(case.walls), width))
-        self.w_dmax = np.zeros(n * len(case.walls))
+        self.hist = np.zeros((n * len(case.walls), width))
+        self.dmax = np.zeros(n * len(case.walls))
         self.contacts = np.zeros((8 * n + 16, 5))
         self.n_contacts = 0
         self.time = 0.0
@@ -532,34 +786,87 @@ def box_of(case, x, rad):
     return lo, hi, np.array([False, False])
 
 
+def law_table(laws_n, laws_t, wall_n, wall_t):
+    """resolve_laws's laws as the kernels take them: one row per species pair (si·n_species + sj), then one
+    per species against the walls (n_species² + si), normal and tangential."""
+    ns = laws_n.shape[0]
+    return (np.concatenate([laws_n.reshape(ns * ns, -1), wall_n]),
+            np.concatenate([laws_t.reshape(ns * ns, -1), wall_t]))
+
+
+def check_threads(threads) -> int:
+    """``threads`` as a number of threads for the packing loop: a whole number from 1 to numba's threads
+    (NUMBA_NUM_THREADS, by default the machine's cores); anything else is a ConfigError."""
+    import numba
+
+    from ..errors import ConfigError
+
+    most = numba.config.NUMBA_NUM_THREADS
+    if isinstance(threads, (bool, np.bool_)) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= most:
+        raise ConfigError("--threads", threads, f"must be a whole number from 1 to {most}, the threads numba may "
+                          "use here (NUMBA_NUM_THREADS)")
+    return int(threads)
+
+
+def _prefer_openmp():
+    """numba's threading layer for the threaded loop: OpenMP first, then its own work queue, TBB last, unless the
+    user chose (NUMBA_THREADING_LAYER or NUMBA_THREADING_LAYER_PRIORITY). The loop launches two parallel regions
+    per step; numba's TBB layer builds a task arena per launch: measured, 0.27 ms a launch, growing to 3.7 ms within
+    a minute (its memory too), against tens of microseconds for OpenMP under the same load (docs/packing.md). The
+    layer is chosen once per process, at the first parallel launch or compilation: this runs before the kernel's."""
+    import os
+
+    import numba
+
+    if "NUMBA_THREADING_LAYER" not in os.environ and "NUMBA_THREADING_LAYER_PRIORITY" not in os.environ:
+        numba.config.THREADING_LAYER_PRIORITY = ["omp", "workqueue", "tbb"]
+
+
 def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = None, laws=None, walls=None,
-            gravity=None, ke_every: int | None = None):
+            gravity=None, ke_every: int | None = None, threads: int = 1):
     """``steps`` velocity-Verlet steps of the packing state ``st`` (updated): (kinetic energy every ke_every
-    steps, number of pair contacts, flags [unused, non-finite])."""
+    steps, number of pair contacts, flags [unused, non-finite]). ``threads``: 1 runs :func:`run`, more
+    :func:`run_threaded` on that many of numba's threads."""
+    import numba
+
     from .collision3d import rules_array
 
+    threads = check_threads(threads)
     sp, laws_n, laws_t, wall_n, wall_t = laws or resolve_laws(case)
     if walls is None:
         walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
     g = np.asarray(case.run.gravity if gravity is None else gravity, float)
     lo, hi, periodic = box_of(case, st.x, st.rad)
-    ke, nc, flags, st.start, st.nbj, st.hist, st.dmax = run(
-        st.x, st.v, st.w, st.rad, st.mass, sp, laws_n, laws_t, wall_n, wall_t, walls, lo, hi, periodic, g, dt, steps,
-        ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax, st.w_hist, st.w_dmax, st.contacts,
-        rules_array(rules))
+    args = (st.x, st.v, st.w, st.rad, st.mass, sp, laws_n.shape[0], *law_table(laws_n, laws_t, wall_n, wall_t), walls,
+            lo, hi, periodic, g, dt, steps, ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax,
+            st.contacts, rules_array(rules))
+    if threads == 1:
+        out = run(*args)
+    else:
+        _prefer_openmp()
+        before = numba.get_num_threads()  # numba's thread count is the calling thread's own
+        numba.set_num_threads(threads)
+        try:
+            out = run_threaded(*args, threads)
+        finally:
+            numba.set_num_threads(before)
+    ke, nc, flags, st.start, st.nbj, st.hist, st.dmax = out
     return ke, nc, flags
 
 
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 0.0,
-             chunk: int = 2000, state: PackState | None = None, rules: dict | None = None) -> PackState:
+             chunk: int = 2000, state: PackState | None = None, rules: dict | None = None,
+             threads: int = 1) -> PackState:
     """Run the packing for ``duration`` (s; default the case's packing.duration) — `pack` and `verify` alike, as
     the engines do: an early stop where the kinetic energy dips (``rest`` × N m g R, off by default) can fall on a
     turning point of a layer bouncing in phase, not on a settled state; dt and the number of steps are case.packing_run's (a run
     past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
-    default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin."""
+    default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin. ``threads``: the force
+    loop's threads (default 1: the same bits on every run; more, the same to round-off — docs/packing.md)."""
     from ..case import packing_run
     from ..errors import ConfigError
 
+    threads = check_threads(threads)
     dt, duration, total = packing_run(case, duration, dt)  # dt and steps, bounded, as every engine's deck
     sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
     st = state or PackState(case)
@@ -570,7 +877,7 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
     while done < total:
         n_steps = min(chunk, total - done)
         ke, nc, flags = advance(case, st, dt, n_steps, rules, laws=(sp, laws_n, laws_t, wall_n, wall_t),
-                                walls=walls, gravity=g)
+                                walls=walls, gravity=g, threads=threads)
         if flags[1]:
             raise ConfigError("run.dt", dt, "the packing became non-finite: the time step is too large")
         for k, e in enumerate(ke[1:], start=1):

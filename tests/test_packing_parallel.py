@@ -1,0 +1,167 @@
+"""The packing loop on several threads (issue 16, item 4): numba threads over shares of the particles and of the
+Verlet list's rows, race-free — a contact's state is updated only by the thread that owns its row, a thread writes
+the forces of its own particles and puts what it adds for another share's particle into its own buffer, summed
+after the loop (reference/packing.py, run_threaded). What the threads compute is tested here; how fast they are,
+only in benchmarks/bench_packing.py."""
+
+import copy
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+
+from demcheck import case as C
+from demcheck.errors import ConfigError
+from demcheck.reference import packing as P
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+two_threads = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="numba has one thread here")
+
+
+def _states_equal(a, b):
+    for name in ("x", "v", "w", "hist", "dmax", "start"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    np.testing.assert_array_equal(a.nbj[:a.start[-1]], b.nbj[:b.start[-1]])  # the list's entries (then spare room)
+    assert a.n_contacts == b.n_contacts
+    np.testing.assert_array_equal(a.contacts[:a.n_contacts], b.contacts[:b.n_contacts])
+    assert a.ke == b.ke
+
+
+def test_one_thread_of_the_threaded_loop_is_the_serial_loop_bit_for_bit(monkeypatch):
+    """The threaded kernel on one thread (one share: no far buffer, the threaded rebuild, the second half kick
+    fused with the next step's first) computes what the serial kernel does, in the same order: the same bits, on
+    a polydisperse pour (three species: six pair laws and three wall laws) through its first collisions, with
+    the contact records of the last step."""
+    case = C.load(CASES / "optin" / "poured-small-poly.toml")
+    serial = P.simulate(case, duration=0.04)
+    P._prefer_openmp()  # as advance() does before a threaded run
+    monkeypatch.setattr(P, "run", lambda *args: P.run_threaded(*args, 1))
+    threaded = P.simulate(case, duration=0.04)
+    assert serial.n_contacts > 20
+    _states_equal(serial, threaded)
+
+
+@two_threads
+def test_two_threads_meet_one_to_round_off_over_a_short_horizon_of_a_pour():
+    """Two threads against one on the same pour. A particle's force is summed in another order (its own share's
+    contacts, then what the share before it added), which changes the last bits, and a pour is chaotic:
+    collisions amplify a difference by orders of magnitude every few milliseconds (measured on this packing:
+    1e-16 of the speeds at 0.02 s, 1e-12 at 0.025 s, 1e-7 m in position at 0.05 s). So the comparison is over a
+    short horizon, the first 0.025 s (31 contacts, the first collisions with the floor and between spheres),
+    where the difference measured 3e-12 of the forces and 4e-12 of the spins; the bound, 1e-8 of each
+    quantity's largest value, leaves room for another machine's round-off and is far below anything physical.
+    (On a settled bed, where chaos has nothing to amplify, two threads stayed within 5e-11 of one in the forces
+    over 0.1 s: docs/packing.md.)"""
+    case = C.load(CASES / "optin" / "poured-small.toml")
+    before = numba.get_num_threads()
+    one = P.simulate(case, duration=0.025, threads=1)
+    two = P.simulate(case, duration=0.025, threads=2)
+    assert numba.get_num_threads() == before  # the thread count is set for the run only
+    nc = one.n_contacts
+    assert nc > 20 and two.n_contacts == nc
+    # contacts among the first and the last particles: both shares hold contacts
+    assert one.contacts[:nc, 0].min() < 75 <= one.contacts[:nc, 0].max()
+    np.testing.assert_array_equal(one.contacts[:nc, :2], two.contacts[:nc, :2])  # the same pairs touch
+    tol = 1e-8
+    for col, name in ((2, "overlap"), (3, "Fn"), (4, "|Ft|")):
+        a, b = one.contacts[:nc, col], two.contacts[:nc, col]
+        np.testing.assert_allclose(b, a, rtol=0, atol=tol * np.abs(a).max(), err_msg=name)
+    for name in ("x", "v", "w"):
+        a, b = getattr(one, name), getattr(two, name)
+        np.testing.assert_allclose(b, a, rtol=0, atol=tol * np.abs(a).max(), err_msg=name)
+
+
+@two_threads
+def test_a_run_on_two_threads_continues_a_state_like_one():
+    """advance() on threads carries the state as on one: the Verlet list, its contact states (walls first, then
+    each pair beside its entry) and the contact records. Two threads then one on the same state against one
+    then one, on the first collisions of a polydisperse pour."""
+    case = C.load(CASES / "optin" / "poured-small-poly.toml")
+    start = P.simulate(case, duration=0.03)
+    a, b = copy.deepcopy(start), copy.deepcopy(start)
+    P.simulate(case, duration=0.005, state=a, threads=2)
+    P.simulate(case, duration=0.005, state=a, threads=1)
+    P.simulate(case, duration=0.005, state=b, threads=1)
+    P.simulate(case, duration=0.005, state=b, threads=1)
+    assert a.n_contacts == b.n_contacts > 10
+    np.testing.assert_array_equal(a.start, b.start)
+    np.testing.assert_array_equal(a.nbj[:a.start[-1]], b.nbj[:b.start[-1]])
+    for name in ("x", "v", "w", "hist", "dmax"):
+        u, w = getattr(a, name), getattr(b, name)
+        np.testing.assert_allclose(u, w, rtol=0, atol=1e-8 * np.abs(w).max(), err_msg=name)
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, "2", True, None, numba.config.NUMBA_NUM_THREADS + 1])
+def test_a_bad_number_of_threads_is_one_clear_line_before_anything_runs(threads):
+    case = C.load(CASES / "packing" / "column-lsd.toml")
+    st = P.PackState(case)
+    x = st.x.copy()
+    with pytest.raises(ConfigError) as info:
+        P.simulate(case, state=st, threads=threads)
+    message = str(info.value)
+    assert info.value.exit_code == 2 and "\n" not in message
+    assert message.startswith("--threads = ")
+    assert f"must be a whole number from 1 to {numba.config.NUMBA_NUM_THREADS}" in message
+    np.testing.assert_array_equal(st.x, x)  # refused before any step
+    with pytest.raises(ConfigError):
+        P.advance(case, st, 1e-6, 10, threads=threads)
+
+
+def test_numba_num_threads_bounds_the_threads():
+    """NUMBA_NUM_THREADS is the most threads a run may ask for (numba cannot start more)."""
+    script = ("from demcheck import case as C\nfrom demcheck.reference import packing as P\n"
+              f"P.simulate(C.load({str(CASES / 'packing' / 'column-lsd.toml')!r}), threads=2)\n")
+    p = subprocess.run([sys.executable, "-c", script], env={**os.environ, "NUMBA_NUM_THREADS": "1"},
+                       capture_output=True, text=True)
+    assert p.returncode != 0
+    assert "demcheck.errors.ConfigError: --threads = 2: must be a whole number from 1 to 1" in p.stderr
+
+
+@two_threads
+def test_the_warm_up_compiles_the_threaded_kernel():
+    """`demcheck warmup` compiles the threaded kernel too (cached on disk like the others), so that a first run on
+    several threads does not compile it; one specialisation each."""
+    from demcheck.comparisons.warmup import _packing
+
+    _packing()
+    assert len(P.run.signatures) == 1 and len(P.run_threaded.signatures) == 1
+
+
+def _pack(*args):
+    return subprocess.run([sys.executable, "-m", "demcheck", "pack", *args], capture_output=True, text=True,
+                          timeout=600)
+
+
+@pytest.mark.parametrize("args, rule", [
+    (["--threads", "0"], "--threads = 0: must be >= 1"),
+    (["--threads", "1.5"], "--threads = '1.5': must be an integer >= 1"),
+    (["--threads", "4096"], "--threads = 4096: must be a whole number from 1 to "),
+    (["--threads", "2", "--engine", "lammps"], "--threads = 2: applies to the reference"),
+    (["--mpi", "2"], "--mpi = 2: applies to an engine"),
+])
+def test_pack_threads_and_ranks_are_checked_in_one_line(args, rule):
+    p = _pack(str(CASES / "packing" / "column-lsd.toml"), *args)
+    assert p.returncode == 2
+    lines = p.stderr.strip().splitlines()
+    assert len(lines) == 1 and rule in lines[0], p.stderr
+
+
+@two_threads
+def test_pack_on_two_threads_settles_the_column_as_on_one():
+    """`demcheck pack --threads 2` runs the threaded loop and says so; a settled column's metrics are the one-thread
+    run's to round-off (a settled stack has nothing chaotic to amplify the summation order)."""
+    import json
+
+    one = json.loads(_pack(str(CASES / "packing" / "column-lsd.toml"), "--json").stdout)
+    p = _pack(str(CASES / "packing" / "column-lsd.toml"), "--threads", "2", "--json")
+    assert p.returncode == 0, p.stderr
+    two = json.loads(p.stdout)
+    assert (one["threads"], two["threads"]) == (1, 2)
+    assert two["contacts"] == one["contacts"]
+    for k, v in one["metrics"].items():
+        if isinstance(v, float):
+            assert two["metrics"][k] == pytest.approx(v, rel=1e-9, abs=1e-12 * max(1.0, abs(v))), k
