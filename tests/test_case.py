@@ -574,3 +574,24 @@ def test_cli_bad_pair_keys_are_one_line_and_exit_2(tmp_path, case, sets, needle)
     assert p.stdout == "" and p.stderr.count("\n") == 1, p.stderr
     assert p.stderr.startswith(f"demcheck: error: {needle}"), p.stderr
     assert not list(tmp_path.iterdir()), "nothing is written before the case is checked"
+
+
+def test_plain_copy_is_a_deep_copy_of_toml_data():
+    """apply_overrides and from_dict copy a case's raw tables with plain_copy (a sweep copies once per point):
+    nothing of the copy is shared with the original, and values that are not TOML's are deep-copied."""
+    import datetime
+
+    from demcheck.case import apply_overrides, plain_copy
+
+    raw = {"a": {"b": [1, 2.5, {"c": "x"}], "d": True, "e": None}, "f": datetime.date(2026, 12, 2),
+           "g": (1, [2]), "h": {"z": [[0.0]]}}
+    copy_ = plain_copy(raw)
+    assert copy_ == raw
+    copy_["a"]["b"][2]["c"] = "y"
+    copy_["a"]["b"].append(3)
+    copy_["g"][1].append(4)
+    copy_["h"]["z"][0][0] = 1.0
+    assert raw == {"a": {"b": [1, 2.5, {"c": "x"}], "d": True, "e": None}, "f": datetime.date(2026, 12, 2),
+                   "g": (1, [2]), "h": {"z": [[0.0]]}}
+    over = apply_overrides(raw, ["a.b.0=7", "h.z=[[2.0]]"])
+    assert (over["a"]["b"][0], over["h"]["z"]) == (7, [[2.0]]) and (raw["a"]["b"][0], raw["h"]["z"]) == (1, [[0.0]])
