@@ -96,13 +96,18 @@ def main():
                     marginal = (large - small) / (args.large - args.small)
                     rows.append((Path(case).stem, method, label, a["kernel"], a["total"], marginal))
         print(f"\n{'case':22s} {'method':9s} {'code':18s} {'kernel ms':>10s} {'API ms':>8s} {'API/kernel':>11s} "
-              f"{'sweep CLI ms':>13s}")
+              f"{'sweep CLI ms':>13s} {'CLI - kernel':>13s}")
         for case, method, label, kernel, total, marginal in rows:
             print(f"{case:22s} {method:9s} {label:18s} {kernel * 1e3:10.3f} {total * 1e3:8.3f} {total / kernel:11.2f} "
-                  f"{marginal * 1e3:13.3f}")
+                  f"{marginal * 1e3:13.3f} {(marginal - kernel) * 1e3:13.3f}")
         now = [r for r in rows if r[2] == "now"]
+
+        def verdict(x, kernel):  # a kernel that alone takes more than 1 ms cannot meet it: said so, not hidden
+            return "met" if x <= 1e-3 else f"MISSED: the kernel alone takes {kernel * 1e3:.2f} ms" if kernel > 1e-3 \
+                else "MISSED"
+
         print("\nCLI marginal per collision ≤ 1 ms: "
-              + ", ".join(f"{c}/{m} {x * 1e3:.2f} ms ({'met' if x <= 1e-3 else 'MISSED'})" for c, m, _, _, _, x in now))
+              + ", ".join(f"{c}/{m} {x * 1e3:.2f} ms ({verdict(x, k)})" for c, m, _, k, _, x in now))
         print("API ≤ 3× kernel: "
               + ", ".join(f"{c}/{m} {t / k:.2f}× ({'met' if t <= 3 * k else 'MISSED'})" for c, m, _, k, t, _ in now))
         if args.before:
