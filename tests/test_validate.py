@@ -723,3 +723,25 @@ def test_validate_quick_runs_one_case_file_per_benchmark(tmp_path):
     assert r.returncode in (0, 1), r.stderr[-2000:]
     files = {c["file"] for c in json.loads(r.stdout)["validation"]["checks"]}
     assert files == set(VA.QUICK) and len(VA.QUICK) == len(VA.BENCHMARKS)
+
+
+def test_the_cli_names_the_law_s_own_misses_and_exits_0_for_them(monkeypatch, tmp_path):
+    """`demcheck validate` prints a law's own miss of the reference in its summary (it was only in the report and
+    the JSON), beside the failing misses, and does not fail on it. The campaign is replaced by its summary: what
+    is tested is the command's presentation and exit status."""
+    from click.testing import CliRunner
+
+    from demcheck import cli
+    from demcheck.comparisons import validate as V
+
+    law = {"kind": "limit", "source": "reference", "verdict": VA.MISSES, "law": True, "expected": "psi2 = 0.5",
+           "file": "thornton-e090-tti-overlap.toml", "deviation": 0.032, "tolerance": 0.024}
+    meets = {**law, "verdict": VA.MEETS, "law": None, "file": "thornton-e090.toml"}
+    summary = {"report": str(tmp_path), "engines": [], "failed": 0,
+               "validation": {"checks": [law, meets], "failed": [], "series": []}}
+    monkeypatch.setattr(V, "run", lambda *a, **k: summary)
+    out = CliRunner().invoke(cli.cli, ["validate", "thornton", "--engines", "none", "--jobs", "1", "--report",
+                                       str(tmp_path)])
+    assert out.exit_code == 0, out.output
+    said = [line for line in out.output.splitlines() if "the law's own miss" in line]
+    assert len(said) == 1 and "psi2 = 0.5 in thornton-e090-tti-overlap.toml: 0.032 > 0.024" in said[0]
