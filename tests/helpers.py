@@ -74,14 +74,25 @@ def proc_stat(pid) -> list[str] | None:
         return None
 
 
-def group_alive(pgid: int) -> list[int]:
-    """The live (not zombie) processes of a process group."""
+def _alive_where(field: int, value: int) -> list[int]:
+    """The live (not zombie) processes whose /proc stat field ``field`` (1: the parent, 2: the process group) is
+    ``value``."""
     import os
 
     out = []
     for d in os.listdir("/proc"):
         if d.isdigit():
             st = proc_stat(d)
-            if st and st[2] == str(pgid) and st[0] != "Z":
+            if st and st[field] == str(value) and st[0] != "Z":
                 out.append(int(d))
     return out
+
+
+def group_alive(pgid: int) -> list[int]:
+    """The live (not zombie) processes of a process group."""
+    return _alive_where(2, pgid)
+
+
+def children_alive(pid: int) -> list[int]:
+    """The live (not zombie) children of a process."""
+    return _alive_where(1, pid)

@@ -17,7 +17,7 @@ from demcheck.engines import discovery, run as runner
 from demcheck.errors import EngineFailed, EngineInterrupted
 
 from .conftest import CASES
-from .helpers import group_alive, proc_stat
+from .helpers import children_alive, group_alive, proc_stat
 
 # a fake LAMMPS: answers -h with a banner; a run starts a child and waits on it forever (a process group
 # of two, as an MPI launch has)
@@ -29,16 +29,6 @@ wait
 SIGNALS = [(signal.SIGINT, 130), (signal.SIGTERM, 143)]
 
 
-def _children(pid: int) -> list[int]:
-    out = []
-    for d in os.listdir("/proc"):
-        if d.isdigit():
-            st = proc_stat(d)
-            if st and st[1] == str(pid) and st[0] != "Z":
-                out.append(int(d))
-    return out
-
-
 def _start(args, cwd, env=None):
     return subprocess.Popen([sys.executable, "-m", "demcheck", *map(str, args)], cwd=cwd, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -48,7 +38,7 @@ def _descendants(pid: int) -> list[int]:
     """The live processes under ``pid``: its children, theirs, …"""
     out, todo = [], [pid]
     while todo:
-        kids = _children(todo.pop())
+        kids = children_alive(todo.pop())
         out += kids
         todo += kids
     return out
