@@ -165,3 +165,64 @@ def test_pack_on_two_threads_settles_the_column_as_on_one():
     for k, v in one["metrics"].items():
         if isinstance(v, float):
             assert two["metrics"][k] == pytest.approx(v, rel=1e-9, abs=1e-12 * max(1.0, abs(v))), k
+
+
+def test_a_run_that_goes_non_finite_stops_in_the_serial_loop_s_state(monkeypatch):
+    """A state that is not finite (one sphere's speed NaN: what a blown-up step leaves) stops the run after the
+    kick of its first step. The threaded loop on one thread stops where the serial one does — without the next
+    step's drift, which it fuses into that step — and leaves the same state, bit for bit."""
+    case = C.load(CASES / "optin" / "poured-small-poly.toml")
+    dt = P.packing_dt(case)
+
+    def state():
+        st = P.PackState(case)
+        st.v[7, 2] = np.nan
+        return st
+
+    serial = state()
+    ke_s, _, flags_s = P.advance(case, serial, dt, 10, ke_every=1)
+    assert flags_s[1] == 1  # the serial loop stopped: non-finite
+    P._prefer_openmp()
+    monkeypatch.setattr(P, "run", lambda *args: P.run_threaded(*args, 1))
+    threaded = state()
+    ke_t, _, flags_t = P.advance(case, threaded, dt, 10, ke_every=1)
+    assert flags_t[1] == 1
+    np.testing.assert_array_equal(ke_s, ke_t)
+    for name in ("x", "v", "w"):
+        np.testing.assert_array_equal(getattr(serial, name), getattr(threaded, name), err_msg=name)
+
+
+@pytest.mark.parametrize("old_skin", [1.2e-3, 0.0])
+@pytest.mark.parametrize("cut", [[0, 40, 41, 120], [0, 0, 60, 120], [0, 120, 120, 120]])
+def test_the_threaded_rebuild_is_the_serial_one(cut, old_skin):
+    """The Verlet list built by shares (here three, uneven: one of a single row, and empty ones) and laid end to
+    end is the serial rebuild's: the same rows, entries, carried contact states and array lengths, on a dense
+    cloud whose list is longer than the first guess (NB_PER_PARTICLE a row). From an old list of the same reach
+    each share's rows fit the room it is given (the threaded path: asserted); from a shorter one the rows outgrow
+    it and the serial rebuild takes over."""
+    rng = np.random.default_rng(7)
+    n, r = 120, 1e-3
+    x = rng.uniform(0.0, 8e-3, (n, 3))
+    rad = np.full(n, r)
+    lo, hi, periodic = np.zeros(3), np.array([8e-3, 8e-3, 8e-3]), np.array([True, True])
+    skin = 1.2e-3
+    empty = (np.zeros(n + 1, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0))
+    old = P._rebuild(x, rad, lo, hi, periodic, old_skin, *empty, 0)
+    dmax = rng.uniform(0.0, 1.0, old[3].shape[0]) * (rng.uniform(size=old[3].shape[0]) < 0.5)  # states to carry
+    old = (old[0], old[1], rng.uniform(size=(old[1].shape[0], 3)), dmax)
+    x2 = x + rng.normal(0.0, 2e-5, x.shape)
+    serial = P._rebuild(x2, rad, lo, hi, periodic, skin, *old, 0)
+    threaded = P._rebuild_threaded(x2, rad, lo, hi, periodic, skin, *old, 0, np.array(cut, np.int64))
+    new_start = serial[0]
+    assert new_start[-1] > P.NB_PER_PARTICLE * n  # the list outgrew the first guess
+    shares = [(cut[c], cut[c + 1]) for c in range(len(cut) - 1)]
+    room = max([P.NB_PER_PARTICLE] + [max(P.NB_PER_PARTICLE * (b - a), (old[0][b] - old[0][a]) * 5 // 4
+                                          + P.NB_PER_PARTICLE) for a, b in shares])
+    fits = max(new_start[b] - new_start[a] for a, b in shares) <= room
+    assert fits == (old_skin == skin)
+    for name, a, b in zip(("start", "nbj", "hist", "dmax"), serial, threaded):
+        assert a.shape == b.shape, name
+        if name == "nbj":
+            a, b = a[:new_start[-1]], b[:new_start[-1]]  # the entries (then spare room)
+        np.testing.assert_array_equal(a, b, err_msg=name)
+    assert (serial[3] != 0.0).sum() > 10  # states were carried over

@@ -196,8 +196,9 @@ def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, 
     cells = _cells(x, box_lo, box_hi, 2.0 * rad.max() + skin, periodic)
     period = _period(box_lo, box_hi, periodic)
     room = NB_PER_PARTICLE
-    for c in range(m):
-        room = max(room, (start[chunks[c + 1]] - start[chunks[c]]) * 5 // 4 + NB_PER_PARTICLE)
+    for c in range(m):  # as the serial rebuild's first try: NB_PER_PARTICLE a row, or the old entries and a quarter
+        room = max(room, NB_PER_PARTICLE * (chunks[c + 1] - chunks[c]),
+                   (start[chunks[c + 1]] - start[chunks[c]]) * 5 // 4 + NB_PER_PARTICLE)
     rows = np.empty((m, room), np.int64)
     ends = np.empty(m, np.int64)
     new_start = np.empty(n + 1, np.int64)
@@ -208,7 +209,10 @@ def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, 
     at = np.zeros(m + 1, np.int64)
     for c in range(m):
         at[c + 1] = at[c] + ends[c]
-    new_j = np.empty(max(nbj.shape[0], at[m], NB_PER_PARTICLE * n), np.int64)
+    size = max(nbj.shape[0], NB_PER_PARTICLE * n)  # the serial rebuild's lengths, so that the states' arrays match
+    if at[m] > size:
+        size = at[m] + at[m] // 4
+    new_j = np.empty(size, np.int64)
     for c in prange(m):
         for i in range(chunks[c], chunks[c + 1]):
             new_start[i] += at[c]
@@ -616,9 +620,9 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
     sits beside its entry, a wall contact's in its particle's row) and writes the forces and torques of its own
     particles; what it adds for another share's particle (a pair across the cut, j > i) goes into its far
     buffer, which that share's thread adds in after the loop (:func:`_gather`) and then kicks and drifts its
-    particles. Race-free, and no locks: two parallel regions a step. The same arithmetic per contact as
-    :func:`run`: with one thread the same bits; with more, a particle's force is summed in another order
-    (round-off)."""
+    particles. Race-free, and no locks: two parallel regions a step (three more at a rebuild). The same arithmetic
+    per contact as :func:`run`: with one thread the same bits; with more, a particle's force is summed in another
+    order (round-off)."""
     n_p = x.shape[0]
     n_w = walls.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
@@ -656,7 +660,9 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
         for b in prange(threads):
             _gather(chunks[b], chunks[b + 1], b, f_far, tq_far, f, tq)
             e_share[b], e_rot_share[b] = _kick(chunks[b], chunks[b + 1], v, w, f, tq, mass, inertia, gravity, dt)
-            if step < steps:
+            # the next step's first half kick and drift, unless the run is over or stops here (a non-finite share:
+            # the serial loop stops after the kick; on one thread the same state)
+            if step < steps and math.isfinite(e_share[b] + e_rot_share[b]):
                 moved[b] = _kick_drift(chunks[b], chunks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
                                        box_hi, periodic, x_ref)
         e = 0.0
