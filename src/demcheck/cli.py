@@ -771,8 +771,9 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
 @click.option("--threads", "threads", type=Number(lo=1, integer=True, unit="threads"), default=1,
               show_default=True,
               help="run the reference's force loop on this many threads (numba's; at most NUMBA_NUM_THREADS, by "
-                   "default the machine's cores): the same physics, summed in another order, so the same result to "
-                   "round-off, not bit for bit (docs/packing.md)")
+                   "default the machine's cores): the same physics, a particle's forces summed in another order — "
+                   "not one thread's bits, and a pour, being chaotic, then agrees in its statistics, not sphere by "
+                   "sphere (docs/packing.md)")
 @click.option("--timeout", type=TIMEOUT, default=3600.0, show_default=True, help="engine run timeout (s)")
 @click.option("--csv", "csv_dir", type=PACK_CSV_DIR, default=None,
               help="write the settled state here: particles.csv (id, x, y, z, radius) and contacts.csv "

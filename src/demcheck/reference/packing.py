@@ -868,7 +868,8 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
     turning point of a layer bouncing in phase, not on a settled state; dt and the number of steps are case.packing_run's (a run
     past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin. ``threads``: the force
-    loop's threads (default 1: the same bits on every run; more, the same to round-off — docs/packing.md)."""
+    loop's threads (default 1: the same bits on every run; more: each step the same to round-off, which a pour's
+    collisions amplify — the same packing in its statistics, docs/packing.md)."""
     from ..case import packing_run
     from ..errors import ConfigError
 
