@@ -487,18 +487,18 @@ def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncati
                                  angle=30.0, spin=0.0))
     nl, tl = model.normal_law.array(), model.tangential_law.array()
     delta, v, dt, steps = 1e-6, 0.01, 1e-7, 1000
-    n, vt = np.array([0.0, 0.0, 1.0]), np.array([v, 0.0, 0.0])
-    hist, ft = np.zeros((1, 3)), np.zeros(3)
+    n, vt = (0.0, 0.0, 1.0), (v, 0.0, 0.0)
+    xi = (0.0, 0.0, 0.0)
     fn = P.normal_force(nl, delta, 0.0, delta)
-    for _ in range(steps):
-        P._spring(nl, tl, delta, n, vt, hist, 0, fn, dt, ft, fn, delta, ROT_RESCALE)
+    for _ in range(steps):  # the packing loop's spring law (μk = μs: no slip state), step after step
+        *xi, f0, f1, f2, _sliding = P._spring_law(nl, tl, delta, n, vt, *xi, False, fn, dt, ROT_RESCALE)
     cap = tl[P.T_MU_K] * fn
-    assert np.linalg.norm(ft) == pytest.approx(cap, rel=1e-12)  # sliding at the Coulomb limit in both
+    assert math.hypot(f0, f1, f2) == pytest.approx(cap, rel=1e-12)  # sliding at the Coulomb limit in both
     if truncation == "force":
-        assert hist[0, 0] == pytest.approx(steps * v * dt, rel=1e-12)  # every increment kept
+        assert xi[0] == pytest.approx(steps * v * dt, rel=1e-12)  # every increment kept
     else:
         eta = P.eta_of(tl, nl, delta)
-        assert hist[0, 0] == pytest.approx((cap - eta * v) / kt_of(tl, delta), rel=1e-9)  # Maw's limit
+        assert xi[0] == pytest.approx((cap - eta * v) / kt_of(tl, delta), rel=1e-9)  # Maw's limit
 
 
 # ----------------------------------------------------------------------------- bounded packing runs

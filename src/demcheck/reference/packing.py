@@ -290,21 +290,6 @@ def _spring_law(nl, tl, delta, n, vt, xi0, xi1, xi2, slipping, fabs, dt, rot):
     return spring_slip(xi0, xi1, xi2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC], mu, tl[T_MU_K], fabs)
 
 
-@njit(cache=True)
-def _spring(nl, tl, delta, n, vt, hist, row, fabs, dt, ft, fn, dmax, rot):
-    """:func:`_spring_law` on row ``row`` of ``hist`` (updated in place; its slip state in hist[row, 3] where
-    μk < μs), the force into ``ft``: one contact's spring as the loop runs it, with array arguments (a test
-    drives the law through it). Returns (fn, dmax)."""
-    two_mu = tl[T_MU_K] != tl[T_MU_S]
-    xi0, xi1, xi2, ft[0], ft[1], ft[2], sliding = _spring_law(nl, tl, delta, n, vt, hist[row, 0], hist[row, 1],
-                                                              hist[row, 2], two_mu and hist[row, 3] != 0.0, fabs,
-                                                              dt, rot)
-    hist[row, 0], hist[row, 1], hist[row, 2] = xi0, xi1, xi2
-    if two_mu:
-        hist[row, 3] = 1.0 if sliding else 0.0
-    return fn, dmax
-
-
 @njit(cache=True, inline="always")
 def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
     """The reaction on particle j of a pair's force (f0, f1, f2) on i, and its torque b (t0, t1, t2)."""
