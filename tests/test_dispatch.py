@@ -334,4 +334,7 @@ def test_a_terminal_ctrl_c_stops_the_local_cluster_and_its_engines(tmp_path):
     assert [p for p in under if proc_stat(p) and proc_stat(p)[0] != "Z"] == []
     assert group_alive(engine) == []
     data = json.loads((tmp_path / "reports" / "latest" / "results.json").read_text())
-    assert data["partial"] is True and [c["case"] for c in data["cases"]] == ["hls-constant-pair"]
+    # the engine-less case is reported if it had finished; the Ctrl-C reaches its worker too, and whether it had
+    # started, or finished, depends on when the second worker came up (a loaded machine: after the engine started).
+    # The case the engine was stopped in is never reported.
+    assert data["partial"] is True and [c["case"] for c in data["cases"]] in ([], ["hls-constant-pair"])
