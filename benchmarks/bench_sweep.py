@@ -3,7 +3,9 @@ item 1: results as arrays). Targets: marginal cost per collision in `demcheck sw
 collision through Python (collide + metrics) ≤ 3× its kernel time.
 
 * Python API: for each case and method, ``collide(case)`` and ``.metrics()`` over a grid of impact speeds, best of
-  3 passes; the kernel time is the Result's wall_time (the compiled solver call).
+  3 passes; the kernel time is the Result's wall_time (the compiled solver call). Beside it the batched API,
+  ``collide_many(cases)`` over the same points (reference/batch.py: the 1-D verlet ones in one compiled call),
+  best of 3.
 * CLI: `demcheck sweep CASE --vary impact.speed=0.5:2:N --json` in a fresh process for two N; the marginal cost is
   the difference over the difference in points (start-up and imports cancel).
 * Side by side, in the same run: the same sweeps with the code before the change (``--before REV``: that
@@ -42,7 +44,18 @@ for _ in range(3):
     total = time.perf_counter() - t
     if best is None or total < best[0]:
         best = (total, kernel)
-print(json.dumps({"total": best[0] / n, "kernel": best[1] / n}))
+try:  # many at once (reference/batch.py), where the code has it
+    from demcheck.reference.batch import collide_many
+except ImportError:
+    collide_many = None
+batch = None
+if collide_many is not None:
+    collide_many(pts[:2], method)
+    for _ in range(3):
+        t = time.perf_counter()
+        collide_many(pts, method)
+        batch = min(batch or 1e9, time.perf_counter() - t)
+print(json.dumps({"total": best[0] / n, "kernel": best[1] / n, "batch": batch and batch / n}))
 """
 
 
@@ -94,13 +107,15 @@ def main():
                     a = api(env, case, method)
                     small, large = cli(env, case, method, args.small), cli(env, case, method, args.large)
                     marginal = (large - small) / (args.large - args.small)
-                    rows.append((Path(case).stem, method, label, a["kernel"], a["total"], marginal))
+                    rows.append((Path(case).stem, method, label, a["kernel"], a["total"], marginal, a["batch"]))
         print(f"\n{'case':22s} {'method':9s} {'code':18s} {'kernel ms':>10s} {'API ms':>8s} {'API/kernel':>11s} "
-              f"{'sweep CLI ms':>13s} {'CLI - kernel':>13s}")
-        for case, method, label, kernel, total, marginal in rows:
+              f"{'batched ms':>11s} {'batched/kernel':>15s} {'sweep CLI ms':>13s} {'CLI - kernel':>13s}")
+        for case, method, label, kernel, total, marginal, batch in rows:
+            batched = f"{batch * 1e3:11.3f} {batch / kernel:15.2f}" if batch else f"{'-':>11s} {'-':>15s}"
             print(f"{case:22s} {method:9s} {label:18s} {kernel * 1e3:10.3f} {total * 1e3:8.3f} {total / kernel:11.2f} "
-                  f"{marginal * 1e3:13.3f} {(marginal - kernel) * 1e3:13.3f}")
-        now = [r for r in rows if r[2] == "now"]
+                  f"{batched} {marginal * 1e3:13.3f} {(marginal - kernel) * 1e3:13.3f}")
+        now = [r[:6] for r in rows if r[2] == "now"]
+        batched = [(r[0], r[1], r[3], r[6]) for r in rows if r[2] == "now"]
 
         def verdict(x, kernel):  # a kernel that alone takes more than 1 ms cannot meet it: said so, not hidden
             return "met" if x <= 1e-3 else f"MISSED: the kernel alone takes {kernel * 1e3:.2f} ms" if kernel > 1e-3 \
@@ -108,8 +123,10 @@ def main():
 
         print("\nCLI marginal per collision ≤ 1 ms: "
               + ", ".join(f"{c}/{m} {x * 1e3:.2f} ms ({verdict(x, k)})" for c, m, _, k, _, x in now))
-        print("API ≤ 3× kernel: "
+        print("API ≤ 3× kernel, one collision a call (collide + metrics): "
               + ", ".join(f"{c}/{m} {t / k:.2f}× ({'met' if t <= 3 * k else 'MISSED'})" for c, m, _, k, t, _ in now))
+        print("API ≤ 3× kernel, many a call (collide_many): "
+              + ", ".join(f"{c}/{m} {b / k:.2f}× ({'met' if b <= 3 * k else 'MISSED'})" for c, m, k, b in batched))
         if args.before:
             print("speed-up over the code before (same run): "
                   + ", ".join(f"{a[0]}/{a[1]} API {b[4] / a[4]:.1f}×, CLI {b[5] / a[5]:.1f}×"

@@ -5,6 +5,8 @@
 * :func:`load` — a case file, or a dict shaped like one, with overrides → a :class:`~demcheck.case.Case`;
 * :func:`collide` — one collision from one source (the reference, an engine, an engine's twin) → a Result with
   ``.metrics()`` and ``.to_frame()``;
+* :func:`collide_many` — many reference collisions at once (cases you built) → a pandas DataFrame of their
+  metrics and statuses, the 1-D verlet ones solved in one compiled call;
 * :func:`sweep` — metrics over a grid of case keys → a pandas DataFrame;
 * :func:`verify` — the verification suite over case files → its results dict (what ``results.json`` holds);
 * :func:`audit` — a user's own LAMMPS or LIGGGHTS deck → the audit as a dict;
@@ -26,7 +28,8 @@ from . import case as _case
 from .errors import ConfigError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result", "ConfigError"]
+__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result",
+           "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
 
@@ -155,6 +158,25 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     from .engines.collide import collide as run_engine
 
     return _framed(run_engine(c, engine, dt=dt, native=native, timeout=timeout))
+
+
+def collide_many(cases: Iterable, method: str | None = None, dt: float | None = None):
+    """Many reference collisions → a DataFrame, one row per case in order: every metric, ``status`` and
+    ``message`` — what :func:`collide` and ``.metrics()`` give for each, without a Result per case. ``cases``:
+    anything :func:`load` takes, each (loaded and validated before any is solved). The cases the 1-D verlet
+    solver takes (method verlet, and nothing moves the contact off the line of centres) are solved in one
+    compiled call, their metrics computed there: a collision then costs about its kernel (docs/performance.md);
+    the others one by one. A case whose solve fails keeps its row, with its error as the status."""
+    import pandas as pd
+
+    from .reference.batch import collide_many as run
+
+    if method not in (None, "adaptive", "verlet"):
+        raise ConfigError("method", method, "must be adaptive or verlet (the reference's)")
+    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        raise ConfigError("dt", dt, "must be a number > 0 (s)")
+    loaded = [load(c) for c in cases]
+    return pd.DataFrame(run(loaded, method, dt))
 
 
 def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method: str | None = None,

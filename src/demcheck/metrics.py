@@ -3,7 +3,9 @@
 Where the Result has exact events (adaptive method) they are used; otherwise the metrics are read off the
 time series the same way for every time-stepped source (the reference's verlet method and the engines):
 contact start and end by linear interpolation of δ between the steps that bracket its sign change, the
-impact rate from the last step before contact, the rebound rate from the first step after it.
+impact rate from the last step before contact, the rebound rate from the first step after it. That reading of a
+series is compiled (``stepped``): one function for every time-stepped source and for the batched solve
+(reference/batch.py), which computes a collision's metrics without handing its series back to Python.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 NORMAL_METRICS = ("restitution", "contact_time", "force_contact_time", "max_overlap", "peak_force",
                   "energy_dissipated")
@@ -25,6 +28,7 @@ def _event(events, name):
     return None if not rows.size else {k: v[rows[0]] for k, v in events.items()}
 
 
+@njit(cache=True)
 def _crossing(t, y, k):
     """Time where y crosses 0 between samples k−1 and k (linear)."""
     y0, y1 = y[k - 1], y[k]
@@ -33,17 +37,78 @@ def _crossing(t, y, k):
     return t[k - 1] + (t[k] - t[k - 1]) * (y0 / (y0 - y1))
 
 
+@njit(cache=True)
+def _window_max(y, lo, hi):
+    """max(y[lo:hi]) as numpy's: NaN when any is NaN."""
+    m = y[lo]
+    for k in range(lo + 1, hi):
+        if m != m:
+            break
+        if y[k] > m or y[k] != y[k]:
+            m = y[k]
+    return m
+
+
+@njit(cache=True)
+def stepped(t, d, r, f):
+    """The contact of a time series without events (t, δ, δ̇, Fn; float64): (k_s, t_s, v_in, k_e, t_e, v_out,
+    k_f, t_f, δ_max, F_max). The contact starts at the first row k_s with δ > 0 (k_s = −1: never; t_s by linear
+    interpolation from the row before, v_in its rate) and ends at the first row k_e ≥ k_s with δ ≤ 0 (k_e = the
+    length and t_e = v_out = NaN when it does not); the force ends at the first row k_f with Fn ≤ 0 after the
+    first with Fn > 0 inside the contact (k_f = −1: not before the contact ends); δ_max and F_max over the rows
+    from k_s to k_e."""
+    n = t.shape[0]
+    nan = math.nan
+    k_s = -1
+    for k in range(n):
+        if d[k] > 0:
+            k_s = k
+            break
+    if k_s < 0:
+        return -1, nan, nan, n, nan, nan, -1, nan, nan, nan
+    t_s, v_in = t[0], r[0]
+    if k_s > 0:
+        t_s, v_in = _crossing(t, d, k_s), r[k_s - 1]
+    k_e, t_e, v_out = n, nan, nan
+    for k in range(k_s, n):
+        if d[k] <= 0:
+            k_e, t_e, v_out = k, _crossing(t, d, k), r[k]
+            break
+    hi = min(k_e, n)
+    k_f, t_f = -1, nan
+    for k in range(k_s, hi):
+        if f[k] > 0:
+            for j in range(k, hi):
+                if f[j] <= 0:
+                    k_f, t_f = j, _crossing(t, f, j)
+                    break
+            break
+    top = min(k_e + 1, n)
+    return k_s, t_s, v_in, k_e, t_e, v_out, k_f, t_f, _window_max(d, k_s, top), _window_max(f, k_s, top)
+
+
+def f64(x) -> np.ndarray:
+    """A column as the compiled readers take it: float64, contiguous and writeable (one specialisation)."""
+    return np.require(np.asarray(x, dtype=np.float64), requirements=("C", "W"))
+
+
 def compute(result) -> dict:
     c = result.table("contact")
     nan = math.nan
     out = {name: nan for name in NORMAL_METRICS}
     if not c or not len(c["t"]):
         return out
-    t = np.asarray(c["t"], dtype=float)
-    d = np.asarray(c["delta"], dtype=float)
-    r = np.asarray(c["delta_dot"], dtype=float)
-    f = np.asarray(c["fn"], dtype=float)
+    t, d, r, f = (f64(c[k]) for k in ("t", "delta", "delta_dot", "fn"))
     ev = result.table("events")
+    if not ev or not len(ev["event"]):
+        k_s, t_s, v_in, k_e, t_e, v_out, k_f, t_f, d_max, f_max = stepped(t, d, r, f)
+        if k_s < 0:
+            return out
+        out["contact_time"] = t_e - t_s
+        out["restitution"] = -v_out / v_in if v_in else nan
+        out["force_contact_time"] = t_f - t_s if k_f >= 0 else out["contact_time"]
+        out["max_overlap"], out["peak_force"] = d_max, f_max
+        return _rest(result, c, out, t, t_s, k_s, False, t_e, k_e, False, v_in, v_out)
     start, end = _event(ev, "contact_start"), _event(ev, "contact_end")
 
     inside = np.flatnonzero(d > 0)
@@ -71,26 +136,18 @@ def compute(result) -> dict:
 
     out["contact_time"] = t_e - t_s
     out["restitution"] = -v_out / v_in if v_in else nan
-    fe = _event(ev, "force_end")
-    if fe is not None:
-        out["force_contact_time"] = float(fe["t"]) - t_s
-    elif ev and len(ev["event"]):
-        out["force_contact_time"] = out["contact_time"]
-    else:
-        # the force ends where it first drops to ≤ 0 while the bodies still overlap; else with the overlap
-        out["force_contact_time"] = out["contact_time"]
-        k_in = np.arange(k_s, min(k_e, len(t)))
-        pos = np.flatnonzero(f[k_in] > 0)
-        if pos.size:
-            stop = np.flatnonzero(f[k_in[pos[0]:]] <= 0)
-            if stop.size:
-                k = int(k_in[pos[0] + stop[0]])
-                out["force_contact_time"] = _crossing(t, f, k) - t_s
+    fe = _event(ev, "force_end")  # (a series without events: where Fn first drops to ≤ 0 inside; ``stepped``)
+    out["force_contact_time"] = float(fe["t"]) - t_s if fe is not None else out["contact_time"]
     mo = _event(ev, "max_overlap")
     out["max_overlap"] = float(mo["delta"]) if mo is not None else float(np.max(d[window]))
     out["peak_force"] = float(np.max(f[window]))
-    k_in = _row_at(t, t_s, k_s, start is not None, before=True)
-    k_out = _row_at(t, t_e, k_e, end is not None, before=False)
+    return _rest(result, c, out, t, t_s, k_s, start is not None, t_e, k_e, end is not None, v_in, v_out)
+
+
+def _rest(result, c, out: dict, t, t_s, k_s, exact_start: bool, t_e, k_e, exact_end: bool, v_in, v_out) -> dict:
+    """The energy dissipated and the tangential metrics, from the rows at contact start and end."""
+    k_in = _row_at(t, t_s, k_s, exact_start, before=True)
+    k_out = _row_at(t, t_e, k_e, exact_end, before=False)
     if "energy" in c and k_out is not None:
         e = c["energy"]
         out["energy_dissipated"] = float(e[k_in] - e[k_out])

@@ -187,15 +187,32 @@ def point_task(values: dict, case, source: str, method, dt, cache=None) -> dict:
     return row
 
 
+BATCH = 256  # points a compiled call of the reference solves (the progress bar moves a batch at a time)
+
+
 def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
               source: str = "reference", campaign=None) -> pd.DataFrame:
     """Solve each point (``sweep_points``) from ``source`` (``check_source``), in ``campaign``
-    (dispatch.Campaign; default this process), the rows in the points' order."""
+    (dispatch.Campaign; default this process), the rows in the points' order. The reference's points in this
+    process are solved BATCH at a time (reference/batch.py: the 1-D verlet ones in one compiled call)."""
     from .dispatch import Campaign
 
+    campaign = campaign or Campaign()
+    if source == "reference" and campaign.in_process:
+        from ..reference.batch import collide_many
+
+        out = []
+        for lo in range(0, len(points), BATCH):
+            part = points[lo:lo + BATCH]
+            for (values, _), got in zip(part, collide_many([case for _, case in part], method, dt)):
+                got.pop("message")
+                out.append({**values, **got})  # point_task's row: the values, the metrics, the status
+                if progress:
+                    progress()
+        return pd.DataFrame(out)
     rows = {}
     tasks = [(i, (values, case, source, method, dt)) for i, (values, case) in enumerate(points)]
-    for i, row in (campaign or Campaign()).completed(point_task, tasks):
+    for i, row in campaign.completed(point_task, tasks):
         rows[i] = row
         if progress:
             progress()

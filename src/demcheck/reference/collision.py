@@ -54,14 +54,15 @@ class Geometry1D:
             self.tangential_velocity = v_rel - self.rate0 * self.n
 
 
-def is_one_dimensional(case: Case, model: ResolvedModel) -> bool:
+def is_one_dimensional(case: Case, model: ResolvedModel, geo: Geometry1D | None = None) -> bool:
     """True when the normal solve alone is exact: no tangential force, and the contact normal cannot turn
-    (a plane wall, or a pair whose relative velocity lies on the line of centres)."""
+    (a plane wall, or a pair whose relative velocity lies on the line of centres). ``geo``: the case's, when
+    the caller has it."""
     if model.tangential.id != "none":
         return False
     if len(case.particles) == 1:
         return True
-    geo = Geometry1D(case)
+    geo = geo or Geometry1D(case)
     return float(np.linalg.norm(geo.tangential_velocity)) <= 1e-12 * max(abs(geo.rate0), 1e-300)
 
 

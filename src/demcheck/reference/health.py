@@ -22,8 +22,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from ..case import Case
+from ..metrics import f64
 
 MAX_OVERLAP_FRACTION = 0.5  # of the smaller radius: beyond it a contact law of small overlaps means nothing
 ENERGY_GAIN_TOLERANCE = 0.01  # of the impact kinetic energy, for laws that cannot create energy
@@ -44,6 +46,52 @@ def _steps(dt: float, t_c: float) -> str:
     return f"dt = {dt:.3g} s, {t_c / dt:.3g} steps per elastic contact time of {t_c:.3g} s"
 
 
+@njit(cache=True)
+def reading(t, d, r, f):
+    """What the rules read off a time series (t, δ, δ̇, Fn; float64), compiled: (k_bad, inside, δ_max, δ_last,
+    t_last) — the first row whose state (δ, δ̇, Fn) is NaN or infinite (−1: none), the rows with δ > 0, the
+    largest δ, and the last row's δ and t."""
+    n = t.shape[0]
+    k_bad, inside, d_max = -1, 0, -math.inf
+    if n == 0:
+        return k_bad, inside, d_max, math.nan, math.nan
+    for k in range(n):
+        if not (math.isfinite(d[k]) and math.isfinite(r[k]) and math.isfinite(f[k])):
+            k_bad = k
+            break
+        if d[k] > 0:
+            inside += 1
+        d_max = max(d_max, d[k])
+    return k_bad, inside, d_max, d[n - 1], t[n - 1]
+
+
+def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: int, impact_energy: float,
+          passive: bool, gained) -> tuple[str, str]:
+    """(status, why) from a series' ``reading`` and ``t`` of its bad row (module docstring; the first rule
+    that fails wins); ``gained()`` is the energy the collision created (−energy_dissipated), read only when the
+    energy rule is reached."""
+    k_bad, inside, d_max, d_last, t_last, t_bad = read
+    if k_bad >= 0:
+        return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
+    if inside < min_steps and (inside > 0 or t_c / dt < min_steps):
+        return "unresolved", (f"only {inside} steps inside the contact ({_steps(dt, t_c)}): the time step does not "
+                              f"resolve the collision (at least {min_steps} are needed)")
+    if inside == 0:
+        return "no-contact", "the bodies never touched"
+    e_in = impact_energy
+    if passive and e_in > 0:
+        energy = gained()
+        if math.isfinite(energy) and energy > ENERGY_GAIN_TOLERANCE * e_in:
+            return "unstable", (f"the collision created {energy / e_in:.3g} of the impact energy ({_steps(dt, t_c)}): "
+                                "the scheme is unstable at this time step")
+    out = overlap_rule(float(d_max), radius)
+    if out is not None:
+        return out
+    if d_last > 0:
+        return "no-separation", f"the contact had not ended by the end of the run (t = {float(t_last):.3g} s)"
+    return "ok", ""
+
+
 def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN_STEPS,
            impact_energy: float | None = None, passive: bool = True) -> tuple[str, str]:
     """(status, why) of a time-stepped result (module docstring); ("ok", "") when every rule holds.
@@ -51,32 +99,14 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
     the energy rule is measured in (default ½ m̄ v² of the normal impact); ``passive``: whether the law can
     only store or dissipate energy (the energy rule applies only then)."""
     c = result.table("contact")  # the arrays: no DataFrame is built for the check
-    dt = result.dt
-    state = np.column_stack([np.asarray(c[k], dtype=float) for k in STATE_COLUMNS])
-    bad = ~np.isfinite(state).all(axis=1)
-    if bad.any():
-        t_bad = float(np.asarray(c["t"])[int(np.argmax(bad))])
-        return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
-    d = np.asarray(c["delta"], dtype=float)
-    inside = int((d > 0).sum())
-    if inside < min_steps and (inside > 0 or t_c / dt < min_steps):
-        return "unresolved", (f"only {inside} steps inside the contact ({_steps(dt, t_c)}): the time step does not "
-                              f"resolve the collision (at least {min_steps} are needed)")
-    if inside == 0:
-        return "no-contact", "the bodies never touched"
+    t, d, r, f = (f64(c[k]) for k in ("t", *STATE_COLUMNS))
+    read = reading(t, d, r, f)
     e_in = impact_energy
     if e_in is None:
         e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
-    gained = -result.metrics()["energy_dissipated"]
-    if passive and e_in > 0 and math.isfinite(gained) and gained > ENERGY_GAIN_TOLERANCE * e_in:
-        return "unstable", (f"the collision created {gained / e_in:.3g} of the impact energy ({_steps(dt, t_c)}): "
-                            "the scheme is unstable at this time step")
-    out = overlap_rule(float(d.max()), radius or result.meta.get("radius0"))
-    if out is not None:
-        return out
-    if d[-1] > 0:
-        return "no-separation", f"the contact had not ended by the end of the run (t = {float(np.asarray(c['t'])[-1]):.3g} s)"
-    return "ok", ""
+    t_bad = float(t[read[0]]) if read[0] >= 0 else math.nan
+    return rules((*read, t_bad), result.dt, t_c, radius or result.meta.get("radius0"), min_steps, e_in,
+                 passive, lambda: -result.metrics()["energy_dissipated"])
 
 
 def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, str]:
@@ -105,10 +135,10 @@ def smallest_radius(case) -> float:
 def impact_scales(case: Case, model) -> dict:
     """The units the oblique metrics are measured in (verdicts.scale): the impact energy, and v_in/R for a
     spin. Shared with bench and dt, so that their errors and the suite's verdicts speak the same units."""
-    return {"impact_energy": _impact_energy(case, model), "spin": model.pair.impact_speed / case.particles[0].radius}
+    return {"impact_energy": impact_energy(case, model), "spin": model.pair.impact_speed / case.particles[0].radius}
 
 
-def _impact_energy(case: Case, model) -> float:
+def impact_energy(case: Case, model) -> float:
     """Kinetic energy of the relative motion, m̄|v_rel|²/2, plus the bodies' spin energy."""
     v = np.asarray(case.particles[0].velocity, float)
     if not case.walls:

@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ..metrics import stepped
+from .health import reading
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
                          illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
                          stage6)
@@ -194,11 +196,13 @@ def _touch_inside(law, d, r, h, m, an, rn):
     """A free-flight step [0, h] whose ends both have a gap (δ < 0) but whose approach turned into
     recession (δ̇: + → −) may hold a touch between them (δ has its maximum inside): the step fraction of the
     touch (the root of δ before the maximum), or 2 when the maximum has no overlap."""
-    tm = _locate(law, M_PRE, 2, -1, d, r, h, 0.0, m, an, r, rn)
-    dm, _, _, _ = _dp5(law, M_PRE, d, r, tm * h, 0.0, m, an)
+    # (np.int64: a literal argument would make numba compile a specialisation of the callee for it)
+    pre = np.int64(M_PRE)
+    tm = _locate(law, pre, np.int64(2), np.int64(-1), d, r, h, 0.0, m, an, r, rn)
+    dm, _, _, _ = _dp5(law, pre, d, r, tm * h, 0.0, m, an)
     if not (dm > 0.0):
         return 2.0
-    return tm * _locate(law, M_PRE, 0, 1, d, r, tm * h, 0.0, m, an, d, dm)
+    return tm * _locate(law, pre, np.int64(0), np.int64(1), d, r, tm * h, 0.0, m, an, d, dm)
 
 
 @njit(cache=True, nogil=True)  # the suite runs cases in threads
@@ -391,3 +395,73 @@ def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
     else:
         status = ST_STEPS
     return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()
+
+
+# ----------------------------------------------------------------------------- many collisions at once
+
+# a batched point's frame: what turns its 1-D solution into the relative velocity of the centres (reference/batch.py)
+FR_WALL, FR_N, FR_A, FR_B, FR_M0, FR_M1, FR_MT, FR_W = 0, 1, 4, 7, 10, 11, 12, 13
+FR_SIZE = 16
+# a batched point's output row: the run's status and steps, metrics.stepped's reading of its contact,
+# health.reading's of its state, and the tangential metrics
+(O_STATUS, O_STEPS, O_KS, O_TS, O_VIN, O_KE, O_TE, O_VOUT, O_KF, O_TF, O_DMAX, O_FMAX, O_BAD, O_INSIDE, O_DALL,
+ O_DLAST, O_TLAST, O_TBAD, O_TR, O_ANGLE, O_SPIN) = range(21)
+O_SIZE = 21
+
+
+@njit(cache=True, inline="always")
+def _relative_velocity(fr, t, r, j):
+    """Component j of the relative velocity of the centres (v0 − v1, or v0 at a wall) at time t and approach rate
+    r, in collision._particles_1d's arithmetic: a wall's particle keeps its tangential velocity (and gravity's
+    tangential part), a pair's centre of mass moves uniformly."""
+    nj = fr[FR_N + j]
+    if fr[FR_WALL] != 0.0:
+        return (fr[FR_A + j] + t * fr[FR_B + j]) + r * nj
+    vcom = fr[FR_A + j] + t * fr[FR_B + j]
+    return (vcom + r * fr[FR_M1] / fr[FR_MT] * nj) - (vcom - r * fr[FR_M0] / fr[FR_MT] * nj)
+
+
+@njit(cache=True)
+def _tangential_1d(fr, t_in, r_in, t_out, r_out, row):
+    """metrics.tangential of a 1-D solve (a fixed normal, no slip columns) into ``row``."""
+    n0, n1, n2 = fr[FR_N], fr[FR_N + 1], fr[FR_N + 2]
+    a0, a1, a2 = (_relative_velocity(fr, t_in, r_in, 0), _relative_velocity(fr, t_in, r_in, 1),
+                  _relative_velocity(fr, t_in, r_in, 2))
+    b0, b1, b2 = (_relative_velocity(fr, t_out, r_out, 0), _relative_velocity(fr, t_out, r_out, 1),
+                  _relative_velocity(fr, t_out, r_out, 2))
+    an_ = a0 * n0 + a1 * n1 + a2 * n2
+    bn = b0 * n0 + b1 * n1 + b2 * n2
+    ta0, ta1, ta2 = a0 - an_ * n0, a1 - an_ * n1, a2 - an_ * n2
+    tb0, tb1, tb2 = b0 - bn * n0, b1 - bn * n1, b2 - bn * n2
+    row[O_ANGLE] = math.degrees(math.atan2(math.sqrt(tb0 * tb0 + tb1 * tb1 + tb2 * tb2), -bn))
+    speed_t = math.sqrt(ta0 * ta0 + ta1 * ta1 + ta2 * ta2)
+    if speed_t > 1e-12 * math.sqrt(a0 * a0 + a1 * a1 + a2 * a2):
+        h0, h1, h2 = ta0 / speed_t, ta1 / speed_t, ta2 / speed_t
+        row[O_TR] = (tb0 * h0 + tb1 * h1 + tb2 * h2) / speed_t
+        # ω0 · (t̂ × n)
+        row[O_SPIN] = (fr[FR_W] * (h1 * n2 - h2 * n1) + fr[FR_W + 1] * (h2 * n0 - h0 * n2)
+                       + fr[FR_W + 2] * (h0 * n1 - h1 * n0))
+
+
+@njit(cache=True, nogil=True)
+def verlet_normal_many(laws, m, an, d_init, r_init, dt, t_max, capacity, frames):
+    """``verlet_normal`` for each row i of the arguments (a law per row of ``laws``; ``frames``: FR_* columns),
+    its series read where they are made (metrics.stepped, health.reading, the tangential metrics) and dropped:
+    an (N, O_SIZE) array of O_* columns, NaN where a reading has no value."""
+    out = np.full((laws.shape[0], O_SIZE), np.nan)
+    for i in range(laws.shape[0]):
+        status, n, T, D, R, F = verlet_normal(laws[i], m[i], an[i], d_init[i], r_init[i], dt[i], t_max[i],
+                                              capacity[i])
+        row = out[i]
+        row[O_STATUS], row[O_STEPS] = status, n
+        (k_s, row[O_TS], row[O_VIN], k_e, row[O_TE], row[O_VOUT], k_f, row[O_TF], row[O_DMAX],
+         row[O_FMAX]) = stepped(T, D, R, F)
+        row[O_KS], row[O_KE], row[O_KF] = k_s, k_e, k_f
+        k_bad, inside, row[O_DALL], row[O_DLAST], row[O_TLAST] = reading(T, D, R, F)
+        row[O_BAD], row[O_INSIDE] = k_bad, inside
+        if k_bad >= 0:
+            row[O_TBAD] = T[k_bad]
+        if k_s >= 0 and k_e < n:
+            k_in = max(k_s - 1, 0)
+            _tangential_1d(frames[i], T[k_in], R[k_in], T[k_e], R[k_e], row)
+    return out
