@@ -10,7 +10,9 @@ on a Dask cluster (--jobs N > 1) the workers compile, out of the listener's sigh
 count. The runs, in one go:
 
 1. the suite on an empty kernel cache (what a fresh clone without the warm-up paid);
-2. `demcheck warmup` on another empty kernel cache (what setup pays once), then the suite on that cache.
+2. `demcheck warmup` on another empty kernel cache (what setup pays once; by default in as many processes as
+   the machine has cores, whose compiling the listener does not see: its process time is the measure), then the
+   suite on that cache.
 
 Run: .venv/bin/python benchmarks/bench_coldstart.py > benchmarks/results/bench_coldstart.txt (the reference alone,
      one process)
@@ -81,10 +83,10 @@ def main():
           f"{os.getloadavg()[0]:.2f}")
     print(f"{'run':44s} {'process s':>10s} {'compile s':>10s} {'compile %':>10s} exit")
     for label, r, here in (("suite, empty kernel cache (cold)", cold, seen),
-                           ("demcheck warmup, empty kernel cache", warm_up, True),
+                           ("demcheck warmup, empty kernel cache", warm_up, False),
                            ("suite after the warm-up", warm, seen)):
         compiled = f"{r['compile']:10.1f} {100 * r['compile'] / r['process']:9.1f}%" if here else \
-            f"{'(workers)':>10s} {'':>10s}"
+            f"{'(workers)':>10s} {'':>10s}"  # (the warm-up compiles in its own processes)
         print(f"{label:44s} {r['process']:10.1f} {compiled} {r['exit']}")
     first = (warm_up["process"] + warm["process"]) / warm["process"]
     if seen:

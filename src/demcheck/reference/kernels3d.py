@@ -648,7 +648,8 @@ def _event_value(y, aux, nl, tl, geo, rules, event):
             if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
             if nl[L_FAMILY] == 1.0:
-                return _normal_mode_force(nl, M_UNLOAD, delta, rate, aux[A_DMAX])
+                # (a float: aux holds the modes as floats, and the other call site passes one)
+                return _normal_mode_force(nl, np.float64(M_UNLOAD), delta, rate, aux[A_DMAX])
             return viscoelastic_force(nl, delta, rate)
         return _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX])
     if event == 2:
@@ -736,8 +737,10 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     delta0 = kinematics(y, geo, rules)[0]
     aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_FAMILY] == 1.0 else M_VE)
     t = 0.0
-    _record(rec, 0, t, y, aux, nl, tl, geo, rules)
-    n, ne = 1, 0
+    # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
+    # and so would a counter's first, literal, value while the loop's types are being inferred)
+    _record(rec, np.int64(0), t, y, aux, nl, tl, geo, rules)
+    n, ne = np.int64(1), np.int64(0)
     ts = geo[G_TS]
     hstep = H_START * ts
     status = ST_NO_SEPARATION
@@ -791,18 +794,19 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         if best_event < 0 and aux[A_NMODE] == M_PRE:
             # a graze: the gap may close and open again inside one free-flight step (δ < 0 at both ends,
             # its maximum inside, where the approach δ̇ turns into recession)
-            r0 = _event_value(y, aux, nl, tl, geo, rules, 2)
-            r1 = _event_value(yn, aux, nl, tl, geo, rules, 2)
+            r0 = _event_value(y, aux, nl, tl, geo, rules, np.int64(2))
+            r1 = _event_value(yn, aux, nl, tl, geo, rules, np.int64(2))
             if r0 > 0.0 and r1 <= 0.0:
-                tm = _locate(y, aux, nl, tl, geo, rules, hstep, 2, -1, r0, r1)
+                tm = _locate(y, aux, nl, tl, geo, rules, hstep, np.int64(2), np.int64(-1), r0, r1)
                 ym, _ = _dp5_3(y, aux, nl, tl, geo, rules, tm * hstep)
                 dm = kinematics(ym, geo, rules)[0]
                 if dm > 0.0:
                     d0 = kinematics(y, geo, rules)[0]
-                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, 0, 1, d0, dm)
+                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, np.int64(0), np.int64(1), d0,
+                                              dm)
                     best_event, best_dir = 0, 1
         if best_event < 0 and tl[T_FAMILY] == SPRING and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
-                and _event_value(yn, aux, nl, tl, geo, rules, 5) > 0.0:
+                and _event_value(yn, aux, nl, tl, geo, rules, np.int64(5)) > 0.0:
             # a spring's stick that ends past the slip surface with no crossing seen: it began on the surface
             # (a slip→stick switch puts it there), dipped inside and came back out within the step — the trial
             # force reversing through 0, a kink of |F| that the state's error control does not see (TTIt at
@@ -1028,7 +1032,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     prev_vt = np.zeros(3)
     a_prev = 0.0
     dmax = 0.0
-    sliding = False
+    sliding = np.bool_(False)  # (not a literal: see adaptive_3d)
     family = tl[T_FAMILY]
     wall = geo[G_WALL] != 0.0
     touched = False
@@ -1130,7 +1134,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                         sliding = False
                     ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
             elif family != NONE:
-                ft = tangential_force(tl, nl, hist, vt, fabs, delta, False, aux[A_TREF:A_TREF + 3])
+                ft = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), aux[A_TREF:A_TREF + 3])
         else:
             hist[:] = 0.0
             lstar[:] = 0.0

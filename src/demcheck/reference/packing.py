@@ -176,13 +176,15 @@ def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, bas
     period = _period(box_lo, box_hi, periodic)
     new_start = np.empty(n + 1, np.int64)
     new_j = np.empty(max(nbj.shape[0], NB_PER_PARTICLE * n), np.int64)
-    need = _neighbour_rows(0, n, x, rad, skin, periodic, period, cells, new_start, new_j)
+    # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it)
+    zero = np.int64(0)
+    need = _neighbour_rows(zero, n, x, rad, skin, periodic, period, cells, new_start, new_j)
     if need > new_j.shape[0]:
         new_j = np.empty(need + need // 4, np.int64)
-        _neighbour_rows(0, n, x, rad, skin, periodic, period, cells, new_start, new_j)
+        _neighbour_rows(zero, n, x, rad, skin, periodic, period, cells, new_start, new_j)
     new_start[n] = need
     new_hist, new_dmax = _new_states(hist, dmax, base, new_j.shape[0])
-    _carry_states(0, n, new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base)
+    _carry_states(zero, n, new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base)
     return new_start, new_j, new_hist, new_dmax
 
 
@@ -236,9 +238,10 @@ def _law(laws_n, laws_t, p):
 
 
 @njit(cache=True)
-def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
+def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot, zero3):
     """The tangential force of every law but the updated spring family, into ``ft`` (history ``hist``, one
-    contact's row, updated in place)."""
+    contact's row, updated in place; ``zero3``: zeros, the slip direction these laws do not read — the caller's
+    buffer: a global array is a read-only type of its own, and numba would compile tangential_force for it)."""
     family = tl[T_FAMILY]
     if (family == LTH or family == ZZY or family == WALTON) and update:
         # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
@@ -262,19 +265,16 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot):
         if sliding:
             mapped = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
             hist[0], hist[1], hist[2] = mapped[0], mapped[1], mapped[2]
-        out = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, ZERO3)
+        out = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, zero3)
         ft[0], ft[1], ft[2] = out[0], out[1], out[2]
         return
-    out = tangential_force(tl, nl, hist, vt, fabs, delta, False, ZERO3)
+    out = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), zero3)
     if family == SPRING:  # setup: the trial force within the static limit, history untouched
         tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
         cap = tl[T_MU_S] * fabs
         if tn > cap and tn > 0.0:
             out = out * (cap / tn)
     ft[0], ft[1], ft[2] = out[0], out[1], out[2]
-
-
-ZERO3 = np.zeros(3)
 
 
 @njit(cache=True, inline="always")
@@ -320,11 +320,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     nbuf = np.empty(3)  # the laws that take arrays (all but the updated spring family)
     vtbuf = np.empty(3)
     ftbuf = np.empty(3)
+    zero3 = np.zeros(3)
     rot = rules[R_ROTATION]
     slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
     torque_radius = rules[R_TORQUE_ARM] == ARM_RADIUS
     record = records.shape[0] > 0
-    law = 0
+    law = np.int64(0)  # (not a literal: its first value would compile _law for it while the types are inferred)
     nl, tl = _law(laws_n, laws_t, law)
     for i in range(lo, hi):
         end = start[i + 1]
@@ -400,7 +401,8 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
             else:
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
                 vtbuf[0], vtbuf[1], vtbuf[2] = vt0, vt1, vt2
-                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r], abs(fn), dt, update, ftbuf, rot)
+                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r], abs(fn), dt, update, ftbuf, rot,
+                                  zero3)
                 ft0, ft1, ft2 = ftbuf[0], ftbuf[1], ftbuf[2]
             f0, f1, f2 = -fn * n0 + ft0, -fn * n1 + ft1, -fn * n2 + ft2
             # torques (b n) × F_t
@@ -496,8 +498,9 @@ def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo
     tq = np.zeros((n_p, 3))
     period = _period(box_lo, box_hi, periodic)
     records = _new_records(start) if steps == 0 else np.zeros((0, 3))  # records at the last step only
-    _contact_forces(0, n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj, hist, dmax,
-                    f, tq, f, tq, records, dt, False, rules)
+    # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it)
+    _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
+                    hist, dmax, f, tq, f, tq, records, dt, np.bool_(False), rules)
     return (0.4 * mass * rad * rad, period, skin, np.zeros(steps // ke_every + 1), np.zeros(2, np.int64), x.copy(),
             f, tq, start, nbj, hist, dmax, records)
 
@@ -539,8 +542,8 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
             records = _new_records(start)
         f[:, :] = 0.0
         tq[:, :] = 0.0
-        _contact_forces(0, n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj, hist,
-                        dmax, f, tq, f, tq, records, dt, True, rules)
+        _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start,
+                        nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules)
         e, e_rot = _kick(0, n_p, v, w, f, tq, mass, inertia, gravity, dt)
         if not _energy(ke, flags, step, ke_every, e, e_rot):
             break
@@ -641,7 +644,7 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
             _zero_rows(f, chunks[c], chunks[c + 1])
             _zero_rows(tq, chunks[c], chunks[c + 1])
             _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
-                            start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, True, rules)
+                            start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules)
         for b in prange(threads):
             _gather(chunks[b], chunks[b + 1], b, f_far, tq_far, f, tq)
             e_share[b], e_rot_share[b] = _kick(chunks[b], chunks[b + 1], v, w, f, tq, mass, inertia, gravity, dt)
