@@ -647,7 +647,15 @@ def incidence(case: Case) -> tuple[float, float]:
 def free_flight(case: Case) -> tuple[float, bool]:
     """(t, touches) of a collision's free flight (gravity included: both bodies fall alike, so only a wall
     sees it): the time until the surfaces first touch, touches = True (0 when they touch at the start); for
-    bodies that never touch, the time of their closest approach (0 when they only separate), False."""
+    bodies that never touch, the time of their closest approach (0 when they only separate), False. Kept in
+    ``case.prepared`` (loading the case computes it; the solvers read it again)."""
+    got = case.prepared.get("free_flight")
+    if got is None:
+        got = case.prepared["free_flight"] = _free_flight(case)
+    return got
+
+
+def _free_flight(case: Case) -> tuple[float, bool]:
     p0 = case.particles[0]
     x0, v0 = np.asarray(p0.position, float), np.asarray(p0.velocity, float)
     if case.walls:

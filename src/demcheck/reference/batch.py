@@ -37,7 +37,7 @@ def _point(case, method, dt):
     t_contact = time_to_contact(case)
     t_max = t_contact + 200.0 * t_c
     dt_given = bool(dt)
-    dt = dt or case.run.dt or auto_dt(case, model)
+    dt = dt or case.run.dt or auto_dt(case, model, t_c)
     if not (dt > 0) or not math.isfinite(dt):
         raise ConfigError("--dt", dt, "must be > 0 (s) and finite")
     capacity = verlet_capacity(case, dt, dt_given, t_contact, t_c, t_max, ROW_BYTES_1D)
@@ -54,9 +54,12 @@ def _point(case, method, dt):
                  m0 + m1]
     frame += map(float, case.particles[0].angular_velocity)
     args = (model.normal_law.array(), model.pair.m_eff, geo.an, geo.delta0, geo.rate0, dt, t_max, capacity)
-    judge = (dt, t_c, health.smallest_radius(case), health.impact_energy(case, model),
+    judge = (dt, t_c, health.smallest_radius(case), lambda: health.impact_energy(case, model),
              model.tangential_law.passive, model.params.get("m_eff"))
     return args, frame, judge
+
+
+_NO_METRICS = dict.fromkeys(NORMAL_METRICS, math.nan)
 
 
 def _row(o, judge) -> dict:
@@ -64,7 +67,7 @@ def _row(o, judge) -> dict:
     metrics.compute and outcome.judge give them for its Result."""
     dt, t_c, radius, impact_energy, passive, m_eff = judge
     nan = math.nan
-    out = {name: nan for name in NORMAL_METRICS}
+    out = dict(_NO_METRICS)
     if o[K.O_KS] >= 0:
         t_s, v_in, t_e, v_out = o[K.O_TS], o[K.O_VIN], o[K.O_TE], o[K.O_VOUT]
         out["contact_time"] = t_e - t_s

@@ -65,11 +65,12 @@ def reading(t, d, r, f):
     return k_bad, inside, d_max, d[n - 1], t[n - 1]
 
 
-def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: int, impact_energy: float,
+def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: int, impact_energy,
           passive: bool, gained) -> tuple[str, str]:
     """(status, why) from a series' ``reading`` and ``t`` of its bad row (module docstring; the first rule
     that fails wins); ``gained()`` is the energy the collision created (−energy_dissipated), read only when the
-    energy rule is reached."""
+    energy rule is reached, and ``impact_energy()`` the energy it is measured in, read only when some was
+    created."""
     k_bad, inside, d_max, d_last, t_last, t_bad = read
     if k_bad >= 0:
         return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
@@ -78,12 +79,13 @@ def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: i
                               f"resolve the collision (at least {min_steps} are needed)")
     if inside == 0:
         return "no-contact", "the bodies never touched"
-    e_in = impact_energy
-    if passive and e_in > 0:
+    if passive:
         energy = gained()
-        if math.isfinite(energy) and energy > ENERGY_GAIN_TOLERANCE * e_in:
-            return "unstable", (f"the collision created {energy / e_in:.3g} of the impact energy ({_steps(dt, t_c)}): "
-                                "the scheme is unstable at this time step")
+        if math.isfinite(energy) and energy > 0.0:  # (none created: the rule holds whatever the impact energy)
+            e_in = impact_energy()
+            if e_in > 0 and energy > ENERGY_GAIN_TOLERANCE * e_in:
+                return "unstable", (f"the collision created {energy / e_in:.3g} of the impact energy "
+                                    f"({_steps(dt, t_c)}): the scheme is unstable at this time step")
     out = overlap_rule(float(d_max), radius)
     if out is not None:
         return out
@@ -105,7 +107,7 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
     if e_in is None:
         e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
     t_bad = float(t[read[0]]) if read[0] >= 0 else math.nan
-    return rules((*read, t_bad), result.dt, t_c, radius or result.meta.get("radius0"), min_steps, e_in,
+    return rules((*read, t_bad), result.dt, t_c, radius or result.meta.get("radius0"), min_steps, lambda: e_in,
                  passive, lambda: -result.metrics()["energy_dissipated"])
 
 

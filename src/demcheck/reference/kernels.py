@@ -355,6 +355,13 @@ def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
     D = np.empty(capacity)
     R = np.empty(capacity)
     F = np.empty(capacity)
+    status, n = _verlet_into(law, m, an, d_init, r_init, dt, t_max, capacity, np.bool_(stop), T, D, R, F)
+    return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()
+
+
+@njit(cache=True)
+def _verlet_into(law, m, an, d_init, r_init, dt, t_max, capacity, stop, T, D, R, F):
+    """``verlet_normal``'s run into the given arrays (at least ``capacity`` long): (status, n)."""
     d, r = d_init, r_init
     dmax = 0.0
     f = normal_force(law, d, r, max(d, 0.0))  # setup: no history update
@@ -394,7 +401,7 @@ def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
                 break
     else:
         status = ST_STEPS
-    return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()
+    return status, n
 
 
 # ----------------------------------------------------------------------------- many collisions at once
@@ -449,9 +456,12 @@ def verlet_normal_many(laws, m, an, d_init, r_init, dt, t_max, capacity, frames)
     its series read where they are made (metrics.stepped, health.reading, the tangential metrics) and dropped:
     an (N, O_SIZE) array of O_* columns, NaN where a reading has no value."""
     out = np.full((laws.shape[0], O_SIZE), np.nan)
+    size = capacity.max() if capacity.shape[0] else 0
+    T_, D_, R_, F_ = np.empty(size), np.empty(size), np.empty(size), np.empty(size)  # one record for every point
     for i in range(laws.shape[0]):
-        status, n, T, D, R, F = verlet_normal(laws[i], m[i], an[i], d_init[i], r_init[i], dt[i], t_max[i],
-                                              capacity[i])
+        status, n = _verlet_into(laws[i], m[i], an[i], d_init[i], r_init[i], dt[i], t_max[i], capacity[i],
+                                 np.bool_(True), T_, D_, R_, F_)
+        T, D, R, F = T_[:n], D_[:n], R_[:n], F_[:n]
         row = out[i]
         row[O_STATUS], row[O_STEPS] = status, n
         (k_s, row[O_TS], row[O_VIN], k_e, row[O_TE], row[O_VOUT], k_f, row[O_TF], row[O_DMAX],

@@ -69,10 +69,12 @@ def case_speed(case: Case) -> float:
     return float(np.linalg.norm(v))
 
 
-def auto_dt(case: Case, model: ResolvedModel | None = None) -> float:
-    """dt = contact time / steps_per_contact (the elastic contact time of the law at the impact speed)."""
-    model = model or resolve(case)
-    return characteristic_time(model) / case.run.steps_per_contact
+def auto_dt(case: Case, model: ResolvedModel | None = None, t_c: float | None = None) -> float:
+    """dt = contact time / steps_per_contact (the elastic contact time of the law at the impact speed; ``t_c``:
+    that time, when the caller has it)."""
+    if t_c is None:
+        t_c = characteristic_time(model or resolve(case))
+    return t_c / case.run.steps_per_contact
 
 
 def judge(result: Result, case: Case, model: ResolvedModel) -> Result:
