@@ -282,6 +282,7 @@ def test_pack_in_lammps_writes_the_dumped_forces(tmp_path):
     f = meshio.read(tmp / "vtk" / "particles.vtu").point_data["force"]
     assert np.all(np.isfinite(f)) and np.abs(f).max() > 0
     assert out["contacts"] == len(pd.read_csv(tmp / "csv" / "contacts.csv"))
+    assert out["mpi"] == 1 and out["source"] == "lammps"  # the ranks it ran on, as the reference's JSON its threads
 
 
 @pytest.fixture(scope="module")

@@ -838,8 +838,8 @@ def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, x
         m = packing_metrics.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
                        forces=run.contacts["fn"].to_numpy(), overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
-        out = {"case": case.name, "source": engine, "engine_version": run.version, "particles": len(run.table),
-               "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
+        out = {"case": case.name, "source": engine, "engine_version": run.version, "mpi": mpi,
+               "particles": len(run.table), "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
         x, rad, contacts = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), run.contacts
         settled = packing_output.from_engine(case, run)
     if csv_dir:
