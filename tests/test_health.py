@@ -726,3 +726,22 @@ def test_a_contact_that_outlasts_the_step_bound_is_no_separation_and_not_cached(
     res = EC.collide(glass_case("hertz", {}), "lammps", cache=cache)
     assert res.status == "no-separation", res.message
     assert not list((tmp_path / "cache").rglob("*.npz"))  # an unhealthy run is never cached
+
+
+def test_the_energy_rule_reads_the_impact_energy_only_when_it_could_fail():
+    """health.rules: the impact energy is at least its floor (½ m̄ v²), so a collision that created no more than
+    ENERGY_GAIN_TOLERANCE of the floor passes without computing it; one that created more is judged on it."""
+    from demcheck.reference import health
+
+    read = (-1, 50, 1e-6, -1e-7, 1e-4, float("nan"))  # resolved, touched, in range, separated
+
+    def never():
+        raise AssertionError("the impact energy was read")
+
+    args = (read, 1e-7, 1e-5, 1e-3, 5)
+    assert health.rules(*args, never, True, lambda: 0.009, floor=1.0) == ("ok", "")
+    assert health.rules(*args, never, True, lambda: -1.0, floor=0.0) == ("ok", "")
+    assert health.rules(*args, never, False, lambda: 5.0, floor=1.0) == ("ok", "")  # not passive: no rule
+    assert health.rules(*args, lambda: 2.0, True, lambda: 0.019, floor=1.0) == ("ok", "")  # 0.95 % of 2
+    status, why = health.rules(*args, lambda: 1.5, True, lambda: 0.02, floor=1.0)
+    assert status == "unstable" and why.startswith("the collision created 0.0133 of the impact energy")

@@ -55,7 +55,7 @@ def _point(case, method, dt):
     frame += map(float, case.particles[0].angular_velocity)
     args = (model.normal_law.array(), model.pair.m_eff, geo.an, geo.delta0, geo.rate0, dt, t_max, capacity)
     judge = (dt, t_c, health.smallest_radius(case), lambda: health.impact_energy(case, model),
-             model.tangential_law.passive, model.params.get("m_eff"))
+             health.impact_energy_floor(model), model.tangential_law.passive, model.params.get("m_eff"))
     return args, frame, judge
 
 
@@ -65,7 +65,7 @@ _NO_METRICS = dict.fromkeys(NORMAL_METRICS, math.nan)
 def _row(o, judge) -> dict:
     """A batched point's metrics, status and message from its output row ``o`` (kernels.O_*), as
     metrics.compute and outcome.judge give them for its Result."""
-    dt, t_c, radius, impact_energy, passive, m_eff = judge
+    dt, t_c, radius, impact_energy, floor, passive, m_eff = judge
     nan = math.nan
     out = dict(_NO_METRICS)
     if o[K.O_KS] >= 0:
@@ -83,7 +83,7 @@ def _row(o, judge) -> dict:
     if status != "too-many-steps":
         read = (int(o[K.O_BAD]), int(o[K.O_INSIDE]), o[K.O_DALL], o[K.O_DLAST], o[K.O_TLAST], o[K.O_TBAD])
         rule, why = health.rules(read, dt, t_c, radius, health.MIN_STEPS, impact_energy, passive,
-                                 lambda: -out["energy_dissipated"])
+                                 lambda: -out["energy_dissipated"], floor)
         if rule != "ok":
             status, message = rule, why
     return {**out, "status": status, "message": message}

@@ -66,11 +66,11 @@ def reading(t, d, r, f):
 
 
 def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: int, impact_energy,
-          passive: bool, gained) -> tuple[str, str]:
+          passive: bool, gained, floor: float = 0.0) -> tuple[str, str]:
     """(status, why) from a series' ``reading`` and ``t`` of its bad row (module docstring; the first rule
     that fails wins); ``gained()`` is the energy the collision created (−energy_dissipated), read only when the
-    energy rule is reached, and ``impact_energy()`` the energy it is measured in, read only when some was
-    created."""
+    energy rule is reached, and ``impact_energy()`` the energy it is measured in, at least ``floor``: read only
+    when the collision created more than the rule allows of the floor."""
     k_bad, inside, d_max, d_last, t_last, t_bad = read
     if k_bad >= 0:
         return "failed", f"the state became NaN or infinite at t = {t_bad:.3g} s ({_steps(dt, t_c)})"
@@ -81,7 +81,7 @@ def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: i
         return "no-contact", "the bodies never touched"
     if passive:
         energy = gained()
-        if math.isfinite(energy) and energy > 0.0:  # (none created: the rule holds whatever the impact energy)
+        if math.isfinite(energy) and energy > ENERGY_GAIN_TOLERANCE * floor:  # (else it holds: e_in ≥ floor ≥ 0)
             e_in = impact_energy()
             if e_in > 0 and energy > ENERGY_GAIN_TOLERANCE * e_in:
                 return "unstable", (f"the collision created {energy / e_in:.3g} of the impact energy "
@@ -108,7 +108,7 @@ def health(result, t_c: float, radius: float | None = None, min_steps: int = MIN
         e_in = 0.5 * result.params.get("m_eff", 0.0) * result.params.get("impact_speed", 0.0) ** 2
     t_bad = float(t[read[0]]) if read[0] >= 0 else math.nan
     return rules((*read, t_bad), result.dt, t_c, radius or result.meta.get("radius0"), min_steps, lambda: e_in,
-                 passive, lambda: -result.metrics()["energy_dissipated"])
+                 passive, lambda: -result.metrics()["energy_dissipated"], max(e_in, 0.0))
 
 
 def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, str]:
@@ -149,4 +149,9 @@ def impact_energy(case: Case, model) -> float:
     for i, p in enumerate(case.particles):
         w = np.asarray(p.angular_velocity, float)
         e += 0.5 * 0.4 * case.mass(i) * p.radius**2 * float(w @ w)
-    return max(e, 0.5 * model.pair.m_eff * model.pair.impact_speed**2)
+    return max(e, impact_energy_floor(model))
+
+
+def impact_energy_floor(model) -> float:
+    """½ m̄ v² of the normal impact: the least :func:`impact_energy` is."""
+    return 0.5 * model.pair.m_eff * model.pair.impact_speed**2
