@@ -31,15 +31,18 @@ def test_the_command_lists_its_scenes():
 
 
 SPECIALISATIONS = r"""
-import json
+import importlib, json, pkgutil
 from numba.core.registry import CPUDispatcher
-from demcheck import metrics
+import demcheck.reference
 from demcheck.comparisons.warmup import warm
-from demcheck.reference import health, kernels, kernels3d, packing
 warm()
-print(json.dumps({f"{m.__name__}.{k}": len(v.signatures) for m in (metrics, health, kernels, kernels3d, packing)
-                  for k, v in vars(m).items() if isinstance(v, CPUDispatcher) and v.__module__ == m.__name__
-                  and len(v.signatures) > 1}))
+mods = [importlib.import_module(f"demcheck.reference.{m.name}") for m in pkgutil.iter_modules(demcheck.reference.__path__)]
+seen = {}
+for m in [importlib.import_module("demcheck.metrics"), *mods]:  # every compiled function, wherever it is imported
+    for v in vars(m).values():
+        if isinstance(v, CPUDispatcher):
+            seen[f"{v.py_func.__module__}.{v.py_func.__name__}"] = len(v.signatures)
+print(json.dumps({k: n for k, n in seen.items() if n > 1}))
 """
 
 

@@ -173,7 +173,8 @@ def collide_many(cases: Iterable, method: str | None = None, dt: float | None = 
 
     if method not in (None, "adaptive", "verlet"):
         raise ConfigError("method", method, "must be adaptive or verlet (the reference's)")
-    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+    if dt is not None and (isinstance(dt, bool) or not (isinstance(dt, (int, float)) and math.isfinite(dt)
+                                                        and dt > 0)):
         raise ConfigError("dt", dt, "must be a number > 0 (s)")
     loaded = [load(c) for c in cases]
     return pd.DataFrame(run(loaded, method, dt))

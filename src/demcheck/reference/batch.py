@@ -108,9 +108,10 @@ def collide_many(cases, method: str | None = None, dt: float | None = None) -> l
         except DemcheckError as exc:
             rows[i] = {"status": f"error: {exc}", "message": str(exc)}
     if batch:
-        args = [np.asarray(col) for col in zip(*(p[0] for _, p in batch))]
-        args[0] = np.ascontiguousarray(np.stack(args[0]))
-        args[7] = args[7].astype(np.int64)
+        cols = list(zip(*(p[0] for _, p in batch)))
+        # the kernel's one specialisation: float64 laws and scalars (a dt given as an int too), int64 capacities
+        args = [np.ascontiguousarray(np.stack(cols[0]), dtype=np.float64),
+                *(np.asarray(c, dtype=np.float64) for c in cols[1:7]), np.asarray(cols[7], dtype=np.int64)]
         out = K.verlet_normal_many(*args, np.array([p[1] for _, p in batch], dtype=np.float64))
         for (i, point), o in zip(batch, out.tolist()):
             rows[i] = _row(o, point[2])

@@ -81,7 +81,9 @@ def rules(read: tuple, dt: float, t_c: float, radius: float | None, min_steps: i
         return "no-contact", "the bodies never touched"
     if passive:
         energy = gained()
-        if math.isfinite(energy) and energy > ENERGY_GAIN_TOLERANCE * floor:  # (else it holds: e_in ≥ floor ≥ 0)
+        # (it holds for none created, and below the floor's share: e_in ≥ floor ≥ 0 — a floor that is not a positive
+        # number proves nothing)
+        if math.isfinite(energy) and energy > 0.0 and (not floor > 0.0 or energy > ENERGY_GAIN_TOLERANCE * floor):
             e_in = impact_energy()
             if e_in > 0 and energy > ENERGY_GAIN_TOLERANCE * e_in:
                 return "unstable", (f"the collision created {energy / e_in:.3g} of the impact energy "
