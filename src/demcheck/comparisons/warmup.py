@@ -13,7 +13,7 @@ With ``jobs`` > 1 the kernels compile side by side in as many processes (numba c
 a process): one task per entry kernel (a wall scene and a pair scene share their kernel, so they are one task),
 the longest first. Two processes that compile different specialisations of one function at once could write
 its cache index over each other's (numba's index is not safe against that), so the functions compiled for two
-argument types (``the normal laws: ``_shared``) are compiled here first; the tasks then only load them.
+argument types (the normal laws: ``_shared``) are compiled here first; the tasks then only load them.
 """
 
 from __future__ import annotations

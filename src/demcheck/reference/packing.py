@@ -176,7 +176,7 @@ def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, bas
     period = _period(box_lo, box_hi, periodic)
     new_start = np.empty(n + 1, np.int64)
     new_j = np.empty(max(nbj.shape[0], NB_PER_PARTICLE * n), np.int64)
-    # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it)
+    # (np.int64: a literal argument would make numba compile a specialisation of the callee for it)
     zero = np.int64(0)
     need = _neighbour_rows(zero, n, x, rad, skin, periodic, period, cells, new_start, new_j)
     if need > new_j.shape[0]:
