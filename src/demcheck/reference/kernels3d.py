@@ -518,7 +518,10 @@ def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
     return tl[T_MU_K] * (-3.0 * fsign * fn + 4.0 * fa - fb) / (2.0 * s)
 
 
-@njit(cache=True)
+# _walton_truncate, _onto_surface and _settle are inlined into adaptive_3d (one or two call sites each): a function
+# numba compiles on its own is a library that links, and optimises once more, the whole right-hand side it calls;
+# inlined, the 3-D solver compiles in ~3/4 of the time (docs/performance.md, "Cold start")
+@njit(cache=True, inline="always")
 def _walton_truncate(y, aux, nl, tl, geo, rules):
     """Walton's stored load back onto the Coulomb limit where it lies above it (the verlet method's truncation),
     and onto it where it rides within WALTON_NEAR_LIMIT below a falling limit (rhs): a load that close to a
@@ -540,7 +543,7 @@ def _walton_truncate(y, aux, nl, tl, geo, rules):
             y[18:21] = xi * (cap / hn)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _onto_surface(y, aux, nl, tl, geo, rules):
     """A slipping spring's history back onto its slip surface after each step. While slipping it follows the
     return map's rate (rhs) and is not error-controlled (the map is unbounded where Kt ∝ √δ → 0 under a
@@ -562,7 +565,7 @@ def _onto_surface(y, aux, nl, tl, geo, rules):
     return False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _settle(y, aux, nl, tl, geo, rules):
     """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
     is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
