@@ -87,6 +87,20 @@ def stepped(t, d, r, f):
     return k_s, t_s, v_in, k_e, t_e, v_out, k_f, t_f, _window_max(d, k_s, top), _window_max(f, k_s, top)
 
 
+def from_stepped(reading: tuple) -> dict:
+    """The normal metrics of a contact ``stepped`` found (k_s ≥ 0), but the energy dissipated (``rate_energy``):
+    for a Result's series (``compute``) and a batched point's (reference/batch.py) alike."""
+    k_s, t_s, v_in, k_e, t_e, v_out, k_f, t_f, d_max, f_max = reading
+    contact_time = t_e - t_s
+    return {"restitution": -v_out / v_in if v_in else math.nan, "contact_time": contact_time,
+            "force_contact_time": t_f - t_s if k_f >= 0 else contact_time, "max_overlap": d_max, "peak_force": f_max}
+
+
+def rate_energy(m_eff: float, v_in: float, v_out: float) -> float:
+    """The energy dissipated from the approach rates at contact start and end: ½ m̄ (v_in² − v_out²)."""
+    return 0.5 * m_eff * (v_in * v_in - v_out * v_out)
+
+
 def f64(x) -> np.ndarray:
     """A column as the compiled readers take it: float64, contiguous and writeable (one specialisation)."""
     return np.require(np.asarray(x, dtype=np.float64), requirements=("C", "W"))
@@ -101,13 +115,11 @@ def compute(result) -> dict:
     t, d, r, f = (f64(c[k]) for k in ("t", "delta", "delta_dot", "fn"))
     ev = result.table("events")
     if not ev or not len(ev["event"]):
-        k_s, t_s, v_in, k_e, t_e, v_out, k_f, t_f, d_max, f_max = stepped(t, d, r, f)
+        read = stepped(t, d, r, f)
+        k_s, t_s, v_in, k_e, t_e, v_out = read[:6]
         if k_s < 0:
             return out
-        out["contact_time"] = t_e - t_s
-        out["restitution"] = -v_out / v_in if v_in else nan
-        out["force_contact_time"] = t_f - t_s if k_f >= 0 else out["contact_time"]
-        out["max_overlap"], out["peak_force"] = d_max, f_max
+        out.update(from_stepped(read))
         return _rest(result, c, out, t, t_s, k_s, False, t_e, k_e, False, v_in, v_out)
     start, end = _event(ev, "contact_start"), _event(ev, "contact_end")
 
@@ -154,7 +166,7 @@ def _rest(result, c, out: dict, t, t_s, k_s, exact_start: bool, t_e, k_e, exact_
     else:
         m_eff = result.params.get("m_eff")
         if m_eff is not None:
-            out["energy_dissipated"] = 0.5 * m_eff * (v_in * v_in - v_out * v_out)
+            out["energy_dissipated"] = rate_energy(m_eff, v_in, v_out)
     if "vrx" in c:
         out.update(tangential(c, k_in, k_out))
     return out

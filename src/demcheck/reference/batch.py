@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from ..errors import ConfigError, DemcheckError
-from ..metrics import NORMAL_METRICS
+from ..metrics import NORMAL_METRICS, from_stepped, rate_energy
 from . import health, kernels as K
 from .collision import Geometry1D, collide, is_one_dimensional
 from .model import characteristic_time, resolve
@@ -66,16 +66,11 @@ def _row(o, judge) -> dict:
     """A batched point's metrics, status and message from its output row ``o`` (kernels.O_*), as
     metrics.compute and outcome.judge give them for its Result."""
     dt, t_c, radius, impact_energy, floor, passive, m_eff = judge
-    nan = math.nan
     out = dict(_NO_METRICS)
     if o[K.O_KS] >= 0:
-        t_s, v_in, t_e, v_out = o[K.O_TS], o[K.O_VIN], o[K.O_TE], o[K.O_VOUT]
-        out["contact_time"] = t_e - t_s
-        out["restitution"] = -v_out / v_in if v_in else nan
-        out["force_contact_time"] = o[K.O_TF] - t_s if o[K.O_KF] >= 0 else out["contact_time"]
-        out["max_overlap"], out["peak_force"] = o[K.O_DMAX], o[K.O_FMAX]
+        out.update(from_stepped(o[K.O_KS:K.O_FMAX + 1]))  # (the O_* columns from O_KS hold stepped's reading)
         if m_eff is not None:
-            out["energy_dissipated"] = 0.5 * m_eff * (v_in * v_in - v_out * v_out)
+            out["energy_dissipated"] = rate_energy(m_eff, o[K.O_VIN], o[K.O_VOUT])
         out.update({"tangential_restitution": o[K.O_TR], "rebound_angle": o[K.O_ANGLE],
                     "rebound_angular_velocity": o[K.O_SPIN]})
     status = STATUS[int(o[K.O_STATUS])]
