@@ -329,12 +329,12 @@ def test_polydisperse_species_pairs_run_in_the_reference_and_lammps():
 
 
 def test_default_suite_leaves_the_optin_cases_out():
-    from demcheck.cli import CASES_DIR, _case_files
+    from demcheck.resources import case_files, cases_dir
 
-    files = _case_files([])
+    files = case_files([])
     assert any(f.parent.name == "packing" for f in files)
     assert not any("optin" in f.parts for f in files)
-    assert _case_files([str(CASES_DIR / "optin")])  # named explicitly, they run
+    assert case_files([str(cases_dir() / "optin")])  # named explicitly, they run
 
 
 def test_ks_distance_and_its_critical_value():

@@ -16,25 +16,40 @@ def reference_fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
-def _numba_cache_dir() -> None:
-    """Numba's on-disk cache keys a compiled function by its own file's timestamp only: a kernel that
-    inlines a function of another module would be served stale after that module changed (seen here: the
-    suite passed on stale 3-D kernels while fresh ones stalled; docs/performance.md). So the kernels cache
-    under a directory named by the fingerprint of the whole reference package: any change to any kernel
-    source starts afresh.
-    Respects a NUMBA_CACHE_DIR set by the user; skipped where the directory cannot be made."""
-    if "NUMBA_CACHE_DIR" in _os.environ:
-        return
-    root = _Path(_os.environ.get("XDG_CACHE_HOME") or _Path.home() / ".cache") / "demcheck" / "numba"
-    where = root / reference_fingerprint()
+def _numba_cache_dir() -> bool:
+    """Where the compiled kernels are cached; False when nowhere writable (they compile in memory, each run).
+
+    Numba's on-disk cache keys a compiled function by its own file's timestamp only: a kernel that inlines a
+    function of another module would be served stale after that module changed (seen here: the suite passed on
+    stale 3-D kernels while fresh ones stalled; docs/performance.md). So the kernels cache under a directory
+    named by the fingerprint of the whole reference package (``$XDG_CACHE_HOME/demcheck/numba/<fingerprint>``,
+    ``~/.cache`` by default): any change to any kernel source starts afresh. A NUMBA_CACHE_DIR set by the user
+    is used as it is. Never the install tree: where no cache directory takes a file (a read-only home, a
+    locked-down container), the kernels are compiled without a cache and one warning line says so."""
+    import sys
+    import tempfile
+
+    given = _os.environ.get("NUMBA_CACHE_DIR")
+    if given:
+        where = _Path(given)
+    else:
+        root = _Path(_os.environ.get("XDG_CACHE_HOME") or _Path.home() / ".cache") / "demcheck" / "numba"
+        where = root / reference_fingerprint()
     try:
         where.mkdir(parents=True, exist_ok=True)
-    except OSError:
-        return
+        with tempfile.TemporaryFile(dir=where):
+            pass
+    except OSError as exc:
+        sys.stderr.write(f"demcheck: warning: no writable kernel cache ({where}: {exc.strerror or exc}); the kernels "
+                         "compile in memory on every run (set XDG_CACHE_HOME or NUMBA_CACHE_DIR to a writable "
+                         "directory)\n")
+        return False
     _os.environ["NUMBA_CACHE_DIR"] = str(where)
+    return True
 
 
-_numba_cache_dir()
+# the compiled kernels' ``cache=`` (``@njit(cache=KERNEL_CACHE)``): never numba's default of the source's folder
+KERNEL_CACHE = _numba_cache_dir()
 
 
 # the Python API (docs/api.md), looked up on first use: ``import demcheck`` loads no solver, engine or pandas

@@ -264,19 +264,9 @@ def _engines(engines, registered) -> tuple[str, ...]:
 
 
 def _case_files(paths) -> list[Path]:
-    if isinstance(paths, (str, Path)):
-        paths = [paths]
-    files = []
-    for p in map(Path, paths):
-        if p.is_dir():
-            files += sorted(p.rglob("*.toml"))
-        elif p.is_file():
-            files.append(p)
-        else:
-            raise ConfigError("paths", str(p), "no such case file or directory")
-    if not files:
-        raise ConfigError("paths", [str(p) for p in paths], "holds no case file (*.toml)")
-    return files
+    from .resources import case_files
+
+    return case_files(paths, "paths")
 
 
 def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:

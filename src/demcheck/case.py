@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from . import resources
 from .errors import ConfigError
 
 KINDS = ("collision", "packing")
@@ -128,9 +129,7 @@ class Case:
 
 def _read(path: str | Path) -> dict:
     """A case file's raw table (its name defaults to the file's)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError("CASE", str(path), "no such case file")
+    path = resources.case_path(path)  # a path as given, else a shipped case by its name
     try:
         raw = tomllib.loads(path.read_bytes().decode("utf-8"))
     except UnicodeDecodeError as exc:

@@ -15,9 +15,9 @@ import click
 
 from . import __version__
 from .errors import ConfigError, DemcheckError
+from . import resources
 from .io import number as as_text, plain
 
-CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
 
 
 def _engine_names() -> list[str]:
@@ -611,6 +611,50 @@ def warmup(jobs):
     click.echo(f"  {'total (wall)':32s} {time.perf_counter() - t:8.2f} s")
 
 
+# ----------------------------------------------------------------------------- cases
+
+
+@cli.command("cases")
+@click.argument("name", required=False, metavar="[NAME]")
+@click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
+def cases_command(name, as_json):
+    """The case files shipped with demcheck, by name and folder: the default suite (what `demcheck verify` runs),
+    packing/, benchmarks/ (`demcheck validate`) and optin/ (long cases, run by naming them). Every command takes a
+    shipped case by its name (`demcheck collide glass-pair`). With NAME: that file's text, to copy and edit
+    (`demcheck cases glass-pair > my-case.toml`)."""
+    import tomllib
+
+    if name is not None:
+        path = resources.case_path(name, "NAME")
+        if as_json:
+            emit_json({"name": path.stem, "path": str(path), "text": path.read_text()})
+        else:
+            click.echo(path.read_text(), nl=False)
+        return
+    root = resources.cases_dir()
+    rows = []
+    for stem, path in resources.shipped_cases().items():
+        raw = tomllib.loads(path.read_text())
+        contact = raw.get("contact") or {}
+        folder = path.parent.relative_to(root).as_posix()
+        rows.append({"name": stem, "folder": "" if folder == "." else folder, "kind": raw.get("kind", "collision"),
+                     "normal": contact.get("normal"), "tangential": contact.get("tangential", "none"),
+                     "in_default_suite": not resources.NAMED_ONLY & set(path.relative_to(root).parts),
+                     "path": str(path)})
+    if as_json:
+        emit_json({"root": str(root), "cases": rows})
+        return
+    click.echo(f"shipped case files ({len(rows)}), in {root}:")
+    for folder in dict.fromkeys(r["folder"] for r in rows):
+        group = [r for r in rows if r["folder"] == folder]
+        what = "in the default suite" if group[0]["in_default_suite"] else "run by naming them"
+        click.echo(f"\n{folder or '.'}/ ({len(group)}, {what})")
+        for r in group:
+            law = r["kind"] if r["kind"] == "packing" else f"{r['normal']} + {r['tangential']}"
+            click.echo(f"  {r['name']:44s} {law}")
+    click.echo("\nrun one by its name (demcheck collide glass-pair); copy one: demcheck cases NAME > my-case.toml")
+
+
 # ----------------------------------------------------------------------------- verify
 
 
@@ -742,7 +786,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
     check_output("DEMCHECK_CACHE", default_dir(), directory=True)
     opts = Options(engines=tuple(names), jobs=jobs, scheduler=scheduler, cache=Cache(refresh=no_cache), timeout=timeout)
     try:
-        summary = run(name, CASES_DIR / "benchmarks", Path(report_dir), opts, quiet=as_json,
+        summary = run(name, resources.cases_dir() / "benchmarks", Path(report_dir), opts, quiet=as_json,
                       junit=Path(junit) if junit else None, argv=["demcheck", "validate", *sys.argv[2:]], quick=quick)
     except KeyboardInterrupt as exc:
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
@@ -1127,21 +1171,7 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
 
 
 def _case_files(paths) -> list[Path]:
-    if not paths:
-        paths = [str(CASES_DIR)]
-    files: list[Path] = []
-    for p in map(Path, paths):
-        if p.is_dir():
-            # directories named optin hold the long cases (the large packings), and benchmarks the published
-            # benchmarks `demcheck validate` runs: run them by naming them
-            files.extend(sorted(f for f in p.rglob("*.toml") if not {"optin", "benchmarks"} & set(f.relative_to(p).parts)))
-        elif p.is_file():
-            files.append(p)
-        else:
-            raise ConfigError("CASE", str(p), "no such case file or directory")
-    if not files:
-        raise ConfigError("CASE", ", ".join(map(str, paths)), "no *.toml case files found")
-    return files
+    return resources.case_files(paths)
 
 
 # ----------------------------------------------------------------------------- entry point

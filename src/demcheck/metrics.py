@@ -15,6 +15,8 @@ import math
 import numpy as np
 from numba import njit
 
+from . import KERNEL_CACHE
+
 NORMAL_METRICS = ("restitution", "contact_time", "force_contact_time", "max_overlap", "peak_force",
                   "energy_dissipated")
 TANGENTIAL_METRICS = ("tangential_restitution", "rebound_angle", "rebound_angular_velocity")
@@ -28,7 +30,7 @@ def _event(events, name):
     return None if not rows.size else {k: v[rows[0]] for k, v in events.items()}
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _crossing(t, y, k):
     """Time where y crosses 0 between samples k−1 and k (linear)."""
     y0, y1 = y[k - 1], y[k]
@@ -37,7 +39,7 @@ def _crossing(t, y, k):
     return t[k - 1] + (t[k] - t[k - 1]) * (y0 / (y0 - y1))
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _window_max(y, lo, hi):
     """max(y[lo:hi]) as numpy's: NaN when any is NaN."""
     m = y[lo]
@@ -49,7 +51,7 @@ def _window_max(y, lo, hi):
     return m
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def stepped(t, d, r, f):
     """The contact of a time series without events (t, δ, δ̇, Fn; float64): (k_s, t_s, v_in, k_e, t_e, v_out,
     k_f, t_f, δ_max, F_max). The contact starts at the first row k_s with δ > 0 (k_s = −1: never; t_s by linear

@@ -33,7 +33,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-DATA = Path(__file__).resolve().parents[1] / "data" / "benchmarks"
+from .. import resources
+
+DATA = resources.data_dir() / "benchmarks"
 LINK = "latest-validate"  # <report>/latest is verify's
 MEETS, MISSES, NO_DATA = "meets", "misses", "no data"
 

@@ -28,6 +28,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .. import resources
+
 AGREE = "agree"
 EXPECTED = "differs as expected"
 UNEXPECTED = "differs unexpectedly"
@@ -37,7 +39,7 @@ FAILED = "failed"
 VERDICTS = (AGREE, EXPECTED, UNEXPECTED, NOT_EXPRESSIBLE, MISSING, FAILED)
 FAILING = (UNEXPECTED, FAILED)
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = resources.data_dir()
 
 
 @dataclass(frozen=True)

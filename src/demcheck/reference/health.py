@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import KERNEL_CACHE
 from ..case import Case
 from ..metrics import f64
 
@@ -46,7 +47,7 @@ def _steps(dt: float, t_c: float) -> str:
     return f"dt = {dt:.3g} s, {t_c / dt:.3g} steps per elastic contact time of {t_c:.3g} s"
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def reading(t, d, r, f):
     """What the rules read off a time series (t, δ, δ̇, Fn; float64), compiled: (k_bad, inside, δ_max, δ_last,
     t_last) — the first row whose state (δ, δ̇, Fn) is NaN or infinite (−1: none), the rows with δ > 0, the

@@ -27,43 +27,45 @@ import math
 
 from numba import njit
 
+from .. import KERNEL_CACHE
+
 # ----------------------------------------------------------------------------- Dormand–Prince 5(4)
 # (the tableau's fractions written as the stages use them: a stage's state must not depend on which solver
 # computes it, to the last bit)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def stage2(y, h, k1):
     return y + h * (k1 / 5)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def stage3(y, h, k1, k2):
     return y + h * (3 / 40 * k1 + 9 / 40 * k2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def stage4(y, h, k1, k2, k3):
     return y + h * (44 / 45 * k1 - 56 / 15 * k2 + 32 / 9 * k3)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def stage5(y, h, k1, k2, k3, k4):
     return y + h * (19372 / 6561 * k1 - 25360 / 2187 * k2 + 64448 / 6561 * k3 - 212 / 729 * k4)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def stage6(y, h, k1, k2, k3, k4, k5):
     return y + h * (9017 / 3168 * k1 - 355 / 33 * k2 + 46732 / 5247 * k3 + 49 / 176 * k4 - 5103 / 18656 * k5)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def solution(y, h, k1, k3, k4, k5, k6):
     """The 5th-order state at the end of the step (also the 7th stage's state: first same as last)."""
     return y + h * (35 / 384 * k1 + 500 / 1113 * k3 + 125 / 192 * k4 - 2187 / 6784 * k5 + 11 / 84 * k6)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def error(h, k1, k3, k4, k5, k6, k7):
     """The difference between the 5th- and the embedded 4th-order solutions."""
     return h * (71 / 57600 * k1 - 71 / 16695 * k3 + 71 / 1920 * k4 - 17253 / 339200 * k5 + 22 / 525 * k6
@@ -77,19 +79,19 @@ H_MIN = 1e-14  # below this (of the time scale) a step that still fails the tole
 H_AFTER_EVENT = 1e-6  # the least step after an event, of the time scale
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def shrink(err):
     """The factor on a rejected step of error norm ``err`` (> 1; a non-finite error takes a tenth)."""
     return 0.1 if not math.isfinite(err) else max(0.1, 0.9 * err ** -0.2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def grow(err):
     """The factor on the next step after an accepted one of error norm ``err`` (≤ 1), within [0.2, 5]."""
     return 5.0 if err == 0.0 else min(5.0, max(0.2, 0.9 * err ** -0.2))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def resume(h, theta, t_scale):
     """The step after an event found at the fraction ``theta`` of a step ``h``: what was left of it."""
     return max(h * (1.0 - theta), H_AFTER_EVENT * t_scale) if theta < 1.0 else h
@@ -101,7 +103,7 @@ THETA_TOL = 1e-15  # the locator stops when its bracket (a fraction of the step)
 LOCATE_ITERATIONS = 200
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def crossed(g0, g1, direction):
     """Whether an event function goes from ``g0`` to ``g1`` across zero in its ``direction``: −1 falling,
     +1 rising (a rise from exactly 0 counts: at contact start the slip function of a fresh history is 0),
@@ -113,7 +115,7 @@ def crossed(g0, g1, direction):
     return (g0 < 0.0 and g1 >= 0.0) or (g0 == 0.0 and g1 > 0.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def illinois_trial(lo, hi, glo, ghi):
     """The regula falsi point of the bracket [lo, hi] (event values glo, ghi), or its midpoint where the
     secant is undefined or leaves the bracket."""
@@ -124,7 +126,7 @@ def illinois_trial(lo, hi, glo, ghi):
     return theta
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def illinois_step(lo, hi, glo, ghi, side, theta, g, direction):
     """Shrink the bracket to the side of θ (event value ``g``) that holds the root — between lo and θ when
     the function has crossed there or is 0 at θ — halving the value kept on the other side when the same
@@ -145,7 +147,7 @@ def illinois_step(lo, hi, glo, ghi, side, theta, g, direction):
 # ----------------------------------------------------------------------------- simultaneous events
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def ended_with_it(terminal, started, in_contact, delta, rate):
     """The simultaneous-event rule: an event that is neither the contact's end nor its start, located in
     contact, whose state lies past δ = 0 and receding, was found together with the contact's end (elastic

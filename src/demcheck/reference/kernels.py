@@ -12,6 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import KERNEL_CACHE
 from ..metrics import stepped
 from .health import reading
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
@@ -31,7 +32,7 @@ EVENT_NAMES = {EV_START: "contact_start", EV_END: "contact_end", EV_FORCE_END: "
 ST_OK, ST_TOLERANCE, ST_STEPS, ST_NO_CONTACT, ST_NO_SEPARATION, ST_UNRESOLVED = 0, 1, 2, 3, 4, 5
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def spow(x, p):
     """Sign-preserving power; p = 0 gives 1 (so LSD's dashpot stays linear through δ = 0). The exponents the
     laws use (1, 1/2, 3/2, 1/4) without a pow call: the packing solver's inner loop calls this per contact
@@ -52,7 +53,7 @@ def spow(x, p):
     return y if x >= 0.0 else -y
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def hls_unloading(law, dmax):
     """(K_U, δ₀) for the largest overlap reached so far."""
     kl = law[L_KL]
@@ -60,12 +61,12 @@ def hls_unloading(law, dmax):
     return ku, dmax * (1.0 - kl / ku)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def viscoelastic_force(law, delta, rate):
     return law[L_K] * spow(delta, law[L_A]) + law[L_ETA] * spow(delta, law[L_B]) * rate
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def normal_force(law, delta, rate, dmax):
     """Total normal force (+ repulsive) of a contact with overlap δ > 0, approach rate δ̇ and, for the
     hysteretic law, the largest overlap so far (the history). No force without overlap."""
@@ -84,7 +85,7 @@ def normal_force(law, delta, rate, dmax):
 # ----------------------------------------------------------------------------- adaptive (DP5(4))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _mode_force(law, mode, d, r, dmax):
     if mode == M_VE:
         return viscoelastic_force(law, d, r)
@@ -96,12 +97,12 @@ def _mode_force(law, mode, d, r, dmax):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _acc(law, mode, d, r, dmax, m, an):
     return -_mode_force(law, mode, d, r, dmax) / m + an
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _dp5(law, mode, d, r, h, dmax, m, an):
     """One Dormand–Prince 5(4) step of (δ, δ̇) (integrator.py's stages); returns the 5th-order state and the
     error estimate."""
@@ -121,7 +122,7 @@ def _dp5(law, mode, d, r, h, dmax, m, an):
     return dn, rn, error(h, k1d, k3d, k4d, k5d, k6d, k7d), error(h, k1r, k3r, k4r, k5r, k6r, k7r)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _event_value(law, mode, event, d, r, dmax, m, an):
     """Value of event function ``event`` in ``mode`` (_event_direction tells which are live)."""
     if event == 0:
@@ -149,7 +150,7 @@ def _event_value(law, mode, event, d, r, dmax, m, an):
     return d - dmax  # event 4
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _event_direction(law, mode, event):
     """+1 / −1 for a live event of this mode, 0 for none."""
     if mode == M_PRE:
@@ -175,7 +176,7 @@ def _event_direction(law, mode, event):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _locate(law, mode, event, direction, d, r, h, dmax, m, an, g0, g1):
     """Root of event function ``event`` within the step [0, h] from (d, r): Illinois regula falsi on θ with a
     bisection fallback, each trial evaluated by a fresh RK step of length θh (5th-order accurate)."""
@@ -191,7 +192,7 @@ def _locate(law, mode, event, direction, d, r, h, dmax, m, an, g0, g1):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _touch_inside(law, d, r, h, m, an, rn):
     """A free-flight step [0, h] whose ends both have a gap (δ < 0) but whose approach turned into
     recession (δ̇: + → −) may hold a touch between them (δ has its maximum inside): the step fraction of the
@@ -205,7 +206,7 @@ def _touch_inside(law, d, r, h, m, an, rn):
     return tm * _locate(law, pre, np.int64(0), np.int64(1), d, r, tm * h, 0.0, m, an, d, dm)
 
 
-@njit(cache=True, nogil=True)  # the suite runs cases in threads
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
 def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale, t_max, capacity):
     """Integrate the 1-D normal impact to relative tolerance ``rtol``.
 
@@ -344,7 +345,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
 # ----------------------------------------------------------------------------- velocity Verlet
 
 
-@njit(cache=True, nogil=True)  # the suite runs cases in threads
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
 def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
     """The engines' scheme (fix nve/sphere) on the 1-D normal problem: v += ½dt a; x += dt v; forces from
     full-step positions and half-step velocities; v += ½dt a. History (δ_max) is updated with each force
@@ -359,7 +360,7 @@ def verlet_normal(law, m, an, d_init, r_init, dt, t_max, capacity, stop=True):
     return status, n, T[:n].copy(), D[:n].copy(), R[:n].copy(), F[:n].copy()
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _verlet_into(law, m, an, d_init, r_init, dt, t_max, capacity, stop, T, D, R, F):
     """``verlet_normal``'s run into the given arrays (at least ``capacity`` long): (status, n)."""
     d, r = d_init, r_init
@@ -416,7 +417,7 @@ FR_SIZE = 16
 O_SIZE = 21
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _relative_velocity(fr, t, r, j):
     """Component j of the relative velocity of the centres (v0 − v1, or v0 at a wall) at time t and approach rate
     r, in collision._particles_1d's arithmetic: a wall's particle keeps its tangential velocity (and gravity's
@@ -428,7 +429,7 @@ def _relative_velocity(fr, t, r, j):
     return (vcom + r * fr[FR_M1] / fr[FR_MT] * nj) - (vcom - r * fr[FR_M0] / fr[FR_MT] * nj)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _tangential_1d(fr, t_in, r_in, t_out, r_out, row):
     """metrics.tangential of a 1-D solve (a fixed normal, no slip columns) into ``row``."""
     n0, n1, n2 = fr[FR_N], fr[FR_N + 1], fr[FR_N + 2]
@@ -450,7 +451,7 @@ def _tangential_1d(fr, t_in, r_in, t_out, r_out, row):
                        + fr[FR_W + 2] * (h0 * n1 - h1 * n0))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=KERNEL_CACHE, nogil=True)
 def verlet_normal_many(laws, m, an, d_init, r_init, dt, t_max, capacity, frames):
     """``verlet_normal`` for each row i of the arguments (a law per row of ``laws``; ``frames``: FR_* columns),
     its series read where they are made (metrics.stepped, health.reading, the tangential metrics) and dropped:

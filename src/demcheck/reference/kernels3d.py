@@ -21,6 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import KERNEL_CACHE
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, EV_REENTER, EV_START, L_ETA,
                       L_B, L_FAMILY, L_KL, L_LIMIT, M_FREE, M_LOAD, M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT,
                       ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE, ST_UNRESOLVED, hls_unloading,
@@ -45,7 +46,7 @@ R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION, R_WALL_SLIP_ARM = 0, 1,
 ARM_CONTACT, ARM_RADIUS, ARM_SURFACE = 0, 1, 2  # R − δ/2, R, R − δ (the last for walls: Yade's contact point)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def wall_arm(code, r, delta):
     """A sphere's lever arm to its contact with a wall, by rule code."""
     if code == ARM_RADIUS:
@@ -64,22 +65,22 @@ C_T, C_X0, C_V0, C_W0, C_X1, C_V1, C_W1, C_D, C_R, C_FN, C_FT, C_VT, C_N, C_E, C
     0, 1, 4, 7, 10, 13, 16, 19, 20, 21, 22, 25, 28, 31, 32)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _cross(a, b):
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _norm(a):
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def kinematics(y, geo, rules):
     """(δ, δ̇, n, ṅ, v_t, slip arms a0s a1s, torque arms a0t a1t)."""
     r0 = geo[G_R0]
@@ -119,14 +120,14 @@ def kinematics(y, geo, rules):
 # ----------------------------------------------------------------------------- tangential laws
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def kt_of(tl, delta):
     if tl[T_KT_SQRT] != 0.0:
         return tl[T_KT] * math.sqrt(tl[T_R] * max(delta, 0.0))
     return tl[T_KT]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def eta_of(tl, nl, delta):
     if tl[T_ETA_NORMAL] != 0.0:
         if nl[L_FAMILY] == 1.0:
@@ -135,7 +136,7 @@ def eta_of(tl, nl, delta):
     return tl[T_ETA]
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _lth_zzy_force(tl, family, xi, vt, fn_abs, delta, mu):
     xm = tl[T_XI] * max(delta, 0.0)
     hn = _norm(xi)
@@ -158,7 +159,7 @@ def _lth_zzy_force(tl, family, xi, vt, fn_abs, delta, mu):
     return f
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def slip_surface(tl, nl, xi, vt, fn_abs, delta, mu):
     """(ψ, w, D): the slip function of the history laws (ψ ≤ 0 sticks), the direction w in history space
     along which a slip reduces ψ, and D = ∇_hψ·w."""
@@ -183,7 +184,7 @@ def slip_surface(tl, nl, xi, vt, fn_abs, delta, mu):
     return -1.0, w, 1.0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def return_map(tl, nl, xi, vt, fn_abs, delta, mu):
     """The history on the slip surface of friction coefficient mu (Coulomb truncation)."""
     family = tl[T_FAMILY]
@@ -210,7 +211,7 @@ def return_map(tl, nl, xi, vt, fn_abs, delta, mu):
     return xi * (cap / hn)  # WALTON
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def tangential_force(tl, nl, xi, vt, fn_abs, delta, slipping, tref):
     """Force on body 0 of the tangential law, in its stick or slip state (SLIDING's stick force is the
     constraint force, computed by the caller)."""
@@ -250,7 +251,7 @@ def tangential_force(tl, nl, xi, vt, fn_abs, delta, slipping, tref):
     return -(cap / hn) * xi if hn > 0.0 else np.zeros(3)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def walton_margin(tl, xi, vt, fn_abs, lstar):
     """x = 1 − (T − T*)/(μ|Fn| − T*): the fraction of the way left to the Coulomb limit (≤ 0: at it)."""
     vn = _norm(vt)
@@ -268,7 +269,7 @@ WALTON_NEAR_LIMIT = 1e-6
 WALTON_RIDE = 1e-9  # below a rising limit, the band in which the load rides it (rhs)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def walton_reverses(vt, previous):
     """Whether the slip reverses its direction (seed 000 §4.8, Walton & Braun 1986): v_t turns against the last
     nonzero slip velocity. Only then is the load at the reversal stored (L* := L); the load passing through
@@ -277,7 +278,7 @@ def walton_reverses(vt, previous):
     return vt[0] * previous[0] + vt[1] * previous[1] + vt[2] * previous[2] < 0.0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def walton_stiffness(tl, xi, vt, fn_abs, lstar):
     """Kt = K0 (1 − (T − T*)/(μ|Fn| − T*))^{1/3} with T, T* the load and the load at the last reversal,
     both measured along the current slip direction (docs/models.md: the 3-D definition); 0 without slip
@@ -293,7 +294,7 @@ def walton_stiffness(tl, xi, vt, fn_abs, lstar):
 # ----------------------------------------------------------------------------- the continuous system
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _normal_mode_force(nl, nmode, delta, rate, dmax):
     if nmode == M_VE:
         return viscoelastic_force(nl, delta, rate)
@@ -305,7 +306,7 @@ def _normal_mode_force(nl, nmode, delta, rate, dmax):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _contact_force(nl, nmode, delta, rate, dmax):
     """The normal force the contact applies: the mode's law, held at 0 where limit_force forbids attraction."""
     fn = _normal_mode_force(nl, nmode, delta, rate, dmax)
@@ -314,7 +315,7 @@ def _contact_force(nl, nmode, delta, rate, dmax):
     return fn
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _accelerations(y, geo, fvec0, tau0, tau1, dy):
     g = geo[G_GX:G_GX + 3]
     dy[0:3] = y[3:6]
@@ -328,14 +329,14 @@ def _accelerations(y, geo, fvec0, tau0, tau1, dy):
         dy[9:18] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _tangent_history(y, n):
     """The history in the current tangent plane: exact in continuous time, and immune to numerical drift."""
     xi = y[18:21]
     return xi - _dot(xi, n) * n
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
     """ψ at a nearby state, with |Fn| taken on the branch of the base point (fsign·Fn), so that a one-sided
     difference does not straddle the kink of |Fn| where a viscous normal force changes sign."""
@@ -345,20 +346,20 @@ def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
     return psi
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
     return return_map(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _fn_at(y, aux, nl, geo, rules):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     return _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
     """Tangential part of dv_t/dt with no tangential force (the normal force and gravity act along n for a
     pair; a wall sees gravity's tangential part): b in v̇_t = A F_t + b."""
@@ -374,7 +375,7 @@ def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
     return b
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def rhs(y, aux, nl, tl, geo, rules, dy):
     """dy ← f(y). Returns (λ, Fn, |F_req| − μs|Fn| for SLIDING in stick, the tangential force (3))."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
@@ -456,7 +457,7 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     return lam, fn, req_margin, ft
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _dp5_3(y, aux, nl, tl, geo, rules, h):
     """One Dormand–Prince 5(4) step of the state (integrator.py's stages); returns the 5th-order state and the
     error estimate."""
@@ -495,19 +496,19 @@ GRAZE_SAME_INSTANT = 1e-12
 UNLOAD_MARGIN = 1e-4
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _margin(tl, vt):
     family = tl[T_FAMILY]
     return UNLOAD_MARGIN * _norm(vt) if (family == LTH or family == ZZY) else 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _unloads(tl, lam, vt):
     """Whether a slip whose stick flow has multiplier λ sticks again (λ < 0, past the margin above)."""
     return lam < -_margin(tl, vt)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
     """d(μk|Fn|)/dt by a one-sided (forward, second-order) difference along the flow ``dy``, on the branch of
     |Fn| of the base point."""
@@ -521,7 +522,7 @@ def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
 # _walton_truncate, _onto_surface and _settle are inlined into adaptive_3d (one or two call sites each): a function
 # numba compiles on its own is a library that links, and optimises once more, the whole right-hand side it calls;
 # inlined, the 3-D solver compiles in ~3/4 of the time (docs/performance.md, "Cold start")
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _walton_truncate(y, aux, nl, tl, geo, rules):
     """Walton's stored load back onto the Coulomb limit where it lies above it (the verlet method's truncation),
     and onto it where it rides within WALTON_NEAR_LIMIT below a falling limit (rhs): a load that close to a
@@ -543,7 +544,7 @@ def _walton_truncate(y, aux, nl, tl, geo, rules):
             y[18:21] = xi * (cap / hn)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _onto_surface(y, aux, nl, tl, geo, rules):
     """A slipping spring's history back onto its slip surface after each step. While slipping it follows the
     return map's rate (rhs) and is not error-controlled (the map is unbounded where Kt ∝ √δ → 0 under a
@@ -565,7 +566,7 @@ def _onto_surface(y, aux, nl, tl, geo, rules):
     return False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _settle(y, aux, nl, tl, geo, rules):
     """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
     is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
@@ -608,7 +609,7 @@ def _settle(y, aux, nl, tl, geo, rules):
                 aux[A_TMODE] = STICK
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _event_direction(nl, tl, aux, event):
     nmode = aux[A_NMODE]
     family = tl[T_FAMILY]
@@ -640,7 +641,7 @@ def _event_direction(nl, tl, aux, event):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _event_value(y, aux, nl, tl, geo, rules, event):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     nmode = aux[A_NMODE]
@@ -685,7 +686,7 @@ def _event_value(y, aux, nl, tl, geo, rules, event):
     return 1.0
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _locate(y, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
@@ -699,7 +700,7 @@ def _locate(y, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
     return hi
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def energy(y, geo):
     """Kinetic (translation + rotation) plus gravitational potential energy of the bodies."""
     g = geo[G_GX:G_GX + 3]
@@ -710,7 +711,7 @@ def energy(y, geo):
     return e
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _record(rec, i, t, y, aux, nl, tl, geo, rules):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     dy = np.empty(y.shape[0])
@@ -727,7 +728,7 @@ def _record(rec, i, t, y, aux, nl, tl, geo, rules):
     rec[i, C_SLIP] = aux[A_TMODE]
 
 
-@njit(cache=True, nogil=True)  # the suite runs cases in threads
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
 def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     """Integrate to relative tolerance ``rtol`` with event location (contact start/end, force end, maximum
     overlap, peak force, loading/unloading, stick→slip, slip→stick, slip reversal). ``scales`` (21) are the
@@ -950,7 +951,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
 ROTATION_THRESHOLD = 1e-10  # of μ|Fn|: a history whose normal part is below it is left as it is
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def normal_part_matters(normal_part, scale, mu, fabs):
     """The rescale_significant rule (LAMMPS's): a history is turned into the new tangent plane only when its
     normal part matters, |ξ·n| scale > ROTATION_THRESHOLD μ|Fn| (``scale`` turns the history into a force: Kt,
@@ -959,7 +960,7 @@ def normal_part_matters(normal_part, scale, mu, fabs):
     return abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def turn_history(xi0, xi1, xi2, n, rot, scale, mu, fabs):
     """The verlet history rule before the increment: LAMMPS turns the history (xi0, xi1, xi2) into the new tangent
     plane and rescales it to its old length — always (ROT_RESCALE) or only where its normal part matters
@@ -977,7 +978,7 @@ def turn_history(xi0, xi1, xi2, n, rot, scale, mu, fabs):
     return xi0, xi1, xi2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def project_history(xi0, xi1, xi2, n, rot):
     """The verlet history rule after the increment: LIGGGHTS projects the history onto the tangent plane
     (ROT_PROJECT), with no rescale."""
@@ -987,7 +988,7 @@ def project_history(xi0, xi1, xi2, n, rot):
     return xi0, xi1, xi2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
     """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
     trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
@@ -1019,7 +1020,7 @@ def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
     return xi0, xi1, xi2, f0, f1, f2, True
 
 
-@njit(cache=True, nogil=True)  # the suite runs cases in threads
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
 def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     """The engines' scheme (fix nve/sphere, I = 0.4 m R²): half kick, drift, forces from full-step positions
     and half-step velocities with the history updated once per step (not at setup), half kick. History

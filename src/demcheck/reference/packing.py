@@ -25,6 +25,7 @@ import numpy as np
 from numba import njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
+from .. import KERNEL_CACHE
 from .kernels import L_LIMIT, normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
                         kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
@@ -37,7 +38,7 @@ from .tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_
 HIST_WIDTH, SLIP_HIST_WIDTH, WALTON_HIST_WIDTH = 3, 4, 9
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _cells(x, box_lo, box_hi, cell, periodic):
     """Linked cells at least ``cell`` (the largest contact distance) wide — a periodic axis with fewer than three
     cells is one cell, so that no neighbour cell is visited twice — as the particles sorted by cell: (dims, the
@@ -67,7 +68,7 @@ def _cells(x, box_lo, box_hi, cell, periodic):
     return dims, which, order, first
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _cell_of(xk, lo, hi, dim, per):
     s = (xk - lo) / (hi - lo)
     if per:
@@ -75,14 +76,14 @@ def _cell_of(xk, lo, hi, dim, per):
     return min(dim - 1, max(0, int(s * dim)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _separation(x, i, j, period):
     """x_j − x_i, by minimum image along the periodic axes: ``period`` = (lx, ly), 0 along an axis that is not
     periodic (a tuple, so that the force loop passes no array per pair: :func:`_law`)."""
     return (_image(x[j, 0] - x[i, 0], period[0]), _image(x[j, 1] - x[i, 1], period[1]), x[j, 2] - x[i, 2])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _image(d, length):
     """The minimum image d − L·floor(d/L + ½) of a separation d along an axis of period L (none if L = 0).
     Where |d| ≤ 0.49 L the floor is 0 whatever the rounding, and d is returned without the division: most
@@ -92,7 +93,7 @@ def _image(d, length):
     return d
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _period(box_lo, box_hi, periodic):
     """(lx, ly) of the periodic box for :func:`_separation`, 0 along an axis that is not periodic."""
     return (box_hi[0] - box_lo[0] if periodic[0] else 0.0, box_hi[1] - box_lo[1] if periodic[1] else 0.0)
@@ -101,7 +102,7 @@ def _period(box_lo, box_hi, periodic):
 NB_PER_PARTICLE = 8  # the neighbour list's first capacity per particle (pairs j > i); grown when short
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _neighbour_rows(lo, hi, x, rad, skin, periodic, period, cells, start, nbj):
     """Rows lo…hi−1 of the Verlet list in compressed rows — for each i, the j > i within r_i + r_j + skin —
     from nbj[0] on (start[i]: where row i begins), as far as nbj has room; returns the entries needed (more
@@ -141,7 +142,7 @@ def _neighbour_rows(lo, hi, x, rad, skin, periodic, period, cells, start, nbj):
     return count
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _carry_states(lo, hi, new_start, new_j, start, nbj, hist, dmax, new_hist, new_dmax, base):
     """Rows lo…hi−1 of a new Verlet list take each pair's contact state (history, largest overlap) from the old
     list where the pair was listed (as LAMMPS's fix neigh/history); the walls' states (the first ``base``
@@ -157,7 +158,7 @@ def _carry_states(lo, hi, new_start, new_j, start, nbj, hist, dmax, new_hist, ne
                     break
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _new_states(hist, dmax, base, entries):
     """Contact-state arrays for a new list of ``entries`` entries, the walls' rows (the first ``base``) kept."""
     new_hist = np.zeros((base + entries, hist.shape[1]))
@@ -167,7 +168,7 @@ def _new_states(hist, dmax, base, entries):
     return new_hist, new_dmax
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, base):
     """A new Verlet list for positions x, each pair's contact state carried over (:func:`_carry_states`); the
     walls' contact states (the first ``base`` rows) stay as they are. Returns the new arrays."""
@@ -188,7 +189,7 @@ def _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, bas
     return new_start, new_j, new_hist, new_dmax
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=KERNEL_CACHE, parallel=True)
 def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax, base, chunks):
     """:func:`_rebuild` on threads, a share of the rows each (``chunks``): the same list and states. Each share
     builds its rows into its own array (room: its rows' last entries and a quarter more), then they are laid end
@@ -229,7 +230,7 @@ def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, 
 NL_SIZE = L_LIMIT + 1  # the length of a normal law's array (kernels.py)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _law(laws_n, laws_t, p):
     """Law ``p``'s normal and tangential arrays as tuples. The force loop hands its laws and vectors to the
     compiled laws by value: every array it passed (a law's row, a buffer) cost a reference count per contact
@@ -237,7 +238,7 @@ def _law(laws_n, laws_t, p):
     return to_fixed_tuple(laws_n[p], NL_SIZE), to_fixed_tuple(laws_t[p], T_SIZE)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot, zero3):
     """The tangential force of every law but the updated spring family, into ``ft`` (history ``hist``, one
     contact's row, updated in place; ``zero3``: zeros, the slip direction these laws do not read — the caller's
@@ -277,7 +278,7 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot, zer
     ft[0], ft[1], ft[2] = out[0], out[1], out[2]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _spring_law(nl, tl, delta, n, vt, xi0, xi1, xi2, slipping, fabs, dt, rot):
     """The spring family with scalars only (laws and vectors as tuples), for the packing solver's inner loop,
     by the verlet rules of kernels3d (turn_history, the increment, project_history, spring_slip — as
@@ -290,7 +291,7 @@ def _spring_law(nl, tl, delta, n, vt, xi0, xi1, xi2, slipping, fabs, dt, rot):
     return spring_slip(xi0, xi1, xi2, vt, kt, eta_of(tl, nl, delta), tl[T_TRUNC], mu, tl[T_MU_K], fabs)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
     """The reaction on particle j of a pair's force (f0, f1, f2) on i, and its torque b (t0, t1, t2)."""
     f[j, 0] -= f0
@@ -301,7 +302,7 @@ def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
     tq[j, 2] += b * t2
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
                     hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules):
     """Forces and torques of the contacts of particles lo…hi−1 (their pairs in the Verlet list, j > i, and
@@ -425,13 +426,13 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                     records[e, 2] = math.sqrt(ft0 ** 2 + ft1 ** 2 + ft2 ** 2)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _new_records(start):
     """One record row per list entry, δ = −1 until the entry is seen touching."""
     return np.full((start[start.shape[0] - 1], 3), -1.0)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _contact_table(start, nbj, records, contacts):
     """The touching pairs' records as rows (i, j, δ, Fn, |Ft|) of ``contacts``, in list order (as many as fit);
     returns their number."""
@@ -446,7 +447,7 @@ def _contact_table(start, nbj, records, contacts):
     return nc
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref):
     """The first half kick and the drift of particles lo…hi−1, wrapped into the periodic box; returns the
     largest squared displacement since the last rebuild."""
@@ -469,7 +470,7 @@ def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_
     return moved
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _kick(lo, hi, v, w, f, tq, mass, inertia, gravity, dt):
     """The second half kick of particles lo…hi−1; returns their translational and rotational kinetic energy."""
     e = 0.0
@@ -483,7 +484,7 @@ def _kick(lo, hi, v, w, f, tq, mass, inertia, gravity, dt):
     return e, e_rot
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps,
            ke_every, start, nbj, hist, dmax, rules):
     """What a run starts from: a new Verlet list (its pair states carried over) and the forces of the initial
@@ -505,7 +506,7 @@ def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo
             f, tq, start, nbj, hist, dmax, records)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _energy(ke, flags, step, ke_every, e, e_rot):
     """Keeps the translational kinetic energy e every ke_every steps; False, flagged, once e + e_rot is not
     finite (the run stops)."""
@@ -517,7 +518,7 @@ def _energy(ke, flags, step, ke_every, e, e_rot):
     return False
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=KERNEL_CACHE, nogil=True)
 def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt, steps,
         ke_every, start, nbj, hist, dmax, contacts, rules):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w modified in place; the contact states
@@ -553,7 +554,7 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
 CONTACT_COST = 8  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
 
 
-@njit(cache=True)
+@njit(cache=KERNEL_CACHE)
 def _balance(start, n_walls, dmax, chunks):
     """Row bounds ``chunks`` (len = shares + 1) that give each share about the same work: each row costs one,
     each of its list entries and walls one more, and each contact (a nonzero largest overlap) CONTACT_COST
@@ -581,13 +582,13 @@ def _balance(start, n_walls, dmax, chunks):
     chunks[m] = n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _zero_rows(a, lo, hi):
     for i in range(lo, hi):
         a[i, 0] = a[i, 1] = a[i, 2] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=KERNEL_CACHE, inline="always")
 def _gather(lo, hi, share, f_far, tq_far, f, tq):
     """Into f and tq of particles lo…hi−1 (share ``share``'s), what the shares before it added for them into
     their far buffers; each row read is zeroed for the next step."""
@@ -599,7 +600,7 @@ def _gather(lo, hi, share, f_far, tq_far, f, tq):
                 f_far[c, i, k] = tq_far[c, i, k] = 0.0
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=KERNEL_CACHE, nogil=True, parallel=True)
 def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt,
                  steps, ke_every, start, nbj, hist, dmax, contacts, rules, threads):
     """:func:`run` on ``threads`` threads (numba's, prange). The particles, and with them the rows of the
