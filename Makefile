@@ -36,7 +36,9 @@ engines-versions: $(STAMP)
 browser:
 	bash scripts/install-browser.sh
 
-run: engines-available warmup
+# the engines install (network, dpkg) while the kernels compile (CPU): side by side, each target's output together
+run: $(STAMP)
+	$(MAKE) --no-print-directory -j2 --output-sync=target engines-available warmup
 	$(BIN)/demcheck verify
 
 test: engines engines-versions browser

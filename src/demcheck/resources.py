@@ -48,7 +48,7 @@ def shipped_cases() -> dict[str, Path]:
 
 def case_path(text: str | Path, key: str = "CASE") -> Path:
     """A CASE argument as a file: an existing path as given, else a shipped case by its name (``glass-pair``) or
-    by its path below the shipped cases (``packing/poured``, ``.toml`` optional). Else ConfigError naming the
+    by its path below the shipped cases (``packing/poured``, ``cases/packing/poured.toml``; ``.toml`` optional). Else ConfigError naming the
     argument and the rule."""
     p = Path(text)
     if p.is_file():
@@ -56,11 +56,12 @@ def case_path(text: str | Path, key: str = "CASE") -> Path:
     if p.exists():
         raise ConfigError(key, str(text), "is a directory, not a case file")
     root = cases_dir()
-    rel = str(text).removesuffix(".toml")
+    rel = p.as_posix().removesuffix(".toml")
     if rel and not p.is_absolute() and ".." not in p.parts:
-        inside = root / f"{rel}.toml"
-        if inside.is_file():
-            return inside
+        # a checkout's spelling (cases/packing/poured.toml) names the shipped file from any directory
+        for below in dict.fromkeys((rel, rel.removeprefix("cases/"))):
+            if (root / f"{below}.toml").is_file():
+                return root / f"{below}.toml"
         named = shipped_cases().get(rel)
         if named is not None:
             return named
