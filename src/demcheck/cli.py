@@ -516,6 +516,8 @@ def _print_summary(s: dict) -> None:
         p.add_row(k, show(v))
     con.print(t)
     con.print(p)
+    if s.get("message"):
+        click.echo(f"note: {s['message']}")
 
 
 # ----------------------------------------------------------------------------- sweep

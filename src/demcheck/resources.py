@@ -46,7 +46,7 @@ def shipped_cases() -> dict[str, Path]:
     return {f.stem: f for f in sorted(root.rglob("*.toml"), key=order)}
 
 
-def case_path(text: str | Path, key: str = "CASE") -> Path:
+def case_path(text: str | Path, key: str = "CASE", what: str = "case file") -> Path:
     """A CASE argument as a file: an existing path as given, else a shipped case by its name (``glass-pair``) or
     by its path below the shipped cases (``packing/poured``, ``cases/packing/poured.toml``; ``.toml`` optional). Else ConfigError naming the
     argument and the rule."""
@@ -65,7 +65,7 @@ def case_path(text: str | Path, key: str = "CASE") -> Path:
         named = shipped_cases().get(rel)
         if named is not None:
             return named
-    raise ConfigError(key, str(text), "no such case file, nor a shipped case of that name "
+    raise ConfigError(key, str(text), f"no such {what}, nor a shipped case of that name "
                                       "(`demcheck cases` lists the shipped ones)")
 
 
@@ -82,7 +82,7 @@ def case_files(paths, key: str = "CASE") -> list[Path]:
         if p.is_dir():
             files += sorted(f for f in p.rglob("*.toml") if not NAMED_ONLY & set(f.relative_to(p).parts))
         else:
-            files.append(case_path(text, key))
+            files.append(case_path(text, key, "case file or directory"))
     if not files:
         raise ConfigError(key, ", ".join(map(str, paths)), "holds no *.toml case files")
     return files

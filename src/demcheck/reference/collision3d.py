@@ -90,6 +90,12 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         scales = np.concatenate([np.full(3, l_scale), np.full(3, v_scale), np.full(3, v_scale / r0)] * 2
                                 + [np.full(3, f_scale if model.tangential_law.family == WALTON else l_scale)])
         status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
+        asked = rtol
+        while STATUS[status] == "too-many-steps" and rtol < RTOL_RELAX_CEILING and \
+                _round_off_floor(rec[:n], l_scale) > rtol:
+            # a tolerance float64 cannot hold on these positions is the solver's to relax, one decade at a time
+            rtol = min(10.0 * rtol, RTOL_RELAX_CEILING)
+            status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
         names = {**kernels.EVENT_NAMES, **k3.EVENT_NAMES_3D}
         idx = np.searchsorted(rec[:, k3.C_T], ev_t)
         events = {"t": ev_t, "event": np.array([names.get(int(c), "force_end_again") if c > 0
@@ -118,6 +124,11 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
     )
     if status_name == "too-many-steps" and method == "adaptive":
         result.message = _points_message(result, rtol, l_scale)
+    elif method == "adaptive" and rtol != asked:
+        result.meta["rtol_asked"] = asked
+        result.message = (f"rtol relaxed from {asked:g} to {rtol:g}: at {asked:g} the steps shrank on the float64 "
+                          f"round-off of the bodies' positions (the overlap scale {l_scale:.3g} m against positions "
+                          f"~{_largest_position(result):.3g} m)")
     tlaw = model.tangential_law
     if tlaw.pushes_at_onset and not result.message:
         result.message = ("truncation=overlap with a Kt that vanishes at contact onset: where the dashpot exceeds "
@@ -133,14 +144,29 @@ def _points_message(result: Result, rtol: float, l_scale: float) -> str:
     7 000 at 1e-11, 700 at 1e-10)."""
     from .outcome import MESSAGES
 
-    p = result.table("particles")
-    x = float(max(np.max(np.abs(p[c])) for c in ("x", "y", "z"))) if len(p["t"]) else 0.0
+    x = _largest_position(result)
     if l_scale > 0 and np.spacing(x) / l_scale > rtol:
         return (f"the adaptive method needed more than {result.meta['steps']} points: the contact's overlap scale "
                 f"({l_scale:.3g} m) is {l_scale / x:.2g} of the bodies' positions (~{x:.3g} m), and the tolerance "
                 f"rtol = {rtol:g} fights their float64 round-off: raise run.rtol (each decade takes about ten "
                 "times fewer points) or the impact speed")
     return MESSAGES["too-many-steps"]
+
+
+# the loosest tolerance the adaptive method relaxes to by itself (the metrics' verdicts need ~1e-6 at most)
+RTOL_RELAX_CEILING = 1e-10
+
+
+def _round_off_floor(rec: np.ndarray, l_scale: float) -> float:
+    """The relative tolerance below which the bodies' float64 positions cannot resolve the overlap scale."""
+    x = float(max(np.max(np.abs(rec[:, k3.C_X0:k3.C_X0 + 3])), np.max(np.abs(rec[:, k3.C_X1:k3.C_X1 + 3])))) \
+        if len(rec) else 0.0
+    return np.spacing(x) / l_scale if l_scale > 0 else 0.0
+
+
+def _largest_position(result: Result) -> float:
+    p = result.table("particles")
+    return float(max(np.max(np.abs(p[c])) for c in ("x", "y", "z"))) if len(p["t"]) else 0.0
 
 
 def tables(rec: np.ndarray, wall: bool) -> tuple[dict, dict]:
