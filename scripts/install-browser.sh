@@ -7,7 +7,8 @@ for b in chromium chromium-browser google-chrome; do
 done
 if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq >/dev/null && apt-get install -y -qq chromium >/dev/null \
+    apt-get update -qq -o DPkg::Lock::Timeout=600 >/dev/null \
+        && apt-get install -y -qq -o DPkg::Lock::Timeout=600 chromium >/dev/null \
         && { echo "browser: chromium installed"; exit 0; }
 fi
 echo "browser: chromium missing: install it as root ('sudo apt-get install chromium')"

@@ -75,9 +75,11 @@ apt_install() {
         return 1
     fi
     # fresh lists before a real install (an old list names versions the mirror no longer has)
-    [ $apt_updated = 1 ] || { apt-get update -qq >/dev/null 2>&1; apt_updated=1; }
+    # another apt (a fresh machine's unattended upgrades, a second install) holds dpkg's lock: wait for it
+    [ $apt_updated = 1 ] || { apt-get update -qq -o DPkg::Lock::Timeout=600 >/dev/null 2>&1; apt_updated=1; }
     local log
-    log=$(DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" 2>&1 >/dev/null)
+    log=$(DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+          -o DPkg::Lock::Timeout=600 "$@" 2>&1 >/dev/null)
     if [ $? -ne 0 ]; then
         echo "engines: $engine install failed: apt-get install $* — $(printf '%s\n' "$log" | grep -E '^E:' | head -n 1)"
         return 1
