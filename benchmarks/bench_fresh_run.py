@@ -4,9 +4,11 @@
 
 ``clone``: ``git clone`` of this checkout's HEAD into a temporary directory, then the parts of ``make run`` one at a
 time, each timed (wall clock): the venv and Python packages (``make .venv/.demcheck-installed``), the engines
-(``make engines-available``), the compiled kernels (``make warmup``) and the default suite (``demcheck verify``).
+and the compiled kernels side by side (``make -j2 engines-available warmup``, as make run does) and the default
+suite (``demcheck verify``).
 ``pip``: ``pip wheel .`` and a new venv with that wheel, then ``demcheck verify --engines none`` from an empty
-directory with an empty kernel cache (``XDG_CACHE_HOME`` in the temporary directory).
+directory with an empty kernel cache (``XDG_CACHE_HOME`` in the temporary directory). Every part runs with an
+empty ``XDG_CACHE_HOME``, so pip downloads every package as on a new machine.
 
 What "fresh" means is the machine's: the script states what it found before it started (the pip cache, which
 engines were already installed, the Debian release), because a second run on the same machine finds them warm. To
@@ -27,6 +29,8 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+# make run's parts, as its recipe runs them (the engines install while the kernels compile)
+PARTS = ("venv and Python packages", "engines and warm-up, side by side (make -j2)", "default suite (demcheck verify)")
 
 
 def sh(cmd: list[str] | str, cwd: Path, env: dict | None = None, log: Path | None = None) -> tuple[float, int]:
@@ -37,14 +41,17 @@ def sh(cmd: list[str] | str, cwd: Path, env: dict | None = None, log: Path | Non
 
 
 def state() -> list[str]:
-    pip_cache = subprocess.run([sys.executable, "-m", "pip", "cache", "dir"], capture_output=True, text=True).stdout.strip()
-    size = sum(f.stat().st_size for f in Path(pip_cache).rglob("*") if f.is_file()) if pip_cache and Path(pip_cache).exists() else 0
+    pip_cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "pip"
+    size = sum(f.stat().st_size for f in pip_cache.rglob("*") if f.is_file()) if pip_cache.exists() else 0
     release = "unknown"
     if Path("/etc/os-release").exists():
         release = next((ln.split("=", 1)[1].strip('"\n') for ln in open("/etc/os-release") if ln.startswith("PRETTY_NAME=")), release)
     found = [p for p in ("liggghts", "yade", "yade-float128", "chromium") if shutil.which(p)]
-    return [f"machine: {release}, {os.cpu_count()} cores, Python {platform.python_version()}",
-            f"before: pip cache {size / 2**20:.0f} MiB; on PATH: {', '.join(found) or 'none of liggghts, yade, chromium'}"]
+    load = os.getloadavg()
+    return [f"machine: {release}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+            f"load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} (other work on the machine slows every part)",
+            f"before: pip cache {size / 2**20:.0f} MiB (not used: each part runs with an empty XDG_CACHE_HOME); "
+            f"on PATH: {', '.join(found) or 'none of liggghts, yade, chromium'}"]
 
 
 def clone_part(tmp: Path) -> list[tuple[str, float, int]]:
@@ -53,10 +60,10 @@ def clone_part(tmp: Path) -> list[tuple[str, float, int]]:
     log = tmp / "make-run.log"
     env = dict(os.environ, XDG_CACHE_HOME=str(tmp / "cache"))  # an empty kernel and engine-run cache
     rows = []
-    for name, cmd in [("venv and Python packages", ["make", ".venv/.demcheck-installed"]),
-                      ("engines (install what it can)", ["make", "engines-available"]),
-                      ("warm-up (compile the kernels)", ["make", "warmup"]),
-                      ("default suite (demcheck verify)", [".venv/bin/demcheck", "verify"])]:
+    for name, cmd in zip(PARTS, [["make", ".venv/.demcheck-installed"],
+                                 ["make", "--no-print-directory", "-j2", "--output-sync=target", "engines-available",
+                                  "warmup"],
+                                 [".venv/bin/demcheck", "verify"]]):
         dt, rc = sh(cmd, work, env, log)
         rows.append((name, dt, rc))
         print(f"  {name}: {dt:.1f} s (exit {rc})", flush=True)
@@ -72,8 +79,9 @@ def pip_part(tmp: Path) -> list[tuple[str, float, int]]:
     env.pop("NUMBA_CACHE_DIR", None)
     log = tmp / "pip.log"
     for name, cmd, cwd in [
-            ("pip wheel . (build)", [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(ROOT)], tmp),
-            ("venv + pip install the wheel", f"{sys.executable} -m venv {venv} && {venv}/bin/pip install -q {wheels}/demcheck-*.whl", tmp),
+            ("venv + pip wheel . (build)", f"{sys.executable} -m venv {venv} && "
+                                           f"{venv}/bin/pip wheel -q --no-deps -w {wheels} {ROOT}", tmp),
+            ("pip install the wheel (with its dependencies)", f"{venv}/bin/pip install -q {wheels}/demcheck-*.whl", tmp),
             ("demcheck verify --engines none (cold)", [str(venv / "bin" / "demcheck"), "verify", "--engines", "none"], empty),
             ("demcheck verify --engines none (warm)", [str(venv / "bin" / "demcheck"), "verify", "--engines", "none"], empty)]:
         dt, rc = sh(cmd, cwd, env, log)
@@ -104,8 +112,7 @@ def main() -> int:
     print("\n| part | wall time | exit |\n|---|---|---|")
     for name, dt, rc in rows:
         print(f"| {name} | {dt:.1f} s | {rc} |")
-    clone = [r for r in rows if r[0] in ("venv and Python packages", "engines (install what it can)",
-                                         "warm-up (compile the kernels)", "default suite (demcheck verify)")]
+    clone = [r for r in rows if r[0] in PARTS]
     if clone:
         print(f"| **make run, total** | **{sum(r[1] for r in clone):.1f} s** ({sum(r[1] for r in clone) / 60:.1f} min) | |")
     return max((r[2] for r in rows), default=0) and 1
