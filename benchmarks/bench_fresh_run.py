@@ -58,7 +58,8 @@ def clone_part(tmp: Path) -> list[tuple[str, float, int]]:
     work = tmp / "clone"
     subprocess.run(["git", "clone", "-q", str(ROOT), str(work)], check=True)
     log = tmp / "make-run.log"
-    env = dict(os.environ, XDG_CACHE_HOME=str(tmp / "cache"))  # an empty kernel and engine-run cache
+    # empty caches: pip's and the kernels' (XDG_CACHE_HOME) and the engine runs' (DEMCHECK_CACHE)
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp / "cache"), DEMCHECK_CACHE=str(tmp / "cache" / "runs"))
     rows = []
     for name, cmd in zip(PARTS, [["make", ".venv/.demcheck-installed"],
                                  ["make", "--no-print-directory", "-j2", "--output-sync=target", "engines-available",
