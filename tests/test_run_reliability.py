@@ -104,6 +104,18 @@ def test_a_worker_that_dies_is_seen_to_end_though_a_helper_holds_its_pipe(tmp_pa
         os.kill(int(pids.read_text()), signal.SIGKILL)
 
 
+def test_a_worker_that_does_not_start_is_not_waited_on_through_a_helper_on_its_stderr(tmp_path):
+    """A worker that writes its reason on stderr and ends without its greeting, leaving a helper on that stderr: the
+    reason is read at once and the helper killed (before: demcheck read the pipe to its end, the helper's whole life)."""
+    done = tmp_path / "done"
+    fake = _script(tmp_path / "worker", f'#!/bin/sh\n(sleep 20; touch "{done}") &\necho "no engine here" >&2\nexit 1\n')
+    info = discovery.EngineInfo("lammps", str(fake), "stand-in")
+    with pytest.raises(EngineFailed, match="lammps's worker did not start: no engine here") as err:
+        runner._start_worker("lammps", [str(fake)], info)
+    assert err.value.fault  # a fault of the worker, not of a deck: run.run tries once more
+    assert not done.exists()  # the helper was not waited for (and was killed with the worker's session)
+
+
 # ----------------------------------------------------------------------------- failures: kept, shown, retried
 
 

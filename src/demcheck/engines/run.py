@@ -464,8 +464,9 @@ class _Worker:
         try:
             self.proc.wait(timeout=WORKER_STOP_TIMEOUT)
         except subprocess.TimeoutExpired:
-            _kill_group(self.proc)
-            self.proc.wait()
+            pass
+        _kill_group(self.proc)  # not ended in time, or ended leaving something in its session
+        self.proc.wait()
         try:
             self.proc.stdout.close()
         except OSError:
@@ -473,6 +474,17 @@ class _Worker:
         with _POOL:
             _WORKERS.discard(self)
         return self.proc.returncode
+
+
+def _available(fd: int, limit: int = 1 << 20) -> bytes:
+    """What can be read from ``fd`` now (at most ``limit`` bytes), without waiting for its end of file."""
+    data = b""
+    while len(data) < limit and select.select([fd], [], [], 0)[0]:
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        data += chunk
+    return data
 
 
 def _start_worker(engine: str, argv: list[str], info) -> _Worker:
@@ -511,7 +523,8 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         why = (hello or {}).get("error") or ""
         if not why:
             w.proc.stdin.close()
-            why = log_tail(w.proc.stderr.read().decode(errors="replace"), 1) or f"exit code {w.proc.wait()}"
+            code = w.proc.wait()  # it ended (no greeting): what it wrote on stderr, not waiting for the pipe's end
+            why = log_tail(_available(w.proc.stderr.fileno()).decode(errors="replace"), 1) or _exit_words(code)
         w.end(kill=True)
         raise _fault(f"{engine}'s worker did not start: {why}")
     w.version = str(hello.get("version", ""))
