@@ -183,10 +183,10 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     registry.get(engine).check_deck(deck, files)  # a deck is code the engine executes: only what demcheck writes
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
     wd.mkdir(parents=True, exist_ok=True)
-    inputs = {"in.deck": deck, **(files or {})}
-    for name, text in inputs.items():
+    for name, text in {"in.deck": deck, **(files or {})}.items():
         (wd / name).write_text(text)
     argv = registry.get(engine).worker_argv(info.executable) if worker and mpi == 1 else None
+    before = {p.name for p in wd.iterdir()} - {"log.txt", SCREEN, OUTPUT}  # the caller's: never removed
 
     def attempt() -> RunOutput:
         if argv is not None:
@@ -198,7 +198,7 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     except EngineFailed as first:
         if not getattr(first, "fault", False) or isinstance(first, EngineInterrupted):
             raise
-        _clear_outputs(wd, inputs)  # the second attempt writes its own log, screen and dump
+        _clear_outputs(wd, before)  # the second attempt writes its own log, screen and dump
         try:
             out = attempt()
         except EngineFailed as again:
@@ -296,12 +296,13 @@ def _timed_out(engine: str, wd: Path, timeout: float, pid: int | None) -> Engine
                          f"{wd}\nkept there: {', '.join(kept) or 'nothing'}\n{tail}", pid=pid)
 
 
-def _clear_outputs(wd: Path, inputs: dict) -> None:
-    """Everything a failed attempt wrote into ``wd``, removed (the deck and its files stay)."""
+def _clear_outputs(wd: Path, keep: set) -> None:
+    """What a failed attempt wrote into ``wd``, removed: every entry but those of ``keep`` (the deck, its files and
+    whatever the directory held before the run)."""
     import shutil
 
     for p in wd.iterdir():
-        if p.name not in inputs:
+        if p.name not in keep:
             if p.is_dir() and not p.is_symlink():
                 shutil.rmtree(p, ignore_errors=True)
             else:
