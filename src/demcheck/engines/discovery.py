@@ -92,21 +92,27 @@ def _group_running(pgid: int) -> bool:
 
 
 def _banner(exe: str, seconds: float) -> tuple[str | None, str]:
-    """(``exe -h``'s output, "") or (None, why) if it does not start or answer in time. Its answer is judged by
-    the process's exit, not by its output pipe's end (its output goes to a file: a helper it leaves behind may
-    hold a pipe open); whatever it leaves running in its process group is killed."""
+    """(``exe -h``'s output, "") or (None, why) if it does not start or answer in time (``output_of``)."""
+    return output_of([exe, "-h"], seconds, "`-h`")
+
+
+def output_of(argv: list[str], seconds: float, what: str = "") -> tuple[str | None, str]:
+    """(what ``argv`` printed, stdout and stderr, "") or (None, why) if it does not start or end within
+    ``seconds``: an engine's question (its banner, its version), asked in a temporary directory with ENGINE_ENV.
+    Its answer is judged by the process's exit, not by its output pipe's end (its output goes to a file: a helper
+    it leaves behind may hold a pipe open); whatever it leaves running in its process group is killed."""
     with tempfile.TemporaryDirectory(prefix="demcheck-discovery-") as cwd:
-        out_path = os.path.join(cwd, "banner.txt")
+        out_path = os.path.join(cwd, "output.txt")
         try:
             with open(out_path, "wb") as out:
-                proc = subprocess.Popen([exe, "-h"], cwd=cwd, stdin=subprocess.DEVNULL, stdout=out,
+                proc = subprocess.Popen(argv, cwd=cwd, stdin=subprocess.DEVNULL, stdout=out,
                                         stderr=subprocess.STDOUT, start_new_session=True, env=engine_env())
         except OSError as exc:
             return None, f"does not start ({exc.strerror or exc})"
         try:
             proc.wait(timeout=seconds)
         except subprocess.TimeoutExpired:
-            return None, f"did not answer `-h` within {seconds:g} s (DEMCHECK_DISCOVERY_TIMEOUT)"
+            return None, f"did not answer {what or 'its question'} within {seconds:g} s (DEMCHECK_DISCOVERY_TIMEOUT)"
         finally:  # answered, timed out or interrupted: nothing it started survives
             end_group(proc.pid)
             proc.wait()
