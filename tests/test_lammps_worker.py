@@ -225,13 +225,32 @@ def test_a_worker_that_died_is_replaced(tmp_path):
     [second] = runner.workers()
     assert second != pid
 
-    # killed during a run, by something other than an interrupt: that run failed, the next one is served
-    threading.Timer(1.0, os.kill, (second, signal.SIGKILL)).start()
-    with pytest.raises(EngineFailed, match=r"its worker process ended: exit code -9") as err:
+    # killed during a run, by something other than an interrupt (a fault of the worker, not of the deck): the run is
+    # made once more on a fresh worker; killed there too, it failed; the next one is served
+    killed = []
+    taken = tmp_path / "c" / "screen.txt"  # the worker's first act on a run
+
+    def kill_each_taker():
+        for attempt in range(2):
+            deadline = time.monotonic() + 120
+            while not (taken.exists() and runner.workers()) and time.monotonic() < deadline:
+                time.sleep(0.02)
+            [taker] = runner.workers()
+            os.kill(taker, signal.SIGKILL)
+            killed.append(taker)
+            while not attempt and taken.exists() and time.monotonic() < deadline:  # the second attempt starts afresh
+                time.sleep(0.02)
+
+    killer = threading.Thread(target=kill_each_taker)
+    killer.start()
+    with pytest.raises(EngineFailed, match=r"its worker process ended: killed by SIGKILL") as err:
         runner.run("lammps", _long_deck(), workdir=tmp_path / "c", timeout=300, worker=True)
-    assert not isinstance(err.value, EngineInterrupted)
+    killer.join()
+    assert not isinstance(err.value, EngineInterrupted) and killed[0] == second
+    assert "a first attempt, on another process, had failed too: its worker process ended: killed by SIGKILL" in str(
+        err.value)
     runner.run("lammps", _deck(), workdir=tmp_path / "d", worker=True)
-    assert runner.workers() and runner.workers()[0] not in (pid, second)
+    assert runner.workers() and runner.workers()[0] not in (pid, *killed)
 
 
 def test_a_worker_handed_out_while_dying_gives_the_run_to_a_new_one(tmp_path, monkeypatch):

@@ -229,15 +229,17 @@ def test_cli_verify_reference_only_exit_codes(tmp_path):
     assert p.returncode == 2 and "no such case file or directory" in p.stderr
 
 
-def test_cli_verify_with_a_missing_engine_runs_the_reference_and_says_so(tmp_path):
+def test_cli_verify_with_a_named_engine_missing_fails_before_any_work(tmp_path):
+    """An engine named with --engines is required (docs/reliability.md): not found, the run fails with the reason,
+    exit 1, no report. Only default discovery skips a missing engine (tests/test_run_reliability.py)."""
     env = dict(os.environ, DEMCHECK_LIGGGHTS="/nonexistent/liggghts", DEMCHECK_CACHE=str(tmp_path / "cache"))
     p = subprocess.run([sys.executable, "-m", "demcheck", "verify", str(CASES / "hertz-wall.toml"), "--engines",
                         "liggghts", "--report", str(tmp_path / "r")], capture_output=True, text=True, env=env,
                        timeout=600)
-    assert p.returncode == 0, p.stderr
-    md = (tmp_path / "r" / "latest" / "report.md").read_text()
-    assert "liggghts: missing (apt-get install liggghts" in md
-    assert "**engine missing** — liggghts" in md
+    assert p.returncode == 1, p.stderr
+    assert "--engines names liggghts, which cannot run (discovery tried twice): liggghts is not usable: " \
+           "/nonexistent/liggghts does not start" in p.stderr and "apt-get install liggghts" in p.stderr
+    assert not (tmp_path / "r").exists()
 
 
 # ----------------------------------------------------------------------------- with the engines

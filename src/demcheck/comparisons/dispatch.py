@@ -26,11 +26,12 @@ shared filesystem) and sends back the entries it would have written, which the c
 atomically; a failed run is never among them), with its hits and misses and its ``demcheck`` log lines (a damaged
 cache entry: each line once).
 
-An interrupt (SIGINT, or SIGTERM as engines.run.handle_sigterm makes it) while a campaign waits on its tasks: the
+An interrupt (SIGINT, or SIGTERM or SIGHUP as engines.run.handle_sigterm makes them) while a campaign waits on its tasks: the
 tasks not started are cancelled, the engines of the workers running its tasks are killed (engines.run.kill_all on
 those workers), the tasks running are waited for — they end without their engines, or, needing none, finish and are
 yielded — and the KeyboardInterrupt goes on to the caller; a second interrupt stops the wait. A local cluster's
-workers ignore SIGINT (a terminal's Ctrl-C reaches every process of demcheck's group: the client decides), print
+workers ignore SIGINT and SIGHUP (a terminal's Ctrl-C or hang-up reaches every process of demcheck's group: the
+client decides), keep their scratch space in a temporary directory removed with the cluster, print
 nothing on stdout (demcheck's own, for --json) and end with the campaign; an existing cluster's workers may run
 engines again once the campaign's tasks have ended.
 """
@@ -80,6 +81,7 @@ class Campaign:
         self.client = None
         self.cluster = None
         self._flying: dict = {}  # future → its task's key
+        self._scratch = None  # a local cluster's scratch space (removed with it)
         self._logged: set = set()
 
     @property
@@ -96,10 +98,15 @@ class Campaign:
                 _probe(self.scheduler, self.key)
                 self.client = Client(self.scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
             else:
-                # no dashboard; the scheduler's own HTTP routes (health, metrics) on a free port of 127.0.0.1
+                # no dashboard; the scheduler's own HTTP routes (health, metrics) on a free port of 127.0.0.1; the
+                # workers' scratch space a directory of this campaign's (Dask's default outlives it in TMPDIR)
+                import tempfile
+
+                self._scratch = tempfile.mkdtemp(prefix="demcheck-dask-")
                 self.cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
-                                            host="127.0.0.1", dashboard_address=None,
-                                            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                                            host="127.0.0.1", dashboard_address=None, local_directory=self._scratch,
+                                            scheduler_kwargs={"dashboard_address": "127.0.0.1:0",
+                                                              "local_directory": self._scratch},
                                             silence_logs=logging.CRITICAL, memory_limit=0)
                 self.client = Client(self.cluster, set_as_default=False)
                 self.client.run(_local_worker)
@@ -214,8 +221,15 @@ class Campaign:
             if client is not None:
                 client.close()
         finally:
-            if cluster is not None:
-                cluster.close()
+            try:
+                if cluster is not None:
+                    cluster.close()
+            finally:
+                if self._scratch is not None:
+                    import shutil
+
+                    shutil.rmtree(self._scratch, ignore_errors=True)
+                    self._scratch = None
 
 
 def _probe(address: str, key: str) -> None:
@@ -243,9 +257,10 @@ def _probe(address: str, key: str) -> None:
 
 def _local_worker() -> None:
     """A local cluster's worker (client.run calls it in the worker's main thread), which shares demcheck's terminal:
-    it ignores SIGINT (a terminal's Ctrl-C reaches every process of demcheck's process group; the client stops the
-    engines and the workers, in that order), and what it might print goes to stderr (stdout is demcheck's: --json)."""
+    it ignores SIGINT and SIGHUP (a terminal's Ctrl-C, and its hang-up when it closes, reach every process of
+    demcheck's process group; the client stops the engines and the workers, in that order), and what it might print goes to stderr (stdout is demcheck's: --json)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)  # a closed terminal's hang-up as well: the client stops them
     sys.stdout.flush()
     os.dup2(sys.stderr.fileno(), sys.stdout.fileno())
 

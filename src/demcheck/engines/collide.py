@@ -85,11 +85,13 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             bodies = len(case.particles) * copies
             hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
                             check=_every_body(bodies))
+        if attempt and not cached:
+            _discard(out.workdir, workdir, engine)  # the shorter run, extended: only the run reported is kept
+        cached = hit is not None  # the run reported is this one
         if hit is not None:
             table, meta = hit
             out = runner.RunOutput(engine, meta["version"], Path(meta["workdir"]), "", meta["wall_time"],
                                    meta["warnings"])
-            cached = True
         else:
             out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
@@ -126,7 +128,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     if non_finite:
         result.status = "failed"
         result.message = (f"{engine} wrote NaN or infinite values ({non_finite}): the run is not used and not "
-                          f"cached; work directory kept: {out.workdir}")
+                          f"cached; work directory kept: {_kept(out.workdir)}")
         return result
     health.apply(result, case, sc.model)
     # the shorter runs that were extended are sound, only short; the final one is cached only when healthy
@@ -136,12 +138,23 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         if length > 1.0:
             result.message += f" (after runs up to {length:g}× the expected duration)"
         if not cached:
-            result.message += f"; work directory kept: {out.workdir}"
-    elif workdir is None and not cached and out.workdir.name.startswith(f"demcheck-{engine}-"):
+            result.message += f"; work directory kept: {_kept(out.workdir)}"
+    elif not cached:
+        _discard(out.workdir, workdir, engine)  # a temporary directory of a run that succeeded
+    return result
+
+
+def _discard(wd: Path, workdir, engine: str) -> None:
+    """A run's temporary work directory removed (never one the caller gave: ``workdir``)."""
+    if workdir is None and wd.name.startswith(f"demcheck-{engine}-"):
         import shutil
 
-        shutil.rmtree(out.workdir, ignore_errors=True)  # a temporary directory of a run that succeeded
-    return result
+        shutil.rmtree(wd, ignore_errors=True)
+
+
+def _kept(wd: Path) -> str:
+    """A work directory kept for a diagnosis, within runner.keep_for_diagnosis's bound, and what is in it."""
+    return f"{wd} ({', '.join(runner.keep_for_diagnosis(wd)) or 'empty'})"
 
 
 def _copies_spread(table: pd.DataFrame, n: int, copies: int) -> float:

@@ -78,8 +78,9 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
 
     bad = dumps.non_finite(table) or dumps.non_finite(contacts)
     if bad or not all(np.isfinite(e) for _, e in ke):
+        kept = ", ".join(runner.keep_for_diagnosis(out.workdir))  # within its bound, as a failed run's
         raise EngineFailed(f"{engine} wrote NaN or infinite values ({bad or 'kinetic energy'}): the packing is not "
-                           f"used and not cached; work directory kept: {out.workdir}")
+                           f"used and not cached; work directory kept: {out.workdir} ({kept})")
     if k is not None:
         cache.put(k + "-contacts", contacts, {})
         cache.put(k, table, {"version": out.version, "ke": ke})

@@ -1,11 +1,21 @@
 """Running an engine: one subprocess per run, in its own work directory, with a timeout.
 
-LAMMPS and LIGGGHTS export the same C symbols, so they never share a process. A failed run keeps its work
-directory and its error names it and quotes the tail of the log; a run past its timeout is killed and
-reported as such.
+LAMMPS and LIGGGHTS export the same C symbols, so they never share a process. A run is judged by its process's
+exit and its files, never by the end of an output pipe (what a process prints goes to ``output.txt`` in its work
+directory: a helper it leaves behind may hold a pipe open long after it ended); what a run leaves running in its
+session is killed when it ends. Every engine process and worker starts with ``discovery.ENGINE_ENV`` (one thread;
+Open MPI's singleton start without its helper daemon, whose start fails on a loaded machine).
+
+A failed run keeps its work directory — the deck and its files, the log, the screen, what the process printed,
+the dump's last frames, each within ``keep_for_diagnosis``'s bound — and its error names the directory and its
+files and quotes the log's tail, or says plainly that the engine wrote nothing and what demcheck saw (an exit
+code, a signal, what a worker answered). A failure without an error of the engine's (no ERROR line, no Python
+traceback: a crash, a silent exit, a worker that died or did not start) is a fault of the process, not of the
+deck: the run is made once more on a fresh process or worker, and fails only if that fails too (both reasons
+given). A run past its timeout is killed and reported as such (not run again).
 
 Each engine runs in its own session (a process group of its own, with its MPI ranks), so a terminal's
-Ctrl-C does not reach it: an interrupt of demcheck (SIGINT, or SIGTERM once ``handle_sigterm`` is installed)
+Ctrl-C does not reach it: an interrupt of demcheck (SIGINT, or SIGTERM or SIGHUP once ``handle_sigterm`` is installed)
 kills the group of every running engine (``kill_all``), starts no new one, and each run killed so raises
 EngineInterrupted — "interrupted", never "failed".
 
@@ -38,7 +48,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import EngineFailed, EngineInterrupted, EngineNotFound
+from ..errors import EngineFailed, EngineInterrupted
 from . import discovery, registry
 
 DEFAULT_TIMEOUT = 600.0
@@ -67,25 +77,37 @@ class RunOutput:
 
 
 class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised in the main thread where SIGINT raises KeyboardInterrupt (see ``handle_sigterm``)."""
+    """SIGTERM or SIGHUP, raised in the main thread where SIGINT raises KeyboardInterrupt (see
+    ``handle_sigterm``); ``signum`` the signal."""
+
+    def __init__(self, signum: int = signal.SIGTERM):
+        super().__init__()
+        self.signum = int(signum)
+
+
+# the signals that stop demcheck as SIGINT does: a kill, and a hang-up (a closed terminal, a dropped ssh session)
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
 
 def handle_sigterm() -> None:
-    """Make SIGTERM interrupt demcheck as SIGINT does: ``Terminated`` is raised in the main thread, so the
-    same handlers stop the engines and write the partial report (exit 143 instead of 130)."""
+    """Make SIGTERM and SIGHUP interrupt demcheck as SIGINT does: ``Terminated`` is raised in the main thread,
+    so the same handlers stop the engines and write the partial report (exit 143 or 129 instead of 130). A
+    SIGHUP that is ignored (``nohup``) stays ignored."""
 
     def raise_terminated(signum, frame):
-        raise Terminated()
+        raise Terminated(signum)
 
-    signal.signal(signal.SIGTERM, raise_terminated)
+    for sig in STOP_SIGNALS:
+        if signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, raise_terminated)
 
 
 def interrupt_exit_code(exc: BaseException | None) -> int:
-    """128 + the signal: 143 for a SIGTERM (``Terminated``, also as the cause of a wrapping exception), 130
-    for a SIGINT."""
+    """128 + the signal: 143 for a SIGTERM, 129 for a SIGHUP (``Terminated``, also as the cause of a wrapping
+    exception), 130 for a SIGINT."""
     while exc is not None:
         if isinstance(exc, Terminated):
-            return 128 + signal.SIGTERM
+            return 128 + getattr(exc, "signum", signal.SIGTERM)
         exc = exc.__cause__ or exc.__context__
     return 128 + signal.SIGINT
 
@@ -144,60 +166,199 @@ def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
     return registry.get(engine).mpi_launcher(executable, ranks)
 
 
+SCREEN = "screen.txt"  # an engine's screen in its work directory (``-screen``; a worker's stdout and stderr)
+OUTPUT = "output.txt"  # what a run's process printed on stdout and stderr (its screen, or what came before one)
+
+
 def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: float = DEFAULT_TIMEOUT,
         files: dict[str, str] | None = None, mpi: int = 1, worker: bool = False) -> RunOutput:
     """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it (``mpi`` ranks: the
     engine's own domain decomposition); ``worker``: in the engine's long-lived worker where it has one (see
-    the module's notes), else as a process of its own."""
-    info = discovery.find(engine)
-    if info is None:
-        raise EngineNotFound(discovery.missing(engine))
+    the module's notes), else as a process of its own. A run that fails without an error of the engine's (a
+    crash, an exit with no ERROR line, a worker that died or did not start: a fault of the process, not of the
+    deck) is run once more on a fresh process or worker before it is called failed."""
+    info = discovery.require(engine)  # named by the caller: tried twice, EngineNotFound with the reason
     if _STOP.is_set():
         raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
     registry.get(engine).check_deck(deck, files)  # a deck is code the engine executes: only what demcheck writes
     wd = Path(workdir) if workdir else Path(tempfile.mkdtemp(prefix=f"demcheck-{engine}-"))
     wd.mkdir(parents=True, exist_ok=True)
-    (wd / "in.deck").write_text(deck)
-    for name, text in (files or {}).items():
+    for name, text in {"in.deck": deck, **(files or {})}.items():
         (wd / name).write_text(text)
     argv = registry.get(engine).worker_argv(info.executable) if worker and mpi == 1 else None
-    if argv is not None:
-        return _run_in_worker(engine, info, list(argv), wd, workdir, timeout)
+    before = {p.name for p in wd.iterdir()} - {"log.txt", SCREEN, OUTPUT}  # the caller's: never removed
+
+    def attempt() -> RunOutput:
+        if argv is not None:
+            return _run_in_worker(engine, info, list(argv), wd, workdir, timeout)
+        return _run_process(engine, info, wd, workdir, timeout, mpi)
+
+    try:
+        return attempt()
+    except EngineFailed as first:
+        if not getattr(first, "fault", False) or isinstance(first, EngineInterrupted):
+            raise
+        _clear_outputs(wd, before)  # the second attempt writes its own log, screen and dump
+        try:
+            out = attempt()
+        except EngineFailed as again:
+            if isinstance(again, EngineInterrupted):
+                raise
+            again.args = (f"{again}\n(a first attempt, on another process, had failed too: {first.what})",)
+            raise again from None
+        out.warnings.append(f"{engine}: a first attempt failed without an error of the engine's ({first.what}); "
+                            "it was run again on a fresh process")
+        return out
+
+
+def _run_process(engine: str, info, wd: Path, workdir, timeout: float, mpi: int) -> RunOutput:
+    """One attempt as a process of its own (its MPI launcher's with ``mpi`` > 1), its output into OUTPUT. The
+    run is judged by the process's exit and its files, never by the end of an output pipe (a helper the
+    engine leaves behind may hold one open); what it leaves running in its session is killed when it ends."""
     cmd = registry.get(engine).argv(info.executable, "in.deck")
     if mpi > 1:
         cmd = mpi_launcher(engine, info.executable, mpi) + cmd
-    env = dict(os.environ, OMP_NUM_THREADS="1")
     started = time.perf_counter()
     with _LOCK:  # an interrupt (kill_all) either sees this run or stops it from starting
         if _STOP.is_set():
             raise _interrupted(engine, wd, workdir, interrupt_exit_code(None), "not started: demcheck was interrupted")
-        proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, text=True, env=env, start_new_session=True)
+        with open(wd / OUTPUT, "wb") as output:
+            proc = subprocess.Popen(cmd, cwd=wd, stdin=subprocess.DEVNULL, stdout=output, stderr=subprocess.STDOUT,
+                                    env=discovery.engine_env(), start_new_session=True)
         _RUNNING.add(proc)
     try:
-        out, _ = proc.communicate(timeout=timeout)
+        proc.wait(timeout=timeout)
     except subprocess.TimeoutExpired:
         _kill_group(proc)
-        out, _ = proc.communicate()
-        log = _read_log(wd, out)
-        raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
-                            f"kept: {wd}\n{log_tail(log)}", pid=proc.pid) from None
+        proc.wait()
+        raise _timed_out(engine, wd, timeout, proc.pid) from None
     except KeyboardInterrupt as exc:  # SIGINT or SIGTERM while waiting on the engine: stop it, and the others
         kill_all()
-        proc.communicate()
+        proc.wait()
         raise _interrupted(engine, wd, workdir, interrupt_exit_code(exc)) from exc
     finally:
         with _LOCK:
             _RUNNING.discard(proc)
+        discovery.end_group(proc.pid)  # whatever the run left running in its session (a helper, a daemon)
     if proc in _KILLED:  # stopped by an interrupt handled elsewhere (another thread's kill_all)
         raise _interrupted(engine, wd, workdir, interrupt_exit_code(None))
     wall = time.perf_counter() - started
-    log = _read_log(wd, out)
+    log = _read_log(wd, None)
     errors = _ERROR.findall(log)
     if proc.returncode != 0 or errors:
-        what = errors[0] if errors else f"exit code {proc.returncode}"
-        raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
+        raise _failed(engine, wd, log, _exit_words(proc.returncode), deck_error=bool(errors) or _raised(log))
     return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log))
+
+
+def _exit_words(code: int | None) -> str:
+    """How a process ended, in words: "exit code 1", "killed by SIGSEGV"."""
+    if code is not None and code < 0:
+        try:
+            return f"killed by {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exit code {code}"
+
+
+def _raised(log: str) -> bool:
+    """A Python deck's exception (Yade, Kratos): the deck's error, as an engine's ERROR line is."""
+    return "Traceback (most recent call last)" in log
+
+
+_MPI_START = re.compile(r"MPI_INIT failed|error occurred in MPI_Init|Returned \"([^\"]+)\"")
+
+
+def _failed(engine: str, wd: Path, log: str, seen: str, deck_error: bool) -> EngineFailed:
+    """The error of a failed run: the engine's ERROR line (else what the process or worker showed: ``seen``), the
+    work directory kept for a diagnosis (its files named, each within its bound: keep_for_diagnosis) and the log's
+    tail, or a plain sentence that the engine wrote none. ``fault``: not the deck's error (run.py retries once)."""
+    errors = _ERROR.findall(log)
+    what = errors[0].strip() if errors else seen
+    mpi = _MPI_START.findall(log)
+    if not errors and mpi:
+        detail = next((m for m in mpi if m), "")
+        what = f"MPI did not start{': ' + detail if detail else ''}; {seen}"
+    kept = keep_for_diagnosis(wd)
+    tail = log_tail(log) if log.strip() else (f"({engine} wrote no log and printed nothing; what demcheck saw: "
+                                              f"{seen})")
+    exc = EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\nkept there: {', '.join(kept) or 'nothing'}"
+                       f"\n{tail}")
+    exc.what = what
+    exc.fault = not deck_error
+    return exc
+
+
+def _timed_out(engine: str, wd: Path, timeout: float, pid: int | None) -> EngineTimeout:
+    log = _read_log(wd, None)
+    kept = keep_for_diagnosis(wd)
+    tail = log_tail(log) if log.strip() else f"({engine} wrote no log and printed nothing)"
+    return EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory kept: "
+                         f"{wd}\nkept there: {', '.join(kept) or 'nothing'}\n{tail}", pid=pid)
+
+
+def _clear_outputs(wd: Path, keep: set) -> None:
+    """What a failed attempt wrote into ``wd``, removed: every entry but those of ``keep`` (the deck, its files and
+    whatever the directory held before the run)."""
+    import shutil
+
+    for p in wd.iterdir():
+        if p.name not in keep:
+            if p.is_dir() and not p.is_symlink():
+                shutil.rmtree(p, ignore_errors=True)
+            else:
+                p.unlink(missing_ok=True)
+
+
+# a kept work directory's bound: each file at most KEEP_FILE_BYTES (a dump cut to its last whole frames, a log or
+# screen to its last lines), KEEP_DIR_BYTES in all (the largest files cut further, then dropped)
+KEEP_FILE_BYTES = 4 << 20
+KEEP_DIR_BYTES = 16 << 20
+_FRAME = b"ITEM: TIMESTEP"
+
+
+def keep_for_diagnosis(wd: Path) -> list[str]:
+    """Bound a failed run's work directory (what a diagnosis needs: the deck and its files, the log, the screen,
+    the dump's last frames): each file cut to its last KEEP_FILE_BYTES (at a frame of a dump, at a line
+    otherwise), the whole within KEEP_DIR_BYTES. The names kept, with their cuts."""
+    names = []
+    try:
+        entries = sorted((p for p in wd.rglob("*") if p.is_file() and not p.is_symlink()),
+                         key=lambda p: (p.name != "in.deck", p.stat().st_size))
+    except OSError:
+        return names
+    left = KEEP_DIR_BYTES
+    for p in entries:
+        try:
+            size = p.stat().st_size
+            bound = min(KEEP_FILE_BYTES, max(left, 0))
+            rel = str(p.relative_to(wd))
+            if size > bound:
+                if bound < 4096:
+                    p.unlink()
+                    names.append(f"{rel} removed ({size} bytes: past the directory's bound)")
+                    continue
+                _cut(p, bound)
+                names.append(f"{rel}: its last {p.stat().st_size} of {size} bytes")
+            else:
+                names.append(rel)
+            left -= p.stat().st_size
+        except OSError:
+            continue
+    return names
+
+
+def _cut(path: Path, bound: int) -> None:
+    """``path`` cut to its end within ``bound`` bytes, from a dump frame's start (else a line's), atomically."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        fh.seek(size - bound)
+        tail = fh.read()
+    at = tail.find(b"\n" + _FRAME) + 1  # a frame's first line (0: none within the bound)
+    if at == 0:
+        at = tail.find(b"\n") + 1
+    tmp = path.with_name(path.name + ".cut")
+    tmp.write_bytes(tail[at:])
+    os.replace(tmp, path)
 
 
 def _interrupted(engine: str, wd: Path, workdir, code: int, what: str = "was stopped by the interrupt"
@@ -214,21 +375,23 @@ def _interrupted(engine: str, wd: Path, workdir, code: int, what: str = "was sto
 
 
 def _read_log(wd: Path, out: str | None) -> str:
-    parts = []
-    for name in ("log.txt", "screen.txt"):
+    """What a run wrote: the longer of its log and its screen (they carry the same lines), after what its process
+    printed besides (``output.txt``: MPI's messages, a crash's; a Python engine's whole output) and ``out``."""
+    texts = {}
+    for name in ("log.txt", SCREEN, OUTPUT):
         p = wd / name
         if p.exists():
-            parts.append(p.read_text(errors="replace"))
-    if out:
-        parts.append(out)
-    # the log and the screen carry the same lines; keep the longer account
-    return max(parts, key=len) if parts else ""
+            texts[name] = p.read_text(errors="replace")
+    log = max((texts.get("log.txt", ""), texts.get(SCREEN, "")), key=len)
+    extra = [t for t in (texts.get(OUTPUT, ""), out or "") if t.strip() and t.strip() not in log]
+    return "\n".join([*extra, log] if log else extra)
 
 
 # ----------------------------------------------------------------------------- long-lived workers
 
 WORKER_START_TIMEOUT = 120.0  # s for a worker to load its engine and answer (a loaded machine included)
 WORKER_STOP_TIMEOUT = 10.0  # s for a worker to end after its input is closed, before it is killed
+WORKER_POLL = 0.5  # s between looks at whether a worker waited on has ended
 _IDLE: dict[tuple, list] = {}  # (engine, worker command) → workers waiting for a run
 _WORKERS: set = set()  # every worker started and not yet ended
 _POOL = threading.Lock()
@@ -243,10 +406,9 @@ class _Worker:
         self.engine = engine
         self.buffer = b""
         self.version = ""
-        env = dict(os.environ, OMP_NUM_THREADS="1")
         self.proc = subprocess.Popen(argv + ["--parent", str(os.getpid())], cwd=tempfile.gettempdir(),
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     env=env, start_new_session=True, bufsize=0)
+                                     env=discovery.engine_env(), start_new_session=True, bufsize=0)
 
     def send(self, request: dict) -> bool:
         """False when the worker is gone (its input closed)."""
@@ -258,9 +420,10 @@ class _Worker:
             return False
 
     def receive(self, timeout: float, greeting: bool = False) -> dict | None:
-        """The next answer; None when the worker ended first; TimeoutError past ``timeout`` seconds.
-        ``greeting``: the first answer; lines before it that are not a JSON object are what the engine printed as
-        it started (Yade's welcome), skipped."""
+        """The next answer; None when the worker ended first (its process's exit, not its pipe's end: a process
+        it left behind may hold that open); TimeoutError past ``timeout`` seconds. ``greeting``: the first answer;
+        lines before it that are not a JSON object are what the engine printed as it started (Yade's welcome),
+        skipped."""
         deadline = time.monotonic() + timeout
         fd = self.proc.stdout.fileno()
         while True:
@@ -268,12 +431,15 @@ class _Worker:
                 left = deadline - time.monotonic()
                 if left <= 0:
                     raise TimeoutError
-                ready, _, _ = select.select([fd], [], [], left)
+                ended = self.proc.poll() is not None  # read before the last look at the pipe: nothing comes after
+                ready, _, _ = select.select([fd], [], [], 0.0 if ended else min(left, WORKER_POLL))
                 if ready:
                     chunk = os.read(fd, 65536)
                     if not chunk:
                         return None
                     self.buffer += chunk
+                elif ended:
+                    return None
             line, _, self.buffer = self.buffer.partition(b"\n")
             if not greeting or line.lstrip().startswith(b"{"):
                 break
@@ -299,8 +465,9 @@ class _Worker:
         try:
             self.proc.wait(timeout=WORKER_STOP_TIMEOUT)
         except subprocess.TimeoutExpired:
-            _kill_group(self.proc)
-            self.proc.wait()
+            pass
+        _kill_group(self.proc)  # not ended in time, or ended leaving something in its session
+        self.proc.wait()
         try:
             self.proc.stdout.close()
         except OSError:
@@ -308,6 +475,17 @@ class _Worker:
         with _POOL:
             _WORKERS.discard(self)
         return self.proc.returncode
+
+
+def _available(fd: int, limit: int = 1 << 20) -> bytes:
+    """What can be read from ``fd`` now (at most ``limit`` bytes), without waiting for its end of file."""
+    data = b""
+    while len(data) < limit and select.select([fd], [], [], 0)[0]:
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            break
+        data += chunk
+    return data
 
 
 def _start_worker(engine: str, argv: list[str], info) -> _Worker:
@@ -319,7 +497,7 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         try:
             w = _Worker(engine, argv)
         except OSError as exc:
-            raise EngineFailed(f"{engine}'s worker did not start: {argv[0]}: {exc.strerror or exc}") from None
+            raise _fault(f"{engine}'s worker did not start: {argv[0]}: {exc.strerror or exc}") from None
         _RUNNING.add(w.proc)
     with _POOL:
         _WORKERS.add(w)
@@ -329,7 +507,7 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         hello = w.receive(WORKER_START_TIMEOUT, greeting=True)
     except TimeoutError:
         w.end(kill=True)
-        raise EngineFailed(f"{engine}'s worker did not start within {WORKER_START_TIMEOUT:g} s") from None
+        raise _fault(f"{engine}'s worker did not start within {WORKER_START_TIMEOUT:g} s") from None
     except KeyboardInterrupt as exc:
         kill_all()
         w.end(kill=True)
@@ -346,9 +524,10 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         why = (hello or {}).get("error") or ""
         if not why:
             w.proc.stdin.close()
-            why = log_tail(w.proc.stderr.read().decode(errors="replace"), 1) or f"exit code {w.proc.wait()}"
+            code = w.proc.wait()  # it ended (no greeting): what it wrote on stderr, not waiting for the pipe's end
+            why = log_tail(_available(w.proc.stderr.fileno()).decode(errors="replace"), 1) or _exit_words(code)
         w.end(kill=True)
-        raise EngineFailed(f"{engine}'s worker did not start: {why}")
+        raise _fault(f"{engine}'s worker did not start: {why}")
     w.version = str(hello.get("version", ""))
     w.proc.stderr.close()  # the worker's own stderr now points at /dev/null or a run's screen.txt
     if w.version != info.version:
@@ -356,6 +535,13 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         raise EngineFailed(f"{engine}'s worker loads version {w.version!r}, but {info.executable} is "
                            f"{info.version!r}: run it without the worker")
     return w
+
+
+def _fault(message: str) -> EngineFailed:
+    """A worker's failure before any deck ran (it did not start): a fault of the process, run.py retries once."""
+    exc = EngineFailed(message)
+    exc.what, exc.fault = message, True
+    return exc
 
 
 def _checkout(engine: str, argv: list[str], info) -> _Worker:
@@ -408,7 +594,11 @@ def _run_in_worker(engine: str, info, argv: list[str], wd: Path, workdir, timeou
     try:
         return _worker_attempt(engine, info, argv, wd, workdir, timeout)
     except _NotTaken:
+        pass
+    try:
         return _worker_attempt(engine, info, argv, wd, workdir, timeout)
+    except _NotTaken as exc:
+        raise _failed(engine, wd, "", f"two workers ended before they took the run ({exc})", deck_error=False) from None
 
 
 def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeout: float) -> RunOutput:
@@ -424,9 +614,7 @@ def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeo
             answer = w.receive(timeout) if w.send({"workdir": str(wd.resolve()), "deck": "in.deck"}) else None
         except TimeoutError:
             w.end(kill=True)
-            log = _read_log(wd, None)
-            raise EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory "
-                                f"kept: {wd}\n{log_tail(log)}", pid=w.proc.pid) from None
+            raise _timed_out(engine, wd, timeout, w.proc.pid) from None
         except KeyboardInterrupt as exc:  # SIGINT or SIGTERM while waiting on the engine: stop it, and the others
             kill_all()
             w.end(kill=True)
@@ -440,17 +628,16 @@ def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeo
         wall = time.perf_counter() - started
         log = _read_log(wd, None)
         errors = _ERROR.findall(log)
-        if answer is None and not any((wd / name).exists() for name in ("log.txt", "screen.txt")):
-            w.end(kill=True)
-            raise _NotTaken()
+        if answer is None and not any((wd / name).exists() for name in ("log.txt", SCREEN)):
+            code = w.end(kill=True)
+            raise _NotTaken(f"its worker process ended: {_exit_words(code)}")
         if answer is None:  # the worker died during the run: the next run starts a new one
             code = w.end(kill=True)
-            what = errors[0] if errors else f"its worker process ended: exit code {code}"
-            raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log)}")
+            raise _failed(engine, wd, log, f"its worker process ended: {_exit_words(code)}", deck_error=bool(errors))
         if not answer.get("ok") or errors:
             message = str(answer.get("error") or "").strip()
-            what = errors[0] if errors else (message.splitlines()[0] if message else "no message")
-            raise EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\n{log_tail(log or message)}")
+            seen = f"its worker answered: {message.splitlines()[0]}" if message else "its worker answered no message"
+            raise _failed(engine, wd, log or message, seen, deck_error=True)
         return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log, answer.get("loop")))
     finally:
         _checkin(w, argv)
