@@ -296,6 +296,9 @@ def apply_overrides(raw: dict, overrides) -> dict:
 
 def set_path(raw: dict, key: str, value: Any) -> None:
     parts = key.split(".")
+    if not all(part.strip() for part in parts):
+        raise ConfigError(_key_text(key) or "(empty key)", value,
+                          "must be a dotted case key without an empty part, e.g. impact.speed")
     node: Any = raw
     for depth, part in enumerate(parts[:-1]):
         here = ".".join(parts[: depth + 1])
