@@ -104,12 +104,15 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     out["native"] = native_summary(native)
     out["lines"] = eng.native_lines(native)
     out["confirmed"] = None
+    eng.check_native(native, "--target")  # an input the engine would refuse: stopped before its run
     if confirm:
         from .dispatch import Campaign
 
         [(_, res)] = (campaign or Campaign()).completed(confirm_task, [(0, (case, engine, step, native))])
-        if not res.ok:
-            raise DemcheckError(f"the confirming {engine} run is {res.status}: {res.message}")
+        if not res.ok:  # what the twin found stays reported, with the run's failure
+            out["confirmed"] = False
+            out["confirm_error"] = f"the confirming {engine} run is {res.status}: {res.message}"
+            return out
         m = res.metrics()
         for metric, entry in out["inputs"].items():
             entry["engine"] = m[metric]
@@ -152,6 +155,8 @@ def text_report(r: dict) -> str:
         lines.append(line + ")")
     lines.append("paste:")
     lines += [f"  {x}" for x in r["lines"]]
-    if r["confirmed"] is False:
+    if r.get("confirm_error"):
+        lines.append(f"NOT CONFIRMED: {r['confirm_error']}")
+    elif r["confirmed"] is False:
         lines.append(f"NOT CONFIRMED: the engine run misses a target by more than {ROOT_TOL:g}")
     return "\n".join(lines)
