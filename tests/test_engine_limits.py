@@ -64,3 +64,11 @@ def test_a_failed_confirming_run_keeps_what_the_twin_found(tmp_path, capsys, mon
     code, out, err = _main(["calibrate", path, "--engine", "lammps", "--target", "restitution=0.5"], capsys)
     assert code == 1, err
     assert "damping tsuji e" in out and "paste:" in out and "NOT CONFIRMED: the confirming lammps run is failed" in out
+
+
+def test_a_target_given_twice_is_refused_not_overwritten(tmp_path, capsys, no_engine):
+    path = tmp_path / "c.toml"
+    path.write_text(to_toml(_case({"liggghts": LIGGGHTS})))
+    code, _, err = _main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.5",
+                          "--target", "restitution=0.6"], capsys)
+    assert code == 2 and "--target = 'restitution=0.6': restitution is given twice" in err, err

@@ -1150,6 +1150,8 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
         key, sep, value = item.partition("=")
         if not sep:
             raise ConfigError("--target", item, "must be METRIC=VALUE, e.g. restitution=0.6")
+        if key.strip() in wanted:
+            raise ConfigError("--target", item, f"{key.strip()} is given twice: give each metric once")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
     calibrate.check_targets(wanted)  # bad input: one line, before any work
     case = _load(case_path, overrides)
