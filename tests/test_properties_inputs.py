@@ -11,6 +11,7 @@ import contextlib
 import io
 import json
 import math
+import re
 
 import pytest
 from hypothesis import given, note
@@ -147,3 +148,24 @@ def test_the_issues_arithmetic_limits_are_one_line(sets):
         argv += ["--set", s]
     code, out, err = _run(argv)
     assert code == 2 and len(err.strip().splitlines()) == 1 and err.startswith("demcheck: error: "), (code, err)
+
+
+NON_FINITE = re.compile(r"\b(nan|inf|infinity)\b", re.I)
+
+
+@given(hostile_cases(), st.sampled_from(["lammps", "liggghts", "yade", "kratos"]))
+def test_hostile_numbers_never_reach_an_engine_deck(args, engine):
+    """The same numbers through ``demcheck deck``: a deck (exit 0) with only finite numbers in it, or one line
+    (exit 2: bad input, or a model the engine cannot express) — never a traceback."""
+    case, sets, _ = args
+    argv = ["deck", str(CASES / case), "--engine", engine]
+    for s in sets:
+        argv += ["--set", s]
+    note(" ".join(argv))
+    code, out, err = _run(argv)
+    assert code in (0, 2), (code, err)
+    if code == 2:
+        lines = err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("demcheck: error: "), err
+    else:
+        assert not NON_FINITE.search(out), NON_FINITE.search(out).group(0)
