@@ -72,3 +72,20 @@ def test_a_target_given_twice_is_refused_not_overwritten(tmp_path, capsys, no_en
     code, _, err = _main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.5",
                           "--target", "restitution=0.6"], capsys)
     assert code == 2 and "--target = 'restitution=0.6': restitution is given twice" in err, err
+
+
+@pytest.mark.engine("lammps")
+def test_the_calibrated_line_pasted_back_realises_the_target_in_collide_as_it_runs(tmp_path):
+    """calibrate works at the step collide runs the case's native setting at (its own step), so the line pasted
+    back into the case realises the target in `demcheck collide` with no --dt (it was calibrated at the seed
+    model's step, and only `collide --dt <calibrate's dt>` realised it)."""
+    import demcheck
+    from demcheck.comparisons.calibrate import ROOT_TOL
+
+    from .test_native import TSUJI
+
+    r = demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), "lammps", {"restitution": 0.6})
+    assert r["confirmed"] is True
+    line = r["lines"][0].removeprefix("pair_coeff * * ")
+    again = demcheck.collide(_case({"lammps": {"pair_coeff": line}}), source="lammps")
+    assert again.dt == r["dt"] and abs(again.metrics()["restitution"] - 0.6) <= ROOT_TOL

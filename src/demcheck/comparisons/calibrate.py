@@ -19,7 +19,7 @@ import math
 from ..case import Case, run_length
 from ..errors import ConfigError, DemcheckError
 from ..engines import registry
-from ..engines.collide import collide, twin_states
+from ..engines.collide import collide, setting, twin_states
 from ..engines.mapping import contact_mapping, native_summary
 
 TARGETS = {"restitution": (0.0, 1.0), "tangential_restitution": (-1.0, 1.0)}
@@ -55,8 +55,11 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     eng = registry.get(engine)
     if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ConfigError("--dt", dt, "must be a number > 0 (s)")
-    step = dt or run_length(case)[0]
-    native = eng.case_native(case) or contact_mapping(case, engine).require()
+    # the step `demcheck collide --engine` runs the case at (a native setting at its own step): the input found
+    # realises the target in the run of the line pasted back into the case
+    native, step = setting(case, engine, dt)
+    step = step or run_length(case)[0]
+    native = native or contact_mapping(case, engine).require()
     if "tangential_restitution" in targets and not _oblique(case):
         raise ConfigError("--target tangential_restitution", targets["tangential_restitution"],
                           "needs an oblique impact (impact.angle > 0): a head-on one has no tangential motion")
