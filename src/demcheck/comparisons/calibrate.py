@@ -109,19 +109,25 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     out["confirmed"] = None
     eng.check_native(native, "--target")  # an input the engine would refuse: stopped before its run
     if confirm:
-        from .dispatch import Campaign
-
-        [(_, res)] = (campaign or Campaign()).completed(confirm_task, [(0, (case, engine, step, native))])
-        if not res.ok:  # what the twin found stays reported, with the run's failure
-            out["confirmed"] = False
-            out["confirm_error"] = f"the confirming {engine} run is {res.status}: {res.message}"
-            return out
-        m = res.metrics()
-        for metric, entry in out["inputs"].items():
-            entry["engine"] = m[metric]
-        out["engine_version"] = res.engine_version
-        out["confirmed"] = all(abs(e["engine"] - e["target"]) <= ROOT_TOL for e in out["inputs"].values())
+        _confirm(out, case, engine, step, native, campaign)
     return out
+
+
+def _confirm(out: dict, case: Case, engine: str, step: float, native, campaign) -> None:
+    """The confirming engine run's values in ``out`` (``confirmed``); a run that fails keeps what the twin found,
+    with the failure (``confirm_error``)."""
+    from .dispatch import Campaign
+
+    [(_, res)] = (campaign or Campaign()).completed(confirm_task, [(0, (case, engine, step, native))])
+    if not res.ok:
+        out["confirmed"] = False
+        out["confirm_error"] = f"the confirming {engine} run is {res.status}: {res.message}"
+        return
+    m = res.metrics()
+    for metric, entry in out["inputs"].items():
+        entry["engine"] = m[metric]
+    out["engine_version"] = res.engine_version
+    out["confirmed"] = all(abs(e["engine"] - e["target"]) <= ROOT_TOL for e in out["inputs"].values())
 
 
 def confirm_task(case: Case, engine: str, dt: float, native, cache=None):
