@@ -74,3 +74,16 @@ def test_a_wrong_argument_is_one_config_error_before_any_work(what, call, key, m
         call()
     assert err.value.key == key, str(err.value)
     assert "\n" not in str(err.value) and not started
+
+
+@pytest.mark.parametrize("make", ["file", "latest-dir"])
+def test_a_report_directory_demcheck_cannot_use_is_refused_before_the_runs(tmp_path, make):
+    """verify(report=…) where the report cannot be written was found only after every case ran."""
+    report = tmp_path / "rep"
+    if make == "file":
+        report.write_text("x")
+    else:
+        (report / "latest").mkdir(parents=True)
+    with pytest.raises(ConfigError) as err:
+        demcheck.verify(CASE, engines="none", report=report)
+    assert err.value.key == "report"

@@ -334,7 +334,7 @@ def _report_dir(report) -> None:
     if p.exists() and not p.is_dir():
         raise ConfigError("report", str(report), f"{p.resolve()} is a file, not a directory")
     latest = p / "latest"
-    if (latest.exists() or latest.is_symlink()) and not latest.is_symlink():
+    if latest.exists() and not latest.is_symlink():
         raise ConfigError("report", str(report), f"{latest} is not the symlink demcheck moves to each new run")
 
 
