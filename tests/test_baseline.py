@@ -80,9 +80,10 @@ def test_a_per_quantity_tolerance_admits_the_change(stored):
 
 
 def test_a_bad_baseline_is_one_line_before_any_work(stored, tmp_path):
-    (tmp_path / "b.json").write_text('{"format": "demcheck-baseline", "version": 1, "tolerances": {"default": -1}}')
+    (tmp_path / "b.json").write_text('{"format": "demcheck-baseline", "version": 1, "cases": {}, '
+                                     '"tolerances": {"default": -1}}')
     p = verify(tmp_path, "--baseline", tmp_path / "b.json")
-    assert p.returncode == 2 and "tolerances.default = -1: must be a finite number >= 0" in p.stderr
+    assert p.returncode == 2 and "at $.tolerances.default: -1 is less than the minimum of 0" in p.stderr
     assert not (tmp_path / "r").exists()  # nothing ran
     p = verify(tmp_path, "--baseline", tmp_path / "missing.json")
     assert p.returncode == 2 and "--baseline = " in p.stderr and "no such file" in p.stderr

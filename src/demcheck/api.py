@@ -32,6 +32,64 @@ __all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calib
            "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
+MAX_TIMEOUT = 1e6  # s, as the command line's --timeout (the pipes' poll() takes at most ~2.1e6 s)
+MAX_JOBS = 256
+
+
+# ----------------------------------------------------------------------------- every argument checked
+# Each public function checks every argument's type and range here, before any work: a wrong one is a ConfigError
+# naming the argument, the value and the rule — never a TypeError or ValueError from deep inside.
+
+
+def _positive(key: str, value, unit: str, hi: float | None = None, optional: bool = True):
+    """``value``: a finite number > 0 (and <= ``hi``), or None when ``optional``."""
+    if value is None and optional:
+        return None
+    rule = f"must be a number > 0{f' and <= {hi:g}' if hi is not None else ''} ({unit})"
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0 \
+            or (hi is not None and value > hi):
+        raise ConfigError(key, value, rule)
+    return value
+
+
+def _flag(key: str, value) -> bool:
+    if not isinstance(value, bool):
+        raise ConfigError(key, value, "must be True or False")
+    return value
+
+
+def _text(key: str, value, rule: str, optional: bool = False):
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise ConfigError(key, value, rule)
+    return value
+
+
+def _path(key: str, value, optional: bool = False):
+    """A file system path: text or os.PathLike (None when ``optional``)."""
+    import os
+
+    if value is None and optional:
+        return None
+    if isinstance(value, bytes) or not isinstance(value, (str, os.PathLike)):
+        raise ConfigError(key, value if isinstance(value, str) else type(value).__name__,
+                          "must be a path (text or pathlib.Path)")
+    return value
+
+
+def _sequence(key: str, value, rule: str) -> list:
+    """``value`` as a list: any iterable but text, bytes and a dict; at most MAX_POINTS items."""
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Iterable):
+        raise ConfigError(key, _shown(value), rule)
+    items = list(itertools.islice(value, MAX_POINTS + 1))
+    if len(items) > MAX_POINTS:
+        raise ConfigError(key, f"more than {MAX_POINTS} items", rule)
+    return items
+
+
+def _shown(value):
+    return value if isinstance(value, (str, int, float, type(None))) else type(value).__name__
 
 
 class Result(_Result):
@@ -56,12 +114,14 @@ def _overrides(overrides: Iterable[str] | Mapping[str, Any] | None, keyword: Map
     """[(dotted key, value)]: ``overrides`` as ``key=value`` texts (--set's form) or a mapping of dotted keys to
     Python values; keywords with ``__`` for the dots (``contact__normal="tti"``)."""
     out = []
+    rule = "must be a list of KEY=VALUE texts or a dict of dotted keys to values"
     if isinstance(overrides, Mapping):
-        out += [(str(k), v) for k, v in overrides.items()]
-    elif overrides:
+        for k, v in overrides.items():
+            out.append((_text("overrides", k, "a key must be a dotted case key (text), e.g. impact.speed"), v))
+    elif overrides is not None:
         if isinstance(overrides, str):
-            raise ConfigError("overrides", overrides, "must be a list of KEY=VALUE texts or a dict, not one text")
-        for item in overrides:
+            raise ConfigError("overrides", overrides, rule + ", not one text")
+        for item in _sequence("overrides", overrides, rule):
             if not isinstance(item, str) or "=" not in item:
                 raise ConfigError("overrides", item, "must be KEY=VALUE with a dotted key, e.g. contact.normal=hertz")
             key, _, text = item.partition("=")
@@ -130,11 +190,13 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     engine and its twin, by default at the native law's own step (run.dt, else its twin's elastic contact time
     over run.steps_per_contact). Overrides as :func:`load` takes them."""
     c = load(case, overrides, **keyword)
-    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ConfigError("dt", dt, "must be a number > 0 (s)")
+    _positive("dt", dt, "s")
+    _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
+    if method not in (None, "adaptive", "verlet"):
+        raise ConfigError("method", _shown(method), "must be adaptive or verlet (the reference's), or None")
     known = sources()
-    if source not in known:
-        raise ConfigError("source", source, f"must be one of {', '.join(known)}")
+    if not isinstance(source, str) or source not in known:
+        raise ConfigError("source", _shown(source), f"must be one of {', '.join(known)}")
     if source == "reference":
         from .reference.collision import collide as run
 
@@ -142,14 +204,10 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     if method is not None:
         raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
                                             "velocity Verlet at dt")
-    from .engines import registry
+    from .engines.collide import setting
 
     engine = source.removesuffix("-twin")
-    native = registry.get(engine).case_native(c)
-    if native is not None:  # the native law's own step (its twin's contact time / run.steps_per_contact)
-        from .comparisons.bench import native_step
-
-        dt = native_step(c, native, dt)
+    native, dt = setting(c, engine, dt)  # the native law's own step (its twin's contact time / run.steps_per_contact)
     if source.endswith("-twin"):
         from .engines.collide import twin_states
 
@@ -172,11 +230,9 @@ def collide_many(cases: Iterable, method: str | None = None, dt: float | None = 
     from .reference.batch import collide_many as run
 
     if method not in (None, "adaptive", "verlet"):
-        raise ConfigError("method", method, "must be adaptive or verlet (the reference's)")
-    if dt is not None and (isinstance(dt, bool) or not (isinstance(dt, (int, float)) and math.isfinite(dt)
-                                                        and dt > 0)):
-        raise ConfigError("dt", dt, "must be a number > 0 (s)")
-    loaded = [load(c) for c in cases]
+        raise ConfigError("method", _shown(method), "must be adaptive or verlet (the reference's)")
+    _positive("dt", dt, "s")
+    loaded = [load(c) for c in _sequence("cases", cases, "must be a list of cases (paths, dicts or Cases)")]
     return pd.DataFrame(run(loaded, method, dt))
 
 
@@ -194,16 +250,17 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     from .comparisons.sweep import Points, check_source, native_vary_rule, run_sweep
 
     check_source(source, method, ("source", "method", "dt"))  # the command's checks, with the API's names
-    if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ConfigError("dt", dt, "must be a number > 0 (s)")
+    _positive("dt", dt, "s")
     if not isinstance(vary, Mapping) or not vary:
-        raise ConfigError("vary", vary, "must be a dict of dotted case keys to lists of values")
+        raise ConfigError("vary", _shown(vary), "must be a dict of dotted case keys to lists of values")
     axes = []
     for key, values in vary.items():
-        values = [values] if isinstance(values, (str, bytes)) else list(values)
+        key = _text("vary", key, "a key must be a dotted case key (text), e.g. impact.speed")
+        values = [values] if isinstance(values, str) else _sequence(
+            f"vary.{key}", values, "must be a list of values, e.g. [0.5, 1.0, 2.0]")
         if not values:
             raise ConfigError(f"vary.{key}", values, "must be a non-empty list of values")
-        axes.append((str(key), values))
+        axes.append((key, values))
     total = math.prod(len(v) for _, v in axes)
     if total > MAX_POINTS:
         raise ConfigError("vary", {k: len(v) for k, v in axes}, f"makes a grid of {total} points; at most "
@@ -234,8 +291,13 @@ def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path
     from .engines import registry
 
     names = _engines(engines, registry.names())
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
+        raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
+    _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
+    _flag("cache", cache)
+    _report_dir(_path("report", report, optional=True))
     files = _case_files(paths)
-    opts = Options(engines=names, jobs=int(jobs), timeout=timeout)
+    opts = Options(engines=names, jobs=jobs, timeout=timeout)
     if cache:
         from .engines.cache import Cache
 
@@ -256,16 +318,33 @@ def _engines(engines, registered) -> tuple[str, ...]:
         return tuple(registered)
     if isinstance(engines, str):
         engines = [] if engines == "none" else [e.strip() for e in engines.split(",") if e.strip()]
-    out = tuple(engines)
+    out = tuple(_sequence("engines", engines, "must be engine names (a list, or one text 'lammps,yade'), "
+                                              "'none' or None"))
     for e in out:
-        if e not in registered:
-            raise ConfigError("engines", e, f"is not a registered engine ({', '.join(registered)})")
+        if not isinstance(e, str) or e not in registered:
+            raise ConfigError("engines", _shown(e), f"is not a registered engine ({', '.join(registered)})")
     return out
+
+
+def _report_dir(report) -> None:
+    """A report directory demcheck can make: not a file, and its ``latest`` a symlink (or absent)."""
+    if report is None:
+        return
+    p = Path(report)
+    if p.exists() and not p.is_dir():
+        raise ConfigError("report", str(report), f"{p.resolve()} is a file, not a directory")
+    latest = p / "latest"
+    if latest.exists() and not latest.is_symlink():
+        raise ConfigError("report", str(report), f"{latest} is not the symlink demcheck moves to each new run")
 
 
 def _case_files(paths) -> list[Path]:
     from .resources import case_files
 
+    rule = "must be a case file's or directory's path, or a list of them"
+    paths = [paths] if isinstance(paths, (str, Path)) else _sequence("paths", paths, rule)
+    for p in paths:
+        _path("paths", p)
     return case_files(paths, "paths")
 
 
@@ -275,8 +354,10 @@ def audit(path, engine: str | None = None, speed: float | None = None, run_engin
     with their measured sizes; ``status`` is "clean" or "traps". ``run_engine=False``: the twin only."""
     from .comparisons.audit import audit as run
 
-    if speed is not None and not (isinstance(speed, (int, float)) and math.isfinite(speed) and speed > 0):
-        raise ConfigError("speed", speed, "must be a number > 0 (m/s)")
+    _path("path", path)
+    _text("engine", engine, "must be an engine's name (text) or None", optional=True)
+    _positive("speed", speed, "m/s")
+    _flag("run_engine", run_engine)
     return run(path, engine=engine, speed=speed, run_engine=run_engine)
 
 
@@ -286,8 +367,15 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
     ``tangential_restitution``) for the case's contact at ``dt``: root finding on the engine's twin, confirmed
     by one engine run (``confirm``). Returns a dict with the input, the line to paste, and the realised
     values (twin and engine)."""
-    from .comparisons.calibrate import calibrate as run
+    from .comparisons.calibrate import calibrate as run, check_targets
 
+    _text("engine", engine, "must be an engine's name (text)")
+    if not isinstance(targets, Mapping):
+        raise ConfigError("targets", _shown(targets), "must be a dict of metric names to values, e.g. "
+                                                      "{'restitution': 0.6}")
+    check_targets(dict(targets))
+    _positive("dt", dt, "s")
+    _flag("confirm", confirm)
     c = load(case, overrides, **keyword)
     return run(c, engine, dict(targets), dt=dt, confirm=confirm)
 
@@ -299,4 +387,6 @@ def packing_universe(path, dt: float = 1.0):
     overlaps (docs/packing.md)."""
     from .engines.packing import universe
 
-    return universe(path, dt)
+    if not Path(_path("path", path)).exists():
+        raise ConfigError("path", str(path), "no such file or directory")
+    return universe(path, _positive("dt", dt, "s", optional=False))

@@ -296,6 +296,9 @@ def apply_overrides(raw: dict, overrides) -> dict:
 
 def set_path(raw: dict, key: str, value: Any) -> None:
     parts = key.split(".")
+    if not all(part.strip() for part in parts):
+        raise ConfigError(_key_text(key) or "(empty key)", value,
+                          "must be a dotted case key without an empty part, e.g. impact.speed")
     node: Any = raw
     for depth, part in enumerate(parts[:-1]):
         here = ".".join(parts[: depth + 1])
@@ -349,7 +352,19 @@ def _vector(d: dict, key: str, where: str, *, default=None, required=False):
         or not all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in v)
     ):
         raise ConfigError(full, v, "must be a vector of 3 finite numbers")
+    if not all(_representable(float(c)) for c in v):
+        raise ConfigError(full, v, VECTOR_RULE)
     return tuple(float(c) for c in v)
+
+
+# A vector's component is squared (|v|², distances, energies): 0, or a magnitude whose square is a normal double.
+COMPONENT_RANGE = (1e-150, 1e150)
+VECTOR_RULE = (f"each component must be 0 or of magnitude in [{COMPONENT_RANGE[0]:g}, {COMPONENT_RANGE[1]:g}] "
+               "(its square must be a normal double)")
+
+
+def _representable(c: float) -> bool:
+    return c == 0.0 or COMPONENT_RANGE[0] <= abs(c) <= COMPONENT_RANGE[1]
 
 
 def _positive(v: float) -> bool:
@@ -524,6 +539,8 @@ def from_dict(raw: dict) -> Case:
                               velocity=_vector(d, "velocity", where, default=(0.0, 0.0, 0.0)),
                               angular_velocity=_vector(d, "angular_velocity", where, default=(0.0, 0.0, 0.0))))
 
+    _check_masses([(p["material"], p["radius"]) for p in particles], materials)  # before anything uses a mass
+
     walls = []
     for i, d in enumerate(raw.get("walls", []) or []):
         where = f"walls.{i}"
@@ -550,8 +567,8 @@ def from_dict(raw: dict) -> Case:
     else:
         dt = _number(run_raw, "dt", "run", rule="must be > 0 (s) or \"auto\"", check=_positive)
     spc = run_raw.get("steps_per_contact", 200)
-    if isinstance(spc, bool) or not isinstance(spc, int) or spc < 2:
-        raise ConfigError("run.steps_per_contact", spc, "must be an integer >= 2")
+    if isinstance(spc, bool) or not isinstance(spc, int) or not 2 <= spc <= 10**15:
+        raise ConfigError("run.steps_per_contact", spc, "must be an integer from 2 to 10^15")
     method = run_raw.get("method", "adaptive")
     if method not in ("adaptive", "verlet"):
         raise ConfigError("run.method", method, "must be adaptive or verlet")
@@ -580,14 +597,14 @@ def from_dict(raw: dict) -> Case:
 
     if kind == "collision":
         if impact is not None:
-            _apply_impact(impact, particles, walls, materials)
+            with np.errstate(all="ignore"):  # a placement beyond doubles is refused in it, by key
+                _apply_impact(impact, particles, walls, materials)
         n_bodies = len(particles) + len(walls)
         if len(particles) not in (1, 2) or n_bodies != 2:
             raise ConfigError("particles", len(particles),
                               "a collision has two particles, or one particle and one wall")
     parts = tuple(Particle(**p) for p in particles)
     _check_geometry(parts, tuple(walls))
-    _check_masses(parts, materials)
 
     resolved_raw = plain_copy(raw)
     resolved_raw.pop("impact", None)
@@ -605,21 +622,68 @@ def from_dict(raw: dict) -> Case:
     # Model ids and parameters are checked here too, so that nothing runs on a bad case.
     from .reference import model as _model
 
-    _model.check_contact(case)
-    if kind == "collision":
-        near = _near_contact(case)
-        if near is not None:
-            case = build(near)
-        model = _model.resolve(case)
-        if model.pair.impact_speed > 0:  # bodies that never meet are the solvers' to report
-            if impact is None:
-                flight = ("particles.0.position", list(case.particles[0].position))
-            else:
-                flight = ("impact.gap", impact["gap"]) if "gap" in impact else ("impact.speed", impact.get("speed"))
-            run_length(case, model=model, flight=flight)
-    elif packing is not None and packing.duration is not None:
-        packing_run(case)  # a packing too long to run is refused here too, before any work
+    with _computable(case):
+        _model.check_contact(case)
+        if kind == "collision":
+            case = _collision_scales(case, build, impact)
+        elif packing is not None and packing.duration is not None:
+            packing_run(case)  # a packing too long to run is refused here too, before any work
     return case
+
+
+def _collision_scales(case: Case, build, impact) -> Case:
+    """The collision moved near its contact, and its run length checked (run_length) — the case's own numbers
+    must give a contact time, a flight and a step a double can hold."""
+    from .reference import model as _model
+
+    near = _near_contact(case)
+    if near is not None:
+        case = build(near)
+    model = _model.resolve(case)
+    if model.pair.impact_speed > 0:  # bodies that never meet are the solvers' to report
+        if impact is None:
+            flight = ("particles.0.position", list(case.particles[0].position))
+        else:
+            flight = ("impact.gap", impact["gap"]) if "gap" in impact else ("impact.speed", impact.get("speed"))
+        run_length(case, model=model, flight=flight)
+    return case
+
+
+@contextlib.contextmanager
+def _computable(case: Case):
+    """An arithmetic fault while a case's scales are computed (an overflow, a division by an underflowed zero, a
+    NaN) is a ConfigError naming the case's most extreme number — never a traceback or a numpy warning."""
+    try:
+        with np.errstate(all="ignore"):
+            yield
+    except (ArithmeticError, ValueError) as exc:
+        key, value = _extreme_number(case)
+        raise ConfigError(key, value, f"the case's numbers are beyond what double precision computes here "
+                                      f"({type(exc).__name__}: {exc})") from None
+
+
+# everyday values of a case's numbers: the one farthest from its own (in decades) is named when scales fail
+EVERYDAY = {"density": 2500.0, "youngs_modulus": 7e10, "radius": 1e-3, "speed": 1.0}
+
+
+def _extreme_number(case: Case) -> tuple[str, object]:
+    """(key, value) of the case's number farthest, in decades, from an everyday grain's: the materials' density
+    and modulus, the radii, the impact speed, and any contact parameter outside [1e-100, 1e100]."""
+    found = []
+    for name, m in case.materials.items():
+        for attr in ("density", "youngs_modulus"):
+            found.append((f"materials.{_key_text(name)}.{attr}", getattr(m, attr), EVERYDAY[attr]))
+    for i, p in enumerate(case.particles):
+        found.append((f"particles.{i}.radius", p.radius, EVERYDAY["radius"]))
+    v = float(np.linalg.norm(np.subtract(case.particles[0].velocity, case.particles[1].velocity
+                                         if len(case.particles) > 1 else 0.0)))
+    if v > 0:
+        found.append(("particles.0.velocity", v, EVERYDAY["speed"]))
+    for k, x in case.contact.params.items():
+        if isinstance(x, (int, float)) and not isinstance(x, bool) and x and not 1e-100 <= abs(x) <= 1e100:
+            found.append((f"contact.{_key_text(k)}", x, 1.0))
+    key, value, _ = max(found, key=lambda f: abs(math.log10(abs(f[1])) - math.log10(f[2])) if f[1] else 0.0)
+    return key, value
 
 
 # Without gravity the bodies fly in straight lines until they touch: they start at most this many elastic
@@ -708,18 +772,28 @@ def _near_contact(case: Case) -> tuple[Particle, ...] | None:
 MASS_RANGE = (1e-30, 1e30)
 
 
-def _check_masses(parts: tuple[Particle, ...], materials: dict) -> None:
+def _check_masses(kinds: list[tuple[str, float]], materials: dict) -> None:
+    """Each particle's mass (``kinds``: its material and radius) in MASS_RANGE, computed in logarithms (r³ of a
+    1e200 m radius overflows a double)."""
     lo, hi = MASS_RANGE
-    for i, (mat, r) in _species(parts).items():
+    seen: dict[tuple[str, float], int] = {}
+    for i, kind in enumerate(kinds):
+        seen.setdefault(kind, i)
+    for (mat, r), i in seen.items():
         rho = materials[mat].density
-        m = rho * 4.0 / 3.0 * math.pi * r**3
-        if lo <= m <= hi:
+        log_m = math.log10(rho) + math.log10(4.0 / 3.0 * math.pi) + 3.0 * math.log10(r)
+        if math.log10(lo) <= log_m <= math.log10(hi):
             continue
         # name the factor farther from an everyday grain (1 mm, 2500 kg/m³)
-        by_density = abs(math.log10(rho / 2500.0)) >= 3.0 * abs(math.log10(r / 1e-3))
+        by_density = abs(math.log10(rho) - math.log10(2500.0)) >= 3.0 * abs(math.log10(r) + 3.0)
         key, value = (f"materials.{_key_text(mat)}.density", rho) if by_density else (f"particles.{i}.radius", r)
         raise ConfigError(key, value, f"gives particle {i} (density {rho:g} kg/m³, radius {r:g} m) a mass of "
-                                      f"{m:.3g} kg: a particle's mass must be in [{lo:g}, {hi:g}] kg")
+                                      f"{_power(log_m)} kg: a particle's mass must be in [{lo:g}, {hi:g}] kg")
+
+
+def _power(log10_x: float) -> str:
+    """10^log10_x as text, also beyond a double's range."""
+    return f"{10.0 ** log10_x:.3g}" if abs(log10_x) < 300 else f"10^{log10_x:.1f}"
 
 
 def _species(parts: tuple[Particle, ...]) -> dict[int, tuple[str, float]]:
@@ -739,7 +813,9 @@ def _apply_impact(impact: dict, particles: list[dict], walls: list[Wall], materi
     if not isinstance(impact, dict):
         raise ConfigError("impact", impact, "must be a table")
     _known_keys(impact, IMPACT_KEYS, "impact")
-    speed = _number(impact, "speed", "impact", rule="must be > 0 (m/s)", check=_positive)
+    lo_v, hi_v = COMPONENT_RANGE
+    speed = _number(impact, "speed", "impact", rule=f"must be > 0 (m/s), in [{lo_v:g}, {hi_v:g}] (its square must "
+                                                    "be a normal double)", check=lambda v: lo_v <= v <= hi_v)
     angle = _number(impact, "angle", "impact", required=False, default=0.0,
                     rule="must be in [0, 90) degrees from the normal", check=lambda v: 0 <= v < 90)
     spin = _number(impact, "spin", "impact", required=False, default=0.0)
@@ -771,6 +847,11 @@ def _apply_impact(impact: dict, particles: list[dict], walls: list[Wall], materi
         p0["angular_velocity"] = tuple(spin * np.cross(n, t))
     else:
         raise ConfigError("impact", impact, "applies to a collision of two particles or of a particle and a wall")
+    for p in particles:  # the placed state: positions (gap / speed of flight), velocities, spins
+        for part, key in (("position", "gap"), ("velocity", "speed"), ("angular_velocity", "spin")):
+            if not all(math.isfinite(c) and _representable(c) for c in p[part]):
+                raise ConfigError(f"impact.{key}", impact.get(key), f"places a particle at {part} "
+                                  f"{[float(c) for c in p[part]]}: {VECTOR_RULE}")
 
 
 def packing_spec(p: dict | None, materials) -> Packing:
@@ -925,6 +1006,7 @@ def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) ->
 # An engine run dumps every step (~1 kB a step for two bodies): a collision's run is refused past this many steps
 # (500 MB of dump; the default suite's longest run, bench at 5000 steps per contact, takes 120 000).
 MAX_STEPS = 500_000
+MIN_TIME = 1e-300  # s: a contact time or step below it has lost a double's precision (subnormals)
 
 
 def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=None,
@@ -938,10 +1020,20 @@ def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=N
 
     model = model or resolve(case)
     t_c = characteristic_time(model)
+    if not (math.isfinite(t_c) and t_c >= MIN_TIME):
+        key, value = _extreme_number(case)
+        raise ConfigError(key, value, f"gives an elastic contact time of {t_c:.3g} s: the case's numbers must give "
+                                      f"a finite time >= {MIN_TIME:g} s (a double's precision)")
     step = dt or case.run.dt or t_c / case.run.steps_per_contact  # dt = auto
     t_flight, t_contact = free_flight(case)[0], 6.0 * t_c * length
+    if not math.isfinite(t_flight):
+        key, value = flight or ("particles.0.position", list(case.particles[0].position))
+        raise ConfigError(key, value, f"gives a free flight of {t_flight} s before the contact: not a finite time")
     t_end = t_flight + t_contact
     steps = t_end / step
+    if not step >= MIN_TIME:  # a step given that small (auto steps are >= t_c / 10^15)
+        key, value = ("--dt", dt) if dt else ("run.dt", case.run.dt)
+        raise ConfigError(key, value, f"gives a time step of {step:.3g} s: it must be >= {MIN_TIME:g} s")
     if steps > MAX_STEPS:
         if t_flight > t_contact:
             key, value = flight or ("particles.0.position", list(case.particles[0].position))

@@ -388,17 +388,10 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         from .engines.collide import collide as run_engine
 
         try:
-            from .engines import registry
+            from .engines.collide import setting
 
-            from .engines.builds import engine_of
-
-            # [engine.NAME] (a build reads its engine's table)
-            native = registry.get(src).case_native(case) if engine_of(src) in ENGINE_NAMES else None
-            step = dt
-            if native is not None:  # a native law runs at its own step, as in the API, sweep and bench
-                from .comparisons.bench import native_step
-
-                step = native_step(case, native, dt)
+            # [engine.NAME] (a build reads its engine's table) at the native law's own step: what `deck` writes
+            native, step = setting(case, src, dt)
             results[src] = run_engine(case, src, dt=step, timeout=timeout, native=native)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
@@ -474,15 +467,15 @@ def deck(case_path, engine, output, dt, overrides):
     """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
     (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
     reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
-    from .engines.collide import deck as make_deck
+    from .engines.collide import setting_deck
 
     case = _load(case_path, overrides)
     if case.kind == "packing":
         from .engines import registry
 
         dk = registry.get(engine).packing_deck(case, dt=dt)
-    else:
-        dk = make_deck(case, engine, dt)
+    else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
+        dk = setting_deck(case, engine, dt)
     if output:  # the files the deck reads go beside it: each checked before any is written
         check_output("--output", output, files=list(dk.files))
         for path in dk.write(output):
@@ -1159,6 +1152,8 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
         key, sep, value = item.partition("=")
         if not sep:
             raise ConfigError("--target", item, "must be METRIC=VALUE, e.g. restitution=0.6")
+        if key.strip() in wanted:
+            raise ConfigError("--target", item, f"{key.strip()} is given twice: give each metric once")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
     calibrate.check_targets(wanted)  # bad input: one line, before any work
     case = _load(case_path, overrides)

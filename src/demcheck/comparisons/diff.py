@@ -18,7 +18,6 @@ on any. Reports: markdown, JSON and JUnit (a test case per case × source).
 
 from __future__ import annotations
 
-import json
 import math
 import xml.etree.ElementTree as ET
 from collections import defaultdict
@@ -27,7 +26,7 @@ from pathlib import Path
 from ..errors import ConfigError
 from ..io import md_text as _t
 from ..io import number, plain
-from . import verdicts
+from . import schema, verdicts
 
 FORMAT = "demcheck-baseline"
 FORMAT_VERSION = 1
@@ -56,17 +55,17 @@ def from_summary(summary: dict, path: str = "") -> dict:
     hash, scales, sources (status, version, metrics) and verdicts per source and metric."""
     cases = {}
     for c in summary.get("cases", []):
-        verdicts: dict = defaultdict(dict)
-        for k in c.get("comparisons", []):
+        judged: dict = defaultdict(dict)
+        for k in c.get("comparisons") or []:
             src, metric = k["source"], k["metric"]
-            old = verdicts[src].get(metric)
-            verdicts[src][metric] = k["verdict"] if old is None else verdicts.worst([old, k["verdict"]])
+            old = judged[src].get(metric)
+            judged[src][metric] = k["verdict"] if old is None else verdicts.worst([old, k["verdict"]])
         sources = {}
         for src, s in (c.get("sources") or {}).items():
             sources[src] = {"status": s.get("status"), "version": s.get("engine_version"),
                             "metrics": _numbers(s.get("metrics"))}
-        cases[c["case"]] = {"hash": c.get("case_hash"), "scales": c.get("scales") or {}, "sources": sources,
-                            "verdicts": {s: dict(v) for s, v in verdicts.items()}}
+        cases[c["case"]] = {"hash": c.get("case_hash"), "scales": _scales(c.get("scales")), "sources": sources,
+                            "verdicts": {s: dict(v) for s, v in judged.items()}}
     engines = {name: (e.get("version") if e.get("found") else None)
                for name, e in (summary.get("engines") or {}).items()}
     return {"path": path, "run_id": summary.get("run_id"), "started": summary.get("started"),
@@ -74,9 +73,16 @@ def from_summary(summary: dict, path: str = "") -> dict:
             "cases": cases, "tolerances": {}}
 
 
+def _scales(scales) -> dict:
+    """A case's scales, the missing ones (null) left out: a metric without its scale is measured relative to
+    OLD's value."""
+    return {k: v for k, v in (scales or {}).items() if v is not None}
+
+
 def load(path, key: str = "OLD") -> dict:
-    """A run from a results.json, a report directory holding one, or a baseline file; bad input is a
-    ConfigError naming ``key``, the path and what is wrong."""
+    """A run from a results.json, a report directory holding one, or a baseline file; bad input — not strict
+    JSON, or JSON of another shape than comparisons/schema.py's — is a ConfigError naming ``key``, the path
+    and what is wrong, before any of it is used."""
     p = Path(path)
     if p.is_dir():
         p = p / "results.json"
@@ -86,39 +92,35 @@ def load(path, key: str = "OLD") -> dict:
     elif not p.is_file():
         raise ConfigError(key, str(path), "no such file or directory")
     try:
-        data = json.loads(p.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        text = p.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(key, str(path), f"cannot be read as JSON ({exc})") from None
+    data = schema.parse(text, key, str(path))
     if not isinstance(data, dict):
         raise ConfigError(key, str(path), "is not a demcheck results.json or baseline (not a JSON object)")
     if data.get("format") == FORMAT:
+        if data.get("version") != FORMAT_VERSION:
+            raise ConfigError(key, str(path), f"baseline format version {data.get('version')!r}: this demcheck "
+                                              f"reads version {FORMAT_VERSION}")
+        schema.check(data, schema.BASELINE, key, str(path))
         return _from_baseline(data, str(path), key)
-    if not isinstance(data.get("cases"), list) or any(not isinstance(c, dict) or "case" not in c
-                                                      for c in data["cases"]):
+    if not isinstance(data.get("cases"), list):
         raise ConfigError(key, str(path), "is not a demcheck results.json or baseline (no list of cases)")
+    schema.check(data, schema.RESULTS, key, str(path))
     return from_summary(data, str(path))
 
 
 def _from_baseline(data: dict, path: str, key: str) -> dict:
-    if data.get("version") != FORMAT_VERSION:
-        raise ConfigError(key, path, f"baseline format version {data.get('version')!r}: this demcheck reads "
-                                     f"version {FORMAT_VERSION}")
-    tol = data.get("tolerances") or {}
-    for name, v in [("default", tol.get("default")), *((f"metrics.{m}", x) for m, x in
-                                                        (tol.get("metrics") or {}).items())]:
-        if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-            raise ConfigError(f"{key}: tolerances.{name}", v, "must be a finite number >= 0 (scaled units)")
+    """A baseline file's run (its shape checked: schema.BASELINE; tolerances finite and >= 0)."""
+    tol = {"default": (data.get("tolerances") or {}).get("default"),
+           "metrics": dict((data.get("tolerances") or {}).get("metrics") or {})}
     cases = {}
-    for name, c in (data.get("cases") or {}).items():
+    for name, c in data["cases"].items():
         sources = {}
         for src, s in (c.get("sources") or {}).items():
-            for m, t in (s.get("tolerances") or {}).items():
-                if not (isinstance(t, (int, float)) and math.isfinite(t) and t >= 0):
-                    raise ConfigError(f"{key}: cases.{name}.sources.{src}.tolerances.{m}", t,
-                                      "must be a finite number >= 0 (scaled units)")
             sources[src] = {"status": s.get("status"), "version": s.get("version"),
                             "metrics": _numbers(s.get("metrics")), "tolerances": dict(s.get("tolerances") or {})}
-        cases[name] = {"hash": c.get("hash"), "scales": c.get("scales") or {}, "sources": sources,
+        cases[name] = {"hash": c.get("hash"), "scales": _scales(c.get("scales")), "sources": sources,
                        "verdicts": {s: dict(v) for s, v in (c.get("verdicts") or {}).items()}}
     return {"path": path, "run_id": data.get("run_id"), "started": data.get("started"),
             "demcheck": data.get("demcheck"), "partial": bool(data.get("partial")),
@@ -157,7 +159,7 @@ def _tolerance(old_run: dict, case: str, source: str, metric: str, default: floa
         return float(per[metric])
     if metric in (tol.get("metrics") or {}):
         return float(tol["metrics"][metric])
-    return float(tol.get("default", default))
+    return float(default if tol.get("default") is None else tol["default"])
 
 
 def compare(old: dict, new: dict, tolerance: float | None = None, rename: dict | None = None,

@@ -281,15 +281,30 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
             summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
             if opts.cache is not None:
                 summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
-            if opts.baseline is not None:
-                from .diff import apply_baseline
-
-                apply_baseline(summary, opts.baseline)
+            after = _judge_baseline(summary, opts.baseline)  # a fault here still leaves the report written
             report.write_all(summary, out_dir, report_root, junit=junit, link=link)
     _print(console, summary)
     if interrupted is not None:
         raise interrupted
+    if after is not None:
+        raise DemcheckError(f"{summary['baseline_error']} (after the runs; the report of the finished cases is "
+                            f"{out_dir})") from after
     return summary
+
+
+def _judge_baseline(summary: dict, baseline: dict | None) -> Exception | None:
+    """The finished cases judged against ``baseline`` (diff.apply_baseline); a failure there is returned, noted
+    in the summary (``baseline_error``), so that the report of what finished is written before it is raised."""
+    if baseline is None:
+        return None
+    from .diff import apply_baseline
+
+    try:
+        apply_baseline(summary, baseline)
+    except Exception as exc:  # noqa: BLE001 - raised again once the report is written
+        summary["baseline_error"] = f"the baseline check failed: {type(exc).__name__}: {exc}"
+        return exc
+    return None
 
 
 def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> dict:

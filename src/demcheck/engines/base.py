@@ -201,6 +201,20 @@ class Engine(ABC):
         """The native configuration as the lines a user pastes into a deck (for a like pair)."""
         return [self.summary(native)]
 
+    def native_limits(self, native: Native) -> list[tuple[str, object, str]]:
+        """What the engine itself would refuse in ``native`` when it runs it: [(its keyword, the value, the
+        engine's rule)], checked before any work (a case's ``[engine.NAME]`` table, a calibrated input before
+        its confirming run). The default: nothing."""
+        return []
+
+    def check_native(self, native: Native, where: str) -> Native:
+        """``native`` when the engine accepts it (native_limits), else a ConfigError naming ``where``.KEYWORD."""
+        from ..errors import ConfigError
+
+        for key, value, rule in self.native_limits(native):
+            raise ConfigError(f"{where}.{key}", value, f"{rule} ({self.title} refuses the run otherwise)")
+        return native
+
     def case_native(self, case) -> Native | None:
         """The Native of the case's ``[engine.<name>]`` table (read once per case), or None without one."""
         table = getattr(case, "natives", {}).get(self.name)
@@ -208,7 +222,7 @@ class Engine(ABC):
             return None
         key = ("native", self.name)
         if key not in case.prepared:
-            case.prepared[key] = self.native_from_case(table, case)
+            case.prepared[key] = self.check_native(self.native_from_case(table, case), f"engine.{self.name}")
         return case.prepared[key]
 
     # ------------------------------------------------------------------ decks and output

@@ -23,6 +23,26 @@ def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, 
     return registry.get(engine).collision_deck(case, dt, length, native=native, **options)
 
 
+def setting(case: Case, engine: str, dt: float | None = None):
+    """(native, dt): what ``engine`` (or a build of it) runs for the case — the case's ``[engine.NAME]`` setting
+    (None: the engine's mapping of the seed model) and its step: ``dt`` (--dt), else the case's run.dt, else, for a
+    native law, its twin's elastic contact time over run.steps_per_contact (the seed model's contact time would
+    leave a stiffer native law unresolved; None: the deck's own auto step). ``demcheck collide``, ``deck`` and the
+    API's collide all take it from here, so that the deck written is the deck run."""
+    native = registry.get(engine).case_native(case)
+    if native is not None and not dt and not case.run.dt:
+        from ..reference.model import characteristic_time, resolve
+
+        dt = characteristic_time(twin_model(resolve(case), native)) / case.run.steps_per_contact
+    return native, dt or None
+
+
+def setting_deck(case: Case, engine: str, dt: float | None = None) -> common.Deck:
+    """The deck ``collide(case, engine, *setting(case, engine, dt))`` runs first: what ``demcheck deck`` writes."""
+    native, step = setting(case, engine, dt)
+    return deck(case, engine, step, native=native)
+
+
 # what a cached run's metadata must hold (engines/cache.py checks each value)
 META_KEYS = {"version": cache_checks.text, "workdir": cache_checks.text, "wall_time": cache_checks.number,
              "warnings": cache_checks.texts}

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -12,6 +13,9 @@ import numpy as np
 
 from .. import registry
 from ..base import Native, PackageEngine, Style
+
+
+MIN_RESTITUTION = 0.05  # LIGGGHTS refuses a coefficientRestitution e <= 0.05
 
 
 class Liggghts(PackageEngine):
@@ -69,13 +73,21 @@ class Liggghts(PackageEngine):
 
         if metric != "restitution":
             return None
-        if native.normal in ("hertz", "hooke"):
-            return Knob("coefficientRestitution", 1e-3, 1.0, native.props.get("restitution", 0.5),
+        if native.normal in ("hertz", "hooke"):  # LIGGGHTS takes 0.05 < e <= 1 (native_limits)
+            return Knob("coefficientRestitution", math.nextafter(MIN_RESTITUTION, 1.0), 1.0,
+                        native.props.get("restitution", 0.5),
                         lambda x: replace(native, props={**native.props, "restitution": x}))
         if native.normal in ("hooke/stiffness", "hertz/stiffness"):
             return Knob("gamman", 0.0, None, native.props.get("gamman") or 1.0,
                         lambda x: replace(native, props={**native.props, "gamman": x}))
         return None
+
+    def native_limits(self, native: Native) -> list[tuple[str, object, str]]:
+        """LIGGGHTS stops on a coefficientRestitution outside 0.05 < e <= 1 (global_properties.cpp)."""
+        e = native.props.get("restitution")
+        if native.normal in ("hertz", "hooke") and e is not None and not MIN_RESTITUTION < e <= 1.0:
+            return [("coefficientRestitution", e, f"must be in ({MIN_RESTITUTION:g}, 1]")]
+        return []
 
     def native_lines(self, native: Native) -> list[str]:
         from .deck import NAMES, fmt

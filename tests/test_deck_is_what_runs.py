@@ -1,0 +1,72 @@
+"""``demcheck deck CASE --engine E`` writes the deck that ``demcheck collide CASE --engine E`` runs: a case's
+``[engine.NAME]`` native setting (not the engine's mapping of the seed model) at the native law's own step — for
+every engine that takes native settings, with the engine run for real and the deck it was given recorded."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from demcheck import cli
+from demcheck.engines import registry
+from demcheck.engines import run as runner
+
+from .test_native import TSUJI, _case, to_toml
+
+NATIVE = {  # per engine that takes native settings: its table, and a word of it the deck must hold
+    "lammps": ({"pair_coeff": TSUJI}, "damping tsuji"),
+    "liggghts": ({"pair_style": "gran model hertz tangential history limitForce on"}, "limitForce on"),
+}
+
+
+def test_every_engine_that_takes_native_settings_is_covered():
+    """An engine whose package reads [engine.NAME] tables overrides native_from_case: each is tested below."""
+    from demcheck.engines.base import Engine
+
+    takes = {name for name in registry.names()
+             if type(registry.get(name)).native_from_case is not Engine.native_from_case}
+    assert takes == set(NATIVE)
+
+
+def _main(argv, capsys) -> tuple[int, str, str]:
+    try:
+        cli.main(argv)
+        code = 0
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.mark.parametrize("dt", [None, "2e-8"])
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in NATIVE])
+def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, monkeypatch):
+    table, word = NATIVE[engine]
+    path = tmp_path / "native.toml"
+    path.write_text(to_toml(_case({engine: table})))
+    extra = ["--dt", dt] if dt else []
+    out_dir = tmp_path / "deck"
+    code, _, err = _main(["deck", str(path), "--engine", engine, "-o", str(out_dir / "in.deck"), *extra], capsys)
+    assert code == 0, err
+    written = (out_dir / "in.deck").read_text()
+    beside = {f.name: f.read_text() for f in out_dir.iterdir() if f.name != "in.deck"}
+
+    ran = []
+    real = runner.run
+
+    def recording(eng, text, *args, **kwargs):
+        ran.append((text, dict(kwargs.get("files") or {})))
+        return real(eng, text, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run", recording)
+    code, out, err = _main(["collide", str(path), "--engine", engine, "--json", *extra], capsys)
+    assert code == 0, err
+    assert ran, "collide ran no deck"
+    assert written == ran[0][0]  # byte for byte: the native law at the step collide used
+    assert beside == ran[0][1]  # and the files it reads (LIGGGHTS's data file)
+    assert word in written and "# mapping fidelity: native" in written
+    summary = json.loads(out)
+    assert summary["params"]["mapping"] == "native" and summary["status"] == "ok"
+    if dt:
+        assert summary["dt"] == float(dt)
