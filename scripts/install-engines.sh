@@ -154,7 +154,7 @@ fi
 
 # --- Yade (Debian) -------------------------------------------------------------------------------------------
 if command -v yade >/dev/null 2>&1 && command -v yade-float128 >/dev/null 2>&1; then
-    echo "engines: Yade ok ($(yade --version 2>/dev/null | sed -n 's/^Yade version: *//p'))"
+    echo "engines: Yade ok ($(yade --version 2>/dev/null | sed -n 's/^Yade version: *\(.*[^ ]\) *$/\1/p'))"
 elif pkgs=$(apt_pick Yade yade -- yade-float128 yade-mpfr150); then
     # shellcheck disable=SC2086
     if apt_install Yade $pkgs; then
