@@ -206,8 +206,9 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
                 raise
             again.args = (f"{again}\n(a first attempt, on another process, had failed too: {first.what})",)
             raise again from None
+        tail = getattr(first, "tail", "")
         out.warnings.append(f"{engine}: a first attempt failed without an error of the engine's ({first.what}); "
-                            "it was run again on a fresh process")
+                            f"it was run again on a fresh process{'; its last lines: ' + tail if tail else ''}")
         return out
 
 
@@ -283,8 +284,8 @@ def _failed(engine: str, wd: Path, log: str, seen: str, deck_error: bool) -> Eng
                                               f"{seen})")
     exc = EngineFailed(f"{engine} failed ({what}); work directory kept: {wd}\nkept there: {', '.join(kept) or 'nothing'}"
                        f"\n{tail}")
-    exc.what = what
-    exc.fault = not deck_error
+    exc.what, exc.fault = what, not deck_error
+    exc.tail = " | ".join(ln.strip() for ln in log_tail(log, 6).splitlines() if ln.strip())[:600]
     return exc
 
 
