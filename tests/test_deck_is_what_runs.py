@@ -12,6 +12,7 @@ from demcheck import cli
 from demcheck.engines import registry
 from demcheck.engines import run as runner
 
+from .conftest import CASES
 from .test_native import TSUJI, _case, to_toml
 
 NATIVE = {  # per engine that takes native settings: its table, and a word of it the deck must hold
@@ -70,3 +71,33 @@ def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, 
     assert summary["params"]["mapping"] == "native" and summary["status"] == "ok"
     if dt:
         assert summary["dt"] == float(dt)
+
+
+ALL = ["lammps", "liggghts", "yade", "kratos"]
+
+
+@pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ALL])
+def test_a_seed_models_deck_is_the_deck_collide_ran(engine, tmp_path, capsys, monkeypatch):
+    """No native setting, two unequal spheres: collide wrote every type pair with the contact pair's
+    configuration and called it "native", while deck mapped each type pair — the same run now, byte for byte."""
+    from demcheck.engines.collide import collide as run_engine
+    import demcheck
+
+    case = demcheck.load(CASES / "tti-pair.toml", {"particles.1.radius": 2e-3}) if engine != "kratos" else \
+        demcheck.load(CASES / "glass-pair.toml", {"particles.1.radius": 2e-3, "contact.normal": "lsd",
+                                                "contact.kn": 1e5, "contact.limit_force": True})
+    from demcheck.engines.collide import setting_deck
+
+    written = setting_deck(case, engine)
+    ran = []
+    real = runner.run
+
+    def recording(eng, text, *args, **kwargs):
+        ran.append((text, dict(kwargs.get("files") or {})))
+        return real(eng, text, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run", recording)
+    res = run_engine(case, engine)
+    assert ran and (written.text, dict(written.files)) == ran[0]
+    assert res.ok, res.message
+    assert "native" not in res.params["mapping"] and "# mapping fidelity: native" not in written.text

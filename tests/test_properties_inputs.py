@@ -169,3 +169,24 @@ def test_hostile_numbers_never_reach_an_engine_deck(args, engine):
         assert len(lines) == 1 and lines[0].startswith("demcheck: error: "), err
     else:
         assert not NON_FINITE.search(out), NON_FINITE.search(out).group(0)
+
+
+@pytest.mark.parametrize("command", [["deck", "--engine", "lammps"], ["deck", "--engine", "liggghts"],
+                                     ["collide", "--engine", "lammps"]])
+def test_a_derived_coefficient_that_overflows_never_reaches_a_deck(command, monkeypatch):
+    """Found by the property above: a 1e4 m sphere of E = 1e308 made LAMMPS's like-pair coefficient 4/3·Ē·√R̄
+    inf, and the deck said `pair_coeff 2 2 hertz inf …`: refused, naming the case's most extreme number, before
+    the deck is written or run."""
+    from demcheck.engines import run as runner
+
+    monkeypatch.setattr(runner, "run", lambda *a, **k: pytest.fail("an engine started"))
+    argv = [command[0], str(CASES / "glass-pair.toml"), *command[1:], "--set", "particles.1.radius=1e4",
+            "--set", "materials.glass.youngs_modulus=1e308"]
+    code, out, err = _run(argv)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "materials.glass.youngs_modulus = 1e+308: makes the" in err and "not finite" in err and not out
+
+
+def test_a_name_that_reads_nan_is_text_not_a_number():
+    code, out, err = _run(["deck", str(CASES / "glass-pair.toml"), "--engine", "lammps", "--set", 'name="nan inf"'])
+    assert code == 0 and "# case: nan inf" in out, err

@@ -657,7 +657,7 @@ def _computable(case: Case):
         with np.errstate(all="ignore"):
             yield
     except (ArithmeticError, ValueError) as exc:
-        key, value = _extreme_number(case)
+        key, value = extreme_number(case)
         raise ConfigError(key, value, f"the case's numbers are beyond what double precision computes here "
                                       f"({type(exc).__name__}: {exc})") from None
 
@@ -666,7 +666,7 @@ def _computable(case: Case):
 EVERYDAY = {"density": 2500.0, "youngs_modulus": 7e10, "radius": 1e-3, "speed": 1.0}
 
 
-def _extreme_number(case: Case) -> tuple[str, object]:
+def extreme_number(case: Case) -> tuple[str, object]:
     """(key, value) of the case's number farthest, in decades, from an everyday grain's: the materials' density
     and modulus, the radii, the impact speed, and any contact parameter outside [1e-100, 1e100]."""
     found = []
@@ -1021,7 +1021,7 @@ def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=N
     model = model or resolve(case)
     t_c = characteristic_time(model)
     if not (math.isfinite(t_c) and t_c >= MIN_TIME):
-        key, value = _extreme_number(case)
+        key, value = extreme_number(case)
         raise ConfigError(key, value, f"gives an elastic contact time of {t_c:.3g} s: the case's numbers must give "
                                       f"a finite time >= {MIN_TIME:g} s (a double's precision)")
     step = dt or case.run.dt or t_c / case.run.steps_per_contact  # dt = auto

@@ -467,13 +467,13 @@ def deck(case_path, engine, output, dt, overrides):
     """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
     (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
     reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
-    from .engines.collide import setting_deck
+    from .engines.collide import finite, setting_deck
 
     case = _load(case_path, overrides)
     if case.kind == "packing":
         from .engines import registry
 
-        dk = registry.get(engine).packing_deck(case, dt=dt)
+        dk = finite(registry.get(engine).packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
         dk = setting_deck(case, engine, dt)
     if output:  # the files the deck reads go beside it: each checked before any is written

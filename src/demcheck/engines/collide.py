@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -20,7 +21,28 @@ from .mapping import contact_mapping, native_summary, twin_model
 
 def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, native=None,
          **options) -> common.Deck:
-    return registry.get(engine).collision_deck(case, dt, length, native=native, **options)
+    return finite(registry.get(engine).collision_deck(case, dt, length, native=native, **options), case)
+
+
+# a number an engine cannot read (NaN, inf), as a word of a deck's command (comments aside)
+NON_FINITE = re.compile(r"(?<![\w.])[-+]?(nan|inf|infinity)(?![\w.])", re.I)
+
+
+def finite(dk: common.Deck, case: Case) -> common.Deck:
+    """``dk`` when every number in its commands and files is finite; else a ConfigError naming the case's most
+    extreme number (a coefficient derived from the case's numbers overflowed: 4/3·Ē·√R̄ of E = 1e308), before
+    the deck is written or run."""
+    for text in (dk.text, *dk.files.values()):
+        for line in text.splitlines():
+            command = line.split("#", 1)[0]
+            if NON_FINITE.search(command):
+                from ..case import extreme_number
+
+                key, value = extreme_number(case)
+                raise ConfigError(key, value, f"makes the {dk.engine} deck hold a number that is not finite "
+                                              f"({command.strip()[:80]!r}): beyond what the engine's input can "
+                                              "express")
+    return dk
 
 
 def setting(case: Case, engine: str, dt: float | None = None):
@@ -74,7 +96,8 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     from . import discovery
 
     mp = contact_mapping(case, engine, native)
-    native = mp.require()
+    mp.require()  # the decks get ``native`` as given (None: the seed model's mapping, type pair by type pair), so
+    # that the deck run is the deck `demcheck deck` writes
     started = time.perf_counter()
     length = 1.0
     cached = False
@@ -137,7 +160,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         source=engine, method="engine", case_name=case.name, case_hash=case.hash,
         model={"normal": case.contact.normal, "tangential": case.contact.tangential,
                "limit_force": case.contact.limit_force},
-        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(native)},
+        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(mp.native)},
         contact=contact, particles=particles, dt=used_dt, wall_time=time.perf_counter() - started,
         engine_version=out.version, status="ok",
         message="; ".join(mp.reasons),
