@@ -70,8 +70,10 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
         return row
     pairs = r.get("pairs", [])
     probed = [p for p in pairs if any("error" not in q for q in p.get("probes", []))]
+    codes = sorted({f["code"] for p in pairs for f in p.get("findings", []) if f["kind"] == "trap"})
     row.update(pairs=len(pairs), probed_pairs=len(probed), status=r.get("status"), traps=r.get("traps"),
-               coverage=r.get("coverage"))
+               coverage=r.get("coverage"), codes=codes, units=(r.get("units") or {}).get("style"),
+               speed_from=str(r.get("speed_from", ""))[:60])
     row["outcome"] = "probed" if probed else "nothing probed"
     if not probed:
         row["why"] = r.get("status_reason") or "no probe ran"
@@ -101,7 +103,8 @@ def main(argv=None) -> int:
     if a.out:
         a.out.parent.mkdir(parents=True, exist_ok=True)
         body = [f"{r['outcome']:<15} {'DEM' if r['dem'] else '   '} {r['deck']}"
-                + (f"  [{r.get('probed_pairs')}/{r.get('pairs')} pairs probed, {r.get('status')}]"
+                + (f"  [{r.get('probed_pairs')}/{r.get('pairs')} pairs and walls probed, units {r.get('units')}, "
+                   f"{r.get('status')}{': ' + ', '.join(r['codes']) if r.get('codes') else ''}]"
                    if r["outcome"] in ("probed", "nothing probed") else "")
                 + (f"  — {r['why']}" if r.get("why") else "") for r in rows]
         a.out.write_text("\n".join(body) + "\n\n" + lines[0] + "\n", encoding="utf-8")
