@@ -237,15 +237,22 @@ def models(model_id, as_json, engine, radius, density, speed):
 
         if model_id is None:
             raise ConfigError("SETTING", None, "--engine needs the native setting to look up")
+        from .comparisons.audit import safe_text
+
         r = reverse(engine, model_id, radius or 1e-3, density or 2500.0, speed or 1.0)
         if as_json:
             emit_json(r)
+            if r["fidelity"] == "failed":
+                sys.exit(1)
             return
         pair = r["pair"]
-        click.echo(f"{engine}: {r['native']}")
+        click.echo(safe_text(f"{engine}: {r['native']}"))
         s = r["seed"]
         if s is None:
             click.echo("  nearest seed model: none (demcheck has no twin of this law); fidelity none")
+        elif r["fidelity"] == "failed":
+            click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — FAILED: the probes "
+                       "measured no contact to compare: " + "; ".join(r["failures"]))
         else:
             click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — {r['fidelity']}"
                        f" (largest gap {r['gap']:.3g} between its converged contact and the seed model's at "
@@ -264,10 +271,12 @@ def models(model_id, as_json, engine, radius, density, speed):
                           if math.isfinite(tw["tangential_restitution"]) else "")
                        + f", tc {tw['contact_time']:.4g} s (seed {sd['contact_time']:.4g} s)")
         for n in r["notes"]:
-            click.echo(f"  note: {n}")
+            click.echo(safe_text(f"  note: {n}"))
         for f in r["findings"]:
-            click.echo(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
+            click.echo(safe_text(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}"))
         click.echo("  `demcheck audit DECK` measures each trap in the engine (docs/audit.md)")
+        if r["fidelity"] == "failed":
+            sys.exit(1)
         return
     from .engines import mapping, registry as engine_registry
     from .reference import normal, tangential
@@ -1110,11 +1119,22 @@ def dt(case_path, target, overrides, as_json):
 def audit(deck_path, engine, speed, as_json, report_dir):
     """Audit a user's own LAMMPS or LIGGGHTS input deck: each type pair's and wall's contact law, probed in the
     engine, its twin and the nearest seed model; the traps it falls into. The deck is read, never run as written.
-    Exit 0: nothing found; 1: a trap; 2: a line it cannot read."""
+    Exit 0: every pair and wall probed or listed, nothing found; 1: a trap; 2: a line it cannot read; 3: nothing
+    probed (never "clean"). --json prints one JSON object in every case, a refusal included."""
     from .comparisons import audit
+    from .errors import DemcheckError, EngineInterrupted
     from .io import write_text
 
-    result = audit.audit(deck_path, engine, speed)
+    try:
+        result = audit.audit(deck_path, engine, speed)
+    except EngineInterrupted:
+        raise
+    except DemcheckError as exc:
+        if as_json:  # the refusal as a JSON object too; the one line still goes to stderr
+            emit_json({"deck": str(deck_path), "status": "refused" if exc.exit_code == 2 else "failed",
+                       "error": audit.safe_text(str(exc).splitlines()[0] if str(exc) else type(exc).__name__),
+                       "exit_code": exc.exit_code})
+        raise
     text = audit.text_report(result)
     if report_dir:
         out = Path(report_dir)
@@ -1125,8 +1145,13 @@ def audit(deck_path, engine, speed, as_json, report_dir):
         emit_json(result)
     else:
         click.echo(text)
+    if result["status"] == "not audited":
+        sys.exit(AUDIT_NOTHING_PROBED)
     if result["traps"]:
         sys.exit(1)
+
+
+AUDIT_NOTHING_PROBED = 3  # `demcheck audit`: the deck was read, nothing was probed — its own status, never 0
 
 
 @cli.command()

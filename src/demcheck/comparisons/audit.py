@@ -12,6 +12,7 @@ contact with the time-step error and the stability margin, and every trap with i
 
 from __future__ import annotations
 
+import copy
 import math
 from pathlib import Path
 
@@ -40,6 +41,7 @@ ASKED_TOL = 0.01
 ATTRACTION_NOTE, ATTRACTION_TRAP = 0.01, 0.10
 MIN_STEPS_PER_CONTACT = 20  # fewer: the contact is resolved too coarsely whatever the error measured
 METRICS = ("restitution", "tangential_restitution", "rebound_angular_velocity", "contact_time", "peak_force")
+HEALTH = ("max_overlap",)  # read for the pass-through check, never compared
 
 
 def readers() -> dict:
@@ -70,42 +72,121 @@ def read(path: str | Path, engine: str | None = None):
     if engine not in found:
         raise ConfigError("--engine", engine, f"audit reads {', '.join(found)} decks")
     setup = found[engine].read(script, Path(path).resolve().parent)
+    setup.regions = script.regions
+    setup.box = script.variables.get("__box__", (None, None))[1]
     for cmd, why in script.unread:
         setup.not_audited.append((cmd.where(), cmd.text, why))
     return setup
 
 
 def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple[float, str]:
+    """The impact speed of the probes, and where it comes from: --speed; else the relative normal approach speed
+    of the placed bodies that meet; else poured or inserted bodies' insertion velocity plus their fall from the
+    top of the insertion region to the floor under the deck's gravity; else the deck's largest speed; else, under
+    gravity, the settling speed (a fall of one diameter, the largest)."""
     if speed is not None:
         return speed, "--speed"
+    found = deck_script.approach_speed(setup)
+    if found is not None:
+        return found
+    fall = _insertion_speed(setup)
+    if fall is not None:
+        return fall
     moving = [(v, w) for v, w in setup.speeds if v > 0]
     if moving:
         v, w = max(moving)
         return v, f"the deck's largest speed ({w})"
-    raise ConfigError("--speed", None, "the deck gives its bodies no speed (no velocity, Velocities or "
-                                       "characteristicVelocity): give the characteristic impact speed (m/s)")
+    radii = [r for b in setup.bodies.values() for r in [b.radius, *(x for x, _ in b.sizes)] if r]
+    if setup.gravity is not None and setup.gravity[0] > 0 and radii:
+        g, _, where = setup.gravity
+        d = 2.0 * max(radii)
+        return math.sqrt(2.0 * g * d), (f"the settling speed: a fall of one diameter ({d:g}) under the deck's "
+                                        f"gravity {g:g} ({where})")
+    raise ConfigError("--speed", None, "the deck gives its bodies no speed (no velocity, Velocities, insertion, "
+                                       "gravity or characteristicVelocity): give the characteristic impact speed")
 
 
-def _body(setup: deck_script.Setup, t: int):
+def _insertion_speed(setup) -> tuple[float, str] | None:
+    best = None
+    for region, vel, _types, where in setup.insertions:
+        v0 = math.sqrt(sum(x * x for x in vel))
+        speed, why = v0, f"the insertion velocity ({where})"
+        if setup.gravity is not None and setup.gravity[0] > 0:
+            g, axis, g_where = setup.gravity
+            bounds = setup.regions.get(region) if region else None
+            if not bounds or not all(map(math.isfinite, bounds[2 * axis:2 * axis + 2])):
+                bounds = setup.box
+            floors = [c for a, c in setup.floors if a == axis]
+            lo = min(floors) if floors else (setup.box[2 * axis] if setup.box else None)
+            if bounds is None or lo is None or not math.isfinite(lo):
+                continue
+            height = max(bounds[2 * axis + 1] - lo, 0.0)
+            speed = math.sqrt(vel[axis] ** 2 + 2.0 * g * height)
+            why = (f"poured or inserted bodies ({where}): insertion velocity {vel[axis]:g} plus the fall of {height:g} "
+                   f"from the top of {'region ' + region if region and setup.regions.get(region) else 'the box'} to "
+                   f"the floor under gravity {g:g} ({g_where})")
+        if speed > 0 and (best is None or speed > best[0]):
+            best = (speed, why)
+    return best
+
+
+def _body(setup: deck_script.Setup, t: int, radius: float | None = None):
+    """(radius, density of a sphere of its mass) of type ``t`` (``radius``: one of its sizes). A 2-D deck's
+    density is per area (LAMMPS's 2-D convention, mass = ρπr²): the probes' spheres get that mass."""
     b = setup.bodies.get(t)
     if b is None or b.radius is None:
         raise deck_script.ScriptError(f"type {t}: the deck gives it no diameter (set type {t} diameter, read_data Atoms, or "
                             "a particle template)")
+    r = radius or b.radius
     if b.density is None:
         if b.mass is None:
             raise deck_script.ScriptError(f"type {t}: the deck gives it no density or mass")
-        return b.radius, b.mass / (4.0 / 3.0 * math.pi * b.radius ** 3)
-    return b.radius, b.density
+        return r, b.mass / (4.0 / 3.0 * math.pi * b.radius ** 3)
+    if setup.dimension == 2:
+        return r, b.density * 0.75 / r
+    return r, b.density
+
+
+def _sides(setup, ps):
+    radii = ps.radii or (None, None)
+    first = _body(setup, ps.i, radii[0])
+    return first, (None if ps.j is None else _body(setup, ps.j, radii[1]))
 
 
 def _effective(setup, ps):
-    r1, rho1 = _body(setup, ps.i)
+    (r1, rho1), second = _sides(setup, ps)
     m1 = rho1 * 4.0 / 3.0 * math.pi * r1 ** 3
-    if ps.j is None:
+    if second is None:
         return m1, r1
-    r2, rho2 = _body(setup, ps.j)
+    r2, rho2 = second
     m2 = rho2 * 4.0 / 3.0 * math.pi * r2 ** 3
     return m1 * m2 / (m1 + m2), r1 * r2 / (r1 + r2)
+
+
+def expand_sizes(setup) -> None:
+    """A pair or wall whose type comes in several sizes (fix pour, templates, per-atom data) is probed at the
+    smallest, the largest and the mass-weighted size of each side: one entry each, said in its label."""
+    out = []
+    for ps in setup.pairs:
+        bi = setup.bodies.get(ps.i)
+        bj = setup.bodies.get(ps.j) if ps.j is not None else None
+        if not ((bi and bi.sizes) or (bj and bj.sizes)):
+            out.append(ps)
+            continue
+        vi = dict(deck_script.size_variants(bi))
+        vj = dict(deck_script.size_variants(bj)) if bj is not None else {}
+        sources = sorted({b.size_from for b in (bi, bj) if b is not None and b.sizes})
+        for label in ("smallest", "largest", "mass-weighted"):
+            q = copy.copy(ps)
+            q.notes, q.findings = list(ps.notes), list(ps.findings)
+            ri = vi.get(label, vi.get(""))
+            rj = vj.get(label, vj.get("")) if bj is not None else None
+            q.radii, q.size = (ri, rj), label
+            q.label = f"{ps.label} ({label})"
+            q.notes.append(f"{label} size of {', '.join(sources)}: radius {ri:g}"
+                           + (f" and {rj:g}" if rj is not None else ""))
+            out.append(q)
+    setup.pairs = out
 
 
 def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
@@ -160,9 +241,10 @@ def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
     return normal, tangential, params, reasons
 
 
-def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> Case:
+def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed, dt: float | None = None) -> Case:
     normal, tangential, params, _ = seed
-    r1, rho1 = _body(setup, ps.i)
+    params = dict(params)  # the seed's own stays whole (a probe case may be built more than once)
+    (r1, rho1), second = _sides(setup, ps)
     e_star = nl.k / (4.0 / 3.0 * math.sqrt(_effective(setup, ps)[1])) if nl.a == 1.5 else 1e9
     nu = 0.3
     if getattr(ps.native, "normal", "") == "hertz/material":
@@ -185,7 +267,7 @@ def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> Case:
     parts = [{"material": "a", "radius": r1}]
     raw = {"name": f"audit-{ps.label.replace(' ', '-').replace('×', 'x')}-{angle:g}", "materials": mats,
            "particles": parts, "impact": {"speed": speed, "angle": angle},
-           "contact": {"normal": normal, "tangential": tangential, **params}, "run": {"dt": setup.dt}}
+           "contact": {"normal": normal, "tangential": tangential, **params}, "run": {"dt": dt or setup.dt}}
     if ps.j is None:
         wall = {"point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}
         if own and ps.wall:
@@ -194,7 +276,7 @@ def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> Case:
             wall.update(rigid=False, material="w")
         raw["walls"] = [wall]
     else:
-        r2, rho2 = _body(setup, ps.j)
+        r2, rho2 = second
         mats["b"] = material(rho2, setup.bodies[ps.j], own)
         parts.append({"material": "b", "radius": r2})
     return from_dict(raw)
@@ -202,7 +284,7 @@ def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed) -> Case:
 
 def _metrics(res) -> dict:
     m = res.metrics()
-    return {k: m.get(k, math.nan) for k in METRICS}
+    return {k: m.get(k, math.nan) for k in METRICS + HEALTH}
 
 
 def _stability(nl, m_eff: float, max_overlap: float, dt: float) -> float:
@@ -216,16 +298,59 @@ def _stability(nl, m_eff: float, max_overlap: float, dt: float) -> float:
     return 2.0 / math.sqrt(k / m_eff) / dt
 
 
-def probe(setup, ps, speed: float, angle: float, run_engine: bool = True) -> dict:
-    """One probe of one type pair: the engine, its twin at the deck's dt and converged, and the seed model."""
+def case_at_step(setup, ps, speed, angle, nl, tl, seed) -> tuple[Case, float, str]:
+    """The probe's case and the step it runs at: the deck's, or — when the contact at the deck's step takes more
+    steps than an engine probe may (case.MAX_STEPS) — the least power-of-two multiple of it that fits, stated. The
+    approach is already the contact alone (the bodies start a thousandth of a radius apart)."""
+    from ..case import MAX_STEPS, run_length
+
+    dt = setup.dt
+    for k in range(80):
+        try:
+            case = probe_case(setup, ps, speed, angle, nl, tl, seed, dt)
+            run_length(case, dt)
+        except ConfigError as exc:
+            if exc.key not in ("run.dt", "--dt") or "steps" not in exc.rule:
+                raise
+            dt *= 2.0
+            continue
+        if k == 0:
+            return case, dt, ""
+        return case, dt, (f"probed at dt = {dt:.4g} ({2 ** k}× the deck's {setup.dt:g}): at the deck's step the contact "
+                          f"takes more than the {MAX_STEPS:,} steps an engine probe may; the time-step error is "
+                          "measured at this coarser step (the deck's own step errs less)")
+    raise ConfigError("timestep", setup.dt, "no step resolves the probe's contact within the run's bound")
+
+
+def health_failure(sides: dict, radius: float) -> str:
+    """Why a probe measured nothing, or "": a side that did not finish (its status), a contact that never formed
+    (no contact time > 0), a restitution that is not a finite number, an overlap that reaches the smaller radius
+    (the bodies pass through each other). Each is a failure with its cause, never a gap of 0."""
+    for name, m in sides.items():
+        if m.get("status", "ok") not in ("ok",) and name != "engine":  # the engine's own failure is engine-failed
+            return f"{name}: {m.get('status')}: {str(m.get('message', ''))[:160]}"
+        tc, e, mo = (m.get(k, math.nan) for k in ("contact_time", "restitution", "max_overlap"))
+        if not (isinstance(tc, float) and math.isfinite(tc) and tc > 0):
+            return f"{name}: the contact never formed (contact time {tc})"
+        if not math.isfinite(e):
+            return f"{name}: the restitution is {e} (no rebound measured)"
+        if isinstance(mo, float) and math.isfinite(mo) and mo >= radius:
+            return f"{name}: the largest overlap {mo:.3g} reaches the radius {radius:.3g} (the bodies pass through)"
+    return ""
+
+
+def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: Tolerances | None = None) -> dict:
+    """One probe of one type pair: the engine, its twin at the probe's dt and converged, and the seed model."""
+    tol = tol or Tolerances.load()
     m_eff, r_eff = _effective(setup, ps)
     eng = registry.get(setup.engine)
     nl, tl = eng.twin(ps.native, m_eff, r_eff)
     seed = seed_of(nl, tl, ps.asked)
-    case = probe_case(setup, ps, speed, angle, nl, tl, seed)
-    out = {"angle": angle, "speed": speed, "seed": {"normal": seed[0], "tangential": seed[1], "reasons": seed[3]}}
+    case, dt, dt_note = case_at_step(setup, ps, speed, angle, nl, tl, seed)
+    out = {"angle": angle, "speed": speed, "dt": dt, "dt_note": dt_note,
+           "seed": {"normal": seed[0], "tangential": seed[1], "reasons": seed[3]}}
     scales = {"impact_energy": 0.5 * m_eff * speed ** 2, "spin": speed / case.particles[0].radius}
-    twin = twin_states(case, setup.engine, setup.dt, native=ps.native)
+    twin = twin_states(case, setup.engine, dt, native=ps.native)
     out["twin"] = {"status": twin.status, "message": twin.message, **_metrics(twin)}
     try:
         conv = collision3d.collide(case, twin_model(resolve(case), ps.native), "adaptive")
@@ -236,7 +361,7 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True) -> dic
     ref = collision3d.collide(case, resolve(case), "adaptive")
     out["seed"].update(status=ref.status, **_metrics(ref))
     if run_engine:
-        res = collide(case, setup.engine, dt=setup.dt, native=ps.native)
+        res = collide(case, setup.engine, dt=dt, native=ps.native)
         out["engine"] = {"status": res.status, "message": res.message, "version": res.engine_version,
                          **_metrics(res)}
         fn = res.contact["fn"].to_numpy() if res.contact is not None and len(res.contact) else np.array([0.0])
@@ -245,25 +370,36 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True) -> dic
         out["engine"]["min_force"] = float(fn[inside].min()) if inside.any() else math.nan
         out["engine_vs_twin"] = _worst(out["engine"], out["twin"], METRICS, scales)
     main = out.get("engine", out["twin"])
+    out["dt_error"] = math.nan
     if conv is not None and conv.ok and twin.ok:
         out["dt_error"] = _worst(out["twin"], out["converged"], [k for k in METRICS if k != "peak_force"], scales)
-    else:
-        out["dt_error"] = math.nan
+        if out["dt_error"] > tol.verlet_rtol:  # is it the step's? the error must shrink with dt
+            half = twin_states(case, setup.engine, dt / 2.0, native=ps.native)
+            out["dt_error_half"] = (_worst({**_metrics(half)}, out["converged"],
+                                           [k for k in METRICS if k != "peak_force"], scales) if half.ok else math.nan)
     t_c = main["contact_time"]
     out["steps_per_contact"] = t_c / setup.dt if math.isfinite(t_c) else math.nan
     mo = twin.metrics().get("max_overlap", math.nan)
     out["stability_margin"] = _stability(nl, m_eff, mo, setup.dt) if math.isfinite(mo) else math.nan
     out["seed_gap"] = _worst(main, out["seed"], [k for k in METRICS if k != "peak_force"], scales)
+    sides = {k: out[k] for k in ("engine", "twin", "converged", "seed") if k in out}
+    out["failure"] = health_failure(sides, min(p.radius for p in case.particles))
     return out
+
+
+REQUIRED = ("restitution", "contact_time")  # every formed contact has them: NaN on both sides is a failure
 
 
 def _worst(a: dict, b: dict, keys, scales) -> float:
     """The largest scaled difference over ``keys``: a metric one side produced and the other did not (NaN) is an
-    infinite difference, never dropped (a metric neither side produces is skipped)."""
+    infinite difference, never dropped; a metric neither side produces is skipped — unless every contact has it
+    (REQUIRED: then neither side measured a contact, an infinite difference too)."""
     worst = 0.0
     for k in keys:
         x, y = a.get(k, math.nan), b.get(k, math.nan)
         if math.isnan(x) and math.isnan(y):
+            if k in REQUIRED:
+                return math.inf
             continue
         d = scaled(x, y, k, scales)
         if not math.isfinite(d):
@@ -274,57 +410,112 @@ def _worst(a: dict, b: dict, keys, scales) -> float:
 
 def _fidelity(gap: float, reasons: list) -> str:
     if not math.isfinite(gap):
-        return "none"
+        return "failed"
     return "exact" if gap <= 1e-6 and not reasons else "approximate"
 
 
 def audit(path: str | Path, engine: str | None = None, speed: float | None = None, run_engine: bool = True,
           tol: Tolerances | None = None) -> dict:
-    """The audit of a deck as a plain dict (the CLI prints it, --json dumps it)."""
+    """The audit of a deck as a plain dict (the CLI prints it, --json dumps it). ``status``: "clean" (every pair
+    and wall probed or listed with its reason, no trap), "traps", or "not audited" (no probe ran: never clean)."""
     from ..engines import discovery
 
     tol = tol or Tolerances.load()
     setup = read(path, engine)
-    v, v_from = characteristic_speed(setup, speed)
-    info = discovery.find(setup.engine) if run_engine else None
-    if run_engine and info is None:
-        from ..errors import EngineNotFound
-
-        raise EngineNotFound(discovery.missing(setup.engine))
+    expand_sizes(setup)
     eng = registry.get(setup.engine)
+    failed: dict = {}
     for ps in setup.pairs:  # every body the probes need, and a twin of every probed law, before any run
         if ps.probe:
             try:
                 eng.twin(ps.native, *_effective(setup, ps))
+            except (ZeroDivisionError, OverflowError) as exc:  # the twin exists: a number under- or overflowed
+                ps.probe = False
+                failed[id(ps)] = (f"the probe cannot be set up: {type(exc).__name__} ({exc}) — a coefficient or a "
+                                  "size under- or overflows in floating point")
             except (ValueError, ArithmeticError) as exc:
                 ps.probe = False
                 ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
-    pairs = []
-    findings = list(setup.findings)
+    probed = [ps for ps in setup.pairs if ps.probe]
+    v, v_from = characteristic_speed(setup, speed) if probed else (None, "no pair or wall is probed")
+    info = discovery.find(setup.engine) if run_engine and probed else None
+    if run_engine and probed and info is None:
+        from ..errors import EngineNotFound
+
+        raise EngineNotFound(discovery.missing(setup.engine))
+    pairs, findings = [], list(setup.findings)
     for ps in setup.pairs:
-        entry = {"pair": ps.label, "where": ps.where, "native": native_summary(ps.native), "asked": ps.asked,
-                 "notes": list(ps.notes), "probes": [], "findings": []}
-        found = list(ps.findings)
-        if ps.probe:
-            angles = ANGLES if ps.asked.get("friction", 0.0) > 0 else ANGLES[:1]
-            for angle in angles:
-                try:
-                    entry["probes"].append(probe(setup, ps, v, angle, run_engine))
-                except DemcheckError as exc:
-                    entry["probes"].append({"angle": angle, "error": str(exc)})
-                    found.append(deck_script.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
-                                           ps.where))
-            _judge(setup, ps, entry, found, tol)
-        entry["findings"] = [_finding(f) for f in found]
+        entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)))
         findings += found
         pairs.append(entry)
     traps = [f for f in findings if f.kind == "trap"]
+    coverage = _coverage(pairs)
+    status = "traps" if traps else "clean"
+    reason = ""
+    if not (coverage["pairs"]["probed"] + coverage["walls"]["probed"]):
+        status = "not audited"
+        reason = _why_nothing(pairs)
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
+            "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
-            "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass} for t, b in
-                       sorted(setup.bodies.items())},
+            "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass,
+                           "sizes": sorted({r for r, _ in b.sizes}) and
+                           [min(r for r, _ in b.sizes), max(r for r, _ in b.sizes)]}
+                       for t, b in sorted(setup.bodies.items())},
             "pairs": pairs, "not_audited": [{"where": w, "text": t, "why": y} for w, t, y in setup.not_audited],
-            "traps": len(traps), "status": "traps" if traps else "clean"}
+            "coverage": coverage, "traps": len(traps), "status": status, "status_reason": reason}
+
+
+def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dict, list]:
+    from ..errors import EngineInterrupted
+
+    entry = {"pair": ps.label, "wall": ps.j is None, "where": ps.where, "native": native_summary(ps.native),
+             "asked": ps.asked, "notes": list(ps.notes), "probes": [], "findings": []}
+    found = list(ps.findings)
+    if failure:
+        found.append(deck_script.Finding("trap", "probe-failed", failure, ps.where))
+    if ps.probe:
+        angles = ANGLES if ps.asked.get("friction", 0.0) > 0 else ANGLES[:1]
+        for angle in angles:
+            try:
+                entry["probes"].append(probe(setup, ps, v, angle, run_engine, tol))
+            except EngineInterrupted:
+                raise  # an interrupt stops the audit (exit 130/143): never a trap of the user's deck
+            except (ValueError, ArithmeticError) as exc:  # a number the probe cannot compute with
+                entry["probes"].append({"angle": angle, "error": str(exc)})
+                found.append(deck_script.Finding("trap", "probe-failed", f"the {angle:g}° probe cannot be computed: "
+                                                 f"{type(exc).__name__}: {exc}", ps.where))
+            except DemcheckError as exc:
+                entry["probes"].append({"angle": angle, "error": str(exc)})
+                found.append(deck_script.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
+                                                 ps.where))
+        _judge(setup, ps, entry, found, tol)
+    entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
+    entry["findings"] = [_finding(f) for f in found]
+    return entry, found
+
+
+def _coverage(pairs: list) -> dict:
+    out = {}
+    for kind, rows in (("pairs", [p for p in pairs if not p["wall"]]), ("walls", [p for p in pairs if p["wall"]])):
+        n, k = len(rows), sum(p["probed"] for p in rows)
+        out[kind] = {"probed": k, "total": n, "fraction": k / n if n else math.nan}
+    return out
+
+
+def _why_nothing(pairs: list) -> str:
+    if not pairs:
+        return "the deck defines no type pair or wall the audit reads"
+    reasons = sorted({n for p in pairs for n in p["notes"] if "not probed" in n}
+                     | {f["text"] for p in pairs for f in p["findings"] if f["code"] in ("probe-failed", "pass-through")})
+    return "no pair or wall was probed" + (": " + "; ".join(r[:160] for r in reasons[:4]) if reasons else "")
+
+
+def units_info(setup) -> dict:
+    """The deck's units and, for a style with a fixed SI meaning, its units of length, mass and time in SI."""
+    si = deck_script.SI_OF.get(setup.units)
+    return {"style": setup.units, "from": setup.units_where,
+            "si": None if si is None else {"length": si[0], "mass": si[1], "time": si[2]}}
 
 
 def _finding(f: deck_script.Finding) -> dict:
@@ -341,6 +532,18 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
     reasons = sorted({r for p in probes for r in p["seed"]["reasons"]})
     entry["seed"] = {"normal": head["seed"]["normal"], "tangential": head["seed"]["tangential"],
                      "fidelity": _fidelity(gap, reasons), "gap": gap, "reasons": reasons}
+    broken = [p for p in probes if p.get("failure")]
+    for p in broken:  # a probe that measured nothing (passing through, no contact, NaN): never "exact"
+        code = "pass-through" if "pass through" in p["failure"] else "probe-failed"
+        found.append(deck_script.Finding("trap", code, f"{p['angle']:g}° probe: {p['failure']}", ps.where,
+                                         {"angle": p["angle"]}))
+    if broken:
+        entry["seed"]["fidelity"] = "failed"
+        probes = [p for p in probes if not p.get("failure")]
+        if not probes:
+            return
+        head = probes[0]
+        main = head.get("engine", head["twin"])
     for p in probes:
         eng = p.get("engine")
         if eng is None:
@@ -371,19 +574,45 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
         entry["notes"].append(f"realised restitution {e_real:.4f} (the deck sets a damping coefficient, not e)")
     if ps.intended is not None:  # the measured size of a mixing or wall-moduli trap: the run it meant
         intended = PairLike(ps, ps.intended)
-        sizes = [_intended_probe(setup, intended, p) for p in probes]
+        sizes = [q for q in (_intended_probe(setup, intended, p) for p in probes) if q is not None]
         for f in found:
-            if f.code in ("mixing", "wall-moduli"):
+            if f.code in ("mixing", "wall-moduli") and not sizes:
+                f.text += "; not measured: the probes of the deck's or the meant setting were not healthy"
+            elif f.code in ("mixing", "wall-moduli"):
                 f.size.update({"probes": sizes})
                 worst = max(sizes, key=lambda s: max(abs(v) for v in s["difference"].values()))
                 key = max(worst["difference"], key=lambda k: abs(worst["difference"][k]))
                 f.text += (f"; measured at {worst['angle']:g}°: {key} {worst['deck'][key]:.4g} in the engine, "
                            f"{worst['intended'][key]:.4g} as meant ({worst['difference'][key] * 100:+.1f}%)")
-    # time step
+    _judge_time_step(setup, entry, found, probes, tol)
+    if not ps.native.limit and "engine" in head:
+        peak, low = head["engine"]["peak_force"], head["engine"]["min_force"]
+        if math.isfinite(low) and low < -ATTRACTION_NOTE * peak:
+            kind = "trap" if low < -ATTRACTION_TRAP * peak else "note"
+            found.append(deck_script.Finding(kind, "attraction", f"the normal force pulls the bodies together "
+                                   f"({low:.4g} N, {-low / peak * 100:.1f}% of the peak) and no limit holds it at 0",
+                                   ps.where, {"min_force": low, "peak_force": peak}))
+
+
+def _judge_time_step(setup, entry: dict, found: list, probes: list, tol: Tolerances) -> None:
+    """The time-step verdicts on the deck's own dt: unstable, too few steps, or an error that shrinks with dt (a
+    gap that stays at dt/2 is a model difference, named so, never a time-step error)."""
     spc = min(p["steps_per_contact"] for p in probes)
     margin = min(p["stability_margin"] for p in probes)
-    dt_err = max((p["dt_error"] for p in probes if not math.isnan(p["dt_error"])), default=math.nan)
-    entry["time_step"] = {"dt": setup.dt, "steps_per_contact": spc, "dt_error": dt_err, "stability_margin": margin}
+    at_deck = [p for p in probes if not p.get("dt_note")]  # a probe at a coarser step says nothing of the deck's
+    dt_err = max((p["dt_error"] for p in at_deck if not math.isnan(p["dt_error"])), default=math.nan)
+    shrinks = all(p.get("dt_error_half", 0.0) < 0.75 * p["dt_error"] for p in at_deck
+                  if math.isfinite(p["dt_error"]) and p["dt_error"] > tol.verlet_rtol)
+    entry["time_step"] = {"dt": setup.dt, "steps_per_contact": spc, "dt_error": dt_err, "stability_margin": margin,
+                          "probe_dt": max(p["dt"] for p in probes), "error_shrinks_with_dt": shrinks}
+    for note in sorted({p["dt_note"] for p in probes if p.get("dt_note")}):
+        entry["notes"].append(note)
+    if math.isfinite(dt_err) and dt_err > tol.verlet_rtol and not shrinks and spc >= MIN_STEPS_PER_CONTACT:
+        half = max(p.get("dt_error_half", math.nan) for p in at_deck)
+        entry["notes"].append(f"model difference, not a time-step error: the stepped twin differs from its converged "
+                              f"contact by {dt_err:.3g} at dt and {half:.3g} at dt/2 — the gap does not shrink with "
+                              "the step")
+        dt_err = math.nan  # not the step's error
     if not (math.isfinite(spc) and math.isfinite(margin)):
         found.append(deck_script.Finding("trap", "probe-unreadable", f"dt = {setup.dt:g} s: the probes give no contact "
                                          "time or overlap to judge the time step by", setup.dt_where))
@@ -395,13 +624,6 @@ def _judge(setup, ps, entry: dict, found: list, tol: Tolerances) -> None:
         found.append(deck_script.Finding("trap", "dt-coarse", f"dt = {setup.dt:g} s: {spc:.1f} steps per contact, "
                                f"time-step error {dt_err:.3g} against the converged contact", setup.dt_where,
                                {"steps_per_contact": spc, "dt_error": dt_err}))
-    if not ps.native.limit and "engine" in head:
-        peak, low = head["engine"]["peak_force"], head["engine"]["min_force"]
-        if math.isfinite(low) and low < -ATTRACTION_NOTE * peak:
-            kind = "trap" if low < -ATTRACTION_TRAP * peak else "note"
-            found.append(deck_script.Finding(kind, "attraction", f"the normal force pulls the bodies together "
-                                   f"({low:.4g} N, {-low / peak * 100:.1f}% of the peak) and no limit holds it at 0",
-                                   ps.where, {"min_force": low, "peak_force": peak}))
 
 
 class PairLike:
@@ -412,19 +634,36 @@ class PairLike:
         self.native = native
 
 
-def _intended_probe(setup, intended, p: dict) -> dict:
+def _intended_probe(setup, intended, p: dict) -> dict | None:
+    """The deck's probe against the run it meant — None when either is unhealthy (a failed run, bodies passing
+    through, a metric that is not finite): a trap's size is never measured from a broken run."""
     q = probe(setup, intended, p["speed"], p["angle"], run_engine="engine" in p)
-    deck = p.get("engine", p["twin"])
-    meant = q.get("engine", q["twin"])
-    keys = [k for k in METRICS if math.isfinite(deck[k]) and math.isfinite(meant[k]) and meant[k] != 0]
+    deck = p["engine"] if "engine" in p else p["twin"]
+    meant = q["engine"] if "engine" in q else q["twin"]
+    if (p.get("failure") or q.get("failure") or deck.get("status", "ok") != "ok" or meant.get("status", "ok") != "ok"
+            or not all(math.isfinite(x.get(k, math.nan)) for x in (deck, meant) for k in REQUIRED)):
+        return None
+    keys = [k for k in METRICS if math.isfinite(deck.get(k, math.nan)) and math.isfinite(meant.get(k, math.nan))
+            and meant[k] != 0]
     return {"angle": p["angle"], "deck": {k: deck[k] for k in keys}, "intended": {k: meant[k] for k in keys},
             "difference": {k: deck[k] / meant[k] - 1.0 for k in keys}}
 
 
 def text_report(r: dict) -> str:
     """The audit as text for people."""
+    u = r["units"]
+    t_unit, v_unit = UNIT_WORDS.get(u["style"], ("time units", "speed units"))
     lines = [f"audit of {r['deck']} ({r['engine']} {r['engine_version'] or ''}".rstrip() + ")",
-             f"  dt = {r['dt']:g} s ({r['dt_from']}); characteristic speed {r['speed']:g} m/s ({r['speed_from']})"]
+             f"  units {u['style']} ({u['from']}); " + (
+                 "the probes run in the deck's units (a consistent system: the same numbers in any), "
+                 + ("times and speeds below in them, SI in brackets" if u["si"] and u["style"] != "si" else
+                    "SI" if u["si"] else "no SI conversion: lj's σ, m and ε are the deck's own")),
+             f"  dt = {r['dt']:g} {t_unit}{_si(r['dt'], u, 'time')} ({r['dt_from']}); characteristic speed "
+             + (f"{r['speed']:g} {v_unit}{_si(r['speed'], u, 'speed')} ({r['speed_from']})" if r["speed"] is not None
+                else f"— ({r['speed_from']})")]
+    cov = r["coverage"]
+    lines.append("  probed: " + ", ".join(f"{c['probed']} of {c['total']} {kind}" for kind, c in cov.items())
+                 + (" (2-D deck: density per area, probed as spheres of that mass)" if r["dimension"] == 2 else ""))
     for p in r["pairs"]:
         lines.append(f"\n{p['pair']}: {p['native']}  [{p['where']}]")
         if "seed" in p:
@@ -440,8 +679,9 @@ def text_report(r: dict) -> str:
                 continue
             m = q.get("engine", q["twin"])
             lines.append(f"  {q['angle']:>3g}°: e {m['restitution']:.4f} (seed {q['seed']['restitution']:.4f}), "
-                         f"et {_f(m['tangential_restitution'])}, spin {_f(m['rebound_angular_velocity'])} rad/s, "
-                         f"tc {m['contact_time']:.4g} s; engine − twin {_f(q.get('engine_vs_twin', math.nan))}")
+                         f"et {_f(m['tangential_restitution'])}, spin {_f(m['rebound_angular_velocity'])} rad/"
+                         f"{t_unit}, tc {m['contact_time']:.4g} {t_unit}{_si(m['contact_time'], u, 'time')}; "
+                         f"engine − twin {_f(q.get('engine_vs_twin', math.nan))}")
         if "time_step" in p:
             t = p["time_step"]
             lines.append(f"  time step: {t['steps_per_contact']:.1f} steps per contact, error {_f(t['dt_error'])}, "
@@ -453,8 +693,33 @@ def text_report(r: dict) -> str:
     if r["not_audited"]:
         lines.append("\nnot audited (read, never run):")
         lines += [f"  {n['where']}: {n['text'][:70]} — {n['why']}" for n in r["not_audited"]]
-    lines.append(f"\n{r['traps']} trap(s)" if r["traps"] else "\nno trap found")
-    return "\n".join(lines)
+    if r["status"] == "not audited":
+        lines.append(f"\nNOT AUDITED: {r['status_reason']} — nothing was probed, so nothing is called clean"
+                     + (f" ({r['traps']} trap(s) read from the settings)" if r["traps"] else ""))
+    else:
+        lines.append(f"\n{r['traps']} trap(s)" if r["traps"] else "\nno trap found")
+    return "\n".join(safe_text(line) for line in lines)
+
+
+UNIT_WORDS = {"si": ("s", "m/s"), "cgs": ("s", "cm/s"), "micro": ("µs", "µm/µs"), "nano": ("ns", "nm/ns"),
+              "lj": ("τ", "σ/τ")}
+
+
+def _si(x, units: dict, kind: str) -> str:
+    si = units["si"]
+    if si is None or units["style"] == "si" or x is None or not math.isfinite(x):
+        return ""
+    factor = si["time"] if kind == "time" else si["length"] / si["time"]
+    return f" [{x * factor:.4g} {'s' if kind == 'time' else 'm/s'}]"
+
+
+_CONTROL = {c: f"\\x{c:02x}" for c in [*range(0, 9), *range(11, 32), 127, *range(128, 160)]}
+
+
+def safe_text(text: str) -> str:
+    """A line for a terminal: control characters from a deck (escape sequences that set the title or clear the
+    screen) shown as \\xNN, never sent raw; a tab stays."""
+    return text.translate(_CONTROL)
 
 
 def _f(x) -> str:
@@ -505,26 +770,42 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
     if tl.family == SPRING:
         implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if tl.kt_sqrt else "")
     # fidelity: the twin's converged contact against the seed model's, at the like pair and ``speed``
-    setup.dt = nl.characteristic_time(m / 2.0, speed) / 1000.0  # the probe case's run.dt (no run uses it)
-    gap, probes = 0.0, []
+    try:
+        setup.dt = nl.characteristic_time(m / 2.0, speed) / 1000.0  # the probe case's run.dt (no run uses it)
+    except (ValueError, ArithmeticError) as exc:
+        raise ConfigError("SETTING", line, f"the contact cannot be computed: {exc}") from None
+    if not (math.isfinite(setup.dt) and setup.dt > 0):
+        raise ConfigError("SETTING", line, f"the contact cannot be computed: its time scale is {setup.dt * 1000:g} s "
+                                           "(a coefficient under- or overflows in floating point)")
+    gap, probes, failures = 0.0, [], []
     scales = {"impact_energy": 0.25 * m * speed ** 2, "spin": speed / radius}
     for angle in (ANGLES if ps.asked.get("friction", 0.0) > 0 else ANGLES[:1]):
-        case = probe_case(setup, ps, speed, angle, nl, tl, seed_of(nl, tl, ps.asked))
-        twin = native_law(case, engine, ps.native)
-        seed = collision3d.collide(case, resolve(case), "adaptive")
+        try:
+            case = probe_case(setup, ps, speed, angle, nl, tl, seed_of(nl, tl, ps.asked))
+            twin = native_law(case, engine, ps.native)
+            seed = collision3d.collide(case, resolve(case), "adaptive")
+        except (ValueError, ArithmeticError) as exc:
+            raise ConfigError("SETTING", line, f"the {angle:g}° probe cannot be computed: {exc}") from None
         g = _worst(_metrics_of(twin.converged), _metrics(seed), [k for k in METRICS if k != "peak_force"], scales)
+        failure = health_failure({"converged twin": {"status": twin.status, **_metrics_of(twin.converged)},
+                                  "seed model": {"status": seed.status, "message": seed.message, **_metrics(seed)}},
+                                 radius)
         probes.append({"angle": angle, "twin": _metrics_of(twin.converged), "twin_by": twin.how,
-                       "seed": _metrics(seed), "gap": g})
+                       "seed": _metrics(seed), "gap": g, "failure": failure})
+        if failure:
+            failures.append(f"{angle:g}°: {failure}")
         gap = max(gap, g)
     e_asked, e_real = ps.asked.get("restitution"), probes[0]["twin"]["restitution"]
     for f in findings:  # the traps that miss the asked e, with the head-on probe's converged e
-        if f["code"] in ("tsuji", "limit") and e_asked is not None and math.isfinite(e_real):
+        if f["code"] in ("tsuji", "limit") and e_asked is not None and math.isfinite(e_real) and not probes[0]["failure"]:
             f["size"].update(asked=e_asked, realised=e_real, difference=e_real - e_asked)
             f["text"] += (f": e = {e_asked:g} asked, {e_real:.4f} realised (head-on at {speed:g} m/s, converged; "
                           "the engine's own step adds its time-step error)")
+    fidelity = "failed" if failures else _fidelity(gap, reasons)
     return {**out, "seed": {"normal": normal, "tangential": tangential, "params": params, "reasons": reasons},
-            "fidelity": _fidelity(gap, reasons), "gap": gap, "probes": probes, "implied": implied}
+            "fidelity": fidelity, "gap": math.nan if failures else gap, "failures": failures, "probes": probes,
+            "implied": implied}
 
 
 def _metrics_of(m: dict) -> dict:
-    return {k: m.get(k, math.nan) for k in METRICS}
+    return {k: m.get(k, math.nan) for k in METRICS + HEALTH}

@@ -9,8 +9,11 @@ reader does:
 * ``variable NAME equal EXPR`` (evaluated when referenced), ``string TEXT``, ``index V1 V2 …`` (the first
   value; an index variable is not redefined), ``delete``; other variable styles are listed as not audited and
   their references make a command unreadable;
-* ``$x``, ``${NAME}`` and ``$(EXPR)`` substitution outside quotes, with a small evaluator of arithmetic (numbers,
-  ``+ - * / ^``, parentheses, ``PI``, ``v_NAME`` and a few functions) — never Python's ``eval``;
+* ``$x``, ``${NAME}`` and ``$(EXPR)`` substitution, inside quotes too (as LAMMPS 22Jul2025 does: checked with its
+  library; inside quotes a reference the reader cannot evaluate stays as written), with a small evaluator of
+  arithmetic (ASCII numbers, ``+ - * / ^``, parentheses, ``PI``, ``v_NAME``, the box bounds ``xlo … zhi``, ``lx``,
+  ``ly``, ``lz`` once a box is defined, and a few functions) — never Python's ``eval``;
+* a bare carriage return (a CR-only file) is refused: LAMMPS reads it as a space, so the lines are one command;
 * ``include FILE`` relative to the deck's directory (a path that leaves it is refused);
 * ``label``, ``jump``, ``next``, ``if`` and ``loop`` are refused: control flow decides which lines run.
 
@@ -29,12 +32,31 @@ from ..errors import DemcheckError
 CONTROL_FLOW = frozenset({"label", "jump", "next", "if", "loop"})
 MAX_INCLUDE_DEPTH = 8
 MAX_LINES = 200_000
+MAX_LINE_CHARS = 100_000  # a command (after substitution) or a string variable longer than this is refused
+MAX_NESTING = 50  # parentheses in one formula (LAMMPS's own parser recurses too)
+MAX_MESSAGE = 400  # characters of deck text an error message quotes
+NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")  # what LAMMPS's numeric() takes
+BOX_KEYS = ("xlo", "xhi", "ylo", "yhi", "zlo", "zhi")
 
 
 class ScriptError(DemcheckError):
-    """A deck the reader cannot read: names the file, the line and the command (exit 2)."""
+    """A deck the reader cannot read: names the file, the line and the command (exit 2). The message quotes at
+    most MAX_MESSAGE characters of deck text (a 100 KB value is cut, never echoed whole)."""
 
     exit_code = 2
+
+    def __init__(self, message: str = ""):
+        message = str(message)
+        if len(message) > MAX_MESSAGE:
+            message = message[:MAX_MESSAGE // 2] + f" … [{len(message) - MAX_MESSAGE} characters cut] … " + \
+                message[-MAX_MESSAGE // 2:]
+        super().__init__(message)
+
+
+def to_number(text: str) -> float | None:
+    """A number as LAMMPS reads one (ASCII digits, optional sign, point and exponent), else None: Python's float
+    would also take '63_000_000_000', full-width digits, 'inf' and 'nan', which LAMMPS stops on."""
+    return float(text) if NUMBER.fullmatch(text) else None
 
 
 @dataclass
@@ -58,11 +80,12 @@ class Script:
     commands: list[Command] = field(default_factory=list)
     variables: dict = field(default_factory=dict)  # name → (style, value or expression)
     unread: list[tuple[Command, str]] = field(default_factory=list)  # variables the reader could not define
+    regions: dict = field(default_factory=dict)  # region id → (xlo, xhi, ylo, yhi, zlo, zhi) or None (other shapes)
 
 
 # ----------------------------------------------------------------------------- the safe evaluator
 
-_TOKEN = re.compile(r"\s*(?:(\d+\.?\d*(?:[eE][+-]?\d+)?|\.\d+(?:[eE][+-]?\d+)?)|(v_[A-Za-z0-9_]+)|"
+_TOKEN = re.compile(r"\s*(?:([0-9]+\.?[0-9]*(?:[eE][+-]?[0-9]+)?|\.[0-9]+(?:[eE][+-]?[0-9]+)?)|(v_[A-Za-z0-9_]+)|"
                     r"([A-Za-z_][A-Za-z0-9_]*)|(\*\*|[-+*/^(),]))")
 _FUNCTIONS = {"sqrt": math.sqrt, "exp": math.exp, "ln": math.log, "log": math.log10, "abs": abs, "sin": math.sin,
               "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos, "atan": math.atan,
@@ -82,6 +105,11 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
         raise _Unevaluable("variables refer to each other too deeply")
     tokens, pos = [], 0
     expr = expr.strip()
+    nest = 0
+    for ch in expr:  # the parser recurses per parenthesis: bound it before parsing (never a RecursionError)
+        nest += (ch == "(") - (ch == ")")
+        if nest > MAX_NESTING:
+            raise _Unevaluable(f"parentheses nested more than {MAX_NESTING} deep")
     while pos < len(expr):
         m = _TOKEN.match(expr, pos)
         if not m or m.end() == pos:
@@ -136,8 +164,10 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
             y = unary()  # right-associative
             try:
                 x = float(x) ** y
-            except (OverflowError, ZeroDivisionError) as exc:
-                raise _Unevaluable(str(exc)) from None
+            except OverflowError:
+                raise _Unevaluable(f"{x:g}^{y:g} overflows (larger than 1.8e308)") from None
+            except ZeroDivisionError:
+                raise _Unevaluable(f"{x:g}^{y:g}: zero to a negative power") from None
             if isinstance(x, complex):
                 raise _Unevaluable("a negative number to a fractional power")
         return x
@@ -159,6 +189,12 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
             take()
             if value in _CONSTANTS:
                 return _CONSTANTS[value]
+            box = variables.get("__box__", (None, None))[1]
+            if box and value in BOX_KEYS + ("lx", "ly", "lz"):
+                if value.startswith("l"):
+                    axis = "xyz".index(value[1])
+                    return box[2 * axis + 1] - box[2 * axis]
+                return box[BOX_KEYS.index(value)]
             if value in _FUNCTIONS and peek() == ("op", "("):
                 take()
                 args = [add()]
@@ -168,7 +204,7 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
                 take("op", ")")
                 try:
                     return float(_FUNCTIONS[value](*args))
-                except (TypeError, ValueError, OverflowError) as exc:
+                except (TypeError, ValueError, OverflowError, ZeroDivisionError) as exc:
                     raise _Unevaluable(f"{value}{tuple(args)}: {exc}") from None
             raise _Unevaluable(f"'{value}' is not a number the reader can know before a run")
         raise _Unevaluable(f"unexpected {value!r} in {expr!r}")
@@ -182,15 +218,15 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
 
 
 def lookup(name: str, variables: dict, depth: int = 0) -> float:
-    if name not in variables:
+    if name not in variables or name == "__box__":
         raise _Unevaluable(f"variable '{name}' is not defined (before this line)")
     style, value = variables[name]
     if style == "equal":
         return evaluate(value, variables, depth)
-    try:
-        return float(value)
-    except ValueError:
-        raise _Unevaluable(f"variable '{name}' = {value!r} is not a number") from None
+    x = to_number(value.strip())
+    if x is None:
+        raise _Unevaluable(f"variable '{name}' = {value[:60]!r} is not a number")
+    return x
 
 
 def number_text(x: float) -> str:
@@ -249,34 +285,27 @@ def _strip_comment(text: str) -> str:
 
 
 def _substitute(text: str, variables: dict) -> tuple[str, str]:
-    """(text with $x, ${NAME} and $(EXPR) replaced outside quotes, the problem or "")."""
-    out, i, quote, problem = [], 0, "", ""
+    """(text with $x, ${NAME} and $(EXPR) replaced, the problem or ""). LAMMPS 22Jul2025 substitutes inside single,
+    double and triple quotes too (checked with its library); there a reference the reader cannot evaluate (a
+    ``fix print`` of a compute) stays as written and is no problem of the line."""
+    out, i, quote, problem, grown = [], 0, "", "", len(text)
     while i < len(text):
         ch = text[i]
-        if quote:
-            if text.startswith(quote, i):
-                out.append(quote)
-                i += len(quote)
-                quote = ""
-                continue
-            out.append(ch)
-            i += 1
-            continue
-        if text.startswith('"""', i):
-            quote = '"""'
+        if quote and text.startswith(quote, i):
             out.append(quote)
-            i += 3
+            i += len(quote)
+            quote = ""
             continue
-        if ch in "'\"":
-            quote = ch
-            out.append(ch)
-            i += 1
+        if not quote and (text.startswith('"""', i) or ch in "'\""):
+            quote = '"""' if text.startswith('"""', i) else ch
+            out.append(quote)
+            i += len(quote)
             continue
         if ch != "$" or i + 1 >= len(text):
             out.append(ch)
             i += 1
             continue
-        nxt = text[i + 1]
+        start, nxt = i, text[i + 1]
         try:
             if nxt == "{":
                 end = text.find("}", i + 2)
@@ -305,14 +334,20 @@ def _substitute(text: str, variables: dict) -> tuple[str, str]:
                 value = _value_text(nxt, variables)
                 i += 2
         except _Unevaluable as exc:
-            problem = problem or str(exc)
-            value = "?"
-            i += 2 if nxt not in "{(" else 0
+            i = start + (2 if nxt not in "{(" else 0)
             if nxt in "{(":
                 close = "}" if nxt == "{" else ")"
-                end = text.find(close, i + 2)
+                end = text.find(close, start + 2)
                 i = end + 1 if end >= 0 else len(text)
+            if quote:  # as written: the command that reads the quoted text is not one the audit reads
+                value = text[start:i]
+            else:
+                problem = problem or str(exc)
+                value = "?"
         out.append(value)
+        grown += len(value)
+        if grown > MAX_LINE_CHARS:
+            raise ScriptError(f"a command grows past {MAX_LINE_CHARS} characters by substitution: {text[:80]!r}")
     return "".join(out), problem
 
 
@@ -326,7 +361,7 @@ def _format(x: float, fmt: str) -> str:
 
 
 def _value_text(name: str, variables: dict) -> str:
-    if name not in variables:
+    if name not in variables or name == "__box__":
         raise _Unevaluable(f"variable '{name}' is not defined (before this line)")
     style, value = variables[name]
     if style == "equal":
@@ -377,9 +412,15 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
     file too, as in LAMMPS)."""
     name = path.name if path.parent == root else str(path.relative_to(root))
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_bytes().decode("utf-8")  # as written: read_text would turn a bare CR into a line end
     except UnicodeDecodeError:
         raise ScriptError(f"{name}: not a text file (UTF-8)") from None
+    bare_cr = text.replace("\r\n", "").find("\r")
+    if bare_cr >= 0:
+        line = text[:bare_cr].count("\n") + 1
+        raise ScriptError(f"{name}:{line}: a carriage return without a line feed (CR-only line endings): LAMMPS reads "
+                          "it as a space, so these lines are one command to the engine; convert the file to LF or "
+                          "CRLF line endings")
     for line_no, raw in _logical_lines(text, name):
         body = _strip_comment(raw).strip()
         if not body:
@@ -399,6 +440,12 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
             return True
         if cmd.name == "variable" and not problem:
             _define(cmd, script)
+        _geometry(cmd, script, root)
+        if cmd.name == "run" and "every" in words:
+            for text in words[words.index("every") + 2:]:
+                if text not in ("NULL", "pre", "post", "start", "stop", "upto", "every") and not NUMBER.fullmatch(text):
+                    script.unread.append((cmd, f"run … every: {text[:60]!r} runs between the chunks of the run: "
+                                               "not audited (never run by demcheck)"))
         if cmd.name == "include":
             if problem or len(words) != 2:
                 raise ScriptError(f"{where}: {body[:60]!r}: include takes one file name"
@@ -429,7 +476,11 @@ def _define(cmd: Command, script: Script) -> None:
     elif style == "equal":
         script.variables[name] = ("equal", " ".join(rest))
     elif style == "string":
-        script.variables[name] = ("string", " ".join(rest))
+        value = " ".join(rest)
+        if len(value) > MAX_LINE_CHARS:
+            raise ScriptError(f"{cmd.where()}: variable {name}: a string of {len(value)} characters, more than the "
+                              f"{MAX_LINE_CHARS} the audit reads")
+        script.variables[name] = ("string", value)
     elif style == "index":
         if not rest:
             raise ScriptError(f"{cmd.where()}: {cmd.text[:60]!r}: an index variable needs a value")
@@ -437,6 +488,46 @@ def _define(cmd: Command, script: Script) -> None:
     else:  # loop, world, universe, atom, vector, python, file, getenv, format, internal, …
         script.variables.pop(name, None)
         script.unread.append((cmd, f"variable style '{style}' is not read (its value is known only in a run)"))
+
+
+def _bound(word: str, default: float) -> float:
+    x = to_number(word)
+    return default if x is None else x
+
+
+def _geometry(cmd: Command, script: Script, root: Path) -> None:
+    """Regions (block and cylinder bounds, for insertion heights) and the box (its bounds become the thermo
+    keywords xlo … zhi in later formulas, as in LAMMPS once create_box or read_data has run)."""
+    w = cmd.words
+    if cmd.name == "region" and len(w) >= 3:
+        bounds = None
+        inf = math.inf
+        box = script.variables.get("__box__", (None, None))[1] or (-inf, inf, -inf, inf, -inf, inf)
+        if w[2] == "block" and len(w) >= 9:
+            bounds = tuple(_bound(x, box[k]) for k, x in enumerate(w[3:9]))
+        elif w[2] == "cylinder" and len(w) >= 9 and w[3] in ("x", "y", "z"):
+            c1, c2, r = (to_number(x) for x in w[4:7])
+            axis = "xyz".index(w[3])
+            if None not in (c1, c2, r):
+                lo, hi = _bound(w[7], box[2 * axis]), _bound(w[8], box[2 * axis + 1])
+                others = [(c1 - r, c1 + r), (c2 - r, c2 + r)]
+                spans = others[:axis] + [(lo, hi)] + others[axis:]
+                bounds = tuple(x for span in spans for x in span)
+        if w[2] != "delete":
+            script.regions[w[1]] = bounds
+    elif cmd.name == "create_box" and len(w) >= 3 and script.regions.get(w[2]):
+        script.variables["__box__"] = ("box", script.regions[w[2]])
+    elif cmd.name == "read_data" and len(w) >= 2:
+        path = (root / w[1]).resolve()
+        if path.is_relative_to(root) and path.is_file():
+            box = [0.0] * 6
+            with path.open(encoding="utf-8", errors="replace") as f:
+                for _, line in zip(range(60), f):
+                    parts = line.split("#", 1)[0].split()
+                    if len(parts) == 4 and parts[2:] in (["xlo", "xhi"], ["ylo", "yhi"], ["zlo", "zhi"]):
+                        k = "xyz".index(parts[2][0])
+                        box[2 * k:2 * k + 2] = [_bound(parts[0], 0.0), _bound(parts[1], 0.0)]
+            script.variables["__box__"] = ("box", tuple(box))
 
 
 # ----------------------------------------------------------------------------- what an engine's reader makes of a deck
@@ -463,6 +554,8 @@ class Body:
     mass: float | None = None
     youngs_modulus: float | None = None  # what the engine's contact settings give the type (for the seed model)
     poisson_ratio: float | None = None
+    sizes: list = field(default_factory=list)  # (radius, mass fraction) when the type comes in several sizes
+    size_from: str = ""  # where the sizes come from (fix pour, templates, per-atom data)
 
 
 @dataclass
@@ -480,6 +573,8 @@ class PairSetting:
     notes: list = field(default_factory=list)
     wall: dict = field(default_factory=dict)  # a wall's own properties (youngs_modulus, poisson_ratio)
     probe: bool = True  # False: listed, not run (no twin for its law)
+    radii: tuple | None = None  # the radii probed (i, j) where a type comes in several sizes; None: the type's own
+    size: str = ""  # which of the sizes: smallest, largest, mass-weighted
 
 
 @dataclass
@@ -493,6 +588,19 @@ class Setup:
     not_audited: list = field(default_factory=list)  # (where, text, why)
     findings: list = field(default_factory=list)
     ntypes: int = 0
+    units: str | None = None  # the deck's unit style (None: no units line — LAMMPS's default, lj)
+    units_where: str = ""
+    dimension: int = 3
+    gravity: tuple | None = None  # (magnitude, axis 0|1|2, where) of fix gravity
+    atoms: dict = field(default_factory=dict)  # id → [type, position or None, velocity or None] (single bodies)
+    groups: dict = field(default_factory=dict)  # group → set of atom ids, or ("type", types)
+    populated: set = field(default_factory=set)  # types the deck gives bodies (create_atoms, data, pour, insert)
+    insertions: list = field(default_factory=list)  # (region id, initial velocity, types, where) of pour/insert
+    floors: list = field(default_factory=list)  # (axis, coordinate) of plane walls
+    regions: dict = field(default_factory=dict)  # the script's regions (bounds or None)
+    box: tuple | None = None
+    created: set = field(default_factory=set)  # types create_atoms makes (LAMMPS's default diameter 1, density 1)
+    molecules: dict = field(default_factory=dict)  # molecule id → its file (inside the deck's directory)
 
 
 # ----------------------------------------------------------------------------- what both engines' decks share
@@ -531,11 +639,11 @@ def note_unread(setup, cmd: "Command", quiet_fixes=frozenset()) -> None:
 def _num(cmd: Command, k: int, what: str) -> float:
     if cmd.problem:
         raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {cmd.problem}")
-    try:
-        x = float(cmd.words[k])
-    except (IndexError, ValueError):
+    x = to_number(cmd.words[k]) if k < len(cmd.words) else None
+    if x is None:
         got = cmd.words[k] if k < len(cmd.words) else "(missing)"
-        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {what} = {got!r} is not a number") from None
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {what} = {got[:60]!r} is not a number (as LAMMPS "
+                          "reads one: ASCII digits, a sign, a point and an exponent)")
     if not math.isfinite(x):
         raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {what} = {cmd.words[k]!r} is not finite")
     return x
@@ -559,13 +667,292 @@ def body(setup: Setup, t: int) -> Body:
     return setup.bodies.setdefault(t, Body(t))
 
 
+# LAMMPS's unit styles and the default time step of each (its `units` command); metal and real convert between
+# their mass, force and time units with constants of LAMMPS's own, so a probe written in them is not read here
+UNITS = {"lj": 0.005, "si": 1e-8, "cgs": 1e-8, "micro": 2.0, "nano": 0.00045, "metal": 0.001, "real": 1.0}
+INCONSISTENT_UNITS = ("metal", "real")
+# each consistent style's units of length, mass and time in SI (lj has none: σ, m and τ are the deck's own)
+SI_OF = {"si": (1.0, 1.0, 1.0), "cgs": (1e-2, 1e-3, 1.0), "micro": (1e-6, 1e-15, 1e-6), "nano": (1e-9, 1e-21, 1e-9)}
+SIZE_STEPS = 41  # a diameter range (fix pour diam range) is probed through this many diameters, mass-weighted
+
+
+def finish(setup: Setup, default_dt_where: str) -> None:
+    """What every reader does after the last command: the units (LAMMPS's default lj without a units line),
+    the default step of the units, each type's representative (mass-weighted) radius where it has several."""
+    if setup.units is None:
+        setup.units, setup.units_where = "lj", "no units line: LAMMPS's default, lj"
+    if setup.dt is None:
+        setup.dt, setup.dt_where = UNITS[setup.units], f"{default_dt_where} for units {setup.units} (no timestep command)"
+    for t in setup.created:  # atom_style sphere: create_atoms makes diameter 1 and density 1 until `set` changes it
+        b = setup.bodies[t]
+        if b.radius is None:
+            b.radius = 0.5
+        if b.density is None and b.mass is None:
+            b.density = 1.0
+    for b in setup.bodies.values():
+        if not b.sizes:
+            continue
+        radii = sorted({r for r, _ in b.sizes})
+        total = sum(w for _, w in b.sizes)
+        if len(radii) == 1 or not total > 0:
+            b.radius, b.sizes = radii[0], []
+            continue
+        b.radius = sum(r * w for r, w in b.sizes) / total
+
+
+def size_variants(b: Body) -> list[tuple[str, float]]:
+    """(label, radius) of the sizes a type's probes take: the smallest, the largest and the mass-weighted mean —
+    or its one radius."""
+    if not b.sizes:
+        return [("", b.radius)]
+    radii = [r for r, _ in b.sizes]
+    return [("smallest", min(radii)), ("largest", max(radii)), ("mass-weighted", b.radius)]
+
+
+def _group(cmd: Command, setup: Setup) -> None:
+    w = cmd.words
+    values = set()
+    for word in w[3:]:
+        lo, _, hi = word.partition(":")
+        if to_number(lo) is None or (hi and to_number(hi) is None):
+            return  # a group by a formula or a region: not read (velocity on it reads no atom)
+        values.update(range(int(float(lo)), int(float(hi or lo)) + 1))
+    setup.groups[w[1]] = ("type", values) if w[2] == "type" else values
+
+
+def _group_atoms(setup: Setup, group: str) -> list:
+    if group == "all":
+        return list(setup.atoms)
+    g = setup.groups.get(group)
+    if isinstance(g, tuple):
+        return [a for a, rec in setup.atoms.items() if rec[0] in g[1]]
+    return [a for a in (g or ()) if a in setup.atoms]
+
+
+def _gravity(cmd: Command, setup: Setup) -> None:
+    """fix ID group gravity MAG vector x y z | spherical φ θ | chute angle: the magnitude and the axis bodies fall
+    along (the vector's largest component; z — y in 2-D — for spherical and chute)."""
+    w = cmd.words
+    if cmd.problem:
+        setup.not_audited.append((cmd.where(), cmd.text, f"fix gravity: {cmd.problem}"))
+        return
+    g = abs(_num(cmd, 4, "gravity magnitude"))
+    axis = 1 if setup.dimension == 2 else 2
+    if w[5:6] == ["vector"] and len(w) >= 9:
+        v = [abs(_num(cmd, 6 + k, "gravity vector")) for k in range(3)]
+        axis = max(range(3), key=lambda k: v[k])
+    setup.gravity = (g, axis, cmd.where())
+
+
+def _set(cmd: Command, setup: Setup) -> None:
+    """set type T | group G | atom N … diameter/density/mass/vx/vy/vz: per type (a group by type, an atom by its
+    type where the deck placed it; the sizes of a type set atom by atom are all probed)."""
+    w = cmd.words
+    kind, target = w[1], w[2]
+    atoms = []
+    if kind == "type":
+        types = type_range(target, setup.ntypes, cmd)
+        if any(x in w for x in ("diameter", "density", "mass")):
+            setup.populated.update(types)  # a type the deck sizes is one it means to have bodies of
+    elif kind == "atom":
+        ids = type_range(target, max(len(setup.atoms), 1), cmd) if setup.atoms else []
+        atoms = [a for a in ids if a in setup.atoms]
+        types = sorted({setup.atoms[a][0] for a in atoms})
+        if not types:
+            setup.not_audited.append((cmd.where(), cmd.text, "set atom: the deck places no such atom where the "
+                                                              "audit can see it (create_atoms single, read_data)"))
+            return
+    else:
+        g = setup.groups.get(target)
+        if target == "all":
+            types = sorted(setup.populated) or sorted(setup.bodies) or list(range(1, setup.ntypes + 1))
+            atoms = list(setup.atoms)
+        elif isinstance(g, tuple):
+            types = sorted(g[1])
+        elif g:
+            atoms = [a for a in g if a in setup.atoms]
+            types = sorted({setup.atoms[a][0] for a in atoms})
+        else:
+            setup.not_audited.append((cmd.where(), cmd.text, f"set group {target}: a group the audit cannot resolve "
+                                                              "to types (by a region or a formula)"))
+            return
+    k = 3
+    while k + 1 < len(w):
+        key = w[k]
+        if key in ("type", "type/fraction", "type/ratio", "type/subset") and to_number(w[k + 1]) is not None:
+            t = int(float(w[k + 1]))
+            setup.populated.add(t)
+            for a in atoms:
+                setup.atoms[a][0] = t
+            source = [setup.bodies.get(x) for x in types]
+            if setup.created & set(types):
+                setup.created.add(t)  # the moved atoms keep create_atoms's defaults
+            new = body(setup, t)
+            for b in source:  # the moved atoms keep what was set on them
+                if b is not None and b is not new:
+                    new.radius = new.radius if new.radius is not None else b.radius
+                    new.density = new.density if new.density is not None else b.density
+            if key == "type" and kind == "atom":
+                types = [t]
+            k += 2 if key == "type" else 4 if key == "type/fraction" else 4
+            continue
+        if key in ("diameter", "density", "mass"):
+            x = _num(cmd, k + 1, key)
+            if not x > 0:
+                raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {key} must be > 0")
+            for t in types:
+                b = body(setup, t)
+                if key == "diameter":
+                    if kind == "atom" and b.radius is not None and b.radius != x / 2:
+                        b.sizes = b.sizes or [(b.radius, 1.0)]
+                        b.sizes.append((x / 2, 1.0))
+                        b.size_from = "set atom"
+                    b.radius = x / 2
+                elif key == "density":
+                    b.density = x
+                else:
+                    b.mass = x
+        elif key in ("vx", "vy", "vz"):
+            x = _num(cmd, k + 1, key)
+            for a in atoms:
+                v = setup.atoms[a][2] or [0.0, 0.0, 0.0]
+                v["xyz".index(key[1])] = x
+                setup.atoms[a][2] = v
+            setup.speeds.append((abs(x), cmd.where()))
+        k += 2
+
+
+def pour(cmd: Command, setup: Setup) -> None:
+    """fix ID group pour N type seed … (LAMMPS): the type, its diameters (diam one D | range lo hi | poly N d p …,
+    number fractions; a range is probed through SIZE_STEPS diameters), density (dens lo hi: the mean), the
+    insertion region and initial velocity (vel … vz) — what the characteristic speed and the sizes need."""
+    w = cmd.words
+    t = int(_num(cmd, 5, "pour type"))
+    if "mol" in w:
+        _pour_molecule(cmd, setup, w[w.index("mol") + 1] if w.index("mol") + 1 < len(w) else "", t)
+        region = w[w.index("region") + 1] if "region" in w and w.index("region") + 1 < len(w) else None
+        setup.insertions.append((region, [0.0, 0.0, 0.0], [], cmd.where()))
+        return
+    b = body(setup, t)
+    setup.populated.add(t)
+    diams, dens, vel, region = [(1.0, 1.0)], (1.0, 1.0), [0.0, 0.0, 0.0], None
+    k = 7
+    while k < len(w):
+        key = w[k]
+        if key == "diam" and w[k + 1:k + 2] == ["one"]:
+            diams, k = [(_num(cmd, k + 2, "diam one"), 1.0)], k + 3
+        elif key == "diam" and w[k + 1:k + 2] == ["range"]:
+            diams = _uniform(_num(cmd, k + 2, "diam lo"), _num(cmd, k + 3, "diam hi"))
+            k += 4
+        elif key == "diam" and w[k + 1:k + 2] == ["poly"]:
+            n = int(_num(cmd, k + 2, "diam poly N"))
+            diams = [(_num(cmd, k + 3 + 2 * i, "diam"), _num(cmd, k + 4 + 2 * i, "fraction")) for i in range(n)]
+            k += 3 + 2 * n
+        elif key == "diam" and to_number(w[k + 1] if k + 1 < len(w) else "") is not None:  # old: diam lo hi
+            diams = _uniform(_num(cmd, k + 1, "diam lo"), _num(cmd, k + 2, "diam hi"))
+            k += 3
+        elif key == "dens":
+            dens, k = (_num(cmd, k + 1, "dens lo"), _num(cmd, k + 2, "dens hi")), k + 3
+        elif key == "vel":
+            n = 3 if setup.dimension == 2 else 5
+            vals = [_num(cmd, k + 1 + i, "vel") for i in range(n)]
+            vel = [max(abs(vals[0]), abs(vals[1])), 0.0, vals[-1]] if n == 5 else [max(abs(vals[0]), abs(vals[1])), vals[2], 0.0]
+            k += 1 + n
+        elif key == "region":
+            region, k = w[k + 1], k + 2
+        else:
+            k += 1
+    rho = 0.5 * (dens[0] + dens[1])
+    if any(not (d > 0) for d, _ in diams) or not rho > 0:
+        raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: diameters and densities must be > 0")
+    b.sizes = [(d / 2, p * rho * d ** 3) for d, p in diams]  # number fraction → mass fraction
+    b.size_from = f"fix {w[1]} pour ({cmd.where()})"
+    b.radius = b.radius or diams[0][0] / 2
+    b.density = rho
+    setup.insertions.append((region, vel, [t], cmd.where()))
+
+
+def _uniform(lo: float, hi: float) -> list[tuple[float, float]]:
+    """A uniform number distribution of diameters on [lo, hi]: its ends (weight 0: the extremes probed) and the
+    midpoints of SIZE_STEPS equal parts (the midpoint rule for the mass-weighted mean, error ~ 1/SIZE_STEPS²)."""
+    mids = [(lo + (hi - lo) * (i + 0.5) / SIZE_STEPS, 1.0) for i in range(SIZE_STEPS)]
+    return [(lo, 0.0), *mids, (hi, 0.0)]
+
+
+def _pour_molecule(cmd: Command, setup: Setup, mol: str, offset: int) -> None:
+    """fix pour … mol ID: the molecule file's spheres (Types + offset, Diameters, Masses) sized per type; a rigid
+    cluster's spheres are probed as single spheres (said in the report)."""
+    path = setup.molecules.get(mol)
+    if path is None:
+        setup.not_audited.append((cmd.where(), cmd.text, f"fix pour mol {mol}: its molecule file is not read"))
+        return
+    sections: dict = {}
+    current = None
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines()[:100_000]:
+        text = line.split("#", 1)[0].strip()
+        if text in ("Coords", "Types", "Diameters", "Masses", "Charges", "Bonds", "Special Bond Counts"):
+            current = sections.setdefault(text, {})
+        elif text and current is not None:
+            parts = text.split()
+            if to_number(parts[0]) is not None and len(parts) >= 2:
+                current[int(float(parts[0]))] = parts[1]
+    for atom, kind in sections.get("Types", {}).items():
+        t = int(float(kind)) + offset
+        d, m = (to_number(sections.get(k, {}).get(atom, "")) for k in ("Diameters", "Masses"))
+        b = body(setup, t)
+        setup.populated.add(t)
+        if d and d > 0:
+            b.radius = d / 2
+        if m and m > 0 and b.density is None:
+            b.mass = m
+        b.size_from = f"molecule {mol} (its spheres probed as single spheres; the rigid cluster is not)"
+    setup.not_audited.append((cmd.where(), cmd.text, f"fix pour of molecule {mol}: rigid clusters of spheres; each "
+                                                      "sphere's contacts are probed as a single sphere's"))
+
+
+def approach_speed(setup: Setup) -> tuple[float, str] | None:
+    """The largest relative normal approach speed of two placed bodies (−Δv·Δx/|Δx| > 0), at most 300 bodies."""
+    placed = [(a, x, v or [0.0, 0.0, 0.0]) for a, (_, x, v) in setup.atoms.items() if x is not None]
+    if not 2 <= len(placed) <= 300:
+        return None
+    best = None
+    for i in range(len(placed)):
+        for j in range(i + 1, len(placed)):
+            (a, xa, va), (b, xb, vb) = placed[i], placed[j]
+            dx = [xb[k] - xa[k] for k in range(3)]
+            d = math.sqrt(sum(x * x for x in dx))
+            if d == 0:
+                continue
+            vn = -sum((vb[k] - va[k]) * dx[k] for k in range(3)) / d
+            if vn > 0 and (best is None or vn > best[0]):
+                best = (vn, f"the relative normal approach speed of atoms {a} and {b}")
+    return best
+
+
 def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
     """The commands both engines share that define bodies, their speeds and the step; True when read."""
     w, name = cmd.words, cmd.name
     if name == "units":
-        if len(w) < 2 or w[1] != "si":
-            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: audit reads decks in units si "
-                              f"(got {w[1] if len(w) > 1 else 'none'})")
+        style = w[1] if len(w) > 1 else "(none)"
+        if style not in UNITS:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not a unit style "
+                              f"({', '.join(UNITS)})")
+        if style in INCONSISTENT_UNITS:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not audited — LAMMPS converts "
+                              "between this style's mass, force and time units with its own constants, which the "
+                              f"audit's probes do not reproduce (it reads {', '.join(u for u in UNITS if u not in INCONSISTENT_UNITS)})")
+        setup.units, setup.units_where = style, cmd.where()
+        return True
+    if name == "dimension":
+        setup.dimension = int(_num(cmd, 1, "dimension"))
+        if setup.dimension not in (2, 3):
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: dimension must be 2 or 3")
+        return True
+    if name == "group" and len(w) >= 4 and w[2] in ("id", "type"):
+        _group(cmd, setup)
+        return True
+    if name == "fix" and len(w) >= 5 and w[3] == "gravity":
+        _gravity(cmd, setup)
         return True
     if name == "timestep":
         dt = _num(cmd, 1, "timestep")
@@ -584,39 +971,33 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
     if name == "create_atoms":
         t = int(_num(cmd, 1, "atom type"))
         body(setup, t)
+        setup.populated.add(t)
+        setup.created.add(t)
+        if w[2:3] == ["single"] and len(w) >= 6:
+            setup.atoms[len(setup.atoms) + 1] = [t, [_num(cmd, 3 + k, "position") for k in range(3)], None]
         return True
-    if name == "set" and len(w) >= 5 and w[1] in ("type", "group"):
-        if w[1] == "group" and w[2] != "all":
-            setup.not_audited.append((cmd.where(), cmd.text, "set group other than all: the audit reads "
-                                                              "properties per type"))
-            return True
-        types = (type_range(w[2], setup.ntypes, cmd) if w[1] == "type"
-                 else list(range(1, setup.ntypes + 1)) or list(setup.bodies))
-        k = 3
-        while k + 1 < len(w):
-            key = w[k]
-            if key in ("diameter", "density", "mass"):
-                x = _num(cmd, k + 1, key)
-                if not x > 0:
-                    raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {key} must be > 0")
-                for t in types:
-                    b = body(setup, t)
-                    if key == "diameter":
-                        b.radius = x / 2
-                    elif key == "density":
-                        b.density = x
-                    else:
-                        b.mass = x
-            elif key in ("vx", "vy", "vz"):
-                setup.speeds.append((abs(_num(cmd, k + 1, key)), cmd.where()))
-            k += 2
+    if name == "set" and len(w) >= 5 and w[1] in ("type", "group", "atom"):
+        _set(cmd, setup)
         return True
     if name == "velocity" and len(w) >= 6 and w[2] == "set":
         v = [0.0 if x == "NULL" else _num(cmd, 3 + i, "velocity") for i, x in enumerate(w[3:6])]
+        ids = _group_atoms(setup, w[1])
+        for a in ids:
+            setup.atoms[a][2] = v
         setup.speeds.append((math.sqrt(sum(x * x for x in v)), cmd.where()))
         return True
     if name == "read_data":
         _read_data(cmd, setup, root)
+        return True
+    if name == "molecule" and len(w) >= 3:
+        path = (root / w[2]).resolve()
+        if path.is_relative_to(root) and path.is_file():
+            setup.molecules[w[1]] = path
+        return True
+    if name == "fix" and len(w) >= 6 and w[3] == "pour":
+        if cmd.problem:
+            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: {cmd.problem}")
+        pour(cmd, setup)
         return True
     return False
 
@@ -641,10 +1022,9 @@ def _read_data(cmd: Command, setup: Setup, root: Path) -> None:
                                                               and not words[-1].replace(".", "").isdigit()):
             section = words[0]
             continue
-        try:
-            nums = [float(x) for x in words if not x.isalpha()]
-        except ValueError:
-            raise ScriptError(f"{where}: {line[:60]!r}: not a number") from None
+        nums = [to_number(x) for x in words if not x.isalpha()]
+        if None in nums:
+            raise ScriptError(f"{where}: {line[:60]!r}: not a number")
         if not section:
             if words[-2:] == ["atom", "types"]:
                 setup.ntypes = int(nums[0])
@@ -657,7 +1037,17 @@ def _read_data(cmd: Command, setup: Setup, root: Path) -> None:
         if section == "Masses" and len(nums) >= 2:
             body(setup, int(nums[0])).mass = nums[1]
         elif section == "Atoms" and len(nums) >= 7:  # atom_style sphere/granular: id type diameter density x y z
-            b = body(setup, int(nums[1]))
+            t = int(nums[1])
+            b = body(setup, t)
+            if not (nums[2] > 0 and nums[3] > 0):
+                raise ScriptError(f"{where}: {line[:60]!r}: diameter and density must be > 0")
             b.radius, b.density = nums[2] / 2, nums[3]
+            b.sizes.append((nums[2] / 2, nums[3] * nums[2] ** 3))
+            b.size_from = f"read_data {cmd.words[1]}"
+            setup.populated.add(t)
+            if len(setup.atoms) < 100_000:
+                setup.atoms[int(nums[0])] = [t, nums[4:7], None]
         elif section == "Velocities" and len(nums) >= 4:
             setup.speeds.append((math.sqrt(sum(x * x for x in nums[1:4])), where))
+            if int(nums[0]) in setup.atoms:
+                setup.atoms[int(nums[0])][2] = nums[1:4]

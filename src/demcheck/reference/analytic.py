@@ -23,8 +23,19 @@ def power_law_integral(a: float) -> float:
 
 
 def power_law_max_overlap(k: float, a: float, m: float, v: float) -> float:
-    """Elastic F = kδ^a: ½mv² = kδ_max^{a+1}/(a+1)."""
-    return ((a + 1.0) * m * v * v / (2.0 * k)) ** (1.0 / (a + 1.0))
+    """Elastic F = kδ^a: ½mv² = kδ_max^{a+1}/(a+1). A stiffness, mass or speed that is not a positive finite
+    number (one that under- or overflowed) is a ValueError naming it, never a ZeroDivisionError."""
+    for name, x in (("stiffness", k), ("mass", m), ("speed", v)):
+        if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
+            raise ValueError(f"the contact's {name} {x:g} is not a positive finite number (it under- or overflows "
+                             "in floating point)")
+    try:
+        x = ((a + 1.0) * m * v * v / (2.0 * k)) ** (1.0 / (a + 1.0))
+    except (OverflowError, ZeroDivisionError) as exc:
+        raise ValueError(f"the largest overlap overflows ({exc}): stiffness {k:g}, mass {m:g}") from None
+    if not (math.isfinite(x) and x > 0):
+        raise ValueError(f"the largest overlap {x:g} under- or overflows: stiffness {k:g}, mass {m:g}")
+    return x
 
 
 def power_law_duration(k: float, a: float, m: float, v: float) -> float:

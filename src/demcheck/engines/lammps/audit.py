@@ -10,11 +10,11 @@ import math
 from pathlib import Path
 
 from ...inputs.script import (NEVER_RUN, Command, note_unread, Finding, PairSetting, ScriptError, Setup,
-                              _num, read_common, type_range)
+                              _num, finish, read_common, to_number, type_range)
 from ..base import Native
 
 NORMAL_ARGS = {"hooke": 2, "hertz": 2, "hertz/material": 3, "dmt": 4, "jkr": 4, "mdr": 6}
-DAMPING = ("velocity", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution", "mdr")
+DAMPING = ("velocity", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution", "mdr", "none")
 TANGENTIAL_ARGS = {"linear_nohistory": 2, "linear_history": 3, "mindlin": 3, "mindlin/force": 3,
                    "mindlin_rescale": 3, "mindlin_rescale/force": 3}
 ROLLING_ARGS = {"none": 0, "sds": 3}
@@ -24,13 +24,16 @@ CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
 PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
 DEFAULT = True  # a LAMMPS-family deck that no other reader claims is read as LAMMPS's
 
-QUIET_FIXES = frozenset({"nve/sphere", "gravity", "print", "ave/time", "ave/atom"})  # fixes without effect on a contact
+QUIET_FIXES = frozenset({"nve/sphere", "gravity", "print", "ave/time", "ave/atom", "enforce2d", "balance",
+                         "freeze"})  # fixes without effect on a contact
+READ_FIXES = ("wall/gran", "wall/gran/region", "pour", "gravity")  # the fixes whose words the audit reads
 
 
 
 def claims(script) -> bool:
-    """LAMMPS's own vocabulary: pair_style granular or a classic gran/* style."""
-    return any(c.name == "pair_style" and c.words[1:2] and (c.words[1] == "granular" or c.words[1] in CLASSIC)
+    """LAMMPS's own vocabulary: pair_style granular or a classic gran/* style (also under hybrid)."""
+    return any(c.name == "pair_style" and c.words[1:2] and (c.words[1] == "granular" or c.words[1] in CLASSIC
+                                                            or any(x in CLASSIC for x in c.words[1:3]))
                for c in script.commands)
 
 
@@ -56,6 +59,9 @@ def parse_granular(cmd: Command, words: list[str], k: int) -> dict:
                 raise _bad(cmd, f"damping takes one of {', '.join(DAMPING)}")
             out["damping"] = words[k + 1]
             k += 2
+            if out["damping"] == "mdr" and k < len(words) and to_number(words[k]) is not None:
+                out["damping_args"] = (_num(cmd, k, "damping mdr type"),)  # damping mdr N: MDR's damping type
+                k += 1
         elif key in ("tangential", "rolling", "twisting", "heat"):
             table = {"tangential": TANGENTIAL_ARGS, "rolling": ROLLING_ARGS, "twisting": TWISTING_ARGS,
                      "heat": HEAT_ARGS}[key]
@@ -136,7 +142,10 @@ def native_of(spec: dict) -> Native:
     else:
         normal_args, damp = (c[0],), c[1]
     tc = spec["tangential_coeffs"]
-    return Native("lammps", spec["normal"], normal_args, damping=spec["damping"], damping_coeff=damp,
+    damping = spec["damping"]
+    if damping == "none":  # no dashpot: newer LAMMPS's `damping none`, written as a velocity dashpot of η 0
+        damping, damp = "velocity", 0.0
+    return Native("lammps", spec["normal"], normal_args, damping=damping, damping_coeff=damp,
                   tangential=spec["tangential"], tangential_args=tuple(tc), limit=spec["limit_damping"])
 
 
@@ -228,32 +237,49 @@ def mixed(a: dict, b: dict, cmd_where: str) -> tuple[Native, Native | None, list
     return nat, intended, notes
 
 
+def _pair_style(cmd: Command, setup: Setup) -> tuple:
+    """(the classic style's spec and notes or None, its name or None) of a pair_style line the audit reads."""
+    w = cmd.words
+    if len(w) < 2:
+        raise _bad(cmd, "pair_style needs a style")
+    if w[1] == "granular":
+        return None, None
+    if w[1] == "none":
+        setup.not_audited.append((cmd.where(), cmd.text, "pair_style none: the bodies do not touch each other; only "
+                                                          "the walls are probed"))
+        return None, None
+    if w[1] in CLASSIC:
+        return classic(cmd, w[1], w, 2), w[1]
+    if w[1] in ("hybrid", "hybrid/overlay") and w[2:3] and w[2] in CLASSIC:
+        if len(w) > 9 + ("limit_damping" in w):
+            raise _bad(cmd, f"pair_style {w[1]}: audit reads one granular sub-style")
+        return classic(cmd, w[2], w, 3), w[2]
+    raise _bad(cmd, f"pair_style {w[1]}: audit reads granular, {', '.join(CLASSIC)} (also as the one sub-style of "
+                    "hybrid), none")
+
+
 def read(script, root: Path) -> Setup:
     """A read deck (inputs.script.Script) → Setup: bodies, every type pair and wall × type, dt, speeds."""
     setup = Setup("lammps")
+    setup.regions = script.regions
     explicit: dict = {}  # (i, j) i ≤ j → (spec, where)
     style_cmd = None
     classic_spec = None
+    classic_name = None
     walls = []  # (spec, where, notes)
     for cmd in script.commands:
         w, name = cmd.words, cmd.name
         if name in NEVER_RUN and name != "quit":
             setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
             continue
-        if cmd.problem and name in ("pair_style", "pair_coeff", "fix", "set", "timestep", "create_box"):
+        if cmd.problem and (name in ("pair_style", "pair_coeff", "set", "timestep", "create_box")
+                            or (name == "fix" and len(w) > 3 and w[3] in READ_FIXES)):
             raise _bad(cmd, cmd.problem)
         if read_common(cmd, setup, root):
             continue
         if name == "pair_style":
             style_cmd = cmd
-            if len(w) < 2:
-                raise _bad(cmd, "pair_style needs a style")
-            if w[1] == "granular":
-                classic_spec = None
-            elif w[1] in CLASSIC:
-                classic_spec = classic(cmd, w[1], w, 2)
-            else:
-                raise _bad(cmd, f"pair_style {w[1]}: audit reads granular, {', '.join(CLASSIC)}")
+            classic_spec, classic_name = _pair_style(cmd, setup)
             continue
         if name == "pair_coeff":
             if style_cmd is None:
@@ -261,10 +287,12 @@ def read(script, root: Path) -> Setup:
             if len(w) < 3:
                 raise _bad(cmd, "pair_coeff needs two types")
             ti, tj = type_range(w[1], setup.ntypes, cmd), type_range(w[2], setup.ntypes, cmd)
+            if style_cmd.words[1] == "none":
+                raise _bad(cmd, "pair_coeff after pair_style none")
             if classic_spec is not None:
                 spec, notes = classic_spec
-                if len(w) > 3:
-                    raise _bad(cmd, f"pair_coeff of {style_cmd.words[1]} takes no coefficients")
+                if len(w) > 3 and w[3:] != [classic_name]:
+                    raise _bad(cmd, f"pair_coeff of {classic_name} takes no coefficients")
             else:
                 spec, notes = parse_granular(cmd, w, 3), []
                 if spec["rest"] != len(w):
@@ -283,10 +311,17 @@ def read(script, root: Path) -> Setup:
                 spec["rest"] = 11 + (1 if spec["limit_damping"] else 0)
                 notes.append(f"classic fix wall/gran {w[4]}: LAMMPS 22Jul2025's classic wall styles mishandle "
                              "sliding and give NaN with γn = 0; use fix wall/gran granular")
+            elif len(w) > 10 and (to_number(w[4]) is not None) and classic_name:  # the old syntax: the pair's style
+                spec, notes = classic(cmd, classic_name, w, 4)
+                spec["rest"] = 10 + (1 if spec["limit_damping"] else 0)
+                notes.append(f"fix wall/gran without a style (LAMMPS before 2016): read with the pair's "
+                             f"{classic_name}, as those versions did; current LAMMPS needs the style word")
             else:
                 raise _bad(cmd, "fix wall/gran: audit reads granular and the classic hooke, hooke/history, "
                                 "hertz/history styles")
             rest = w[spec["rest"]:] if "rest" in spec else []
+            if rest[:1] and rest[0] in ("xplane", "yplane", "zplane") and len(rest) > 1 and to_number(rest[1]) is not None:
+                setup.floors.append(("xyz".index(rest[0][0]), float(rest[1])))
             if w[3] == "wall/gran" and rest[:1] and rest[0] not in ("xplane", "yplane", "zplane"):
                 notes.append(f"wall {rest[0]}: probed as a flat wall (the contact law is the same; curvature "
                              "is not)")
@@ -297,10 +332,10 @@ def read(script, root: Path) -> Setup:
         note_unread(setup, cmd, QUIET_FIXES)
     if style_cmd is None:
         raise ScriptError("the deck has no pair_style: nothing defines its contacts")
-    if setup.dt is None:
-        setup.dt, setup.dt_where = 1e-8, "LAMMPS's default for units si (no timestep command)"
-    types = sorted(setup.bodies) or sorted({t for k in explicit for t in k})
-    _pairs(setup, types, explicit)
+    finish(setup, "LAMMPS's default")
+    types = sorted(setup.populated) or sorted(setup.bodies) or sorted({t for k in explicit for t in k})
+    if style_cmd.words[1] != "none":
+        _pairs(setup, types, explicit)
     _walls(setup, types, explicit, walls)
     return setup
 
@@ -401,7 +436,8 @@ def _walls(setup: Setup, types: list[int], explicit: dict, walls: list) -> None:
 
 
 REVERSE_SYNTAX = ("a pair_style granular pair_coeff's arguments after the types: \"hertz/material 63e9 0.6 0.24 "
-                  "damping tsuji tangential mindlin NULL 1.0 0.5\"")
+                  "damping tsuji tangential mindlin NULL 1.0 0.5\", or a classic style with its coefficients: "
+                  "\"gran/hooke/history 2000 NULL 50 NULL 0.5 0\"")
 
 
 def reverse(line: str, setup: Setup | None = None) -> PairSetting:
@@ -409,6 +445,15 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     (``demcheck models --engine lammps "…"``); leading types (``* *``, ``1 1``) are read and dropped.
     ``setup`` (the lookup's, shared with other readers) takes nothing from a pair_coeff."""
     words = line.split()
+    words = words[1:] if words[:1] == ["pair_style"] else words
+    if words[:1] and words[0] in CLASSIC:  # a classic style with its coefficients, as audit reads it
+        cmd = Command(["pair_style", *words], "models", 1, line)
+        spec, notes = classic(cmd, words[0], cmd.words, 2)
+        if len(cmd.words) not in (8, 9) or cmd.words[8:] not in ([], ["limit_damping"]):
+            raise _bad(cmd, f"{words[0]} takes Kn Kt γn γt μ dampflag [limit_damping]")
+        ps = PairSetting("1-1", 1, 1, native_of(spec), "models", _asked(spec), notes=list(notes))
+        _static(ps, spec, "models")
+        return ps
     if len(words) > 2 and all(_is_type(w) for w in words[:2]):
         words = words[2:]
     cmd = Command(["pair_coeff", "1", "1", *words], "models", 1, line)

@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 from ...inputs.script import (NEVER_RUN, Body, Command, note_unread, Finding, PairSetting, ScriptError,
-                              Setup, _num, body, read_common)
+                              Setup, _num, body, finish, read_common, to_number)
 from ..base import Native
 
 MODELS = ("hertz", "hooke", "hooke/stiffness", "hertz/stiffness")  # the probed ones (they have a twin)
@@ -17,7 +17,10 @@ OTHER_MODELS = ("luding", "edinburgh", "thornton_ning", "hooke/hysteresis", "her
 TANGENTIAL = ("off", "no_history", "history")
 OWN_MODULI = True  # the deck writer writes each type's own Young's modulus and Poisson's ratio
 
-QUIET_FIXES = frozenset({"nve/sphere", "gravity", "particledistribution/discrete", "check/timestep/gran"})
+QUIET_FIXES = frozenset({"nve/sphere", "gravity", "particledistribution/discrete", "check/timestep/gran",
+                         "enforce2d", "balance", "freeze"})
+READ_FIXES = ("property/global", "wall/gran", "particletemplate/sphere", "particledistribution/discrete",
+              "insert/pack", "insert/stream", "insert/rate/region", "mesh/surface", "mesh/surface/stress", "gravity")
 
 
 
@@ -41,7 +44,7 @@ def _bad(cmd: Command, why: str):
 
 # the range of each property a law reads: (rule, test); a value outside it is refused with its own name
 RANGES = {"youngsModulus": ("must be > 0", lambda x: x > 0),
-          "poissonsRatio": ("must be in (-1, 0.5)", lambda x: -1.0 < x < 0.5),
+          "poissonsRatio": ("must be in [0, 0.5] (LIGGGHTS 3.8.0 stops on a negative one)", lambda x: 0.0 <= x <= 0.5),
           "coefficientRestitution": ("must be in (0, 1]", lambda x: 0.0 < x <= 1.0),
           "coefficientFriction": ("must be >= 0", lambda x: x >= 0.0),
           "characteristicVelocity": ("must be > 0", lambda x: x > 0),
@@ -107,16 +110,21 @@ def _prop(cmd: Command, w: list[str]) -> tuple[str, str, list[float]]:
 
 def read(script, root: Path) -> Setup:
     setup = Setup("liggghts")
+    setup.regions = script.regions
     props: dict = {}  # name → (kind, values, where)
     style = None
     walls = []
+    meshes: dict = {}  # mesh fix id → its wall type
+    templates: dict = {}  # template id → (type, radius, density)
+    distributions: dict = {}  # distribution id → [(template id, mass fraction)]
     hard = soft = False
     for cmd in script.commands:
         w, name = cmd.words, cmd.name
         if name in NEVER_RUN and name != "quit":
             setup.not_audited.append((cmd.where(), cmd.text, "not audited (never run by demcheck)"))
             continue
-        if cmd.problem and name in ("pair_style", "pair_coeff", "fix", "set", "timestep", "create_box"):
+        if cmd.problem and (name in ("pair_style", "pair_coeff", "set", "timestep", "create_box")
+                            or (name == "fix" and len(w) > 3 and w[3] in READ_FIXES)):
             raise _bad(cmd, cmd.problem)
         if read_common(cmd, setup, root):
             continue
@@ -132,61 +140,169 @@ def read(script, root: Path) -> Setup:
                 raise _bad(cmd, f"{w[k]!r} is not a keyword of pair_style gran")
             style = (spec, cmd.where())
             continue
-        if name == "fix" and len(w) > 3 and w[3] == "property/global":
+        style_name = w[3] if name == "fix" and len(w) > 3 else ""
+        if style_name == "property/global":
             pname, kind, values = _prop(cmd, w)
             props[pname] = (kind, values, cmd.where())
-            continue
-        if name == "fix" and len(w) > 3 and w[3] == "wall/gran":
-            spec, k = parse_style(cmd, w, 4)
-            if w[k:k + 1] == ["primitive"] and w[k + 1:k + 2] == ["type"]:
-                t = int(_num(cmd, k + 2, "wall type"))
-                walls.append((spec, t, w[1], cmd.where(), w[k + 3] if len(w) > k + 3 else ""))
-            else:
-                setup.not_audited.append((cmd.where(), cmd.text, "fix wall/gran with a mesh: not probed (audit "
-                                                                 "probes primitive walls)"))
-            continue
-        if name == "fix" and len(w) > 3 and w[3] == "particletemplate/sphere":
-            _template(cmd, w, setup)
-            continue
-        if name == "fix" and len(w) > 3 and w[3].startswith("insert"):
-            if "vel" in w and w[w.index("vel") + 1:w.index("vel") + 2] == ["constant"]:
-                i = w.index("vel") + 2
-                v = [_num(cmd, i + d, "vel") for d in range(3)]
-                setup.speeds.append((math.sqrt(sum(x * x for x in v)), cmd.where()))
-            continue
-        note_unread(setup, cmd, QUIET_FIXES)
+        elif style_name in ("mesh/surface", "mesh/surface/stress") and "type" in w:
+            meshes[w[1]] = int(_num(cmd, w.index("type") + 1, "mesh type"))
+        elif style_name == "wall/gran":
+            _wall(cmd, w, setup, walls, meshes)
+        elif style_name == "particletemplate/sphere":
+            _template(cmd, w, setup, templates)
+        elif style_name == "particletemplate/multisphere":
+            _clump(cmd, w, setup, templates, root)
+        elif style_name == "particledistribution/discrete":
+            _distribution(cmd, w, distributions)
+        elif style_name.startswith("insert"):
+            _insert(cmd, w, setup, templates, distributions)
+        else:
+            note_unread(setup, cmd, QUIET_FIXES)
     if style is None:
         raise ScriptError("the deck has no pair_style gran: nothing defines its contacts")
-    if setup.dt is None:
-        setup.dt, setup.dt_where = 1e-8, "the default for units si (no timestep command)"
+    finish(setup, "the default")
     if "characteristicVelocity" in props:
         setup.speeds.append((props["characteristicVelocity"][1][0], props["characteristicVelocity"][2]))
     wall_types = {t for _, t, _, _, _ in walls}
-    types = [t for t in sorted(setup.bodies) if t not in wall_types]
+    # a wall's type is a particle type too where the deck gives it bodies (LIGGGHTS's tutorials declare their
+    # primitive walls on the particles' own type: that type is both)
+    types = sorted(setup.populated) or [t for t in sorted(setup.bodies) if t not in wall_types]
+    _poisson_half(setup, props)
     _moduli(setup, props, hard, soft)
     spec, where = style
     for a in types:
         for b in types:
             if b >= a:
                 setup.pairs.append(_pair(setup, spec, where, props, a, b, f"{a}-{b}"))
-    for wspec, t_wall, fix_id, wwhere, _ in walls:
+    for wspec, t_wall, fix_id, wwhere, what in walls:
         for t in types:
             ps = _pair(setup, wspec, wwhere, props, t, t_wall, f"wall {fix_id} × {t}")
             ps.j = None
             ps.wall = {"youngs_modulus": _per_type(props, "youngsModulus", t_wall),
                        "poisson_ratio": _per_type(props, "poissonsRatio", t_wall)}
+            if what.startswith("mesh"):
+                ps.notes.append(f"{what}: probed as a flat wall of its material (type {t_wall}); the mesh's "
+                                "curvature and edges are not probed")
             setup.pairs.append(ps)
     return setup
 
 
-def _template(cmd, w, setup):
+def _wall(cmd, w, setup, walls, meshes) -> None:
+    spec, k = parse_style(cmd, w, 4)
+    if w[k:k + 1] == ["primitive"] and w[k + 1:k + 2] == ["type"]:
+        t = int(_num(cmd, k + 2, "wall type"))
+        shape = w[k + 3] if len(w) > k + 3 else ""
+        walls.append((spec, t, w[1], cmd.where(), shape))
+        if shape in ("xplane", "yplane", "zplane") and len(w) > k + 4 and to_number(w[k + 4]) is not None:
+            setup.floors.append(("xyz".index(shape[0]), float(w[k + 4])))
+    elif w[k:k + 1] == ["mesh"] and "meshes" in w:
+        n = int(_num(cmd, w.index("n_meshes") + 1, "n_meshes")) if "n_meshes" in w else 1
+        for mesh in w[w.index("meshes") + 1:w.index("meshes") + 1 + n]:
+            if mesh not in meshes:
+                setup.not_audited.append((cmd.where(), cmd.text, f"mesh {mesh}: its fix mesh/surface (and wall type) "
+                                                                  "is not read"))
+                continue
+            walls.append((spec, meshes[mesh], f"{w[1]}:{mesh}", cmd.where(), f"mesh {mesh}"))
+    else:
+        setup.not_audited.append((cmd.where(), cmd.text, "fix wall/gran: neither a primitive nor a mesh wall"))
+
+
+def _template(cmd, w, setup, templates):
+    """fix ID group particletemplate/sphere seed atom_type T density constant ρ radius constant r | gaussian|
+    lognormal μ σ …: the type's body (a distribution's mean radius for a random one)."""
     if "atom_type" not in w:
         return
     t = int(_num(cmd, w.index("atom_type") + 1, "atom_type"))
     b = body(setup, t)
-    for key, attr, factor in (("density", "density", 1.0), ("radius", "radius", 1.0)):
-        if key in w and w[w.index(key) + 1:w.index(key) + 2] == ["constant"]:
-            setattr(b, attr, _num(cmd, w.index(key) + 2, key) * factor)
+    values = {}
+    for key in ("density", "radius"):
+        if key in w:
+            i = w.index(key)
+            kind = w[i + 1] if i + 1 < len(w) else ""
+            if kind not in ("constant", "gaussian", "lognormal", "uniform"):
+                raise _bad(cmd, f"{key} {kind}: not a LIGGGHTS template distribution")
+            x = _num(cmd, i + 2, key)
+            if kind == "uniform":
+                x = 0.5 * (x + _num(cmd, i + 3, key))
+            if not x > 0:
+                raise _bad(cmd, f"{key} = {x:g}: must be > 0")
+            values[key] = x
+            if kind != "constant":
+                b.size_from = f"template {w[1]} ({kind} {key}: its mean probed)"
+    b.density = values.get("density", b.density)
+    b.radius = values.get("radius", b.radius)
+    templates[w[1]] = (t, b.radius, b.density)
+
+
+POISSON_HALF = 0.5 - 1e-9  # the probes' ν for LIGGGHTS's ν = 0.5 (the case's materials take ν < 0.5)
+
+
+def _poisson_half(setup, props) -> None:
+    """LIGGGHTS takes ν = 0.5 (incompressible); the probes' materials take ν < 0.5: probed at 0.5 − 1e-9 (E*
+    changes by 4e-9 relative), said in a note."""
+    if "poissonsRatio" not in props:
+        return
+    kind, values, where = props["poissonsRatio"]
+    if any(v == 0.5 for v in values):
+        props["poissonsRatio"] = (kind, [POISSON_HALF if v == 0.5 else v for v in values], where)
+        setup.findings.append(Finding("note", "poisson-half", "poissonsRatio 0.5 is probed as 0.5 − 1e-9 (demcheck's "
+                                      "materials take ν < 0.5; E* changes by 4e-9 relative)", where))
+
+
+def _clump(cmd, w, setup, templates, root):
+    """fix ID group particletemplate/multisphere … atom_type T density constant ρ … spheres file F scale s: a
+    clump of spheres; its spheres' contacts are probed as single spheres of the file's radii (× scale)."""
+    if "atom_type" not in w or "file" not in w:
+        return
+    t = int(_num(cmd, w.index("atom_type") + 1, "atom_type"))
+    scale = _num(cmd, w.index("scale") + 1, "scale") if "scale" in w else 1.0
+    path = (root / w[w.index("file") + 1]).resolve()
+    if not path.is_relative_to(root) or not path.is_file():
+        raise _bad(cmd, f"spheres file {w[w.index('file') + 1]!r}: no such file in the deck's directory")
+    radii = []
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines()[:10_000]:
+        nums = [to_number(x) for x in line.split("#", 1)[0].split()]
+        if len(nums) >= 4 and None not in nums[:4] and nums[3] > 0:
+            radii.append(nums[3] * scale)
+    if not radii:
+        raise _bad(cmd, "the spheres file gives no sphere (x y z r per line)")
+    b = body(setup, t)
+    if "density" in w and w[w.index("density") + 1:w.index("density") + 2] == ["constant"]:
+        b.density = _num(cmd, w.index("density") + 2, "density")
+    b.radius = max(radii)
+    templates[w[1]] = (t, b.radius, b.density)
+    b.sizes = [(r, r ** 3) for r in radii] if len(set(radii)) > 1 else []
+    b.size_from = f"multisphere template {w[1]} (its spheres probed as single spheres; the clump's rigidity is not)"
+
+
+def _distribution(cmd, w, distributions):
+    """fix ID group particledistribution/discrete seed N template1 fraction1 …: mass fractions (LIGGGHTS's)."""
+    n = int(_num(cmd, 5, "number of templates"))
+    distributions[w[1]] = [(w[6 + 2 * i], _num(cmd, 7 + 2 * i, "fraction")) for i in range(n)]
+
+
+def _insert(cmd, w, setup, templates, distributions):
+    """fix ID group insert/pack|stream|rate/region … distributiontemplate D … vel constant vx vy vz region R: the
+    types it inserts (with every size of its distribution), their initial velocity, the insertion region."""
+    vel = [0.0, 0.0, 0.0]
+    if "vel" in w and w[w.index("vel") + 1:w.index("vel") + 2] == ["constant"]:
+        i = w.index("vel") + 2
+        vel = [_num(cmd, i + d, "vel") for d in range(3)]
+        setup.speeds.append((math.sqrt(sum(x * x for x in vel)), cmd.where()))
+    region = w[w.index("region") + 1] if "region" in w and w.index("region") + 1 < len(w) else None
+    dist = w[w.index("distributiontemplate") + 1] if "distributiontemplate" in w else None
+    types = []
+    for template, fraction in distributions.get(dist, []):
+        if template not in templates:
+            continue
+        t, r, rho = templates[template]
+        types.append(t)
+        setup.populated.add(t)
+        b = body(setup, t)
+        if "multisphere" not in b.size_from:
+            b.sizes.append((r, fraction))
+            b.size_from = f"distribution {dist} ({cmd.where()})"
+    setup.insertions.append((region, [abs(vel[0]), abs(vel[1]), abs(vel[2])], types, cmd.where()))
 
 
 def _per_type(props, name, t):
@@ -322,6 +438,7 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     if k != len(cmd.words):
         raise _bad(cmd, f"{cmd.words[k]!r} is not a keyword of pair_style gran (a property is NAME=VALUE)")
     props: dict = {}
+    unread = []
     switches = {"hard_particles": False, "soft_particles": False}
     for w in words:
         if "=" not in w:
@@ -332,8 +449,12 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
                 raise _bad(cmd, f"{name}={text}: takes yes or no")
             switches[name] = text in ("yes", "on")
             continue
-        if name not in REVERSE_PROPERTIES:
-            raise _bad(cmd, f"{name}: not a property read here ({', '.join(REVERSE_PROPERTIES + REVERSE_SWITCHES)})")
+        if name not in REVERSE_PROPERTIES:  # a property of a sub-model the twin has none of: noted, not failed
+            if not name.isidentifier():
+                raise _bad(cmd, f"{name[:40]!r}: not a property name")
+            unread.append(f"{name}={text[:40]}: not read by the lookup (the twin has no {name}; "
+                          f"it reads {', '.join(REVERSE_PROPERTIES)})")
+            continue
         if name in props:
             raise _bad(cmd, f"{name} is given twice")
         c = Command(["fix", "p", "all", "property/global", name, "scalar", text], "models", 1, w)
@@ -351,8 +472,9 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     for name in ("youngsModulus", "poissonsRatio"):  # one type: per-type values
         if name in props:
             props[name] = ("peratomtype", props[name][1], "models")
-    if "poissonsRatio" in props and not -1.0 < props["poissonsRatio"][1][0] < 0.5:
-        raise _bad(cmd, f"poissonsRatio={props['poissonsRatio'][1][0]:g}: must be in (-1, 0.5)")
+    if "poissonsRatio" in props and not 0.0 <= props["poissonsRatio"][1][0] <= 0.5:
+        raise _bad(cmd, f"poissonsRatio={props['poissonsRatio'][1][0]:g}: must be in [0, 0.5] (LIGGGHTS 3.8.0 stops "
+                        "on a negative one)")
     for name in ("youngsModulus", "characteristicVelocity"):
         if name in props and not props[name][1][0] > 0:
             raise _bad(cmd, f"{name}={props[name][1][0]:g}: must be > 0")
@@ -369,6 +491,7 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
     for flag in spec["flags"]:
         if flag not in CASE_FLAGS:
             ps.notes.append(f"{flag}: not part of the lookup (the twin reads {', '.join(CASE_FLAGS)})")
+    ps.notes += unread
     return ps
 
 
