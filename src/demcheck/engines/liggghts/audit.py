@@ -450,8 +450,9 @@ def reverse(line: str, setup: Setup | None = None) -> PairSetting:
             switches[name] = text in ("yes", "on")
             continue
         if name not in REVERSE_PROPERTIES:  # a property of a sub-model the twin has none of: noted, not failed
-            if not name.isidentifier():
-                raise _bad(cmd, f"{name[:40]!r}: not a property name")
+            if not name.isidentifier() or to_number(text) is None:  # a property/global value is a number
+                raise _bad(cmd, f"{name[:40]}: not a property read here ({', '.join(REVERSE_PROPERTIES)}), and "
+                                f"{text[:40]!r} is not a property/global number")
             unread.append(f"{name}={text[:40]}: not read by the lookup (the twin has no {name}; "
                           f"it reads {', '.join(REVERSE_PROPERTIES)})")
             continue
