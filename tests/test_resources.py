@@ -71,3 +71,20 @@ def test_demcheck_cases_lists_and_prints_a_shipped_case(tmp_path):
     assert out.exit_code == 0 and "glass-pair" in out.output and "benchmarks/ (" in out.output
     text = CliRunner().invoke(cli, ["cases", "glass-pair"])
     assert text.exit_code == 0 and text.output == (SHIPPED / "glass-pair.toml").read_text()
+
+
+def test_a_case_by_the_name_its_file_gives_and_a_near_miss_suggested():
+    assert resources.case_path("suite-hertz-wall") == SHIPPED / "suite" / "normal-hertz-wall.toml"
+    with pytest.raises(ConfigError) as e:
+        resources.case_path("glas-pair")
+    assert str(e.value).endswith("did you mean 'glass-pair'?")
+
+
+def test_the_engine_run_cache_follows_xdg_cache_home_like_the_kernels(monkeypatch, tmp_path):
+    from demcheck.engines import cache
+
+    monkeypatch.delenv("DEMCHECK_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert cache.default_dir() == tmp_path / "demcheck" / "engine-runs"
+    monkeypatch.setenv("DEMCHECK_CACHE", str(tmp_path / "mine"))
+    assert cache.default_dir() == tmp_path / "mine"

@@ -16,7 +16,7 @@ import click
 from . import __version__
 from .errors import ConfigError, DemcheckError
 from . import resources
-from .io import number as as_text, plain
+from .io import console, number as as_text, plain
 
 
 
@@ -435,10 +435,9 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
 
 
 def _print_side_by_side(summaries: dict, skipped: dict) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    con = console()
     first = next(iter(summaries.values()), None)
     if first is not None:
         m = first["model"]
@@ -497,10 +496,9 @@ def deck(case_path, engine, output, dt, overrides):
 
 
 def _print_summary(s: dict) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    con = console()
     m = s["model"]
     head = f"[bold]{s['case']}[/]  normal={m['normal']} tangential={m['tangential']}"
     head += f" limit_force={m['limit_force']}  method={s['method']}"
@@ -578,7 +576,6 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     if as_json:
         emit_json({"vary": [parse_vary(v)[0] for v in varies], "rows": table.to_dict(orient="records")})
     else:
-        from rich.console import Console
         from rich.table import Table
 
         t = Table()
@@ -586,7 +583,7 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
             t.add_column(c, justify="right")
         for _, row in table.iterrows():
             t.add_row(*[show(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
-        Console().print(t)
+        console().print(t)
     if (table["status"] != "ok").any():
         sys.exit(1)
 
@@ -1208,7 +1205,7 @@ def main(argv=None) -> None:
     received: list[int] = []  # the signals that reached demcheck during this command
     restore = lambda: None  # noqa: E731
     if threading.current_thread() is threading.main_thread():
-        runner.handle_sigterm()  # SIGTERM as SIGINT: engines stopped, a partial report, exit 143
+        runner.handle_sigterm()  # SIGTERM, SIGHUP as SIGINT: engines stopped, a partial report, exit 143, 129
         restore = _record_signals(received)
     try:
         cli.main(args=argv, prog_name="demcheck", standalone_mode=False)
@@ -1240,14 +1237,14 @@ def main(argv=None) -> None:
 
 
 def _record_signals(received: list[int]):
-    """Let the SIGINT and SIGTERM handlers (KeyboardInterrupt, engines.run's Terminated) note each signal in
+    """Let the SIGINT, SIGTERM and SIGHUP handlers (KeyboardInterrupt, engines.run's Terminated) note each signal in
     ``received`` before they raise; returns the function that puts them back. An interrupt raised where Python
     cannot pass it on (a ctypes callback during numba's compilation prints it and drops it, and numba then
     fails with an error of its own) is still known to have happened."""
     import signal
 
     previous = {}
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         handler = signal.getsignal(sig)
         if callable(handler):  # not SIG_IGN (a background job's SIGINT) nor SIG_DFL
 

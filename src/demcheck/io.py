@@ -83,3 +83,18 @@ def md_text(text) -> str:
     ``[x](https://…) _y_`` would be a link and emphasis), sources, reasons and messages — so that none is read
     as a link, emphasis, code or a table's ``|``, in report.md or in report.html."""
     return MD_PUNCTUATION.sub(r"\\\1", str(text).replace("\r", " ").replace("\n", " "))
+
+
+def console(stderr: bool = False, **options):
+    """A rich Console for demcheck's tables: on a terminal its width; into a pipe or file (where rich assumes 80
+    columns and cuts every column of a wide table to a few characters) wide enough for the tables, unless
+    COLUMNS says otherwise."""
+    import os
+    import sys
+
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    if "width" not in options and not os.environ.get("COLUMNS") and not stream.isatty():
+        options["width"] = 200
+    return Console(stderr=stderr, **options)

@@ -47,8 +47,8 @@ def shipped_cases() -> dict[str, Path]:
 
 
 def case_path(text: str | Path, key: str = "CASE", what: str = "case file") -> Path:
-    """A CASE argument as a file: an existing path as given, else a shipped case by its name (``glass-pair``) or
-    by its path below the shipped cases (``packing/poured``, ``cases/packing/poured.toml``; ``.toml`` optional). Else ConfigError naming the
+    """A CASE argument as a file: an existing path as given, else a shipped case by its file's name
+    (``glass-pair``), by the ``name`` the file gives (``suite-hertz-wall``) or by its path below the shipped cases (``packing/poured``, ``cases/packing/poured.toml``; ``.toml`` optional). Else ConfigError naming the
     argument and the rule."""
     p = Path(text)
     if p.is_file():
@@ -62,11 +62,29 @@ def case_path(text: str | Path, key: str = "CASE", what: str = "case file") -> P
         for below in dict.fromkeys((rel, rel.removeprefix("cases/"))):
             if (root / f"{below}.toml").is_file():
                 return root / f"{below}.toml"
-        named = shipped_cases().get(rel)
+        named = shipped_cases().get(rel) or _by_case_name().get(rel)
         if named is not None:
             return named
+    import difflib
+
+    close = difflib.get_close_matches(rel, [*shipped_cases(), *_by_case_name()], n=1, cutoff=0.8)
+    hint = f"; did you mean '{close[0]}'?" if close and ".." not in p.parts else ""
     raise ConfigError(key, str(text), f"no such {what}, nor a shipped case of that name "
-                                      "(`demcheck cases` lists the shipped ones)")
+                                      f"(`demcheck cases` lists the shipped ones){hint}")
+
+
+def _by_case_name() -> dict[str, Path]:
+    """The shipped cases by the ``name`` their files give (a suite file's stem and name may differ:
+    suite/normal-hertz-wall.toml is the case suite-hertz-wall, as its reports call it)."""
+    import tomllib
+
+    out: dict[str, Path] = {}
+    for path in shipped_cases().values():
+        with open(path, "rb") as fh:
+            name = tomllib.load(fh).get("name")
+        if isinstance(name, str):
+            out.setdefault(name, path)
+    return out
 
 
 def case_files(paths, key: str = "CASE") -> list[Path]:

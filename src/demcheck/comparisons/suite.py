@@ -26,6 +26,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from .. import __version__
+from ..io import console as rich_console
 from ..case import Case, expand, naming_file
 from ..engines import registry
 from ..engines.base import case_natives
@@ -238,7 +239,7 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
     from . import report
 
     opts = opts or Options()
-    console = Console(stderr=True, quiet=quiet)
+    console = rich_console(stderr=True, quiet=quiet)
     cases = collect(files)  # bad input: one line before any work
     run_id = _dt.datetime.now().strftime("%Y%m%d-%H%M%S") + f"-{os.getpid()}"
     out_dir = report_root / run_id

@@ -3,7 +3,7 @@
 Key: SHA-256 of the source's name (an engine, or a build's label) and version (a build with its own
 executable also its binary's identity, engines/builds.py), the deck and the files it reads. Value: the parsed dump
 (every column, float64) and the run's metadata, in one ``.npz`` written atomically, so an interrupted run
-never leaves a half-written entry. Location: ``$DEMCHECK_CACHE``, else ``~/.cache/demcheck/engine-runs``.
+never leaves a half-written entry. Location: ``$DEMCHECK_CACHE``, else ``$XDG_CACHE_HOME/demcheck/engine-runs`` (``~/.cache`` by default, as the kernels').
 
 Only finite tables are stored (NaN or infinite output is a failed run, never reused). An entry that fails
 to load or to validate (truncated, changed bytes, metadata keys missing or of the wrong type, columns missing,
@@ -33,7 +33,9 @@ log = logging.getLogger("demcheck.cache")
 
 def default_dir() -> Path:
     env = os.environ.get("DEMCHECK_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "demcheck" / "engine-runs"
+    if env:
+        return Path(env)
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "demcheck" / "engine-runs"
 
 
 def key(engine: str, version: str, deck: str, files: dict[str, str]) -> str:

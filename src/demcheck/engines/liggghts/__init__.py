@@ -22,7 +22,7 @@ class Liggghts(PackageEngine):
     name = "liggghts"
     title = "LIGGGHTS"
     release = "LIGGGHTS 3.8.0"
-    how_to_install = "apt-get install liggghts (Debian), or `make engines`"
+    how_to_install = "apt-get install liggghts openmpi-bin (Debian), or `make engines` in a clone of demcheck"
     banner = re.compile(r"LIGGGHTS \(Version (LIGGGHTS-PUBLIC [^,)]+)", re.M)
     # slip velocity and torques at the contact point; the history is projected into the new tangent plane
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
