@@ -129,16 +129,20 @@ def _neighbour_rows(lo, hi, x, rad, skin, periodic, period, cells, start, nbj):
                     if not periodic[1]:
                         continue
                     cy %= dims[1]
-                column = (cx * dims[1] + cy) * dims[2]  # cells c2 − 1 … c2 + 1 of this column, one range
-                for k in range(first[column + max(c2 - 1, 0)], first[column + min(c2 + 1, dims[2] - 1) + 1]):
-                    j = order[k]
-                    d0, d1, d2 = _separation(x, i, j, period)
-                    reach = rad[i] + rad[j] + skin
-                    # the distance first, for every j: mostly apart, a branch predicted right (j > i is a coin)
-                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach and j > i:
-                        if count < nbj.shape[0]:
-                            nbj[count] = j
-                        count += 1
+                column = (cx * dims[1] + cy) * dims[2]  # cells c2 − 1 … c2 + 1 of this column
+                for c in range(column + max(c2 - 1, 0), column + min(c2 + 1, dims[2] - 1) + 1):
+                    # a cell's particles in descending index: those j > i come first, and the rest of the cell
+                    # is skipped (half the distances a rebuild would compute; the same entries in the same order)
+                    for k in range(first[c], first[c + 1]):
+                        j = order[k]
+                        if j <= i:
+                            break
+                        d0, d1, d2 = _separation(x, i, j, period)
+                        reach = rad[i] + rad[j] + skin
+                        if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                            if count < nbj.shape[0]:
+                                nbj[count] = j
+                            count += 1
     return count
 
 
