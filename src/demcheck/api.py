@@ -351,7 +351,8 @@ def _case_files(paths) -> list[Path]:
 def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:
     """The audit of a user's own LAMMPS or LIGGGHTS deck (``demcheck audit``) as a dict: per type pair and
     wall × type the native law, the nearest seed model, the probes (engine, twin, seed model) and the traps
-    with their measured sizes; ``status`` is "clean" or "traps". ``run_engine=False``: the twin only."""
+    with their measured sizes; ``status`` is "clean", "traps" or "not audited" (nothing probed: never clean).
+    ``run_engine=False``: the twin only."""
     from .comparisons.audit import audit as run
 
     _path("path", path)
