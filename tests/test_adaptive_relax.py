@@ -1,5 +1,6 @@
 """Issue 33 item 3: the adaptive 3-D method completes every case at its defaults. A tolerance float64 cannot hold
-on the bodies' positions is the solver's to relax (a decade at a time, to 1e-10 at most), and the result says so;
+on the bodies' positions is the solver's to relax (to the first decade above the round-off floor, only where that floor
+is at most 1e-10), and the result says so;
 a case it completes at the asked tolerance is solved exactly as before."""
 
 from __future__ import annotations

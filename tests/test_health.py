@@ -513,11 +513,10 @@ def test_an_engine_run_over_a_damaged_entry_runs_again_and_replaces_it(tmp_path,
 def test_an_engine_run_whose_entry_cannot_be_written_keeps_its_result(tmp_path, damage, caplog):
     from demcheck.engines.cache import key
     from demcheck.engines.collide import collide as run_engine, deck
-    from demcheck.engines.mapping import contact_mapping
 
     case = glass_case("hertz", {})
     cache = Cache(tmp_path / "cache")
-    dk = deck(case, "lammps", native=contact_mapping(case, "lammps").require())  # the deck collide runs
+    dk = deck(case, "lammps")  # the deck collide runs: the seed model's mapping (no native setting)
     PUT_DAMAGE[damage](cache, key("lammps", discovery.find("lammps").version, dk.text, dk.files))
     first = run_engine(case, "lammps")
     with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
