@@ -66,17 +66,63 @@ def detect(script: deck_script.Script, found: dict) -> str:
 
 
 def read(path: str | Path, engine: str | None = None):
-    script = deck_script.read(path)
+    """The deck as its engine reads it: where the engine's package can evaluate the set-up in the engine
+    (``ENGINE_READ``: a worker process, an allow-list, a budget), the engine's substitution, control flow and
+    bodies; else — the engine not installed, or its read stopped (the reason is kept in ``read_by``) — the
+    present reader (inputs/script.py)."""
+    path = Path(path)
     found = readers()
-    engine = engine or detect(script, found)
-    if engine not in found:
-        raise ConfigError("--engine", engine, f"audit reads {', '.join(found)} decks")
-    setup = found[engine].read(script, Path(path).resolve().parent)
+    try:
+        script, refusal = deck_script.read(path), None
+    except deck_script.ScriptError as exc:
+        script, refusal = None, exc
+    name = engine or (detect(script, found) if script is not None else _sniff(path, found))
+    if name not in found:
+        raise ConfigError("--engine", name, f"audit reads {', '.join(found)} decks")
+    root = path.resolve().parent
+    via, answer, why, refused_by_engine = getattr(found[name], "ENGINE_READ", None), None, "", False
+    if via is not None and path.is_file():
+        if not via.available():
+            why = "the engine's Python module is not installed"
+        else:
+            try:
+                answer = via.engine_read(path)
+                why, refused_by_engine = answer.stopped, answer.engine_error
+            except via.ReadFailed as exc:
+                why = str(exc)
+            if why:
+                answer = None
+    if answer is not None:
+        script = via.script_of(answer, root)
+    elif script is None:
+        if why and refusal is not None and "control flow" in str(refusal):
+            raise deck_script.ScriptError(f"{refusal} — the engine's read: {why}")
+        raise refusal
+    setup = found[name].read(script, root)
     setup.regions = script.regions
     setup.box = script.variables.get("__box__", (None, None))[1]
-    for cmd, why in script.unread:
-        setup.not_audited.append((cmd.where(), cmd.text, why))
+    if answer is not None:
+        via.apply(setup, answer, script)
+    elif via is not None:
+        setup.read_by = f"demcheck's reader (inputs/script.py): {why}"
+        if refused_by_engine:  # the installed engine stops on a set-up line: the deck as written does not run
+            where = why.split(": ", 1)[0]
+            setup.findings.append(deck_script.Finding("trap", "engine-refuses", f"the installed engine refuses the "
+                                                      f"deck: {why}", where))
+    for cmd, why_not in script.unread:
+        setup.not_audited.append((cmd.where(), cmd.text, why_not))
     return setup
+
+
+def _sniff(path: Path, found: dict) -> str:
+    """The engine of a deck the present reader refuses: its vocabulary read from the raw words of its lines."""
+    try:
+        text = path.read_bytes().decode("utf-8", errors="replace")
+    except OSError:
+        raise deck_script.ScriptError(f"DECK = {str(path)!r}: no such file") from None
+    raw = deck_script.Script([deck_script.Command(line.split("#", 1)[0].split(), path.name, 0, line)
+                              for line in text.splitlines()[:deck_script.MAX_LINES]])
+    return detect(raw, found)
 
 
 def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple[float, str]:
@@ -438,11 +484,8 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
                 ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
     probed = [ps for ps in setup.pairs if ps.probe]
     v, v_from = characteristic_speed(setup, speed) if probed else (None, "no pair or wall is probed")
-    info = discovery.find(setup.engine) if run_engine and probed else None
-    if run_engine and probed and info is None:
-        from ..errors import EngineNotFound
-
-        raise EngineNotFound(discovery.missing(setup.engine))
+    # the deck names its engine (--engine or its vocabulary): a named engine is required, never skipped
+    info = discovery.require(setup.engine, "the deck") if run_engine and probed else None
     pairs, findings = [], list(setup.findings)
     for ps in setup.pairs:
         entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)))
@@ -456,7 +499,7 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
         status = "not audited"
         reason = _why_nothing(pairs)
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
-            "units": units_info(setup), "dimension": setup.dimension,
+            "read_by": setup.read_by, "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
             "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass,
                            "sizes": sorted({r for r, _ in b.sizes}) and
@@ -654,6 +697,7 @@ def text_report(r: dict) -> str:
     u = r["units"]
     t_unit, v_unit = UNIT_WORDS.get(u["style"], ("time units", "speed units"))
     lines = [f"audit of {r['deck']} ({r['engine']} {r['engine_version'] or ''}".rstrip() + ")",
+             f"  read by {r['read_by']}",
              f"  units {u['style']} ({u['from']}); " + (
                  "the probes run in the deck's units (a consistent system: the same numbers in any), "
                  + ("times and speeds below in them, SI in brackets" if u["si"] and u["style"] != "si" else

@@ -601,6 +601,7 @@ class Setup:
     box: tuple | None = None
     created: set = field(default_factory=set)  # types create_atoms makes (LAMMPS's default diameter 1, density 1)
     molecules: dict = field(default_factory=dict)  # molecule id → its file (inside the deck's directory)
+    read_by: str = "demcheck's reader (inputs/script.py)"  # which path read the deck: the engine or the reader
 
 
 # ----------------------------------------------------------------------------- what both engines' decks share

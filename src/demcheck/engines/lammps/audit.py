@@ -12,6 +12,7 @@ from pathlib import Path
 from ...inputs.script import (NEVER_RUN, Command, note_unread, Finding, PairSetting, ScriptError, Setup,
                               _num, finish, read_common, to_number, type_range)
 from ..base import Native
+from . import read as ENGINE_READ  # the deck's set-up evaluated in LAMMPS itself (a worker process)
 
 NORMAL_ARGS = {"hooke": 2, "hertz": 2, "hertz/material": 3, "dmt": 4, "jkr": 4, "mdr": 6}
 DAMPING = ("velocity", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution", "mdr", "none")
