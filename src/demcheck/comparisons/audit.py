@@ -99,6 +99,7 @@ def read(path: str | Path, engine: str | None = None):
             raise deck_script.ScriptError(f"{refusal} — the engine's read: {why}")
         raise refusal
     setup = found[name].read(script, root)
+    setup.script = script
     setup.regions = script.regions
     setup.box = script.variables.get("__box__", (None, None))[1]
     if answer is not None:
@@ -128,8 +129,9 @@ def _sniff(path: Path, found: dict) -> str:
 def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple[float, str]:
     """The impact speed of the probes, and where it comes from: --speed; else the relative normal approach speed
     of the placed bodies that meet; else poured or inserted bodies' insertion velocity plus their fall from the
-    top of the insertion region to the floor under the deck's gravity; else the deck's largest speed; else, under
-    gravity, the settling speed (a fall of one diameter, the largest)."""
+    top of the insertion region to the floor under the deck's gravity; else the deck's largest speed; else the
+    closing rate of growing bodies (fix adapt); else, under gravity, the settling speed (a fall of one diameter,
+    the largest)."""
     if speed is not None:
         return speed, "--speed"
     found = deck_script.approach_speed(setup)
@@ -142,6 +144,9 @@ def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple
     if moving:
         v, w = max(moving)
         return v, f"the deck's largest speed ({w})"
+    grown = deck_script.growth_speed(setup, setup.script) if setup.script is not None else None
+    if grown is not None:
+        return grown
     radii = [r for b in setup.bodies.values() for r in [b.radius, *(x for x, _ in b.sizes)] if r]
     if setup.gravity is not None and setup.gravity[0] > 0 and radii:
         g, _, where = setup.gravity

@@ -81,6 +81,8 @@ class Script:
     variables: dict = field(default_factory=dict)  # name → (style, value or expression)
     unread: list[tuple[Command, str]] = field(default_factory=list)  # variables the reader could not define
     regions: dict = field(default_factory=dict)  # region id → (xlo, xhi, ylo, yhi, zlo, zhi) or None (other shapes)
+    atom_formulas: dict = field(default_factory=dict)  # atom-style variable → its formula (for fix adapt's growth)
+    radius_computes: dict = field(default_factory=dict)  # compute id → "radius" | "diameter" (property/atom)
 
 
 # ----------------------------------------------------------------------------- the safe evaluator
@@ -421,12 +423,18 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
         raise ScriptError(f"{name}:{line}: a carriage return without a line feed (CR-only line endings): LAMMPS reads "
                           "it as a space, so these lines are one command to the engine; convert the file to LF or "
                           "CRLF line endings")
+    labels: dict = {}  # label → (index of the next command, its line)
     for line_no, raw in _logical_lines(text, name):
         body = _strip_comment(raw).strip()
         if not body:
             continue
         where = f"{name}:{line_no}"
         head = body.split(None, 1)[0]
+        if head == "label" and len(body.split()) == 2:  # a jump back to it is read as a loop (_loop_end)
+            labels[body.split()[1]] = (len(script.commands), line_no)
+            continue
+        if head in ("jump", "next") and _loop_end(body, labels, script, path, name, where):
+            continue
         if head in CONTROL_FLOW:
             raise ScriptError(f"{where}: {body[:60]!r}: not audited: control flow ('{head}' decides which lines "
                               "run; unroll it, or audit each branch as its own deck)")
@@ -466,6 +474,51 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
     return False
 
 
+LOOP_SAFE = frozenset({"run", "print", "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump",
+                       "write_dump", "write_restart", "write_data", "reset_timestep", "next"})
+SET_READ = frozenset({"type", "type/fraction", "type/ratio", "type/subset", "diameter", "density", "mass", "vx", "vy",
+                      "vz", "omega", "angmom", "x", "y", "z", "image", "shape", "quat"})
+
+
+def _loop_end(body: str, labels: dict, script: Script, path: Path, name: str, where: str) -> bool:
+    """``next V …`` (read as nothing) or a backward ``jump SELF|this-file LABEL`` that closes a loop whose body
+    sets nothing the audit reads — runs, output, ``next`` of a loop or index variable, ``set … property/atom``
+    and other per-atom values the contacts do not depend on, loop/index variables (LAMMPS keeps the first
+    definition) — and that ``next`` ends: then the set-up after any number of passes is the set-up after one,
+    and the reader goes on after the jump (noted). Any other jump is control flow (refused by the caller)."""
+    w = body.split()
+    if w[0] == "next":
+        return len(w) > 1
+    if len(w) != 3 or w[2] not in labels or (w[1] != "SELF" and (path.parent / w[1]).resolve() != path):
+        return False
+    start, label_line = labels[w[2]]
+    loop = script.commands[start:]
+    counters = set()
+    for cmd in loop:
+        if cmd.name == "variable" and cmd.words[2:3] in (["loop"], ["index"]):
+            counters.add(cmd.words[1])
+            continue
+        if cmd.name == "set" and not SET_READ & set(cmd.words[3::2]):
+            continue
+        if cmd.name not in LOOP_SAFE:
+            return False
+    nexts = [b for b in _bodies_between(path, label_line, where) if b.split()[:1] == ["next"]]
+    defined = {n for n, (style, _) in script.variables.items() if style == "index"} | counters \
+        | {c.words[1] for c in script.commands if c.name == "variable" and c.words[2:3] == ["loop"]}
+    if not any(set(b.split()[1:]) & defined for b in nexts):
+        return False  # no loop variable runs out: the loop may never end
+    script.unread.append((Command(w, name, label_line, f"label {w[2]} … {body}"),
+                          f"a loop (lines {label_line}–{where.rsplit(':', 1)[1]}) read once: its body sets nothing the "
+                          "audit reads, so every pass leaves the same set-up; its runs are not audited"))
+    return True
+
+
+def _bodies_between(path: Path, first: int, where: str) -> list[str]:
+    last = int(where.rsplit(":", 1)[1])
+    text = path.read_bytes().decode("utf-8")
+    return [_strip_comment(raw).strip() for n, raw in _logical_lines(text, path.name) if first < n < last]
+
+
 def _define(cmd: Command, script: Script) -> None:
     w = cmd.words
     if len(w) < 3:
@@ -486,6 +539,8 @@ def _define(cmd: Command, script: Script) -> None:
             raise ScriptError(f"{cmd.where()}: {cmd.text[:60]!r}: an index variable needs a value")
         script.variables.setdefault(name, ("index", rest[0]))
     else:  # loop, world, universe, atom, vector, python, file, getenv, format, internal, …
+        if style == "atom":
+            script.atom_formulas[name] = " ".join(rest)
         script.variables.pop(name, None)
         script.unread.append((cmd, f"variable style '{style}' is not read (its value is known only in a run)"))
 
@@ -499,6 +554,8 @@ def _geometry(cmd: Command, script: Script, root: Path) -> None:
     """Regions (block and cylinder bounds, for insertion heights) and the box (its bounds become the thermo
     keywords xlo … zhi in later formulas, as in LAMMPS once create_box or read_data has run)."""
     w = cmd.words
+    if cmd.name == "compute" and len(w) == 5 and w[3] == "property/atom" and w[4] in ("radius", "diameter"):
+        script.radius_computes[w[1]] = w[4]
     if cmd.name == "region" and len(w) >= 3:
         bounds = None
         inf = math.inf
@@ -601,6 +658,8 @@ class Setup:
     box: tuple | None = None
     created: set = field(default_factory=set)  # types create_atoms makes (LAMMPS's default diameter 1, density 1)
     molecules: dict = field(default_factory=dict)  # molecule id → its file (inside the deck's directory)
+    script: object = None  # the Script read (its atom-style formulas and computes, for growth_speed)
+    growth: list = field(default_factory=list)  # (every N steps, atom variable, where) of fix adapt … atom diameter
     read_by: str = "demcheck's reader (inputs/script.py)"  # which path read the deck: the engine or the reader
 
 
@@ -930,6 +989,33 @@ def approach_speed(setup: Setup) -> tuple[float, str] | None:
     return best
 
 
+def growth_speed(setup: Setup, script: Script) -> tuple[float, str] | None:
+    """Bodies that meet by growing (fix adapt … atom diameter v_NAME, NAME an atom-style formula of a
+    property/atom radius or diameter compute): the rate two touching spheres of the largest radius close,
+    2·ΔR/(N·dt), ΔR the growth one application gives that radius — evaluated by the reader's own evaluator."""
+    radii = [r for b in setup.bodies.values() for r in [b.radius, *(x for x, _ in b.sizes)] if r]
+    best = None
+    for every, name, where in setup.growth:
+        formula = script.atom_formulas.get(name)
+        if formula is None or not radii or not every > 0 or not setup.dt:
+            continue
+        r = max(radii)
+        text = formula
+        for cid, kind in script.radius_computes.items():
+            text = re.sub(rf"\bc_{re.escape(cid)}\b", f"({r!r})" if kind == "radius" else f"({2 * r!r})", text)
+        try:
+            grown = evaluate(text, script.variables) / 2.0
+        except _Unevaluable:
+            continue
+        dr = grown - r
+        if dr > 0 and (best is None or dr > best[0]):
+            v = 2.0 * dr / (every * setup.dt)
+            best = (dr, (v, f"growing bodies ({where}): every {every:g} steps the diameter of the largest "
+                            f"(radius {r:g}) grows by {2 * dr:.4g}, so two touching ones close at 2ΔR/(N·dt) = "
+                            f"{v:.4g} on average (the growth comes in jumps)"))
+    return best[1] if best else None
+
+
 def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
     """The commands both engines share that define bodies, their speeds and the step; True when read."""
     w, name = cmd.words, cmd.name
@@ -994,6 +1080,9 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
         path = (root / w[2]).resolve()
         if path.is_relative_to(root) and path.is_file():
             setup.molecules[w[1]] = path
+        return True
+    if name == "fix" and len(w) >= 8 and w[3] == "adapt" and w[5:7] == ["atom", "diameter"] and w[7].startswith("v_"):
+        setup.growth.append((_num(cmd, 4, "adapt every N"), w[7][2:], cmd.where()))
         return True
     if name == "fix" and len(w) >= 6 and w[3] == "pour":
         if cmd.problem:

@@ -452,6 +452,8 @@ def script_of(answer: EngineRead, root: Path):
                 continue
         if head == "run" and words:
             cmd = Command(["run", "0"], rec["file"], rec["line"], rec["text"])
+        if words and head == "variable" and words[2:3] == ["atom"]:
+            script.atom_formulas[words[1]] = " ".join(words[3:])  # as the engine substituted it
         _geometry(cmd, script, root)
         script.commands.append(cmd)
     return script
