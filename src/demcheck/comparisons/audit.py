@@ -496,6 +496,7 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
         entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)))
         findings += found
         pairs.append(entry)
+    _in_si(pairs, deck_script.SI_OF.get(setup.units), v)
     traps = [f for f in findings if f.kind == "trap"]
     coverage = _coverage(pairs)
     status = "traps" if traps else "clean"
@@ -503,6 +504,10 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
     if not (coverage["pairs"]["probed"] + coverage["walls"]["probed"]):
         status = "not audited"
         reason = _why_nothing(pairs)
+        restarts = [w for w, t, _ in setup.not_audited if t.split()[:1] == ["read_restart"]]
+        if not pairs and restarts:
+            reason += (f" — its box, types and bodies come from read_restart ({restarts[0]}), a binary file demcheck "
+                       "does not read (audit the deck that wrote it)")
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
             "read_by": setup.read_by, "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
@@ -541,6 +546,25 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dic
     entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
     entry["findings"] = [_finding(f) for f in found]
     return entry, found
+
+
+def _in_si(pairs: list, si: tuple | None, speed: float | None) -> None:
+    """Each probe's physical quantities also in SI ("si": seconds, m/s, rad/s, newtons) where the deck's units
+    have a fixed SI meaning (si, cgs, micro, nano: length, mass and time factors; force = mass·length/time²);
+    lj's σ, m and τ are the deck's own: no "si"."""
+    if si is None:
+        return
+    length, mass, time = si
+    for entry in pairs:
+        for p in entry["probes"]:
+            if "error" in p:
+                continue
+            m = p.get("engine", p["twin"])
+            p["si"] = {"speed_m_per_s": p["speed"] * length / time, "dt_s": p["dt"] * time,
+                       "contact_time_s": m["contact_time"] * time,
+                       "rebound_angular_velocity_rad_per_s": m["rebound_angular_velocity"] / time,
+                       "peak_force_N": m["peak_force"] * mass * length / time ** 2,
+                       "max_overlap_m": m["max_overlap"] * length}
 
 
 def _coverage(pairs: list) -> dict:
