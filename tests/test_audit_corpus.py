@@ -329,9 +329,10 @@ def test_a_tiny_diameter_is_a_failure_not_a_missing_twin(tmp_path):
     ("units si\r\natom_style sphere\rpair_style granular\r\n", "carriage return"),
     ("timestep 1_000e-10\npair_style granular\n", "1_000e-10"),  # Python's float takes it; LAMMPS does not
     ("timestep １e-7\n", "is not a number"),
-    ("timestep $(10^10^10)\n", "overflows"),
-    ("timestep $(" + "(" * 200 + "1" + ")" * 200 + ")\n", "nested more than"),
-    ("variable a string " + "x" * 200_000 + "\n", "characters"),
+    ("timestep $(10^400)\n", "overflows"),
+    # lines demcheck's reader refuses and LAMMPS reads (the engine read takes over: the deck then lacks a pair_style)
+    ("timestep $(" + "(" * 200 + "1" + ")" * 200 + ")\n", "no pair_style"),
+    ("variable a string " + "x" * 200_000 + "\n", "no pair_style"),
 ])
 def test_unreadable_lines_are_one_line_exit_2(tmp_path, text, what):
     deck = tmp_path / "in.bad"

@@ -85,8 +85,9 @@ velocity all ramp vz 1 -1 z -0.004 0.004 units box
 
 @pytest.mark.engine("lammps")
 def test_files_and_code_never_executed_and_listed(tmp_path):
-    """shell, python, write_data, dump, log, print/fix print to a file: not one runs (no file appears), each is
-    listed as never executed; `run 100000000` runs as run 0 (the read ends at once)."""
+    """shell, write_data, dump, log, print/fix print to a file, partition's command, run … every's command: not one
+    runs (no file appears), each is listed as never executed; `run 100000000` runs as run 0 (the read ends at
+    once)."""
     deck = _deck(tmp_path, HEAD + """create_atoms 1 single 0 0 0.002 units box
 set type 1 diameter 0.002 density 2500
 velocity all set 0 0 -1
@@ -96,14 +97,15 @@ dump d all atom 1 dumped.txt
 log logged.txt
 print "hello" file printed.txt
 fix fp all print 1 "x" file fix-printed.txt
+partition yes 1 shell touch partition-ran
 """ + LAW + """fix w all wall/gran granular hertz/material 63e9 0.9 0.3 damping coeff_restitution tangential linear_nohistory 0 0 zplane -0.01 NULL
-run 100000000
+run 100000000 every 5 "shell touch every-ran"
 """)
     r = A.audit(deck)
     assert r["read_by"].startswith("the engine (LAMMPS")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.deck"]
     listed = {n["text"].split()[0] + (" print" if "fix" in n["text"] else ""): n["why"] for n in r["not_audited"]}
-    for head in ("shell", "write_data", "dump", "log", "print", "fix print"):
+    for head in ("shell", "write_data", "dump", "log", "print", "fix print", "partition", "run"):
         assert "never executed" in listed[head], (head, listed)
     assert r["coverage"]["walls"]["probed"] == 1 and r["coverage"]["pairs"]["probed"] == 1
     assert {f["code"] for p in r["pairs"] for f in p["findings"] if f["kind"] == "trap"} == {"wall-moduli"}
@@ -160,3 +162,20 @@ timestep 2e-8
     refused = [f for f in A.read(deck).findings if f.code == "engine-refuses"]
     assert refused and "in.deck:11" in refused[0].where and "Cannot use tsuji model" in refused[0].text
     assert r["traps"] >= 1 and r["status"] == "traps" and codes is not None
+
+
+@pytest.mark.engine("lammps")
+def test_the_readers_formulas_agree_with_the_engines(tmp_path):
+    """The reader's evaluator (LIGGGHTS decks, and LAMMPS decks without the engine) against LAMMPS's own $(…): ^ is
+    left to right and a sign binds tighter (main evaluated 2^3^2 = 512 and -2^2 = -4; LAMMPS gives 64 and 4)."""
+    from demcheck.inputs.script import evaluate
+
+    exprs = ["2^3^2", "-2^2", "2^-1", "2*3^2", "-3^2*2", "1-2^2", "(1+2)^2^0.5", "4/2/2", "2-3-4", "-(2)^3",
+             "sqrt(16)^2", "2^3^-1", "10^10^10"]
+    deck = _deck(tmp_path, "".join(f"variable x{i} equal $({e})\n" for i, e in enumerate(exprs))
+                 + "".join(f"print ${{x{i}}}\n" for i in range(len(exprs))))
+    answer = R.engine_read(deck)
+    engine = [float(rec["words"][3]) for rec in answer.lines if rec["words"] and rec["words"][0] == "variable"]
+    assert len(engine) == len(exprs)
+    for e, x in zip(exprs, engine):
+        assert evaluate(e, {}) == pytest.approx(x, rel=1e-12), e

@@ -144,26 +144,20 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
         return x
 
     def mul():
-        x = unary()
+        x = power()
         while peek() in (("op", "*"), ("op", "/")):
             op = take()[1]
-            y = unary()
+            y = power()
             if op == "/" and y == 0:
                 raise _Unevaluable("division by zero")
             x = x * y if op == "*" else x / y
         return x
 
-    def unary():
-        if peek() in (("op", "-"), ("op", "+")):
-            sign = -1.0 if take()[1] == "-" else 1.0
-            return sign * unary()
-        return power()
-
-    def power():
-        x = atom()
-        if peek() == ("op", "^"):
+    def power():  # as LAMMPS evaluates it (checked with its library): left to right, 2^3^2 = 64, -2^2 = 4
+        x = unary()
+        while peek() == ("op", "^"):
             take()
-            y = unary()  # right-associative
+            y = unary()
             try:
                 x = float(x) ** y
             except OverflowError:
@@ -173,6 +167,12 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
             if isinstance(x, complex):
                 raise _Unevaluable("a negative number to a fractional power")
         return x
+
+    def unary():  # a sign binds tighter than ^ in LAMMPS
+        if peek() in (("op", "-"), ("op", "+")):
+            sign = -1.0 if take()[1] == "-" else 1.0
+            return sign * unary()
+        return atom()
 
     def atom():
         kind, value = peek()
@@ -471,9 +471,13 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
                 return True
             continue
         script.commands.append(cmd)
+    if labels.get(PENDING):
+        raise ScriptError(f"{name}:{labels[PENDING][0]}: 'next' outside a loop the reader can read: not audited: "
+                          "control flow ('next' changes a variable's value for the lines after it)")
     return False
 
 
+PENDING = "\0next"  # labels' key for the lines of `next` not yet inside a closed loop
 LOOP_SAFE = frozenset({"run", "print", "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump",
                        "write_dump", "write_restart", "write_data", "reset_timestep", "next"})
 SET_READ = frozenset({"type", "type/fraction", "type/ratio", "type/subset", "diameter", "density", "mass", "vx", "vy",
@@ -487,8 +491,11 @@ def _loop_end(body: str, labels: dict, script: Script, path: Path, name: str, wh
     definition) — and that ``next`` ends: then the set-up after any number of passes is the set-up after one,
     and the reader goes on after the jump (noted). Any other jump is control flow (refused by the caller)."""
     w = body.split()
-    if w[0] == "next":
-        return len(w) > 1
+    if w[0] == "next":  # only inside a label … jump loop, checked when its jump closes it (else refused at the end)
+        if len(w) < 2 or not any(k != PENDING for k in labels):
+            return False
+        labels.setdefault(PENDING, []).append(int(where.rsplit(":", 1)[1]))
+        return True
     if len(w) != 3 or w[2] not in labels or (w[1] != "SELF" and (path.parent / w[1]).resolve() != path):
         return False
     start, label_line = labels[w[2]]
@@ -505,8 +512,13 @@ def _loop_end(body: str, labels: dict, script: Script, path: Path, name: str, wh
     nexts = [b for b in _bodies_between(path, label_line, where) if b.split()[:1] == ["next"]]
     defined = {n for n, (style, _) in script.variables.items() if style == "index"} | counters \
         | {c.words[1] for c in script.commands if c.name == "variable" and c.words[2:3] == ["loop"]}
-    if not any(set(b.split()[1:]) & defined for b in nexts):
+    if w[2] == PENDING or not any(set(b.split()[1:]) & defined for b in nexts):
         return False  # no loop variable runs out: the loop may never end
+    last = int(where.rsplit(":", 1)[1])
+    labels[PENDING] = [n for n in labels.get(PENDING, []) if not label_line < n < last]
+    for b in nexts:  # the loop ran its variables out: LAMMPS deletes them
+        for v in b.split()[1:]:
+            script.variables.pop(v, None)
     script.unread.append((Command(w, name, label_line, f"label {w[2]} … {body}"),
                           f"a loop (lines {label_line}–{where.rsplit(':', 1)[1]}) read once: its body sets nothing the "
                           "audit reads, so every pass leaves the same set-up; its runs are not audited"))

@@ -46,8 +46,7 @@ ALLOWED = frozenset({
     "comm_style", "neighbor", "neigh_modify", "lattice", "region", "create_box", "create_atoms", "delete_atoms",
     "displace_atoms", "set", "mass", "velocity", "group", "variable", "pair_style", "pair_coeff", "pair_modify",
     "timestep", "fix", "unfix", "fix_modify", "compute", "uncompute", "run", "reset_timestep",
-    "read_data", "molecule", "special_bonds", "change_box", "run_style", "min_style", "next", "timer",
-    "partition"})
+    "read_data", "molecule", "special_bonds", "change_box", "run_style", "min_style", "next", "timer"})
 VARIABLE_STYLES = frozenset({"delete", "index", "loop", "equal", "string", "atom", "vector", "format", "internal"})
 PAIR_STYLES = frozenset({"granular", "gran/hooke", "gran/hooke/history", "gran/hertz/history", "hybrid",
                          "hybrid/overlay", "none", "zero", "soft", "lj/cut"})
@@ -62,6 +61,15 @@ COMPUTE_STYLES = frozenset({
     "contact/atom", "pair/local", "property/local", "stress/atom", "coord/atom", "ke/atom", "erotate/sphere/atom",
     "fabric", "rigid/local", "fragment/atom", "granular/mdr"})
 FILE_ARGS = {"read_data": 1, "molecule": 2, "include": 1}  # the word that names a file read
+MOLECULE_KEYS = frozenset({"offset", "toff", "boff", "aoff", "doff", "ioff", "scale", "json"})
+
+
+def _is_number(word: str) -> bool:
+    try:
+        float(word)
+    except ValueError:
+        return False
+    return True
 
 
 @dataclass
@@ -288,6 +296,10 @@ class Walker:
             if len(words) <= k:
                 return f"{head}: names no file"
             self._inside(words[k])
+            if head == "molecule":  # molecule ID FILE [keywords] [FILE …]: every file it names
+                for word in words[k + 1:]:
+                    if word not in MOLECULE_KEYS and not _is_number(word):
+                        self._inside(word)
         if head == "create_atoms" and "random" in words:
             i = words.index("random")
             n = words[i + 1] if i + 1 < len(words) else ""
@@ -430,7 +442,8 @@ if __name__ == "__main__":
 # ----------------------------------------------------------------------------- the caller's side: a Script and a Setup
 
 WRITERS = frozenset({"shell", "python", "plugin", "write_data", "write_restart", "write_dump", "write_coeff",
-                     "write_file", "dump", "log", "restart", "print", "thermo_modify", "fitpod", "mdi", "kim"})
+                     "write_file", "dump", "log", "restart", "print", "thermo_modify", "fitpod", "mdi", "kim",
+                     "partition"})  # partition runs the command it is given
 
 
 def script_of(answer: EngineRead, root: Path):
@@ -451,6 +464,8 @@ def script_of(answer: EngineRead, root: Path):
             if head != "fix":
                 continue
         if head == "run" and words:
+            if "every" in words:
+                script.unread.append((cmd, "run … every: the commands between its chunks never executed by demcheck"))
             cmd = Command(["run", "0"], rec["file"], rec["line"], rec["text"])
         if words and head == "variable" and words[2:3] == ["atom"]:
             script.atom_formulas[words[1]] = " ".join(words[3:])  # as the engine substituted it
