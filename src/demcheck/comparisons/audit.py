@@ -112,6 +112,14 @@ def read(path: str | Path, engine: str | None = None):
                                                       f"deck: {why}", where))
     for cmd, why_not in script.unread:
         setup.not_audited.append((cmd.where(), cmd.text, why_not))
+    if setup.units in deck_script.INCONSISTENT_UNITS:
+        convert = getattr(found[name], "to_si", None)
+        if convert is None:
+            raise deck_script.ScriptError(
+                f"{setup.units_where}: {setup.units_text[:70]!r}: units {setup.units}: not audited — {name} converts "
+                "between this style's mass, force and time units with constants of its own, which its reader does "
+                "not convert")
+        convert(setup)
     return setup
 
 

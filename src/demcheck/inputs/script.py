@@ -672,7 +672,8 @@ class Setup:
     molecules: dict = field(default_factory=dict)  # molecule id → its file (inside the deck's directory)
     script: object = None  # the Script read (its atom-style formulas and computes, for growth_speed)
     growth: list = field(default_factory=list)  # (every N steps, atom variable, where) of fix adapt … atom diameter
-    read_by: str = "demcheck's reader (inputs/script.py)"  # which path read the deck: the engine or the reader
+    read_by: str = "demcheck's reader (inputs/script.py)"
+    units_text: str = ""  # the units line as written  # which path read the deck: the engine or the reader
 
 
 # ----------------------------------------------------------------------------- what both engines' decks share
@@ -742,7 +743,7 @@ def body(setup: Setup, t: int) -> Body:
 # LAMMPS's unit styles and the default time step of each (its `units` command); metal and real convert between
 # their mass, force and time units with constants of LAMMPS's own, so a probe written in them is not read here
 UNITS = {"lj": 0.005, "si": 1e-8, "cgs": 1e-8, "micro": 2.0, "nano": 0.00045, "metal": 0.001, "real": 1.0}
-INCONSISTENT_UNITS = ("metal", "real")
+INCONSISTENT_UNITS = ("metal", "real")  # their force unit is not mass·length/time²: converted (engine's to_si)
 # each consistent style's units of length, mass and time in SI (lj has none: σ, m and τ are the deck's own)
 SI_OF = {"si": (1.0, 1.0, 1.0), "cgs": (1e-2, 1e-3, 1.0), "micro": (1e-6, 1e-15, 1e-6), "nano": (1e-9, 1e-21, 1e-9)}
 SIZE_STEPS = 41  # a diameter range (fix pour diam range) is probed through this many diameters, mass-weighted
@@ -1036,11 +1037,8 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
         if style not in UNITS:
             raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not a unit style "
                               f"({', '.join(UNITS)})")
-        if style in INCONSISTENT_UNITS:
-            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not audited — LAMMPS converts "
-                              "between this style's mass, force and time units with its own constants, which the "
-                              f"audit's probes do not reproduce (it reads {', '.join(u for u in UNITS if u not in INCONSISTENT_UNITS)})")
-        setup.units, setup.units_where = style, cmd.where()
+        setup.units, setup.units_where = style, cmd.where()  # metal and real: converted after the read (to_si)
+        setup.units_text = cmd.text
         return True
     if name == "dimension":
         setup.dimension = int(_num(cmd, 1, "dimension"))
