@@ -12,7 +12,6 @@ import pytest
 
 from demcheck.comparisons import audit as A
 from demcheck.errors import EngineInterrupted
-from demcheck.inputs.script import ScriptError
 
 from .conftest import ROOT
 
@@ -93,9 +92,16 @@ def test_no_units_line_is_lammps_default_lj(tmp_path):
     assert "units lj" in A.text_report(r)
 
 
-def test_metal_units_are_refused_with_the_reason(tmp_path):
-    with pytest.raises(ScriptError, match="units metal: not audited"):
-        A.read(_deck(tmp_path, POUR_LJ.replace("units lj", "units metal")))
+def test_metal_units_are_converted_to_si(tmp_path):
+    """units metal: read, then converted to SI with LAMMPS's factors (Å, ps; tests/test_audit_units.py checks the
+    dynamics against LAMMPS's own run); the same deck in lj gives the numbers before conversion."""
+    lj = A.read(_deck(tmp_path, POUR_LJ, "in.lj"))
+    metal = A.read(_deck(tmp_path, POUR_LJ.replace("units lj", "units metal"), "in.metal"))
+    assert metal.units == "si" and "units metal, converted to SI" in metal.units_where
+    for t, b in lj.bodies.items():
+        if b.radius is not None:
+            assert metal.bodies[t].radius == pytest.approx(b.radius * 1e-10, rel=1e-12)
+    assert metal.dt == pytest.approx(lj.dt * 1e-12, rel=1e-12)
 
 
 TWO_BODY = """units si

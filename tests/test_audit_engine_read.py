@@ -158,10 +158,10 @@ fix w all wall/gran granular hooke 1e5 0.5 tangential linear_nohistory 0 0 zplan
 timestep 2e-8
 """)
     r = A.audit(deck)
-    codes = [f for p in r["pairs"] for f in p["findings"]]
     refused = [f for f in A.read(deck).findings if f.code == "engine-refuses"]
     assert refused and "in.deck:11" in refused[0].where and "Cannot use tsuji model" in refused[0].text
-    assert r["traps"] >= 1 and r["status"] == "traps" and codes is not None
+    assert r["read_by"].startswith("demcheck's reader") and "the engine stops here" in r["read_by"]
+    assert r["traps"] >= 1 and r["status"] == "traps" and r["coverage"]["walls"]["probed"] == 1
 
 
 @pytest.mark.engine("lammps")

@@ -1,6 +1,8 @@
 """``demcheck audit DECK``: does a user's own LAMMPS or LIGGGHTS deck do what it asks for?
 
-The deck is read (inputs/script.py), never run as written; the engine's package reads its contact commands
+The deck is read, never run as written: by the engine itself where its package can (a LAMMPS deck's set-up evaluated
+in LAMMPS in a worker process under an allow-list and a budget, engines/lammps/read.py), else by demcheck's reader
+(inputs/script.py); the engine's package reads its contact commands
 into one Native per type pair and wall × type (engines/<name>/audit.py). For each, the standard probes — a
 head-on impact and oblique ones at 30° and 60° — with the deck's radii, densities and time step at a
 characteristic speed run in three places: the engine itself (a deck written by the engine's deck writer from

@@ -1,6 +1,7 @@
 """A reader of the LAMMPS-family input language (LIGGGHTS shares it), for auditing a user's own deck.
 
-Nothing read here is ever executed: the reader turns a deck into a list of :class:`Command` (words after
+Nothing read here is ever executed (this reader serves LIGGGHTS decks, and LAMMPS decks where LAMMPS itself
+cannot read them: engines/lammps/read.py): the reader turns a deck into a list of :class:`Command` (words after
 quoting and substitution, with the file and line they came from). What it implements, as LAMMPS's input
 reader does:
 
@@ -15,7 +16,9 @@ reader does:
   ``ly``, ``lz`` once a box is defined, and a few functions) — never Python's ``eval``;
 * a bare carriage return (a CR-only file) is refused: LAMMPS reads it as a space, so the lines are one command;
 * ``include FILE`` relative to the deck's directory (a path that leaves it is refused);
-* ``label``, ``jump``, ``next``, ``if`` and ``loop`` are refused: control flow decides which lines run.
+* a ``label … jump SELF`` loop whose body sets nothing the audit reads, ended by a ``next`` of a loop or index
+  variable, is read once (_loop_end); any other ``jump``, ``next``, ``if`` and ``loop`` is refused: control flow
+  decides which lines run (a LAMMPS deck's control flow is followed by the engine itself: engines/lammps/read.py).
 
 :class:`ScriptError` (exit 2) names the file, line and command it cannot read.
 """
