@@ -179,3 +179,20 @@ def test_the_readers_formulas_agree_with_the_engines(tmp_path):
     assert len(engine) == len(exprs)
     for e, x in zip(exprs, engine):
         assert evaluate(e, {}) == pytest.approx(x, rel=1e-12), e
+
+
+@pytest.mark.engine("lammps")
+def test_a_jump_inside_an_if_leaves_the_branch_and_its_file(tmp_path):
+    """`if "${k} < 3" then "jump SELF place"`: the loop runs while k < 3 (two atoms, at −3 mm and 0), and the lines
+    after it run once, as in LAMMPS (a jump from a branch ends the file position the if was read at)."""
+    deck = _deck(tmp_path, HEAD + """variable k loop 3
+label place
+create_atoms 1 single 0 0 $(0.003*v_k-0.006) units box
+next k
+if "${k} < 3" then "jump SELF place"
+set type 1 diameter 0.002 density 2500
+velocity all set 0 0 -1
+""")
+    answer = R.engine_read(deck)
+    assert sorted(a["x"][2] for a in answer.state["atoms"]) == pytest.approx([-0.003, 0.0], abs=1e-15)
+    assert [rec["words"][0] for rec in answer.lines if rec["words"]].count("set") == 1

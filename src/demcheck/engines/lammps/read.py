@@ -174,7 +174,7 @@ class Walker:
     def __init__(self, lmp, deck: Path):
         self.lmp, self.root = lmp, deck.parent
         self.files: dict = {}
-        self.frames = [[self._lines(deck), 0]]
+        self.frames = [[self._lines(deck), 0, "file"]]  # (name, lines), next index, file | branch (an if's)
         self.out: list = []
         self.count = 0
         self.skip_jump = False
@@ -201,7 +201,7 @@ class Walker:
     def walk(self) -> str:
         while self.frames:
             frame = self.frames[-1]
-            (name, lines), k = frame
+            (name, lines), k, _ = frame
             if k >= len(lines):
                 self.frames.pop()
                 continue
@@ -243,7 +243,7 @@ class Walker:
             rec["ran"] = True
             return "quit"
         if head == "include":
-            self.frames.append([self._lines(self._inside(words[1] if len(words) == 2 else "")), 0])
+            self.frames.append([self._lines(self._inside(words[1] if len(words) == 2 else "")), 0, "file"])
             rec["ran"] = True
             return None
         if head == "jump":
@@ -329,7 +329,9 @@ class Walker:
             if not found:
                 raise _Refused(f"{name}: jump {words[1]} {words[2]}: no such label")
             start = found[0] + 1
-        self.frames[-1] = [(target, lines), start]  # the jump ends the file it was in, as LAMMPS does
+        while self.frames[-1][2] == "branch":  # a jump inside an if's branch leaves the branch and its file
+            self.frames.pop()
+        self.frames[-1] = [(target, lines), start, "file"]  # the jump ends the file it was in, as LAMMPS does
         return None
 
     def _if(self, rec, words, name, line):
@@ -353,7 +355,7 @@ class Walker:
         for cond, cmds in branches:
             if cond is not None and not self._true(cond, name, line):
                 continue
-            self.frames.append([(name, [(line, c) for c in cmds]), 0])
+            self.frames.append([(name, [(line, c) for c in cmds]), 0, "branch"])
             break
         return None
 
