@@ -69,11 +69,12 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
                    trace=traceback.format_exc().splitlines()[-3:])
         return row
     pairs = r.get("pairs", [])
-    probed = [p for p in pairs if any("error" not in q for q in p.get("probes", []))]
+    probed = [p for p in pairs if p.get("probed")]  # the report's own count: a probe that measured a contact
     codes = sorted({f["code"] for p in pairs for f in p.get("findings", []) if f["kind"] == "trap"})
     row.update(pairs=len(pairs), probed_pairs=len(probed), status=r.get("status"), traps=r.get("traps"),
                coverage=r.get("coverage"), codes=codes, units=(r.get("units") or {}).get("style"),
-               speed_from=str(r.get("speed_from", ""))[:60])
+               speed_from=str(r.get("speed_from", ""))[:60],
+               read_by="engine" if str(r.get("read_by", "")).startswith("the engine") else "reader")
     row["outcome"] = "probed" if probed else "nothing probed"
     if not probed:
         row["why"] = r.get("status_reason") or "no probe ran"
@@ -103,7 +104,8 @@ def main(argv=None) -> int:
     if a.out:
         a.out.parent.mkdir(parents=True, exist_ok=True)
         body = [f"{r['outcome']:<15} {'DEM' if r['dem'] else '   '} {r['deck']}"
-                + (f"  [{r.get('probed_pairs')}/{r.get('pairs')} pairs and walls probed, units {r.get('units')}, "
+                + (f"  [{r.get('probed_pairs')}/{r.get('pairs')} pairs and walls probed, read by the {r.get('read_by')}, "
+                   f"units {r.get('units')}, "
                    f"{r.get('status')}{': ' + ', '.join(r['codes']) if r.get('codes') else ''}]"
                    if r["outcome"] in ("probed", "nothing probed") else "")
                 + (f"  — {r['why']}" if r.get("why") else "") for r in rows]
@@ -125,6 +127,9 @@ def report_totals(rows: list, seconds: float, engine_runs: bool) -> str:
                    f"refused {count(rs, 'refused')}, nothing probed {count(rs, 'nothing probed')}, "
                    f"failed {count(rs, 'failed')}, crashes {count(rs, 'crash')}")
     out.append(f"  nothing probed but called clean: {false_clean}")
+    by_engine = [r for r in dem if r.get("read_by") == "engine"]
+    out.append(f"  DEM decks read by the engine itself: {len(by_engine)} (the others by demcheck's reader: the engine "
+               "has no read path there, or its read stopped — each report's read_by says why)")
     out.append(f"  wall time {seconds:.0f} s")
     return "\n".join(out)
 

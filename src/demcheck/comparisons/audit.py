@@ -1,6 +1,8 @@
 """``demcheck audit DECK``: does a user's own LAMMPS or LIGGGHTS deck do what it asks for?
 
-The deck is read (inputs/script.py), never run as written; the engine's package reads its contact commands
+The deck is read, never run as written: by the engine itself where its package can (a LAMMPS deck's set-up evaluated
+in LAMMPS in a worker process under an allow-list and a budget, engines/lammps/read.py), else by demcheck's reader
+(inputs/script.py); the engine's package reads its contact commands
 into one Native per type pair and wall × type (engines/<name>/audit.py). For each, the standard probes — a
 head-on impact and oblique ones at 30° and 60° — with the deck's radii, densities and time step at a
 characteristic speed run in three places: the engine itself (a deck written by the engine's deck writer from
@@ -66,24 +68,80 @@ def detect(script: deck_script.Script, found: dict) -> str:
 
 
 def read(path: str | Path, engine: str | None = None):
-    script = deck_script.read(path)
+    """The deck as its engine reads it: where the engine's package can evaluate the set-up in the engine
+    (``ENGINE_READ``: a worker process, an allow-list, a budget), the engine's substitution, control flow and
+    bodies; else — the engine not installed, or its read stopped (the reason is kept in ``read_by``) — the
+    present reader (inputs/script.py)."""
+    path = Path(path)
     found = readers()
-    engine = engine or detect(script, found)
-    if engine not in found:
-        raise ConfigError("--engine", engine, f"audit reads {', '.join(found)} decks")
-    setup = found[engine].read(script, Path(path).resolve().parent)
+    try:
+        script, refusal = deck_script.read(path), None
+    except deck_script.ScriptError as exc:
+        script, refusal = None, exc
+    name = engine or (detect(script, found) if script is not None else _sniff(path, found))
+    if name not in found:
+        raise ConfigError("--engine", name, f"audit reads {', '.join(found)} decks")
+    root = path.resolve().parent
+    via, answer, why, refused_by_engine = getattr(found[name], "ENGINE_READ", None), None, "", False
+    if via is not None and path.is_file():
+        if not via.available():
+            why = "the engine's Python module is not installed"
+        else:
+            try:
+                answer = via.engine_read(path)
+                why, refused_by_engine = answer.stopped, answer.engine_error
+            except via.ReadFailed as exc:
+                why = str(exc)
+            if why:
+                answer = None
+    if answer is not None:
+        script = via.script_of(answer, root)
+    elif script is None:
+        if why and refusal is not None and "control flow" in str(refusal):
+            raise deck_script.ScriptError(f"{refusal} — the engine's read: {why}")
+        raise refusal
+    setup = found[name].read(script, root)
+    setup.script = script
     setup.regions = script.regions
     setup.box = script.variables.get("__box__", (None, None))[1]
-    for cmd, why in script.unread:
-        setup.not_audited.append((cmd.where(), cmd.text, why))
+    if answer is not None:
+        via.apply(setup, answer, script)
+    elif via is not None:
+        setup.read_by = f"demcheck's reader (inputs/script.py): {why}"
+        if refused_by_engine:  # the installed engine stops on a set-up line: the deck as written does not run
+            where = why.split(": ", 1)[0]
+            setup.findings.append(deck_script.Finding("trap", "engine-refuses", f"the installed engine refuses the "
+                                                      f"deck: {why}", where))
+    for cmd, why_not in script.unread:
+        setup.not_audited.append((cmd.where(), cmd.text, why_not))
+    if setup.units in deck_script.INCONSISTENT_UNITS:
+        convert = getattr(found[name], "to_si", None)
+        if convert is None:
+            raise deck_script.ScriptError(
+                f"{setup.units_where}: {setup.units_text[:70]!r}: units {setup.units}: not audited — {name} converts "
+                "between this style's mass, force and time units with constants of its own, which its reader does "
+                "not convert")
+        convert(setup)
     return setup
+
+
+def _sniff(path: Path, found: dict) -> str:
+    """The engine of a deck the present reader refuses: its vocabulary read from the raw words of its lines."""
+    try:
+        text = path.read_bytes().decode("utf-8", errors="replace")
+    except OSError:
+        raise deck_script.ScriptError(f"DECK = {str(path)!r}: no such file") from None
+    raw = deck_script.Script([deck_script.Command(line.split("#", 1)[0].split(), path.name, 0, line)
+                              for line in text.splitlines()[:deck_script.MAX_LINES]])
+    return detect(raw, found)
 
 
 def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple[float, str]:
     """The impact speed of the probes, and where it comes from: --speed; else the relative normal approach speed
     of the placed bodies that meet; else poured or inserted bodies' insertion velocity plus their fall from the
-    top of the insertion region to the floor under the deck's gravity; else the deck's largest speed; else, under
-    gravity, the settling speed (a fall of one diameter, the largest)."""
+    top of the insertion region to the floor under the deck's gravity; else the deck's largest speed; else the
+    closing rate of growing bodies (fix adapt); else, under gravity, the settling speed (a fall of one diameter,
+    the largest)."""
     if speed is not None:
         return speed, "--speed"
     found = deck_script.approach_speed(setup)
@@ -96,6 +154,9 @@ def characteristic_speed(setup: deck_script.Setup, speed: float | None) -> tuple
     if moving:
         v, w = max(moving)
         return v, f"the deck's largest speed ({w})"
+    grown = deck_script.growth_speed(setup, setup.script) if setup.script is not None else None
+    if grown is not None:
+        return grown
     radii = [r for b in setup.bodies.values() for r in [b.radius, *(x for x, _ in b.sizes)] if r]
     if setup.gravity is not None and setup.gravity[0] > 0 and radii:
         g, _, where = setup.gravity
@@ -438,16 +499,14 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
                 ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
     probed = [ps for ps in setup.pairs if ps.probe]
     v, v_from = characteristic_speed(setup, speed) if probed else (None, "no pair or wall is probed")
-    info = discovery.find(setup.engine) if run_engine and probed else None
-    if run_engine and probed and info is None:
-        from ..errors import EngineNotFound
-
-        raise EngineNotFound(discovery.missing(setup.engine))
+    # the deck names its engine (--engine or its vocabulary): a named engine is required, never skipped
+    info = discovery.require(setup.engine, "the deck") if run_engine and probed else None
     pairs, findings = [], list(setup.findings)
     for ps in setup.pairs:
         entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)))
         findings += found
         pairs.append(entry)
+    _in_si(pairs, deck_script.SI_OF.get(setup.units), v)
     traps = [f for f in findings if f.kind == "trap"]
     coverage = _coverage(pairs)
     status = "traps" if traps else "clean"
@@ -455,8 +514,12 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
     if not (coverage["pairs"]["probed"] + coverage["walls"]["probed"]):
         status = "not audited"
         reason = _why_nothing(pairs)
+        restarts = [w for w, t, _ in setup.not_audited if t.split()[:1] == ["read_restart"]]
+        if not pairs and restarts:
+            reason += (f" — its box, types and bodies come from read_restart ({restarts[0]}), a binary file demcheck "
+                       "does not read (audit the deck that wrote it)")
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
-            "units": units_info(setup), "dimension": setup.dimension,
+            "read_by": setup.read_by, "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
             "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass,
                            "sizes": sorted({r for r, _ in b.sizes}) and
@@ -493,6 +556,25 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dic
     entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
     entry["findings"] = [_finding(f) for f in found]
     return entry, found
+
+
+def _in_si(pairs: list, si: tuple | None, speed: float | None) -> None:
+    """Each probe's physical quantities also in SI ("si": seconds, m/s, rad/s, newtons) where the deck's units
+    have a fixed SI meaning (si, cgs, micro, nano: length, mass and time factors; force = mass·length/time²);
+    lj's σ, m and τ are the deck's own: no "si"."""
+    if si is None:
+        return
+    length, mass, time = si
+    for entry in pairs:
+        for p in entry["probes"]:
+            if "error" in p:
+                continue
+            m = p.get("engine", p["twin"])
+            p["si"] = {"speed_m_per_s": p["speed"] * length / time, "dt_s": p["dt"] * time,
+                       "contact_time_s": m["contact_time"] * time,
+                       "rebound_angular_velocity_rad_per_s": m["rebound_angular_velocity"] / time,
+                       "peak_force_N": m["peak_force"] * mass * length / time ** 2,
+                       "max_overlap_m": m["max_overlap"] * length}
 
 
 def _coverage(pairs: list) -> dict:
@@ -654,6 +736,7 @@ def text_report(r: dict) -> str:
     u = r["units"]
     t_unit, v_unit = UNIT_WORDS.get(u["style"], ("time units", "speed units"))
     lines = [f"audit of {r['deck']} ({r['engine']} {r['engine_version'] or ''}".rstrip() + ")",
+             f"  read by {r['read_by']}",
              f"  units {u['style']} ({u['from']}); " + (
                  "the probes run in the deck's units (a consistent system: the same numbers in any), "
                  + ("times and speeds below in them, SI in brackets" if u["si"] and u["style"] != "si" else

@@ -1,6 +1,7 @@
 """A reader of the LAMMPS-family input language (LIGGGHTS shares it), for auditing a user's own deck.
 
-Nothing read here is ever executed: the reader turns a deck into a list of :class:`Command` (words after
+Nothing read here is ever executed (this reader serves LIGGGHTS decks, and LAMMPS decks where LAMMPS itself
+cannot read them: engines/lammps/read.py): the reader turns a deck into a list of :class:`Command` (words after
 quoting and substitution, with the file and line they came from). What it implements, as LAMMPS's input
 reader does:
 
@@ -15,7 +16,9 @@ reader does:
   ``ly``, ``lz`` once a box is defined, and a few functions) — never Python's ``eval``;
 * a bare carriage return (a CR-only file) is refused: LAMMPS reads it as a space, so the lines are one command;
 * ``include FILE`` relative to the deck's directory (a path that leaves it is refused);
-* ``label``, ``jump``, ``next``, ``if`` and ``loop`` are refused: control flow decides which lines run.
+* a ``label … jump SELF`` loop whose body sets nothing the audit reads, ended by a ``next`` of a loop or index
+  variable, is read once (_loop_end); any other ``jump``, ``next``, ``if`` and ``loop`` is refused: control flow
+  decides which lines run (a LAMMPS deck's control flow is followed by the engine itself: engines/lammps/read.py).
 
 :class:`ScriptError` (exit 2) names the file, line and command it cannot read.
 """
@@ -81,6 +84,8 @@ class Script:
     variables: dict = field(default_factory=dict)  # name → (style, value or expression)
     unread: list[tuple[Command, str]] = field(default_factory=list)  # variables the reader could not define
     regions: dict = field(default_factory=dict)  # region id → (xlo, xhi, ylo, yhi, zlo, zhi) or None (other shapes)
+    atom_formulas: dict = field(default_factory=dict)  # atom-style variable → its formula (for fix adapt's growth)
+    radius_computes: dict = field(default_factory=dict)  # compute id → "radius" | "diameter" (property/atom)
 
 
 # ----------------------------------------------------------------------------- the safe evaluator
@@ -142,26 +147,20 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
         return x
 
     def mul():
-        x = unary()
+        x = power()
         while peek() in (("op", "*"), ("op", "/")):
             op = take()[1]
-            y = unary()
+            y = power()
             if op == "/" and y == 0:
                 raise _Unevaluable("division by zero")
             x = x * y if op == "*" else x / y
         return x
 
-    def unary():
-        if peek() in (("op", "-"), ("op", "+")):
-            sign = -1.0 if take()[1] == "-" else 1.0
-            return sign * unary()
-        return power()
-
-    def power():
-        x = atom()
-        if peek() == ("op", "^"):
+    def power():  # as LAMMPS evaluates it (checked with its library): left to right, 2^3^2 = 64, -2^2 = 4
+        x = unary()
+        while peek() == ("op", "^"):
             take()
-            y = unary()  # right-associative
+            y = unary()
             try:
                 x = float(x) ** y
             except OverflowError:
@@ -171,6 +170,12 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
             if isinstance(x, complex):
                 raise _Unevaluable("a negative number to a fractional power")
         return x
+
+    def unary():  # a sign binds tighter than ^ in LAMMPS
+        if peek() in (("op", "-"), ("op", "+")):
+            sign = -1.0 if take()[1] == "-" else 1.0
+            return sign * unary()
+        return atom()
 
     def atom():
         kind, value = peek()
@@ -421,12 +426,18 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
         raise ScriptError(f"{name}:{line}: a carriage return without a line feed (CR-only line endings): LAMMPS reads "
                           "it as a space, so these lines are one command to the engine; convert the file to LF or "
                           "CRLF line endings")
+    labels: dict = {}  # label → (index of the next command, its line)
     for line_no, raw in _logical_lines(text, name):
         body = _strip_comment(raw).strip()
         if not body:
             continue
         where = f"{name}:{line_no}"
         head = body.split(None, 1)[0]
+        if head == "label" and len(body.split()) == 2:  # a jump back to it is read as a loop (_loop_end)
+            labels[body.split()[1]] = (len(script.commands), line_no)
+            continue
+        if head in ("jump", "next") and _loop_end(body, labels, script, path, name, where):
+            continue
         if head in CONTROL_FLOW:
             raise ScriptError(f"{where}: {body[:60]!r}: not audited: control flow ('{head}' decides which lines "
                               "run; unroll it, or audit each branch as its own deck)")
@@ -463,7 +474,64 @@ def _read_file(path: Path, root: Path, script: Script, depth: int) -> bool:
                 return True
             continue
         script.commands.append(cmd)
+    if labels.get(PENDING):
+        raise ScriptError(f"{name}:{labels[PENDING][0]}: 'next' outside a loop the reader can read: not audited: "
+                          "control flow ('next' changes a variable's value for the lines after it)")
     return False
+
+
+PENDING = "\0next"  # labels' key for the lines of `next` not yet inside a closed loop
+LOOP_SAFE = frozenset({"run", "print", "thermo", "thermo_style", "thermo_modify", "dump", "dump_modify", "undump",
+                       "write_dump", "write_restart", "write_data", "reset_timestep", "next"})
+SET_READ = frozenset({"type", "type/fraction", "type/ratio", "type/subset", "diameter", "density", "mass", "vx", "vy",
+                      "vz", "omega", "angmom", "x", "y", "z", "image", "shape", "quat"})
+
+
+def _loop_end(body: str, labels: dict, script: Script, path: Path, name: str, where: str) -> bool:
+    """``next V …`` (read as nothing) or a backward ``jump SELF|this-file LABEL`` that closes a loop whose body
+    sets nothing the audit reads — runs, output, ``next`` of a loop or index variable, ``set … property/atom``
+    and other per-atom values the contacts do not depend on, loop/index variables (LAMMPS keeps the first
+    definition) — and that ``next`` ends: then the set-up after any number of passes is the set-up after one,
+    and the reader goes on after the jump (noted). Any other jump is control flow (refused by the caller)."""
+    w = body.split()
+    if w[0] == "next":  # only inside a label … jump loop, checked when its jump closes it (else refused at the end)
+        if len(w) < 2 or not any(k != PENDING for k in labels):
+            return False
+        labels.setdefault(PENDING, []).append(int(where.rsplit(":", 1)[1]))
+        return True
+    if len(w) != 3 or w[2] not in labels or (w[1] != "SELF" and (path.parent / w[1]).resolve() != path):
+        return False
+    start, label_line = labels[w[2]]
+    loop = script.commands[start:]
+    counters = set()
+    for cmd in loop:
+        if cmd.name == "variable" and cmd.words[2:3] in (["loop"], ["index"]):
+            counters.add(cmd.words[1])
+            continue
+        if cmd.name == "set" and not SET_READ & set(cmd.words[3::2]):
+            continue
+        if cmd.name not in LOOP_SAFE:
+            return False
+    nexts = [b for b in _bodies_between(path, label_line, where) if b.split()[:1] == ["next"]]
+    defined = {n for n, (style, _) in script.variables.items() if style == "index"} | counters \
+        | {c.words[1] for c in script.commands if c.name == "variable" and c.words[2:3] == ["loop"]}
+    if w[2] == PENDING or not any(set(b.split()[1:]) & defined for b in nexts):
+        return False  # no loop variable runs out: the loop may never end
+    last = int(where.rsplit(":", 1)[1])
+    labels[PENDING] = [n for n in labels.get(PENDING, []) if not label_line < n < last]
+    for b in nexts:  # the loop ran its variables out: LAMMPS deletes them
+        for v in b.split()[1:]:
+            script.variables.pop(v, None)
+    script.unread.append((Command(w, name, label_line, f"label {w[2]} … {body}"),
+                          f"a loop (lines {label_line}–{where.rsplit(':', 1)[1]}) read once: its body sets nothing the "
+                          "audit reads, so every pass leaves the same set-up; its runs are not audited"))
+    return True
+
+
+def _bodies_between(path: Path, first: int, where: str) -> list[str]:
+    last = int(where.rsplit(":", 1)[1])
+    text = path.read_bytes().decode("utf-8")
+    return [_strip_comment(raw).strip() for n, raw in _logical_lines(text, path.name) if first < n < last]
 
 
 def _define(cmd: Command, script: Script) -> None:
@@ -486,6 +554,8 @@ def _define(cmd: Command, script: Script) -> None:
             raise ScriptError(f"{cmd.where()}: {cmd.text[:60]!r}: an index variable needs a value")
         script.variables.setdefault(name, ("index", rest[0]))
     else:  # loop, world, universe, atom, vector, python, file, getenv, format, internal, …
+        if style == "atom":
+            script.atom_formulas[name] = " ".join(rest)
         script.variables.pop(name, None)
         script.unread.append((cmd, f"variable style '{style}' is not read (its value is known only in a run)"))
 
@@ -499,6 +569,8 @@ def _geometry(cmd: Command, script: Script, root: Path) -> None:
     """Regions (block and cylinder bounds, for insertion heights) and the box (its bounds become the thermo
     keywords xlo … zhi in later formulas, as in LAMMPS once create_box or read_data has run)."""
     w = cmd.words
+    if cmd.name == "compute" and len(w) == 5 and w[3] == "property/atom" and w[4] in ("radius", "diameter"):
+        script.radius_computes[w[1]] = w[4]
     if cmd.name == "region" and len(w) >= 3:
         bounds = None
         inf = math.inf
@@ -601,6 +673,10 @@ class Setup:
     box: tuple | None = None
     created: set = field(default_factory=set)  # types create_atoms makes (LAMMPS's default diameter 1, density 1)
     molecules: dict = field(default_factory=dict)  # molecule id → its file (inside the deck's directory)
+    script: object = None  # the Script read (its atom-style formulas and computes, for growth_speed)
+    growth: list = field(default_factory=list)  # (every N steps, atom variable, where) of fix adapt … atom diameter
+    read_by: str = "demcheck's reader (inputs/script.py)"
+    units_text: str = ""  # the units line as written  # which path read the deck: the engine or the reader
 
 
 # ----------------------------------------------------------------------------- what both engines' decks share
@@ -670,7 +746,7 @@ def body(setup: Setup, t: int) -> Body:
 # LAMMPS's unit styles and the default time step of each (its `units` command); metal and real convert between
 # their mass, force and time units with constants of LAMMPS's own, so a probe written in them is not read here
 UNITS = {"lj": 0.005, "si": 1e-8, "cgs": 1e-8, "micro": 2.0, "nano": 0.00045, "metal": 0.001, "real": 1.0}
-INCONSISTENT_UNITS = ("metal", "real")
+INCONSISTENT_UNITS = ("metal", "real")  # their force unit is not mass·length/time²: converted (engine's to_si)
 # each consistent style's units of length, mass and time in SI (lj has none: σ, m and τ are the deck's own)
 SI_OF = {"si": (1.0, 1.0, 1.0), "cgs": (1e-2, 1e-3, 1.0), "micro": (1e-6, 1e-15, 1e-6), "nano": (1e-9, 1e-21, 1e-9)}
 SIZE_STEPS = 41  # a diameter range (fix pour diam range) is probed through this many diameters, mass-weighted
@@ -929,6 +1005,33 @@ def approach_speed(setup: Setup) -> tuple[float, str] | None:
     return best
 
 
+def growth_speed(setup: Setup, script: Script) -> tuple[float, str] | None:
+    """Bodies that meet by growing (fix adapt … atom diameter v_NAME, NAME an atom-style formula of a
+    property/atom radius or diameter compute): the rate two touching spheres of the largest radius close,
+    2·ΔR/(N·dt), ΔR the growth one application gives that radius — evaluated by the reader's own evaluator."""
+    radii = [r for b in setup.bodies.values() for r in [b.radius, *(x for x, _ in b.sizes)] if r]
+    best = None
+    for every, name, where in setup.growth:
+        formula = script.atom_formulas.get(name)
+        if formula is None or not radii or not every > 0 or not setup.dt:
+            continue
+        r = max(radii)
+        text = formula
+        for cid, kind in script.radius_computes.items():
+            text = re.sub(rf"\bc_{re.escape(cid)}\b", f"({r!r})" if kind == "radius" else f"({2 * r!r})", text)
+        try:
+            grown = evaluate(text, script.variables) / 2.0
+        except _Unevaluable:
+            continue
+        dr = grown - r
+        if dr > 0 and (best is None or dr > best[0]):
+            v = 2.0 * dr / (every * setup.dt)
+            best = (dr, (v, f"growing bodies ({where}): every {every:g} steps the diameter of the largest "
+                            f"(radius {r:g}) grows by {2 * dr:.4g}, so two touching ones close at 2ΔR/(N·dt) = "
+                            f"{v:.4g} on average (the growth comes in jumps)"))
+    return best[1] if best else None
+
+
 def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
     """The commands both engines share that define bodies, their speeds and the step; True when read."""
     w, name = cmd.words, cmd.name
@@ -937,11 +1040,8 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
         if style not in UNITS:
             raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not a unit style "
                               f"({', '.join(UNITS)})")
-        if style in INCONSISTENT_UNITS:
-            raise ScriptError(f"{cmd.where()}: {cmd.text[:70]!r}: units {style}: not audited — LAMMPS converts "
-                              "between this style's mass, force and time units with its own constants, which the "
-                              f"audit's probes do not reproduce (it reads {', '.join(u for u in UNITS if u not in INCONSISTENT_UNITS)})")
-        setup.units, setup.units_where = style, cmd.where()
+        setup.units, setup.units_where = style, cmd.where()  # metal and real: converted after the read (to_si)
+        setup.units_text = cmd.text
         return True
     if name == "dimension":
         setup.dimension = int(_num(cmd, 1, "dimension"))
@@ -993,6 +1093,9 @@ def read_common(cmd: Command, setup: Setup, root: Path) -> bool:
         path = (root / w[2]).resolve()
         if path.is_relative_to(root) and path.is_file():
             setup.molecules[w[1]] = path
+        return True
+    if name == "fix" and len(w) >= 8 and w[3] == "adapt" and w[5:7] == ["atom", "diameter"] and w[7].startswith("v_"):
+        setup.growth.append((_num(cmd, 4, "adapt every N"), w[7][2:], cmd.where()))
         return True
     if name == "fix" and len(w) >= 6 and w[3] == "pour":
         if cmd.problem:

@@ -12,6 +12,7 @@ from pathlib import Path
 from ...inputs.script import (NEVER_RUN, Command, note_unread, Finding, PairSetting, ScriptError, Setup,
                               _num, finish, read_common, to_number, type_range)
 from ..base import Native
+from . import read as ENGINE_READ  # the deck's set-up evaluated in LAMMPS itself (a worker process)
 
 NORMAL_ARGS = {"hooke": 2, "hertz": 2, "hertz/material": 3, "dmt": 4, "jkr": 4, "mdr": 6}
 DAMPING = ("velocity", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution", "mdr", "none")
@@ -534,3 +535,102 @@ def _is_type(word: str) -> bool:
     import re
 
     return re.fullmatch(r"\d*\*\d*|\d+", word) is not None
+
+
+# ----------------------------------------------------------------------------- units metal and real, in SI
+
+N_AVOGADRO = 6.02214076e23
+# LAMMPS's own force-to-acceleration constants (update.cpp: a = ftm2v·F/m), so the SI numbers give its dynamics
+FTM2V = {"metal": 1.0 / 1.0364269e-4, "real": 1.0 / 48.88821291 / 48.88821291}
+BASE = {"metal": (1e-10, 1e-3 / N_AVOGADRO, 1e-12), "real": (1e-10, 1e-3 / N_AVOGADRO, 1e-15)}  # Å, g/mol, ps|fs
+
+
+def si_factors(style: str) -> tuple[float, float, float, float]:
+    """(length, mass, time, force) of ``metal`` or ``real`` in SI as LAMMPS's dynamics sees them: the force unit
+    is what moves a mass unit by ftm2v length units per time unit² (metal: 1 eV/Å; real: 1 kcal/mol/Å)."""
+    length, mass, time = BASE[style]
+    return length, mass, time, FTM2V[style] * mass * length / time ** 2
+
+
+def _native_si(nat: Native, length: float, mass: float, time: float, force: float) -> Native:
+    """A granular Native of a metal/real deck in SI, each coefficient by its role in the force (LAMMPS's
+    granular models use them as they are, in the style's force, length, mass and time units)."""
+    import dataclasses
+
+    stiff = {"hooke": force / length, "hertz": force / length ** 2, "hertz/material": force / length ** 2}
+    if nat.normal not in stiff:
+        return nat  # a law demcheck has no twin of: listed, never probed
+    normal_args = (nat.normal_args[0] * stiff[nat.normal], *nat.normal_args[1:])
+    damp = {"velocity": force * time / length, "mass_velocity": force * time / (mass * length),
+            "viscoelastic": force * time / (mass * length ** 2)}.get(nat.damping, 1.0)
+    t = list(nat.tangential_args)
+    if nat.tangential == "linear_history" and t:
+        t[0] *= force / length
+    elif nat.tangential.startswith("mindlin") and t and t[0] is not None:
+        t[0] *= force / length ** 2
+    return dataclasses.replace(nat, normal_args=normal_args, damping_coeff=nat.damping_coeff * damp,
+                               tangential_args=tuple(t), comments=[*nat.comments, "converted to SI from the deck's units"])
+
+
+def to_si(setup) -> None:
+    """A Setup read in units metal or real, converted to SI with LAMMPS's own factors (si_factors): bodies, dt,
+    speeds, insertions, gravity, floors, regions, box, atoms and every pair's Native. The probes then run in SI
+    (demcheck's twin and case need a consistent system) and the report says so."""
+    style = setup.units
+    length, mass, time, force = si_factors(style)
+    area = setup.dimension == 2
+    for b in setup.bodies.values():
+        b.radius = None if b.radius is None else b.radius * length
+        b.density = None if b.density is None else b.density * mass / length ** (2 if area else 3)
+        b.mass = None if b.mass is None else b.mass * mass
+        b.sizes = [(r * length, w) for r, w in b.sizes]
+    for ps in setup.pairs:
+        ps.native = _native_si(ps.native, length, mass, time, force)
+        if ps.intended is not None:
+            ps.intended = _native_si(ps.intended, length, mass, time, force)
+    setup.dt *= time
+    speed = length / time
+    setup.speeds = [(v * speed, w) for v, w in setup.speeds]
+    setup.insertions = [(r, [x * speed for x in v], t, w) for r, v, t, w in setup.insertions]
+    if setup.gravity is not None:
+        g, axis, where = setup.gravity
+        setup.gravity = (g * force / mass, axis, where)
+    setup.floors = [(a, c * length) for a, c in setup.floors]
+    setup.regions = {k: (None if b is None else tuple(x * length for x in b)) for k, b in setup.regions.items()}
+    setup.box = None if setup.box is None else tuple(x * length for x in setup.box)
+    setup.atoms = {a: [t, None if x is None else [c * length for c in x], None if v is None else [c * speed for c in v]]
+                   for a, (t, x, v) in setup.atoms.items()}
+    _units_damping(setup, style)
+    setup.units_where = (f"{setup.units_where}: units {style}, converted to SI with LAMMPS's own factors (length "
+                         f"{length:g} m, mass {mass:.6g} kg, time {time:g} s, force {force:.6g} N — its ftm2v); the "
+                         "probes run and the report speaks in SI")
+    setup.dt_where = f"{setup.dt_where}, converted to s"
+    setup.units = "si"
+
+
+def _units_damping(setup, style: str) -> None:
+    """LAMMPS's damping tsuji and coeff_restitution compute the dashpot from √(m·k) in the style's own numbers,
+    without its ftm2v: in metal and real the dashpot is √ftm2v times the one that gives the asked e (98.2× in metal,
+    1/48.9 in real). A trap with its size (for hooke + coeff_restitution the realised e in closed form: the damping
+    ratio ζ' = √ftm2v·ζ(e), e' = exp(−πζ'/√(1−ζ'²)), no rebound for ζ' ≥ 1 — checked against LAMMPS running the deck
+    in its own units); the pair is listed, not probed (its SI probe would compute the asked e, not LAMMPS's)."""
+    root = math.sqrt(FTM2V[style])
+    for ps in setup.pairs:
+        nat = ps.native
+        if nat.damping not in ("tsuji", "coeff_restitution") or nat.normal not in PROBED_NORMALS:
+            continue
+        e = nat.damping_coeff
+        size = {"damping_factor": root}
+        text = (f"units {style}: LAMMPS's damping {nat.damping} computes its dashpot from √(m·k) without the style's "
+                f"force–mass constant (ftm2v): the dashpot is {root:.4g}× the one that gives e = {e:g}")
+        if nat.normal == "hooke" and nat.damping == "coeff_restitution" and 0 < e < 1:
+            z = -math.log(e) / math.sqrt(math.pi ** 2 + math.log(e) ** 2) * root
+            e_real = math.exp(-math.pi * z / math.sqrt(1.0 - z * z)) if z < 1 else 0.0
+            size.update(asked=e, realised=e_real, damping_ratio=z)
+            text += (f": e = {e:g} asked, {e_real:.4g} realised (damping ratio {z:.4g}"
+                     + ("; above 1, the bodies do not rebound)" if z >= 1 else ")"))
+        text += "; give the dashpot as damping velocity (η in force·time/length), which LAMMPS reads as it is given"
+        ps.findings.append(Finding("trap", "units-damping", text, ps.where, size))
+        ps.probe = False
+        ps.notes.append(f"listed, not probed: in units {style} LAMMPS's {nat.damping} dashpot is not the SI one a "
+                        "probe would compute (trap units-damping)")

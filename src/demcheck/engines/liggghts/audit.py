@@ -209,7 +209,7 @@ def _wall(cmd, w, setup, walls, meshes) -> None:
 
 def _template(cmd, w, setup, templates):
     """fix ID group particletemplate/sphere seed atom_type T density constant ρ radius constant r | gaussian|
-    lognormal μ σ …: the type's body (a distribution's mean radius for a random one)."""
+    lognormal [number|mass] μ σ …: the type's body (a distribution's mean radius for a random one)."""
     if "atom_type" not in w:
         return
     t = int(_num(cmd, w.index("atom_type") + 1, "atom_type"))
@@ -221,9 +221,10 @@ def _template(cmd, w, setup, templates):
             kind = w[i + 1] if i + 1 < len(w) else ""
             if kind not in ("constant", "gaussian", "lognormal", "uniform"):
                 raise _bad(cmd, f"{key} {kind}: not a LIGGGHTS template distribution")
-            x = _num(cmd, i + 2, key)
+            j = i + 2 + (w[i + 2:i + 3] in (["number"], ["mass"]))  # gaussian number μ σ: LIGGGHTS 3.8's form
+            x = _num(cmd, j, key)
             if kind == "uniform":
-                x = 0.5 * (x + _num(cmd, i + 3, key))
+                x = 0.5 * (x + _num(cmd, j + 1, key))
             if not x > 0:
                 raise _bad(cmd, f"{key} = {x:g}: must be > 0")
             values[key] = x
