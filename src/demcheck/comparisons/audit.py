@@ -66,8 +66,11 @@ def detect(script: deck_script.Script, found: dict) -> str:
 
 
 def read(path: str | Path, engine: str | None = None):
-    script = deck_script.read(path)
     found = readers()
+    own = [n for n, r in found.items() if hasattr(r, "claims_file") and r.claims_file(Path(path))]
+    if own and (engine is None or engine in own):  # a Kratos project (.json), a Yade script (.py): its own reader
+        return found[engine or own[0]].read_file(Path(path))
+    script = deck_script.read(path)
     engine = engine or detect(script, found)
     if engine not in found:
         raise ConfigError("--engine", engine, f"audit reads {', '.join(found)} decks")
