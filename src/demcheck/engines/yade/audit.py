@@ -33,6 +33,7 @@ UTILS_DEFAULT = Call("FrictMat", [], {"density": 1e3, "young": 1e7, "poisson": 0
 NEWTON_DAMPING = 0.2
 DEFAULT_DT = 1e-8
 WALLS = ("wall", "facet", "box", "facetBox", "facetCylinder")
+PACKS = ("regularHexa", "regularOrtho")  # pack.regular*(predicate, radius=…, gap=…, material=…)
 FRICT_FAMILY = ("FrictMat", "ViscElMat", "CohFrictMat", "FrictViscoMat", "ViscElCapMat", "MortarMat")
 
 
@@ -197,6 +198,8 @@ def _append_bodies(value, st: _State, line: int):
     items = value if isinstance(value, tuple) else (value,)
     ids = []
     for v in items:
+        if isinstance(v, Call) and v.name in PACKS and _number(v.kw.get("radius")):  # a pack of equal spheres
+            v = Call("sphere", [None, v.kw["radius"]], dict(v.kw), v.line)
         if isinstance(v, Call) and (v.name == "sphere" or v.name in WALLS):
             v.kw.setdefault("__material_at__", len(st.materials) - 1)
             st.bodies.append(v)
