@@ -139,6 +139,15 @@ def _settings(project: dict, setup: Setup, where: str) -> None:
     if project.get("RollingFrictionOption") is True:
         setup.not_audited.append((where, "RollingFrictionOption true", "rolling friction is not probed (a head-on "
                                   "impact does not roll)"))
+    procs = project.get("processes") if isinstance(project.get("processes"), dict) else {}
+    for plist in procs.values():
+        for proc in plist if isinstance(plist, list) else []:
+            par = proc.get("Parameters", {}) if isinstance(proc, dict) else {}
+            v = (par.get("velocity_constraints_settings") or {}).get("value") if isinstance(par, dict) else None
+            if isinstance(v, list) and len(v) == 3 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                          and math.isfinite(x) for x in v) and any(v):
+                setup.speeds.append((math.sqrt(sum(x * x for x in v)), f"{where}: the velocity imposed on "
+                                     f"{str(par.get('model_part_name'))[:40]}"))
     if project.get("PeriodicDomainOption") is True:
         setup.not_audited.append((where, "PeriodicDomainOption true", "periodic images are not probed"))
 
@@ -149,6 +158,8 @@ def _materials(doc: dict, name: str, meshes: dict, setup: Setup, project: dict, 
         w = f"{name}: materials[{k}]"
         if not isinstance(m, dict) or not isinstance(m.get("Variables", {}), dict):
             raise ScriptError(f"{w}: not an object with Variables")
+        if "Variables" not in m and "properties" in m:
+            raise _bad(w, "properties", "{…}", "Kratos DEM 10.4.4 reads a material's values from 'Variables'")
         mid = m.get("material_id")
         if isinstance(mid, bool) or not isinstance(mid, int) or not 0 <= mid < 10**9:
             raise _bad(w, "material_id", mid, "must be a whole number ≥ 0")
@@ -185,9 +196,10 @@ def _parts_nodes(mesh, sub: str) -> list:
         return [n for (etype, _, nodes) in mesh.elements.values() if etype in SPHERES for n in nodes[:1]]
     nodes = []
     for pname, part in mesh.parts.items():
-        if pname == sub or pname.startswith(sub + "."):
-            nodes += part.nodes
-    return nodes
+        if pname == sub or pname.startswith(sub + "."):  # its nodes, and its elements' (a part may list either)
+            nodes += part.nodes + [n for e in part.elements if e in mesh.elements
+                                   and mesh.elements[e][0] in SPHERES for n in mesh.elements[e][2][:1]]
+    return list(dict.fromkeys(nodes))
 
 
 def _bodies(meshes: dict, spheres: dict, inlets: dict, mats: dict, setup: Setup) -> None:
@@ -198,8 +210,13 @@ def _bodies(meshes: dict, spheres: dict, inlets: dict, mats: dict, setup: Setup)
     vel = {c: (mesh.nodal.get(f"VELOCITY_{c}", {}) if mesh else {}) for c in "XYZ"}
     for sub, mid in spheres.items():
         m = mats[mid]
+        nodes = _parts_nodes(mesh, sub)
+        if not any(radius.get(n, 0) > 0 for n in nodes):
+            setup.not_audited.append((f"SpheresPart{'.' + sub if sub else ''}", m["name"], "no sphere with a RADIUS "
+                                      "in the project's DEM .mdpa" + ("" if mesh else " (the file is not there)")))
+            continue
         b = setup.bodies.setdefault(mid, Body(mid, density=m["rho"]))
-        for n in _parts_nodes(mesh, sub):
+        for n in nodes:
             r = radius.get(n)
             if r is None or not r > 0:
                 continue
@@ -218,12 +235,12 @@ def _bodies(meshes: dict, spheres: dict, inlets: dict, mats: dict, setup: Setup)
                 continue
             d = part.data
             m = mats[mid]
-            b = setup.bodies.setdefault(mid, Body(mid, density=m["rho"]))
             try:
                 r = float(d.get("RADIUS", "nan"))
             except ValueError:
                 r = math.nan
             if math.isfinite(r) and r > 0:
+                b = setup.bodies.setdefault(mid, Body(mid, density=m["rho"]))
                 b.sizes.append((r, r ** 3))
                 b.size_from = (b.size_from + ", " if b.size_from else "") + f"inlet {pname}'s RADIUS"
                 if str(d.get("STANDARD_DEVIATION", "0")).strip() not in ("0", "0.0"):
