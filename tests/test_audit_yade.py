@@ -92,11 +92,37 @@ def test_a_yade_script_is_audited_with_yade_runs(tmp_path):
             assert q["engine"]["status"] == "ok" and q["engine_vs_twin"] <= 1e-9, (p["pair"], q)
     # a sphere on the wall: m = ρ 4/3 π R³, k = 2e4, c = 0.05; e of a spring-dashpot held at ≥ 0
     m = 2500.0 * 4.0 / 3.0 * math.pi * 1e-9
-    w0, g = math.sqrt(2.0e4 / m), 0.05 / (2.0 * m)
+    assert wall["probes"][0]["engine"]["restitution"] == pytest.approx(_held_restitution(2.0e4, 0.05, m), abs=2e-3)
+
+
+def _held_restitution(k: float, c: float, m: float) -> float:
+    """A linear spring-dashpot (k, c) on a body of mass m whose force is held at ≥ 0: the closed form (the body
+    leaves where k δ + c δ' = 0 on unloading, with the speed it has then)."""
+    w0, g = math.sqrt(k / m), c / (2.0 * m)
     w = math.sqrt(w0 * w0 - g * g)
-    t_end = (math.pi - math.atan2(2 * g * w, w0 * w0 - 2 * g * g)) / w  # where k δ + c δ' = 0 on unloading
-    e_held = math.exp(-g * t_end) * math.hypot(math.cos(w * t_end) * w - g * math.sin(w * t_end), 0) / w
-    assert wall["probes"][0]["engine"]["restitution"] == pytest.approx(abs(e_held), abs=2e-3)
+    t_end = (math.pi - math.atan2(2 * g * w, w0 * w0 - 2 * g * g)) / w
+    return abs(math.exp(-g * t_end) * (math.cos(w * t_end) * w - g * math.sin(w * t_end)) / w)
+
+
+@pytest.mark.engine("yade")
+def test_viscelmat_tc_en_on_a_wall_is_found_as_a_restitution_trap(tmp_path):
+    """ViscElMat(tc, en) calibrates with m̄ = m/2 on a wall (Yade gives the wall the sphere's mass): the audit
+    asks for en = 0.5 and finds the wall's realised e — the closed form of kn = m̄(π² + ln²en)/tc², cn =
+    −2m̄ ln en/tc on the whole mass m, held at ≥ 0: 0.646 (docs/yade.md measured 0.6458) — a restitution trap;
+    the engine equals its twin to 1e-9."""
+    text = VISCEL.replace("param = {'kn': kn * 2.0, 'ks': kn * 2.0 * 0.5, 'cn': 0.05 * 2.0, 'cs': 0.0}",
+                          "param = {'tc': 5e-5, 'en': 0.5, 'et': 1.0}")
+    r = A.audit(_script(tmp_path, text))
+    wall = next(p for p in r["pairs"] if p["wall"])
+    q = wall["probes"][0]
+    assert q["engine_vs_twin"] <= 1e-9
+    m = 2500.0 * 4.0 / 3.0 * math.pi * 1e-9
+    ln = math.log(0.5)
+    e_closed = _held_restitution(m / 2 * (math.pi ** 2 + ln * ln) / 5e-5 ** 2, -2 * (m / 2) * ln / 5e-5, m)
+    assert e_closed == pytest.approx(0.646, abs=1e-3)
+    assert q["engine"]["restitution"] == pytest.approx(e_closed, abs=2e-3)
+    trap = [f for f in wall["findings"] if f["code"] == "restitution"]
+    assert trap and trap[0]["size"]["asked"] == 0.5
 
 
 @pytest.mark.engine("yade")

@@ -461,6 +461,8 @@ def _native(ma: Call, mb: Call, ip2, law2, setup: Setup, a: int, b: int | None):
     if mu is None:
         return listed, {}, "a frictionAngle is computed at run time"
     if phys == VISCEL and law2.name == "Law2_ScGeom_ViscElPhys_Basic":
+        if all(k in m.kw for m in (ma, mb) for k in ("tc", "en")) and not any("kn" in m.kw for m in (ma, mb)):
+            return _viscel_tc(ma, mb, setup, a, b, listed)
         return _viscel(ma, mb, mu, listed)
     if phys == MINDLIN and law2.name == "Law2_ScGeom_MindlinPhys_Mindlin":
         return _mindlin(ma, mb, ip2, setup, a, b, listed)
@@ -523,3 +525,27 @@ def _mindlin(ma: Call, mb: Call, ip2: Call, setup: Setup, a: int, b: int | None,
                  props={"kno": kno, "betan": float(betan), "betas": 0.0, "kso": 0.0, "mu": 0.0, "r_eff": r_eff})
     nat.comments = [f"MindlinPhys kno = (4/3)E*√R̄_Y = {kno:.10g} (E* {e_star:.6g} Pa, R̄_Y {r_y:.6g} m)"]
     return nat, {}, ""
+
+
+def _viscel_tc(ma: Call, mb: Call, setup: Setup, a: int, b: int | None, listed: Native):
+    """ViscElMat(tc, en, …): Yade calibrates each contact's kn, cn from the bodies' masses when it forms —
+    each material 2m̄(π² + ln²en)/tc² and −4m̄ ln en/tc, in series, with m̄ = m₁m₂/(m₁ + m₂) and a wall's mass
+    taken as the sphere's (docs/yade.md; a twin given these runs as Yade to round-off). Probed head-on (the
+    shear calibration from et is not twinned here), asking for en: the trap is the wall's half mass."""
+    vals = [(m.kw.get("tc"), m.kw.get("en")) for m in (ma, mb)]
+    if not all(_number(t) and t > 0 and _number(e) and 0 < e <= 1 for t, e in vals):
+        return listed, {}, "ViscElMat tc or en is computed at run time (or out of range)"
+    if vals[0] != vals[1]:
+        return listed, {}, "ViscElMat tc/en differ between the two materials (the probe's script takes one)"
+    tc, en = vals[0]
+    rho = setup.bodies[a].density
+    m1 = rho * 4.0 / 3.0 * math.pi * setup.bodies[a].radius ** 3
+    m2 = m1 if b is None else setup.bodies[b].density * 4.0 / 3.0 * math.pi * setup.bodies[b].radius ** 3
+    m_bar = m1 * m2 / (m1 + m2)  # a wall's mass is the sphere's
+    ln = math.log(en)
+    kn = m_bar * (math.pi ** 2 + ln * ln) / tc ** 2  # two equal per-material values in series
+    cn = -2.0 * m_bar * ln / tc
+    nat = Native("yade", normal=VISCEL, tangential="none", limit=True,
+                 props={"tc": tc, "en": en, "et": 1.0, "kn": kn, "cn": cn, "ks": 0.0, "cs": 0.0, "mu": 0.0})
+    nat.comments = [f"ViscElMat tc = {tc:g}, en = {en:g}: Yade's kn = {kn:.10g}, cn = {cn:.10g} for m̄ = {m_bar:.6g} kg"]
+    return nat, {"restitution": float(en)}, ""
