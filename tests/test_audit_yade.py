@@ -159,3 +159,19 @@ def test_a_bad_script_is_one_line_and_exit_2(tmp_path, text, word):
     out = _cli("audit", str(_script(tmp_path, text)))
     assert out.returncode == 2, out.stdout + out.stderr
     assert len(out.stderr.strip().splitlines()) == 1 and word in out.stderr
+
+
+@pytest.mark.engine("yade")
+def test_newton_damping_is_measured_in_yade(tmp_path):
+    """NewtonIntegrator() without damping= is Yade's damping 0.2: the audit runs the head-on probe again in Yade
+    with it. For an undamped linear contact (cn = 0) the energy argument — the force ×1.2 while approaching,
+    ×0.8 while separating — gives e = √(0.8/1.2) = 0.8165 (to the step's O(dt): 3e-3); the trap carries both."""
+    text = VISCEL.replace("'cn': 0.05 * 2.0", "'cn': 0.0")
+    r = A.audit(_script(tmp_path, text))
+    for p in r["pairs"]:
+        trap = [f for f in p["findings"] if f["code"] == "newton-damping"]
+        assert trap and trap[0]["kind"] == "trap", p["findings"]
+        size = trap[0]["size"]
+        assert size["damping"] == 0.2 and size["restitution"] == pytest.approx(1.0, abs=3e-3)
+        assert size["with_damping"] == pytest.approx(math.sqrt(0.8 / 1.2), abs=3e-3)
+    assert r["traps"] >= 2

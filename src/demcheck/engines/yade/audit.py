@@ -262,14 +262,15 @@ def _newton(e: Call, setup: Setup, where: str) -> None:
     if not _number(damping):
         setup.not_audited.append((where, "NewtonIntegrator damping", "computed at run time"))
     elif damping > 0:
+        setup.newton_damping = (float(damping), where, "damping" not in e.kw)
         setup.findings.append(Finding(
             "note", "newton-damping",
             f"NewtonIntegrator damping = {damping:g}" + (" (Yade's default: the script does not set it)"
                                                           if "damping" not in e.kw else "")
             + ": Cundall's non-viscous damping scales every body's force by 1 ∓ damping (against or along its "
             "velocity) on top of the contact law; it lowers the rebound (measured, docs/findings.md: a Mindlin wall "
-            "impact with en = 0.7 realises 0.5721 with damping 0.2, 0.6996 without). The probes run without it "
-            "(its effect on this script's contacts is not measured)", where,
+            "impact with en = 0.7 realises 0.5721 with damping 0.2, 0.6996 without). The probes run without it; with "
+            "engine runs each head-on probe is run again with it and the effect is a trap of its pair", where,
             {"damping": damping}))
 
 
@@ -550,3 +551,26 @@ def _viscel_tc(ma: Call, mb: Call, setup: Setup, a: int, b: int | None, listed: 
                  props={"tc": tc, "en": en, "et": 1.0, "kn": kn, "cn": cn, "ks": 0.0, "cs": 0.0, "mu": 0.0})
     nat.comments = [f"ViscElMat tc = {tc:g}, en = {en:g}: Yade's kn = {kn:.10g}, cn = {cn:.10g} for m̄ = {m_bar:.6g} kg"]
     return nat, {"restitution": float(en)}, ""
+
+
+def measure(setup: Setup, ps: PairSetting, entry: dict, rerun) -> list:
+    """NewtonIntegrator's damping, measured: the head-on probe run again in Yade with the script's damping
+    (``rerun(native)`` → the engine's metrics); its restitution against the undamped probe's is the trap's size."""
+    damping, where, default = getattr(setup, "newton_damping", (0.0, "", False))
+    head = entry["probes"][0]
+    if not damping or head.get("failure") or head["angle"] != 0.0 or head["engine"].get("status") != "ok":
+        return []
+    import copy
+
+    nat = copy.deepcopy(ps.native)
+    nat.props["newton_damping"] = damping
+    got = rerun(nat)
+    e0, e1 = head["engine"]["restitution"], got.get("restitution", math.nan)
+    if got.get("status") != "ok" or not (math.isfinite(e0) and math.isfinite(e1)):
+        return [Finding("note", "newton-damping", f"NewtonIntegrator damping = {damping:g}: its effect could not be "
+                        f"measured ({got.get('status')}: {str(got.get('message', ''))[:120]})", where)]
+    return [Finding("trap", "newton-damping", f"NewtonIntegrator damping = {damping:g}"
+                    + (" (Yade's default: the script does not set it)" if default else "")
+                    + f" lowers this contact's head-on restitution from {e0:.4f} to {e1:.4f} (measured in Yade: "
+                    "Cundall's non-viscous damping scales the contact force by 1 ∓ damping on top of the law)",
+                    where, {"damping": damping, "restitution": e0, "with_damping": e1, "difference": e1 - e0})]
