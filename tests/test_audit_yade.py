@@ -140,12 +140,36 @@ def test_yade_mindlin_is_audited_with_its_normal_law(tmp_path):
         assert p["probes"][0]["engine_vs_twin"] <= 1e-9
 
 
-def test_cundall_strack_is_listed_not_probed(tmp_path):
-    text = MINDLIN.replace("Ip2_FrictMat_FrictMat_MindlinPhys(betan=0.2)", "Ip2_FrictMat_FrictMat_FrictPhys()") \
-        .replace("Law2_ScGeom_MindlinPhys_Mindlin()", "Law2_ScGeom_FrictPhys_CundallStrack()")
-    r = A.audit(_script(tmp_path, text), run_engine=False)
-    assert r["status"] == "not audited"
-    assert all(not p["probed"] and any("CundallStrack" in n for n in p["notes"]) for p in r["pairs"])
+CUNDALL = MINDLIN.replace("Ip2_FrictMat_FrictMat_MindlinPhys(betan=0.2)", "Ip2_FrictMat_FrictMat_FrictPhys()") \
+    .replace("Law2_ScGeom_MindlinPhys_Mindlin()", "Law2_ScGeom_FrictPhys_CundallStrack()") \
+    .replace("young = 7e10", "young = 1e7").replace("O.dt = 1e-7", "O.dt = 1e-6")
+
+
+@pytest.mark.engine("yade")
+def test_cundall_strack_normal_law_is_probed_with_yades_own_stiffness(tmp_path):
+    """Law2_ScGeom_FrictPhys_CundallStrack: the reader's kn and ks are the ones Yade's Ip2_FrictMat_FrictMat_
+    FrictPhys computes — read from Yade itself (a script of this test, stepped once, printing each interaction's
+    phys.kn and phys.ks) for the pair and the wall; the head-on probes equal their twin to 1e-9; the shear law is
+    listed, not probed (no twin of it matches a Yade run yet)."""
+    from demcheck.engines import discovery
+
+    probe = tmp_path / "kn.py"
+    probe.write_text(CUNDALL.replace("sphere((0, 0, 3.2e-3), 1.5e-3)", "sphere((0, 0, 2.99e-3), 1.5e-3)")
+                     .replace("wall(-0.002,", "wall(-1.49e-3,") + "O.step()\nfor i in O.interactions:\n"
+                     "    print('PHYS', min(i.id1, i.id2), max(i.id1, i.id2), repr(i.phys.kn), repr(i.phys.ks))\n")
+    out = subprocess.run([discovery.find("yade").executable, "-x", "-n", str(probe)], capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path)
+    phys = {(int(w[1]), int(w[2])): (float(w[3]), float(w[4])) for w in (ln.split() for ln in out.stdout.splitlines())
+            if w and w[0] == "PHYS"}
+    assert set(phys) == {(0, 1), (0, 2)}, out.stdout + out.stderr
+    setup = A.read(_script(tmp_path, CUNDALL))
+    pair, wall = setup.pairs
+    assert (pair.native.props["kn"], pair.native.props["ks"]) == pytest.approx(phys[(0, 1)], rel=1e-12)
+    assert (wall.native.props["kn"], wall.native.props["ks"]) == pytest.approx(phys[(0, 2)], rel=1e-12)
+    r = A.audit(_script(tmp_path, CUNDALL))
+    for p in r["pairs"]:
+        assert p["probed"] and len(p["probes"]) == 1 and p["probes"][0]["engine_vs_twin"] <= 1e-9
+        assert any("CundallStrack" in n and "not" in n for n in p["notes"])
 
 
 def _cli(*args):

@@ -64,6 +64,7 @@ class Evaluator:
 
     def __init__(self):
         self.names: dict = {}
+        self.attrs: dict = {}  # dotted names the script set literally (O.engines), readable again
 
     def __call__(self, node, depth: int = 0):
         if depth > 60:
@@ -84,6 +85,8 @@ class Evaluator:
                 return CONSTANTS[node.id]
             return Unknown(f"line {node.lineno}: {node.id} is not bound to a value the script gives literally")
         if isinstance(node, ast.Attribute):
+            if _dotted(node) in self.attrs:
+                return self.attrs[_dotted(node)]
             base = _dotted(node.value)
             if base in MODULES and node.attr in CONSTANTS:
                 return CONSTANTS[node.attr]
@@ -111,6 +114,8 @@ class Evaluator:
                     return UNKNOWN
                 r = op(a, b)
                 return r if _number(r) and math.isfinite(r) else Unknown(f"line {node.lineno}: not a finite number")
+            if isinstance(a, tuple) and isinstance(b, tuple) and op is operator.add:
+                return a + b
             if isinstance(a, tuple) and _number(b) and op in (operator.mul, operator.truediv) and \
                     all(_number(x) for x in a):
                 return tuple(op(x, b) for x in a)
