@@ -186,6 +186,9 @@ def _materials(doc: dict, name: str, meshes: dict, setup: Setup, project: dict, 
         kind[head[1] if len(head) > 1 else ""] = by_name[mname]["id"]
     _bodies(meshes, spheres, inlets, mats, setup)
     wall_mats = _walls(meshes.get("_FEM_boundary"), walls)
+    for pname, key, why in getattr(meshes.get("_FEM_boundary"), "notes", []):
+        setup.not_audited.append((f"FEM boundary {pname[:40]}", key, f"{why}: the probes' wall is fixed and "
+                                  "not sticky"))
     _relations(doc, name, mats, setup, wall_mats)
 
 
@@ -228,6 +231,14 @@ def _bodies(meshes: dict, spheres: dict, inlets: dict, mats: dict, setup: Setup)
             if s > 0:
                 setup.speeds.append((s, f"{mesh.path.name}: node {n}'s VELOCITY"))
         b.size_from = f"{mesh.path.name if mesh else 'the .mdpa'}'s RADIUS"
+    for pname, part in (mesh.parts.items() if mesh else []):  # initial velocities given per sub-model part
+        v = [part.data.get(f"INITIAL_VELOCITY_{c}_VALUE", "0") for c in "XYZ"]
+        try:
+            v = [float(x) for x in v]
+        except ValueError:
+            continue
+        if any(v) and all(math.isfinite(x) for x in v):
+            setup.speeds.append((math.sqrt(sum(x * x for x in v)), f"{mesh.path.name}: {pname}'s INITIAL_VELOCITY"))
     inlet = meshes.get("_Inlet")
     for sub, mid in inlets.items():
         for pname, part in (inlet.parts.items() if inlet else []):
@@ -267,6 +278,10 @@ def _walls(boundary, walls: dict) -> set:
     if boundary is None or not boundary.conditions:
         return set()
     out = set()
+    for pname, part in boundary.parts.items():
+        for key, why in (("IS_STICKY", "particles stick to this wall"), ("RIGID_BODY_MOTION", "the wall moves")):
+            if str(part.data.get(key, "0")).strip() not in ("0", ""):
+                boundary.notes = getattr(boundary, "notes", []) + [(pname, key, why)]
     for sub, mid in walls.items():
         if sub == "" or any((p == sub or p.startswith(sub + ".")) and part.conditions
                             for p, part in boundary.parts.items()):
