@@ -34,6 +34,8 @@ UTILS_DEFAULT = Call("FrictMat", [], {"density": 1e3, "young": 1e7, "poisson": 0
 NEWTON_DAMPING = 0.2
 DEFAULT_DT = 1e-8
 WALLS = ("wall", "facet", "box", "facetBox", "facetCylinder")
+MATERIAL_KEYS = frozenset({"young", "poisson", "density", "frictionAngle", "kn", "cn", "ks", "cs", "tc", "en", "et",
+                           "label", "material"})  # what the probes read from a material
 PACKS = ("regularHexa", "regularOrtho")  # pack.regular*(predicate, radius=…, gap=…, material=…)
 FRICT_FAMILY = ("FrictMat", "ViscElMat", "CohFrictMat", "FrictViscoMat", "ViscElCapMat", "MortarMat")
 
@@ -445,6 +447,10 @@ def _pairs(st: _State, setup: Setup, types: dict, laws: dict) -> None:
             ps.notes.append(f"{CUNDALL}: its normal law probed head-on; its shear (μ = {_mu(ma, mb):.4g}, ks = "
                             f"{nat.props['ks']:.4g}) is not — no twin of its shear force matches a Yade run yet "
                             "(the ViscElPhys spring differs by 3.8e-3 at 30° on a wall)")
+        extra = sorted({k for m in (ma, mb) for k in m.kw if k not in MATERIAL_KEYS and not k.startswith("_")})
+        if extra and ps.probe:
+            setup.not_audited.append((ps.where, f"{label}: {', '.join(extra)}", "material keywords the probes do not "
+                                      "include (rolling resistance, cohesion, capillarity, …)"))
         if wall and walls[b][0] != "wall":
             ps.notes.append(f"a {walls[b][0]} ({walls[b][1]}) probed as a flat Wall")
         if why:
