@@ -481,6 +481,8 @@ def _native(ma: Call, mb: Call, ip2, law2, setup: Setup, a: int, b: int | None):
     mu = _mu(ma, mb)
     if mu is None:
         return listed, {}, "a frictionAngle is computed at run time"
+    if any(m.kw.get("SPHmode") not in (None, False, 0) for m in (ma, mb)):
+        return listed, {}, "ViscElMat(SPHmode=…): smoothed-particle forces, not a contact law"
     if phys == VISCEL and law2.name == "Law2_ScGeom_ViscElPhys_Basic":
         if all(k in m.kw for m in (ma, mb) for k in ("tc", "en")) and not any("kn" in m.kw for m in (ma, mb)):
             return _viscel_tc(ma, mb, setup, a, b, listed)
