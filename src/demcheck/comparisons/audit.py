@@ -74,6 +74,9 @@ def read(path: str | Path, engine: str | None = None):
     present reader (inputs/script.py)."""
     path = Path(path)
     found = readers()
+    own = [n for n, r in found.items() if hasattr(r, "claims_file") and r.claims_file(path)]
+    if own and (engine is None or engine in own):  # a Kratos project (.json), a Yade script (.py): its own reader
+        return found[engine or own[0]].read_file(path)
     try:
         script, refusal = deck_script.read(path), None
     except deck_script.ScriptError as exc:
@@ -553,6 +556,9 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dic
                 found.append(deck_script.Finding("trap", "probe-failed", f"the {angle:g}° probe did not run: {exc}",
                                                  ps.where))
         _judge(setup, ps, entry, found, tol)
+        measure = getattr(readers()[setup.engine], "measure", None)  # an engine reader's own measured traps
+        if measure is not None and run_engine and entry["probes"] and "engine" in entry["probes"][0]:
+            found += measure(setup, ps, entry, lambda native: _rerun(setup, ps, native, entry["probes"][0]))
     entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
     entry["findings"] = [_finding(f) for f in found]
     return entry, found
@@ -892,3 +898,11 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
 
 def _metrics_of(m: dict) -> dict:
     return {k: m.get(k, math.nan) for k in METRICS + HEALTH}
+
+
+def _rerun(setup, ps, native, p: dict) -> dict:
+    """The engine's metrics of probe ``p`` run again with another Native (an engine reader's measured trap)."""
+    nl, tl = registry.get(setup.engine).twin(native, *_effective(setup, ps))
+    case = probe_case(setup, ps, p["speed"], p["angle"], nl, tl, seed_of(nl, tl, ps.asked), p["dt"])
+    res = collide(case, setup.engine, dt=p["dt"], native=native)
+    return {"status": res.status, "message": res.message, **_metrics(res)}

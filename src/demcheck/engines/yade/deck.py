@@ -23,6 +23,9 @@ from ..mapping import contact_mapping
 from .mapping import MINDLIN, VISCEL
 
 VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
+# a ViscElPhys Native whose props name this Law2 runs as FrictMat + FrictPhys + CundallStrack: the same linear
+# spring and incremental shear spring capped at μFn, without dashpots (cn = cs = 0), as Yade's FrictPhys computes
+CUNDALL = "Law2_ScGeom_FrictPhys_CundallStrack"
 HEAD = "ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS ff ff ff\n-1 1\n-1 1\n-1 1\nITEM: ATOMS " \
        + " ".join(common.DUMP_COLUMNS) + "\n"
 ROW = "%d %d" + " %.17g" * (len(common.DUMP_COLUMNS) - 2) + "\n"
@@ -31,6 +34,7 @@ NAMES = frozenset({
     "O", "Vector3", "utils", "FrictMat", "ViscElMat", "ForceResetter", "InsertionSortCollider", "Bo1_Sphere_Aabb",
     "Bo1_Wall_Aabb", "InteractionLoop", "Ig2_Sphere_Sphere_ScGeom", "Ig2_Wall_Sphere_ScGeom",
     "Ip2_FrictMat_FrictMat_MindlinPhys", "Law2_ScGeom_MindlinPhys_Mindlin", "Ip2_ViscElMat_ViscElMat_ViscElPhys",
+    "Ip2_FrictMat_FrictMat_FrictPhys", "Law2_ScGeom_FrictPhys_CundallStrack",
     "Law2_ScGeom_ViscElPhys_Basic", "NewtonIntegrator", "open", "range", "len",
     # the template's own variables
     "DT", "STEPS", "G", "ids", "mass", "inertia", "radius", "out", "k", "n", "i", "s", "x", "v", "w", "f", "t", "a",
@@ -115,6 +119,14 @@ def materials(nat, case: Case, sc) -> tuple[str, str]:
     """(particle material, wall material) as Yade constructor calls, from the native configuration."""
     p = nat.props
     phi = math.atan(p.get("mu", 0.0))
+    if nat.normal == VISCEL and p.get("law2") == CUNDALL:
+        # Ip2_FrictMat_FrictMat_FrictPhys: kn = 2EaRa·EbRb/(EaRa + EbRb), ks = kn·poisson for equal materials —
+        # E R̄·2 for a pair, E·R on a Wall (Ig2_Wall_Sphere_ScGeom gives the wall the sphere's radius)
+        radii = [q.radius for q in case.particles]
+        r = radii[0] if case.walls else 2.0 * radii[0] * radii[1] / (radii[0] + radii[1])
+        body = (f"FrictMat(young={_num(p['kn'] / r)}, poisson={_num(p['ks'] / p['kn'])}, frictionAngle={_num(phi)}, "
+                "density=1.0)")
+        return body, body
     if nat.normal == VISCEL:
         if p.get("tc") is not None:  # Yade's own calibration input (never mapped: docs/yade.md's trap)
             body = (f"ViscElMat(tc={_num(p['tc'])}, en={_num(p['en'])}, et={_num(p.get('et', 1.0))}, "
@@ -150,7 +162,9 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     body_mat, wall_mat = materials(nat, case, sc)
     p = nat.props
     g = [float(x) for x in case.run.gravity]
-    if nat.normal == VISCEL:
+    if nat.normal == VISCEL and p.get("law2") == CUNDALL:
+        phys, law = "Ip2_FrictMat_FrictMat_FrictPhys()", "Law2_ScGeom_FrictPhys_CundallStrack()"
+    elif nat.normal == VISCEL:
         phys, law = "Ip2_ViscElMat_ViscElMat_ViscElPhys()", "Law2_ScGeom_ViscElPhys_Basic()"
     else:
         phys = (f"Ip2_FrictMat_FrictMat_MindlinPhys(betan={_num(p['betan'])}, betas={_num(p['betas'])})"
@@ -193,7 +207,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
               "              InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],",
               f"                              [{phys}],",
               f"                              [{law}]),",
-              "              NewtonIntegrator(damping=0.0, gravity=G)]",
+              # damping 0 (Yade's default is 0.2): a Native's newton_damping only where the audit measures its effect
+              f"              NewtonIntegrator(damping={_num(float(p.get('newton_damping', 0.0)))}, gravity=G)]",
               "O.dt = DT",
               f"out = open({common.DUMP_FILE!r}, 'w')",
               "n = len(ids)",
