@@ -254,3 +254,23 @@ def test_conductances():
     assert rel(lens, 2 * 10.0 * math.sqrt(math.pi * (1e-3 * d - d * d / 4))) < 1e-9  # intersection circle
     assert series_conductivity(3.0, 3.0) == 3.0
     assert conductance(HeatLaw("radius", 10.0, r).array(), -1e-9) == 0.0
+
+
+def test_slack_zero_gives_no_torque_only_while_the_spring_is_unstretched():
+    base = dict(mu_r=0.01, r_roll=R, k_r=1.0, c_r=1.0, cap=CAP_TOTAL)
+    n, w = np.array([1.0, 0.0, 0.0]), np.array([0.0, 5.0, 0.0])
+    plain = rolling_torque(RollingLaw("epsd", **base).array(), w, n, 1.0, 0.0, np.zeros(3))[0]
+    zero = rolling_torque(RollingLaw("epsd", slack_zero=True, **base).array(), w, n, 1.0, 0.0, np.zeros(3))[0]
+    assert rel(np.linalg.norm(plain), 0.01 * R) < 1e-15 and not zero.any()
+    stretched = rolling_torque(RollingLaw("epsd", slack_zero=True, **base).array(), w, n, 1.0, 1e-3, np.zeros(3))[0]
+    assert rel(np.linalg.norm(stretched), 0.01 * R) < 1e-15
+
+
+def test_adhesive_impact_with_the_load_controlled_break():
+    law = AdhesionLaw("jkr", 5e-4, 5e7, 0.1, break_at=1)
+    vs = b.capture_velocity_closed(5e-4, 5e7, 0.1, M / 2, "load")
+    assert vs < b.capture_velocity_closed(5e-4, 5e7, 0.1, M / 2)  # less of the loop is walked
+    for factor in (0.9, 3.0):
+        out = b.adhesive_impact(law, M / 2, factor * vs)
+        assert abs(out["restitution"] - b.adhesive_restitution_closed(factor * vs, vs)) < 1e-8
+    assert b.pull_off(law)["pull_off_force"] > 0  # the largest tension is still (3/2)πwR̄

@@ -4,7 +4,8 @@
   δ = a²/R̄ − √(2πwa/E*) and F = 4E*a³/(3R̄) − √(8πwE*a³) (w the work of adhesion, w = 2γ for two like surfaces
   of surface energy γ). It replaces the elastic normal law. Hysteresis: the contact forms at δ = 0 (jumping to
   F = −(8/9)·(3/2)πwR̄) and breaks at δ_f = −3a_f²/R̄ with a_f³ = πwR̄²/(8E*), where F = −(5/6)πwR̄ (pull-off under
-  imposed displacement); under imposed load it breaks at F = −(3/2)πwR̄, δ = −a_c²/(3R̄), a_c³ = 9πwR̄²/(8E*).
+  imposed displacement; ``break_at`` = load moves the break to δ_c, as LAMMPS does); under imposed load it
+  breaks at F = −(3/2)πwR̄, δ_c = −a_c²/(3R̄), a_c³ = 9πwR̄²/(8E*).
 * ``dmt`` (Derjaguin, Muller & Toporov, J. Colloid Interface Sci. 53 (1975) 314-326): F = (4/3)E*√R̄ δ^{3/2} − 2πwR̄
   while δ ≥ 0; pull-off 2πwR̄ at δ = 0, no hysteresis. It replaces the elastic normal law.
 * ``sjkr`` (simplified JKR cohesion, LIGGGHTS ``cohesion sjkr``/``sjkr2``): an extra force −kc·A on top of the
@@ -30,8 +31,9 @@ from .. import KERNEL_CACHE
 NONE, JKR, DMT, SJKR = 0, 1, 2, 3
 FAMILIES = {"none": NONE, "jkr": JKR, "dmt": DMT, "sjkr": SJKR}
 AREA_LENS, AREA_BAND = 0, 1
-AD_FAMILY, AD_R, AD_E, AD_W, AD_KC, AD_AREA, AD_WALL, AD_R0, AD_R1 = range(9)
-AD_SIZE = 9
+BREAK_DISPLACEMENT, BREAK_LOAD = 0, 1
+AD_FAMILY, AD_R, AD_E, AD_W, AD_KC, AD_AREA, AD_WALL, AD_R0, AD_R1, AD_BREAK = range(10)
+AD_SIZE = 10
 
 
 @dataclass(frozen=True)
@@ -45,9 +47,10 @@ class AdhesionLaw:
     wall: bool = False
     r0: float = 0.0
     r1: float = 0.0
+    break_at: int = BREAK_DISPLACEMENT  # jkr: the contact breaks at δ_f (imposed displacement) or δ_c (imposed load)
 
     slot = "adhesion"
-    params = ("r_eff", "e_eff", "w", "k_c", "area", "wall", "r0", "r1")
+    params = ("r_eff", "e_eff", "w", "k_c", "area", "wall", "r0", "r1", "break_at")
 
     @property
     def history_size(self) -> int:
@@ -59,13 +62,13 @@ class AdhesionLaw:
 
     def array(self) -> np.ndarray:
         return np.array([FAMILIES[self.id], self.r_eff, self.e_eff, self.w, self.k_c, self.area,
-                         float(self.wall), self.r0, self.r1])
+                         float(self.wall), self.r0, self.r1, self.break_at])
 
     @classmethod
     def from_array(cls, a) -> "AdhesionLaw":
         ids = {v: k for k, v in FAMILIES.items()}
         return cls(ids[int(a[AD_FAMILY])], *(float(x) for x in a[AD_R:AD_AREA]), int(a[AD_AREA]), bool(a[AD_WALL]),
-                   float(a[AD_R0]), float(a[AD_R1]))
+                   float(a[AD_R0]), float(a[AD_R1]), int(a[AD_BREAK]))
 
     # closed forms of the law (pull-off)
     def pull_off_force(self, control: str = "load") -> float:
@@ -101,8 +104,12 @@ def jkr_radius(delta, r, e, w):
 
 
 @njit(cache=KERNEL_CACHE)
-def jkr_break(r, e, w):
-    """δ_f: below it a JKR contact under imposed displacement breaks."""
+def jkr_break(r, e, w, rule):
+    """The overlap below which a JKR contact breaks: δ_f = −3a_f²/R̄ (imposed displacement, a_f³ = πwR̄²/(8E*)),
+    or δ_c = −a_c²/(3R̄) (imposed load, a_c³ = 9πwR̄²/(8E*); LAMMPS's pull-off distance)."""
+    if rule == BREAK_LOAD:
+        ac = (9.0 * math.pi * w * r * r / (8.0 * e)) ** (1.0 / 3.0)
+        return -ac * ac / (3.0 * r)
     af = (math.pi * w * r * r / (8.0 * e)) ** (1.0 / 3.0)
     return -3.0 * af * af / r
 
@@ -127,7 +134,7 @@ def adhesive_force(p, delta, touching):
     family = p[AD_FAMILY]
     r, e, w = p[AD_R], p[AD_E], p[AD_W]
     if family == JKR:
-        now = delta >= 0.0 or (touching != 0.0 and delta >= jkr_break(r, e, w))
+        now = delta >= 0.0 or (touching != 0.0 and delta >= jkr_break(r, e, w, p[AD_BREAK]))
         if not now:
             return 0.0, 0.0
         a = jkr_radius(delta, r, e, w)

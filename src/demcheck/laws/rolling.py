@@ -10,7 +10,9 @@ Powder Technology 206 (2011) 269-282:
   Mk updated incrementally, Mk ← Mk − kr w dt, limited to the full-mobilisation torque Mm = μr Rr |Fn|; a dashpot
   Md = −f Cr w with Cr = ηr·2√(Ir kr). Ai et al. take f = 0 once the spring is fully mobilised (``cap`` = ``spring``),
   LAMMPS's ``rolling sds`` caps the sum of spring and dashpot (``cap`` = ``total``: Mk is reset so that
-  |Mk − Cr w| = Mm, the Maw rule of its tangential model). ηr = 0 is the type C model without its viscous part.
+  |Mk − Cr w| = Mm, the Maw rule of its tangential model; with ``slack_zero`` the torque is zero when the sum is
+  over the limit while the spring is unstretched, as LAMMPS does at its setup step). ηr = 0 is the type C model
+  without its viscous part.
 
 Rr is the rolling radius (R̄ = R0R1/(R0+R1) for a pair, R for a sphere on a wall); Ir the equivalent moment of
 inertia of Ai et al., 1/Ir = 1/(I0 + m0R0²) + 1/(I1 + m1R1²) (= 1.4 m R² for a solid sphere on a wall).
@@ -31,8 +33,8 @@ NONE, CONSTANT_TORQUE, VISCOUS, EPSD = 0, 1, 2, 3
 FAMILIES = {"none": NONE, "constant_torque": CONSTANT_TORQUE, "viscous": VISCOUS, "epsd": EPSD}
 CAP_SPRING, CAP_TOTAL = 0, 1
 # layout of RollingLaw.array()
-RL_FAMILY, RL_MU, RL_R, RL_K, RL_C, RL_CAP, RL_FULL_DIRECTION = range(7)
-RL_SIZE = 7
+RL_FAMILY, RL_MU, RL_R, RL_K, RL_C, RL_CAP, RL_FULL_DIRECTION, RL_SLACK_ZERO = range(8)
+RL_SIZE = 8
 
 
 @dataclass(frozen=True)
@@ -46,9 +48,10 @@ class RollingLaw:
     c_r: float = 0.0  # rolling viscous coefficient (N·m·s/rad), types B and C
     cap: int = CAP_SPRING  # type C: what the full-mobilisation torque limits (spring only, or spring + dashpot)
     full_direction: bool = False  # type A: direction from all of ω0 − ω1, its normal part removed afterwards
+    slack_zero: bool = False  # type C, cap total: over the limit with an unstretched spring (Mk = 0), no torque
 
     slot = "rolling"
-    params = ("mu_r", "r_roll", "k_r", "c_r", "cap", "full_direction")
+    params = ("mu_r", "r_roll", "k_r", "c_r", "cap", "full_direction", "slack_zero")
 
     @property
     def history_size(self) -> int:
@@ -56,13 +59,13 @@ class RollingLaw:
 
     def array(self) -> np.ndarray:
         return np.array([FAMILIES[self.id], self.mu_r, self.r_roll, self.k_r, self.c_r, self.cap,
-                         float(self.full_direction)])
+                         float(self.full_direction), float(self.slack_zero)])
 
     @classmethod
     def from_array(cls, a) -> "RollingLaw":
         ids = {v: k for k, v in FAMILIES.items()}
         return cls(ids[int(a[RL_FAMILY])], float(a[RL_MU]), float(a[RL_R]), float(a[RL_K]), float(a[RL_C]),
-                   int(a[RL_CAP]), bool(a[RL_FULL_DIRECTION]))
+                   int(a[RL_CAP]), bool(a[RL_FULL_DIRECTION]), bool(a[RL_SLACK_ZERO]))
 
 
 def equivalent_inertia(m0: float, r0: float, m1: float = math.inf, r1: float = 1.0) -> float:
@@ -103,6 +106,8 @@ def rolling_torque(p, w, n, fn_abs, dt, hist):
             total = spring + damp
             mag = math.sqrt(total[0] ** 2 + total[1] ** 2 + total[2] ** 2)
             if mag > cap:
+                if p[RL_SLACK_ZERO] != 0.0 and not (spring[0] != 0.0 or spring[1] != 0.0 or spring[2] != 0.0):
+                    return out, spring  # the engine's rule: no stored rolling, no torque (seen at its setup step)
                 total = total * (cap / mag)
                 spring = total - damp
             return total, spring

@@ -63,8 +63,9 @@ def twist_stop_closed(mass: float, radius: float, omega0: float, mu_tw: float, f
     return 0.4 * mass * radius * radius * abs(omega0) / (mu_tw * fn)
 
 
-def jkr_loop_energy(r: float, e: float, w: float) -> float:
-    """W = −∫ F dδ from the break δ_f to δ = 0 along JKR's branch, by its antiderivative in a."""
+def jkr_loop_energy(r: float, e: float, w: float, break_at: str = "displacement") -> float:
+    """W = −∫ F dδ from the break (δ_f, or δ_c when the law breaks at the load-controlled pull-off) to δ = 0
+    along JKR's branch, by its antiderivative in a."""
     c = math.sqrt(2.0 * math.pi * w / e)
     k1, k2 = 4.0 * e / (3.0 * r), math.sqrt(8.0 * math.pi * w * e)
 
@@ -73,12 +74,12 @@ def jkr_loop_energy(r: float, e: float, w: float) -> float:
                 + k2 * c / 4.0 * a * a)
 
     a0 = (c * r) ** (2.0 / 3.0)
-    af = (math.pi * w * r * r / (8.0 * e)) ** (1.0 / 3.0)
+    af = ((1.0 if break_at == "displacement" else 9.0) * math.pi * w * r * r / (8.0 * e)) ** (1.0 / 3.0)
     return -(g(a0) - g(af))
 
 
-def capture_velocity_closed(r: float, e: float, w: float, m_eff: float) -> float:
-    return math.sqrt(2.0 * jkr_loop_energy(r, e, w) / m_eff)
+def capture_velocity_closed(r: float, e: float, w: float, m_eff: float, break_at: str = "displacement") -> float:
+    return math.sqrt(2.0 * jkr_loop_energy(r, e, w, break_at) / m_eff)
 
 
 def adhesive_restitution_closed(v: float, v_capture: float) -> float:
@@ -204,7 +205,7 @@ def adhesive_impact(law: AdhesionLaw, m_eff: float, v: float, t_end: float = Non
     """A head-on impact at approach speed v of two bodies interacting by an elastic JKR (or DMT) law: free
     flight to δ = 0, contact until the law breaks it (δ_f) or t_end. Returns the restitution (0 if captured)."""
     p = law.array()
-    brk = law.separation_at_pull_off("displacement") if law.id == "jkr" else 0.0
+    brk = law.separation_at_pull_off("displacement" if law.break_at == 0 else "load") if law.id == "jkr" else 0.0
     t_end = t_end if t_end is not None else 200.0 * _contact_time_scale(law, m_eff, v)
 
     def rhs(t, y):
@@ -244,3 +245,79 @@ def conduction(law: HeatLaw, delta: float, c0: float, c1: float, t0: float, t1: 
     sol = solve_ivp(rhs, (0.0, t_end), [t0, t1], method="DOP853", rtol=RTOL, atol=1e-14, events=[efold])
     return {"heat_time_constant": float(sol.t_events[0][0]) if sol.t_events[0].size else math.nan,
             "conductance": h}
+
+
+# ----------------------------------------------------------------------------- the engines' discrete scheme
+
+
+def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, omega1, dt: float, steps: int, *,
+                kn: float = 0.0, adhesion: AdhesionLaw | None = None, rolling: RollingLaw | None = None,
+                twisting: TwistingLaw | None = None, marshall_t: tuple[float, float] | None = None,
+                heat: HeatLaw | None = None, cp: float = 0.0, temps=(300.0, 400.0)) -> dict:
+    """Two like spheres, body 0 at the origin, body 1 at (x1, 0, 0) moving at (v1, 0, 0), stepped the way the
+    engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
+    half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
+    step). The normal force is a linear spring kn·δ, or the adhesion law's when it replaces the normal law; the
+    limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄| for jkr: the engine's critical force).
+    ``marshall_t`` = (kt, μt) gives Marshall's twisting law at each step's contact radius √(R̄δ).
+    Returns per step (after it): x, v, ω, f, τ (2×3 each), T (2) and the heat flow Q into body 0."""
+    from ..laws.twisting import marshall, twisting_torque
+
+    mass = density * 4.0 / 3.0 * math.pi * radius ** 3
+    inertia = 0.4 * mass * radius * radius
+    rbar = radius / 2.0
+    x = np.array([[0.0, 0.0, 0.0], [x1, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, 0.0], [v1, 0.0, 0.0]])
+    w = np.array([omega0, omega1], dtype=float)
+    temp = np.array(temps, dtype=float)
+    state = {"roll": np.zeros(3), "twist": 0.0, "touch": 0.0}
+    arrays = {k: (law.array() if law is not None else None) for k, law in
+              (("adhesion", adhesion), ("rolling", rolling), ("twisting", twisting), ("heat", heat))}
+
+    def forces(update):
+        d = x[1] - x[0]
+        dist = math.sqrt(d @ d)
+        n = d / dist
+        delta = 2.0 * radius - dist
+        f, tq = np.zeros((2, 3)), np.zeros((2, 3))
+        if adhesion is not None and adhesion.replaces_normal:
+            fn, touch = adhesive_force(arrays["adhesion"], delta, state["touch"])
+            fcrit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
+        else:
+            fn, touch = kn * delta, float(delta > 0.0)
+            fcrit = abs(fn)
+        if not touch:
+            state.update(roll=np.zeros(3), twist=0.0, touch=0.0)
+            return f, tq, 0.0
+        state["touch"] = 1.0
+        f[0], f[1] = -fn * n, fn * n
+        wrel = w[0] - w[1]
+        h = dt if update else 0.0
+        if rolling is not None:
+            m, hist = rolling_torque(arrays["rolling"], wrel, n, fcrit, h, state["roll"])
+            state["roll"] = hist if update else state["roll"]
+            tq[0] += m
+            tq[1] -= m
+        tl = marshall(marshall_t[0], 0.0, marshall_t[1], math.sqrt(rbar * delta)) if marshall_t else twisting
+        if tl is not None:
+            m, phi = twisting_torque(tl.array(), wrel, n, fcrit, h, state["twist"])
+            state["twist"] = phi if update else state["twist"]
+            tq[0] += m
+            tq[1] -= m
+        q = conductance(arrays["heat"], delta) * (temp[1] - temp[0]) if heat is not None else 0.0
+        return f, tq, q
+
+    f, tq, q = forces(False)
+    out = {k: [] for k in ("x", "v", "omega", "f", "torque", "T", "Q")}
+    for _ in range(steps):
+        v += 0.5 * dt * f / mass
+        x += dt * v
+        w += 0.5 * dt * tq / inertia
+        f, tq, q = forces(True)
+        v += 0.5 * dt * f / mass
+        w += 0.5 * dt * tq / inertia
+        if heat is not None:
+            temp += dt * np.array([q, -q]) / (mass * cp)
+        for k, val in (("x", x), ("v", v), ("omega", w), ("f", f), ("torque", tq), ("T", temp), ("Q", q)):
+            out[k].append(np.copy(val))
+    return {k: np.array(val) for k, val in out.items()}
