@@ -253,13 +253,17 @@ def conduction(law: HeatLaw, delta: float, c0: float, c1: float, t0: float, t1: 
 def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, omega1, dt: float, steps: int, *,
                 kn: float = 0.0, adhesion: AdhesionLaw | None = None, rolling: RollingLaw | None = None,
                 twisting: TwistingLaw | None = None, marshall_t: tuple[float, float] | None = None,
-                heat: HeatLaw | None = None, cp: float = 0.0, temps=(300.0, 400.0)) -> dict:
+                heat: HeatLaw | None = None, cp: float = 0.0, temps=(300.0, 400.0),
+                setup_increment: bool = False) -> dict:
     """Two like spheres, body 0 at the origin, body 1 at (x1, 0, 0) moving at (v1, 0, 0), stepped the way the
     engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
     half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
-    step). The normal force is a linear spring kn·δ, or the adhesion law's when it replaces the normal law; the
+    step). The normal force is a linear spring kn·δ (plus a cohesion law's force), or the adhesion law's when it
+    replaces the normal law; the
     limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄| for jkr: the engine's critical force).
     ``marshall_t`` = (kt, μt) gives Marshall's twisting law at each step's contact radius √(R̄δ).
+    ``setup_increment``: the set-up force call already adds one step's spring increment to the torques it applies
+    (and forgets it: the history still starts at step 1), as LIGGGHTS's rolling models do.
     Returns per step (after it): x, v, ω, f, τ (2×3 each), T (2) and the heat flow Q into body 0."""
     from ..laws.twisting import marshall, twisting_torque
 
@@ -285,6 +289,8 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
             fcrit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
         else:
             fn, touch = kn * delta, float(delta > 0.0)
+            if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
+                fn += adhesive_force(arrays["adhesion"], delta, 1.0)[0]
             fcrit = abs(fn)
         if not touch:
             state.update(roll=np.zeros(3), twist=0.0, touch=0.0)
@@ -292,7 +298,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         state["touch"] = 1.0
         f[0], f[1] = -fn * n, fn * n
         wrel = w[0] - w[1]
-        h = dt if update else 0.0
+        h = dt if update or setup_increment else 0.0
         if rolling is not None:
             m, hist = rolling_torque(arrays["rolling"], wrel, n, fcrit, h, state["roll"])
             state["roll"] = hist if update else state["roll"]
