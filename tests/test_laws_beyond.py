@@ -274,3 +274,17 @@ def test_adhesive_impact_with_the_load_controlled_break():
         out = b.adhesive_impact(law, M / 2, factor * vs)
         assert abs(out["restitution"] - b.adhesive_restitution_closed(factor * vs, vs)) < 1e-8
     assert b.pull_off(law)["pull_off_force"] > 0  # the largest tension is still (3/2)πwR̄
+
+
+def test_twist_from_an_unstretched_spring_against_its_closed_form():
+    """Wind-up first (an undamped oscillator: φ = (ω0/Ω) sin Ωt, Ω = √(ktw/I)) until ktw φ reaches the limit at t1,
+    then a constant torque: t_stop = t1 + I ω0 cos(Ω t1)/limit."""
+    law = TwistingLaw("sds", 1e-8, 0.0, 1e-6)
+    inertia, fn, w0 = 0.4 * M * R * R, M * G, 10.0
+    cap = 1e-6 * fn
+    omega = math.sqrt(1e-8 / inertia)
+    t1 = math.asin(cap * omega / (1e-8 * w0)) / omega
+    closed = t1 + inertia * w0 * math.cos(omega * t1) / cap
+    out = b.twist_decay(law, M, R, w0, fn, 10 * closed, preloaded=False)
+    assert rel(out["twist_stop_time"], closed) < SOLVER
+    assert out["twist_stop_time"] > b.twist_decay(law, M, R, w0, fn, 10 * closed)["twist_stop_time"]

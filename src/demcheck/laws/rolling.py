@@ -76,7 +76,7 @@ def equivalent_inertia(m0: float, r0: float, m1: float = math.inf, r1: float = 1
 
 
 def epsd_damping(eta_r: float, i_r: float, k_r: float) -> float:
-    """Cr = ηr · 2√(Ir kr) (Ai et al. 2011, eq. 15: ηr is the ratio to the critical damping)."""
+    """Cr = ηr · 2√(Ir kr) (Ai et al. 2011: ηr is the ratio to the critical damping)."""
     return eta_r * 2.0 * math.sqrt(i_r * k_r)
 
 

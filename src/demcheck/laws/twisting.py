@@ -4,7 +4,7 @@
   Mt = −ktw φ − γtw φ̇, limited to |Mt| ≤ μtw |Fn|; when the limit is reached the stored angle is reset so that
   spring + dashpot equal the limit (the Maw rule; LAMMPS ``twisting sds``, after Marshall 2009).
 * ``marshall``: the same law with its coefficients from the tangential law and the contact radius a
-  (Marshall, J. Comput. Phys. 228 (2009) 1541-1561, eqs. 32-44; LAMMPS ``twisting marshall``):
+  (Marshall, J. Comput. Phys. 228 (2009) 1541-1561; LAMMPS ``twisting marshall``):
   ktw = ½ kt a², γtw = ½ γt a², μtw = ⅔ a μt.
 
 The torque returned (a vector, Mt n) acts on body 0; body 1 takes its opposite. The history is φ (1 value).

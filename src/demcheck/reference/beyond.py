@@ -149,9 +149,11 @@ def incline_critical_angle(law: RollingLaw, mass: float, radius: float, g: float
 # ----------------------------------------------------------------------------- twist
 
 
-def twist_decay(law: TwistingLaw, mass: float, radius: float, omega0: float, fn: float, t_end: float) -> dict:
+def twist_decay(law: TwistingLaw, mass: float, radius: float, omega0: float, fn: float, t_end: float,
+                preloaded: bool = True) -> dict:
     """A sphere spinning about the plane's normal, its twisting spring preloaded at the limit (slipping from the
-    start): integrated with the law's limit as a state constraint; the stop is the event ω = 0."""
+    start; the closed form's assumption) or unstretched (it winds up first, as in an engine run that starts
+    there): integrated with the law's limit as a state constraint; the stop is the event ω = 0."""
     inertia = 0.4 * mass * radius * radius
     cap = law.mu_tw * fn
 
@@ -163,7 +165,7 @@ def twist_decay(law: TwistingLaw, mass: float, radius: float, omega0: float, fn:
             return [m / inertia, -law.gamma_tw * (m / inertia) / law.k_tw if law.k_tw > 0 else 0.0]
         return [m / inertia, w]
 
-    phi0 = (cap - law.gamma_tw * omega0) / law.k_tw if law.k_tw > 0 else 0.0
+    phi0 = (cap - law.gamma_tw * omega0) / law.k_tw if law.k_tw > 0 and preloaded else 0.0
     ev = _stop_event_index(0)
     sol = solve_ivp(rhs, (0.0, t_end), [omega0, phi0], method="DOP853", rtol=RTOL, atol=1e-14, events=[ev])
     return {"twist_stop_time": float(sol.t_events[0][0]) if sol.t_events[0].size else math.nan}
