@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from demcheck.engines import discovery
-from demcheck.laws.adhesion import BREAK_LOAD, AdhesionLaw
-from demcheck.laws.heat import HeatLaw
-from demcheck.laws.rolling import CAP_TOTAL, RollingLaw
-from demcheck.laws.twisting import TwistingLaw
+from demcheck.laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion
+from demcheck.laws.heat import AreaHeat, RadiusHeat
+from demcheck.laws.rolling import CAP_TOTAL, EpsdRolling
+from demcheck.laws.twisting import MarshallTwisting, SdsTwisting
 from demcheck.reference.beyond import verlet_pair
 
 pytestmark = pytest.mark.engine("lammps")
@@ -72,14 +72,14 @@ def test_rolling_sds_is_type_c_with_the_limit_on_spring_and_dashpot(tmp_path):
     w0, w1, mu = [0.0, 30.0, 5.0], [0.0, -10.0, 40.0], 0.002
     eng = run_lammps(tmp_path, f"hooke 1e4 0 tangential linear_nohistory 0 0 rolling sds 2e3 0.3 {mu}",
                      0.0019, 0.0, w0, w1, 300)
-    law = RollingLaw("epsd", mu, RBAR, 2e3 * RBAR ** 2, 0.3 * RBAR ** 2, CAP_TOTAL, slack_zero=True)
+    law = EpsdRolling(mu, RBAR, 2e3 * RBAR ** 2, 0.3 * RBAR ** 2, CAP_TOTAL, slack_zero=True)
     ref = verlet_pair(R, RHO, 0.0019, 0.0, w0, w1, DT, 300, kn=1e4, rolling=law)
     fn = np.abs(ref["f"][:, 0, 0])
     assert np.any(np.linalg.norm(ref["torque"][:, 0], axis=1) >= mu * RBAR * fn * (1 - 1e-12))  # at its limit
     assert_twin(eng, ref)
     # without the engine's set-up rule (no torque while the unstretched spring is over the limit) it is not exact
     plain = verlet_pair(R, RHO, 0.0019, 0.0, w0, w1, DT, 300, kn=1e4,
-                        rolling=RollingLaw("epsd", mu, RBAR, 2e3 * RBAR ** 2, 0.3 * RBAR ** 2, CAP_TOTAL))
+                        rolling=EpsdRolling(mu, RBAR, 2e3 * RBAR ** 2, 0.3 * RBAR ** 2, CAP_TOTAL))
     assert np.abs(plain["omega"] - eng[:, :, 7:10]).max() > 1e-6 * np.abs(eng[:, :, 7:10]).max()
 
 
@@ -89,7 +89,7 @@ def test_twisting_sds_and_marshall(tmp_path, marshall):
     twist = "tangential linear_history 200 0 0.001 twisting marshall" if marshall else \
         "tangential linear_nohistory 0 0 twisting sds 1e-4 1e-8 2e-6"
     eng = run_lammps(tmp_path, f"hooke 1e4 0 {twist}", 0.0019, 0.0, w0, w1, 300)
-    kw = {"marshall_t": (200.0, 0.001)} if marshall else {"twisting": TwistingLaw("sds", 1e-4, 1e-8, 2e-6)}
+    kw = {"twisting": MarshallTwisting(200.0, 0.0, 0.001) if marshall else SdsTwisting(1e-4, 1e-8, 2e-6)}
     ref = verlet_pair(R, RHO, 0.0019, 0.0, w0, w1, DT, 300, kn=1e4, **kw)
     assert_twin(eng, ref)
     fn = np.abs(ref["f"][:, 0, 0])
@@ -104,7 +104,7 @@ def test_jkr_and_dmt_impacts(tmp_path, model, v1, break_at):
     steps = 6000 if v1 == -0.003 else 4000
     eng = run_lammps(tmp_path, f"{model} {E!r} 0 {NU!r} {GAMMA!r} tangential linear_nohistory 0 0",
                      2 * R + 1e-6, v1, [0, 0, 0], [0, 0, 0], steps)
-    law = AdhesionLaw(model, RBAR, E_STAR, 2 * GAMMA, break_at=break_at)
+    law = (JkrAdhesion(RBAR, E_STAR, 2 * GAMMA, break_at) if model == "jkr" else DmtAdhesion(RBAR, E_STAR, 2 * GAMMA))
     ref = verlet_pair(R, RHO, 2 * R + 1e-6, v1, [0, 0, 0], [0, 0, 0], DT, steps, adhesion=law)
     assert_twin(eng, ref)
     assert np.any(ref["f"][:, 1, 0] < 0)  # the attraction acted
@@ -118,7 +118,7 @@ def test_jkr_breaks_at_the_load_controlled_pull_off_not_at_the_displacement_cont
     eng = run_lammps(tmp_path, f"jkr {E!r} 0 {NU!r} {GAMMA!r} tangential linear_nohistory 0 0",
                      2 * R + 1e-6, -0.02, [0, 0, 0], [0, 0, 0], 4000)
     textbook = verlet_pair(R, RHO, 2 * R + 1e-6, -0.02, [0, 0, 0], [0, 0, 0], DT, 4000,
-                           adhesion=AdhesionLaw("jkr", RBAR, E_STAR, 2 * GAMMA))
+                           adhesion=JkrAdhesion(RBAR, E_STAR, 2 * GAMMA))
     e_engine = (eng[-1, 1, 4] - eng[-1, 0, 4]) / 0.02
     e_textbook = (textbook["v"][-1, 1, 0] - textbook["v"][-1, 0, 0]) / 0.02
     m_eff = RHO * 4 / 3 * math.pi * R ** 3 / 2
@@ -128,8 +128,7 @@ def test_jkr_breaks_at_the_load_controlled_pull_off_not_at_the_displacement_cont
     assert e_engine - e_textbook > 0.009
 
 
-@pytest.mark.parametrize("mode,law", [("area 10", HeatLaw("area", 10.0, RBAR)),
-                                      ("radius 10", HeatLaw("radius", 10.0, RBAR))])
+@pytest.mark.parametrize("mode,law", [("area 10", AreaHeat(10.0, RBAR)), ("radius 10", RadiusHeat(10.0, RBAR))])
 def test_heat_area_and_radius(tmp_path, mode, law):
     eng = run_lammps(tmp_path, f"hooke 1e4 0 tangential linear_nohistory 0 0 heat {mode}", 0.0019, 0.0,
                      [0, 0, 0], [0, 0, 0], 300, heat_cp=800.0)

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from demcheck.engines import discovery
-from demcheck.laws.adhesion import AREA_BAND, AREA_LENS, AdhesionLaw
-from demcheck.laws.heat import HeatLaw
-from demcheck.laws.rolling import CAP_SPRING, RollingLaw, epsd_damping, equivalent_inertia
+from demcheck.laws.adhesion import AREA_BAND, AREA_LENS, SjkrAdhesion
+from demcheck.laws.heat import LensHeat, RadiusHeat
+from demcheck.laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling, epsd_damping, equivalent_inertia
 from demcheck.reference.beyond import verlet_pair
 
 pytestmark = pytest.mark.engine("liggghts")
@@ -24,7 +24,8 @@ MASS = RHO * 4.0 / 3.0 * math.pi * R ** 3
 W0, W1 = [2000.0, 3000.0, 500.0], [-500.0, -1000.0, 4000.0]
 BASE = [f"fix m1 all property/global kn peratomtypepair 1 {KN!r}",
         f"fix m2 all property/global kt peratomtypepair 1 {KT!r}",
-        "fix m3 all property/global gamman peratomtypepair 1 0", "fix m4 all property/global gammat peratomtypepair 1 0",
+        "fix m3 all property/global gamman peratomtypepair 1 0",
+        "fix m4 all property/global gammat peratomtypepair 1 0",
         "fix m5 all property/global coefficientFriction peratomtypepair 1 0"]
 ROLL = BASE + [f"fix m6 all property/global coefficientRollingFriction peratomtypepair 1 {MU_R!r}"]
 
@@ -73,10 +74,10 @@ def pair_run(w0=W0, w1=W1, **kw):
 
 def test_cdt_is_type_a_with_its_direction_from_the_whole_relative_spin(tmp_path):
     eng = run_liggghts(tmp_path, "model hooke/stiffness tangential history rolling_friction cdt", ROLL, W0, W1)
-    assert max(gap(eng, pair_run(rolling=RollingLaw("constant_torque", MU_R, RBAR, full_direction=True))).values()) \
+    assert max(gap(eng, pair_run(rolling=ConstantTorqueRolling(MU_R, RBAR, full_direction=True))).values()) \
         <= 1e-9
     # Ai et al.'s type A (direction from the rolling part only) is another torque when the bodies also twist
-    textbook = gap(eng, pair_run(rolling=RollingLaw("constant_torque", MU_R, RBAR)))
+    textbook = gap(eng, pair_run(rolling=ConstantTorqueRolling(MU_R, RBAR)))
     assert textbook["torque"] > 0.05
 
 
@@ -92,7 +93,7 @@ def test_epsd_family_is_type_c_with_the_limit_on_the_spring(tmp_path, model, eta
     else:  # kr = 2.25 (or the given factor) · kn μr² R̄², Cr = ηr · 2√(Ir kr)
         k_r = (stiffness or 2.25) * KN * MU_R ** 2 * RBAR ** 2
         c_r = epsd_damping(eta, equivalent_inertia(MASS, R, MASS, R), k_r)
-    law = RollingLaw("epsd", MU_R, RBAR, k_r, c_r, CAP_SPRING)
+    law = EpsdRolling(MU_R, RBAR, k_r, c_r, CAP_SPRING)
     ref = pair_run(rolling=law, setup_increment=True)
     assert max(gap(eng, ref).values()) <= 1e-9
     fn = np.abs(ref["f"][:, 0, 0])
@@ -107,20 +108,19 @@ def test_sjkr_cohesion(tmp_path, model, area):
     props = BASE + ["fix m9 all property/global cohesionEnergyDensity peratomtypepair 1 1e3"]
     eng = run_liggghts(tmp_path, f"model hooke/stiffness tangential history cohesion {model}", props,
                        [0, 0, 0], [0, 0, 0])
-    ref = pair_run([0, 0, 0], [0, 0, 0], adhesion=AdhesionLaw("sjkr", RBAR, k_c=1e3, area=area, r0=R, r1=R))
+    ref = pair_run([0, 0, 0], [0, 0, 0], adhesion=SjkrAdhesion(1e3, area, False, R, R))
     assert max(gap(eng, ref).values()) <= 1e-9
     other = AREA_BAND if area == AREA_LENS else AREA_LENS  # the two area rules are told apart
-    assert gap(eng, pair_run([0, 0, 0], [0, 0, 0], adhesion=AdhesionLaw("sjkr", RBAR, k_c=1e3, area=other,
-                                                                         r0=R, r1=R)))["f"] > 1e-6
+    assert gap(eng, pair_run([0, 0, 0], [0, 0, 0], adhesion=SjkrAdhesion(1e3, other, False, R, R)))["f"] > 1e-6
 
 
 def test_heat_gran_conduction_is_the_lens_conductance(tmp_path):
     props = BASE + ["fix m10 all property/global thermalConductivity peratomtype 10",
                     "fix m11 all property/global thermalCapacity peratomtype 800"]
     eng = run_liggghts(tmp_path, "model hooke/stiffness tangential history", props, [0, 0, 0], [0, 0, 0], heat=True)
-    ref = pair_run([0, 0, 0], [0, 0, 0], heat=HeatLaw("lens", 10.0, RBAR, R, R), cp=800.0)
+    ref = pair_run([0, 0, 0], [0, 0, 0], heat=LensHeat(10.0, R, R), cp=800.0)
     assert max(gap(eng, ref, heat=True).values()) <= 1e-9
     # against Batchelor & O'Brien's 2ka at the Hertz radius: √(2π) larger for like spheres at small overlap
-    bo = pair_run([0, 0, 0], [0, 0, 0], heat=HeatLaw("radius", 10.0, RBAR), cp=800.0)
+    bo = pair_run([0, 0, 0], [0, 0, 0], heat=RadiusHeat(10.0, RBAR), cp=800.0)
     ratio = eng[0, 0, 17] / bo["Q"][0]
     assert abs(ratio - math.sqrt(2 * math.pi)) < 0.05 * math.sqrt(2 * math.pi)

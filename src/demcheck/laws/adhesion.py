@@ -15,78 +15,82 @@
 Thornton & Ning (Powder Technol. 99 (1998) 154-162) give the adhesive impact of elastic JKR spheres: capture below
 v_s (the energy of the hysteresis loop) and e = √(1 − (v_s/v)²) above (reference/beyond.py).
 
-Sign: F > 0 repels. ``touching`` is the contact state kept between steps (JKR's hysteresis).
+Sign: F > 0 repels. ``touching`` (0 or 1) is the contact state kept between steps (JKR's hysteresis).
+Compiled force functions ``<id>_adhesion_force(c, delta, touching) → (F, touching after)``: for jkr and dmt the
+whole elastic normal force (they replace the normal law: ``replaces_normal``), for sjkr the cohesive force to add
+to the normal law's. :func:`adhesive_force` calls the one of a record.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
+from .base import SubModel
 
-NONE, JKR, DMT, SJKR = 0, 1, 2, 3
-FAMILIES = {"none": NONE, "jkr": JKR, "dmt": DMT, "sjkr": SJKR}
 AREA_LENS, AREA_BAND = 0, 1
 BREAK_DISPLACEMENT, BREAK_LOAD = 0, 1
-AD_FAMILY, AD_R, AD_E, AD_W, AD_KC, AD_AREA, AD_WALL, AD_R0, AD_R1, AD_BREAK = range(10)
-AD_SIZE = 10
 
 
 @dataclass(frozen=True)
-class AdhesionLaw:
-    id: str = "none"
+class JkrAdhesion(SubModel):
+    slot: ClassVar[str] = "adhesion"
+    id: ClassVar[str] = "jkr"
+    history_size: ClassVar[int] = 1  # the touching flag
+    title: ClassVar[str] = "Johnson-Kendall-Roberts adhesive elastic contact"
+    replaces_normal: ClassVar[bool] = True
     r_eff: float = 0.0  # R̄
     e_eff: float = 0.0  # E*
-    w: float = 0.0  # work of adhesion (J/m²), jkr and dmt
-    k_c: float = 0.0  # cohesion energy density (J/m³), sjkr
-    area: int = AREA_LENS  # sjkr's contact area rule
-    wall: bool = False
-    r0: float = 0.0
-    r1: float = 0.0
-    break_at: int = BREAK_DISPLACEMENT  # jkr: the contact breaks at δ_f (imposed displacement) or δ_c (imposed load)
+    w: float = 0.0  # work of adhesion (J/m²)
+    break_at: int = BREAK_DISPLACEMENT  # the contact breaks at δ_f (imposed displacement) or δ_c (imposed load)
 
-    slot = "adhesion"
-    params = ("r_eff", "e_eff", "w", "k_c", "area", "wall", "r0", "r1", "break_at")
-
-    @property
-    def history_size(self) -> int:
-        return 1 if self.id == "jkr" else 0  # the touching flag
-
-    @property
-    def replaces_normal(self) -> bool:
-        return self.id in ("jkr", "dmt")
-
-    def array(self) -> np.ndarray:
-        return np.array([FAMILIES[self.id], self.r_eff, self.e_eff, self.w, self.k_c, self.area,
-                         float(self.wall), self.r0, self.r1, self.break_at])
-
-    @classmethod
-    def from_array(cls, a) -> "AdhesionLaw":
-        ids = {v: k for k, v in FAMILIES.items()}
-        return cls(ids[int(a[AD_FAMILY])], *(float(x) for x in a[AD_R:AD_AREA]), int(a[AD_AREA]), bool(a[AD_WALL]),
-                   float(a[AD_R0]), float(a[AD_R1]), int(a[AD_BREAK]))
-
-    # closed forms of the law (pull-off)
     def pull_off_force(self, control: str = "load") -> float:
-        if self.id == "jkr":
-            return (1.5 if control == "load" else 5.0 / 6.0) * math.pi * self.w * self.r_eff
-        if self.id == "dmt":
-            return 2.0 * math.pi * self.w * self.r_eff
+        return (1.5 if control == "load" else 5.0 / 6.0) * math.pi * self.w * self.r_eff
+
+    def separation_at_pull_off(self, control: str | None = None) -> float:
+        """The overlap δ at which the contact breaks (negative: a neck); by default under the record's rule."""
+        control = control or ("load" if self.break_at == BREAK_LOAD else "displacement")
+        return jkr_break(self.r_eff, self.e_eff, self.w, BREAK_LOAD if control == "load" else BREAK_DISPLACEMENT)
+
+
+@dataclass(frozen=True)
+class DmtAdhesion(SubModel):
+    slot: ClassVar[str] = "adhesion"
+    id: ClassVar[str] = "dmt"
+    title: ClassVar[str] = "Derjaguin-Muller-Toporov adhesive elastic contact"
+    replaces_normal: ClassVar[bool] = True
+    r_eff: float = 0.0
+    e_eff: float = 0.0
+    w: float = 0.0
+
+    def pull_off_force(self, control: str = "load") -> float:
+        return 2.0 * math.pi * self.w * self.r_eff
+
+    def separation_at_pull_off(self, control: str | None = None) -> float:
         return 0.0
 
-    def separation_at_pull_off(self, control: str = "load") -> float:
-        """The overlap δ at which the contact breaks (negative: a neck)."""
-        if self.id != "jkr":
-            return 0.0
-        if control == "load":
-            ac = (9.0 * math.pi * self.w * self.r_eff ** 2 / (8.0 * self.e_eff)) ** (1.0 / 3.0)
-            return -ac * ac / (3.0 * self.r_eff)
-        af = (math.pi * self.w * self.r_eff ** 2 / (8.0 * self.e_eff)) ** (1.0 / 3.0)
-        return -3.0 * af * af / self.r_eff
+
+@dataclass(frozen=True)
+class SjkrAdhesion(SubModel):
+    slot: ClassVar[str] = "adhesion"
+    id: ClassVar[str] = "sjkr"
+    title: ClassVar[str] = "simplified JKR cohesion (force = energy density × contact area)"
+    replaces_normal: ClassVar[bool] = False
+    k_c: float = 0.0  # cohesion energy density (J/m³)
+    area: int = AREA_LENS
+    wall: bool = False
+    r0: float = 0.0
+    r1: float = 0.0  # unused on a wall
+
+    def pull_off_force(self, control: str = "load") -> float:
+        return 0.0
+
+    def separation_at_pull_off(self, control: str | None = None) -> float:
+        return 0.0
 
 
 @njit(cache=KERNEL_CACHE)
@@ -115,36 +119,47 @@ def jkr_break(r, e, w, rule):
 
 
 @njit(cache=KERNEL_CACHE)
-def contact_area(p, delta):
-    if p[AD_AREA] == AREA_BAND:
-        rx = p[AD_R0] if p[AD_WALL] != 0.0 else 2.0 * p[AD_R]
-        return 2.0 * math.pi * rx * delta
-    r0 = p[AD_R0]
-    if p[AD_WALL] != 0.0:
+def jkr_adhesion_force(c, delta, touching):
+    r, e, w = c[0], c[1], c[2]
+    if not (delta >= 0.0 or (touching != 0.0 and delta >= jkr_break(r, e, w, c[3]))):
+        return 0.0, 0.0
+    a = jkr_radius(delta, r, e, w)
+    return 4.0 * e * a ** 3 / (3.0 * r) - math.sqrt(8.0 * math.pi * w * e * a ** 3), 1.0
+
+
+@njit(cache=KERNEL_CACHE)
+def dmt_adhesion_force(c, delta, touching):
+    if delta < 0.0:
+        return 0.0, 0.0
+    r, e, w = c[0], c[1], c[2]
+    return 4.0 / 3.0 * e * math.sqrt(r) * delta ** 1.5 - 2.0 * math.pi * w * r, 1.0
+
+
+@njit(cache=KERNEL_CACHE)
+def lens_area(r0, r1, delta, wall):
+    """The circle where two undeformed spheres (or a sphere and a plane) intersect."""
+    if wall:
         return math.pi * (2.0 * r0 * delta - delta * delta)
-    r1 = p[AD_R1]
     d = r0 + r1 - delta
     return -0.25 * math.pi * (d - r0 - r1) * (d + r0 - r1) * (d - r0 + r1) * (d + r0 + r1) / (d * d)
 
 
 @njit(cache=KERNEL_CACHE)
-def adhesive_force(p, delta, touching):
-    """(F, touching after this evaluation): for jkr and dmt the whole elastic normal force, for sjkr the cohesive
-    force to add to the normal law's. ``touching`` (0 or 1) is the state before; JKR keeps a contact to δ_f."""
-    family = p[AD_FAMILY]
-    r, e, w = p[AD_R], p[AD_E], p[AD_W]
-    if family == JKR:
-        now = delta >= 0.0 or (touching != 0.0 and delta >= jkr_break(r, e, w, p[AD_BREAK]))
-        if not now:
-            return 0.0, 0.0
-        a = jkr_radius(delta, r, e, w)
-        return 4.0 * e * a ** 3 / (3.0 * r) - math.sqrt(8.0 * math.pi * w * e * a ** 3), 1.0
-    if family == DMT:
-        if delta < 0.0:
-            return 0.0, 0.0
-        return 4.0 / 3.0 * e * math.sqrt(r) * delta ** 1.5 - 2.0 * math.pi * w * r, 1.0
-    if family == SJKR:
-        if delta <= 0.0:
-            return 0.0, 0.0
-        return -p[AD_KC] * contact_area(p, delta), 1.0
-    return 0.0, 0.0
+def sjkr_adhesion_force(c, delta, touching):
+    k_c, area, wall, r0, r1 = c[0], c[1], c[2], c[3], c[4]
+    if delta <= 0.0:
+        return 0.0, 0.0
+    if area == AREA_BAND:
+        rx = r0 if wall != 0.0 else 2.0 * (r0 * r1 / (r0 + r1))
+        return -k_c * 2.0 * math.pi * rx * delta, 1.0
+    return -k_c * lens_area(r0, r1, delta, wall != 0.0), 1.0
+
+
+FORCES = {"jkr": jkr_adhesion_force, "dmt": dmt_adhesion_force, "sjkr": sjkr_adhesion_force}
+
+
+def adhesive_force(law, delta: float, touching: float = 0.0) -> tuple[float, float]:
+    """(F, touching after) of an adhesion record (or None: no force)."""
+    if law is None or law.id not in FORCES:
+        return 0.0, 0.0
+    return FORCES[law.id](law.array(), float(delta), float(touching))

@@ -10,45 +10,51 @@ Q = H (T1 − T0)).
 
 a is the Hertz contact radius √(R̄δ) unless stated. Two bodies at fixed contact relax as
 T1 − T0 ∝ exp(−t/τ), τ = 1/(H (1/C0 + 1/C1)), C = m c_p (reference/beyond.py).
+
+Compiled functions ``<id>_heat_force(c, delta, dT) → Q`` (W into body 0, dT = T1 − T0), after laws/base.py's
+convention (the record holds its radii); :func:`conductance` gives H of a record.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
-
-NONE, RADIUS, AREA, LENS = 0, 1, 2, 3
-FAMILIES = {"none": NONE, "radius": RADIUS, "area": AREA, "lens": LENS}
-HT_FAMILY, HT_K, HT_R, HT_R0, HT_R1, HT_WALL = range(6)
-HT_SIZE = 6
+from .adhesion import lens_area
+from .base import SubModel
 
 
 @dataclass(frozen=True)
-class HeatLaw:
-    id: str = "none"
-    k: float = 0.0  # ks (W/(m·K)) for radius, hs (W/(m²·K)) for area, 2k0k1/(k0+k1) for lens
+class RadiusHeat(SubModel):
+    slot: ClassVar[str] = "heat"
+    id: ClassVar[str] = "radius"
+    title: ClassVar[str] = "conductance 2 ks a (Batchelor & O'Brien 1977)"
+    k: float = 0.0  # ks (W/(m·K))
     r_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class AreaHeat(SubModel):
+    slot: ClassVar[str] = "heat"
+    id: ClassVar[str] = "area"
+    title: ClassVar[str] = "conductance hs π a²"
+    k: float = 0.0  # hs (W/(m²·K))
+    r_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class LensHeat(SubModel):
+    slot: ClassVar[str] = "heat"
+    id: ClassVar[str] = "lens"
+    title: ClassVar[str] = "conductance 2 ks √A over the spheres' intersection circle"
+    k: float = 0.0  # ks = 2k0k1/(k0+k1)
     r0: float = 0.0
     r1: float = 0.0
     wall: bool = False
-
-    slot = "heat"
-    params = ("k", "r_eff", "r0", "r1", "wall")
-    history_size = 0
-
-    def array(self) -> np.ndarray:
-        return np.array([FAMILIES[self.id], self.k, self.r_eff, self.r0, self.r1, float(self.wall)])
-
-    @classmethod
-    def from_array(cls, a) -> "HeatLaw":
-        ids = {v: k for k, v in FAMILIES.items()}
-        return cls(ids[int(a[HT_FAMILY])], float(a[HT_K]), float(a[HT_R]), float(a[HT_R0]), float(a[HT_R1]),
-                   bool(a[HT_WALL]))
 
 
 def series_conductivity(k0: float, k1: float) -> float:
@@ -57,28 +63,30 @@ def series_conductivity(k0: float, k1: float) -> float:
 
 
 @njit(cache=KERNEL_CACHE)
-def conductance(p, delta):
-    """H at overlap δ (0 out of contact)."""
-    if delta <= 0.0:
-        return 0.0
-    family = p[HT_FAMILY]
-    if family == RADIUS:
-        return 2.0 * p[HT_K] * math.sqrt(p[HT_R] * delta)
-    if family == AREA:
-        return p[HT_K] * math.pi * p[HT_R] * delta
-    if family == LENS:
-        r0 = p[HT_R0]
-        if p[HT_WALL] != 0.0:
-            area = math.pi * (2.0 * r0 * delta - delta * delta)
-        else:
-            r1 = p[HT_R1]
-            d = r0 + r1 - delta
-            area = -0.25 * math.pi * (d - r0 - r1) * (d + r0 - r1) * (d - r0 + r1) * (d + r0 + r1) / (d * d)
-        return 2.0 * p[HT_K] * math.sqrt(area)
-    return 0.0
+def radius_heat_force(c, delta, d_temp):
+    return 2.0 * c[0] * math.sqrt(c[1] * delta) * d_temp if delta > 0.0 else 0.0
 
 
 @njit(cache=KERNEL_CACHE)
-def heat_flow(p, delta, t0, t1):
-    """Q into body 0 (W)."""
-    return conductance(p, delta) * (t1 - t0)
+def area_heat_force(c, delta, d_temp):
+    return c[0] * math.pi * c[1] * delta * d_temp if delta > 0.0 else 0.0
+
+
+@njit(cache=KERNEL_CACHE)
+def lens_heat_force(c, delta, d_temp):
+    return 2.0 * c[0] * math.sqrt(lens_area(c[1], c[2], delta, c[3] != 0.0)) * d_temp if delta > 0.0 else 0.0
+
+
+FORCES = {"radius": radius_heat_force, "area": area_heat_force, "lens": lens_heat_force}
+
+
+def heat_flow(law, delta: float, t0: float, t1: float) -> float:
+    """Q into body 0 (W) of a heat record (or None: 0)."""
+    if law is None or law.id not in FORCES:
+        return 0.0
+    return FORCES[law.id](law.array(), float(delta), float(t1 - t0))
+
+
+def conductance(law, delta: float) -> float:
+    """H at overlap δ (0 out of contact)."""
+    return heat_flow(law, delta, 0.0, 1.0)

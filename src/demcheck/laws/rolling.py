@@ -4,68 +4,72 @@ Types after Ai, Chen, Rotter & Ooi, "Assessment of rolling resistance models in 
 Powder Technology 206 (2011) 269-282:
 
 * ``constant_torque`` (type A, "constant directional torque"): M = −μr Rr |Fn| ŵ, with w the rolling part of the
-  relative angular velocity (ω0 − ω1 minus its component along the normal n). Zero when w = 0.
+  relative angular velocity (ω0 − ω1 minus its component along the normal n). Zero when w = 0. With
+  ``full_direction`` the direction is taken from all of ω0 − ω1 and its normal part removed afterwards (what
+  LIGGGHTS's ``cdt`` does: a twisting spin then lowers the torque).
 * ``viscous`` (type B): M = −Cr w, a torque proportional to the relative rolling velocity (Cr in N·m·s).
 * ``epsd`` (type C, elastic–plastic spring–dashpot, Iwashita & Oda 1998 as written by Ai et al.): a spring torque
   Mk updated incrementally, Mk ← Mk − kr w dt, limited to the full-mobilisation torque Mm = μr Rr |Fn|; a dashpot
-  Md = −f Cr w with Cr = ηr·2√(Ir kr). Ai et al. take f = 0 once the spring is fully mobilised (``cap`` = ``spring``),
-  LAMMPS's ``rolling sds`` caps the sum of spring and dashpot (``cap`` = ``total``: Mk is reset so that
+  Md = −f Cr w with Cr = ηr·2√(Ir kr). Ai et al. take f = 0 once the spring is fully mobilised (``cap`` = 0,
+  spring), LAMMPS's ``rolling sds`` caps the sum of spring and dashpot (``cap`` = 1, total: Mk is reset so that
   |Mk − Cr w| = Mm, the Maw rule of its tangential model; with ``slack_zero`` the torque is zero when the sum is
-  over the limit while the spring is unstretched, as LAMMPS does at its setup step). ηr = 0 is the type C model
+  over the limit while the spring is unstretched, as LAMMPS does at its set-up step). ηr = 0 is the type C model
   without its viscous part.
 
 Rr is the rolling radius (R̄ = R0R1/(R0+R1) for a pair, R for a sphere on a wall); Ir the equivalent moment of
 inertia of Ai et al., 1/Ir = 1/(I0 + m0R0²) + 1/(I1 + m1R1²) (= 1.4 m R² for a solid sphere on a wall).
-The torque returned acts on body 0; body 1 takes its opposite. The history is the spring torque Mk (3 values).
+
+Compiled force functions ``<id>_rolling_force(c, w, n, fn_abs, dt, history) → (torque on body 0, new history)``
+(c the record's ``array()``, w = ω0 − ω1, n the unit normal; body 1 takes the opposite torque). They take n
+and dt beside laws/base.py's ``(c, fn_abs, r_eff, rate, history)``: the rolling part of w needs n, the spring
+needs dt, and the record holds its own rolling radius. :func:`rolling_torque` calls the one of a record.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
+from .base import SubModel
 
-NONE, CONSTANT_TORQUE, VISCOUS, EPSD = 0, 1, 2, 3
-FAMILIES = {"none": NONE, "constant_torque": CONSTANT_TORQUE, "viscous": VISCOUS, "epsd": EPSD}
 CAP_SPRING, CAP_TOTAL = 0, 1
-# layout of RollingLaw.array()
-RL_FAMILY, RL_MU, RL_R, RL_K, RL_C, RL_CAP, RL_FULL_DIRECTION, RL_SLACK_ZERO = range(8)
-RL_SIZE = 8
 
 
 @dataclass(frozen=True)
-class RollingLaw:
-    """One rolling-resistance law at one contact (the numbers its force function needs)."""
-
-    id: str = "none"
-    mu_r: float = 0.0  # coefficient of rolling resistance (dimensionless: Mm = μr Rr |Fn|)
+class ConstantTorqueRolling(SubModel):
+    slot: ClassVar[str] = "rolling"
+    id: ClassVar[str] = "constant_torque"
+    title: ClassVar[str] = "constant directional torque (Ai et al. 2011 type A)"
+    mu_r: float = 0.0  # coefficient of rolling resistance (Mm = μr Rr |Fn|)
     r_roll: float = 0.0  # rolling radius Rr
-    k_r: float = 0.0  # rolling stiffness (N·m/rad), type C
-    c_r: float = 0.0  # rolling viscous coefficient (N·m·s/rad), types B and C
-    cap: int = CAP_SPRING  # type C: what the full-mobilisation torque limits (spring only, or spring + dashpot)
-    full_direction: bool = False  # type A: direction from all of ω0 − ω1, its normal part removed afterwards
-    slack_zero: bool = False  # type C, cap total: over the limit with an unstretched spring (Mk = 0), no torque
+    full_direction: bool = False
 
-    slot = "rolling"
-    params = ("mu_r", "r_roll", "k_r", "c_r", "cap", "full_direction", "slack_zero")
 
-    @property
-    def history_size(self) -> int:
-        return 3 if self.id == "epsd" else 0
+@dataclass(frozen=True)
+class ViscousRolling(SubModel):
+    slot: ClassVar[str] = "rolling"
+    id: ClassVar[str] = "viscous"
+    title: ClassVar[str] = "viscous rolling resistance (Ai et al. 2011 type B)"
+    c_r: float = 0.0  # N·m·s/rad
 
-    def array(self) -> np.ndarray:
-        return np.array([FAMILIES[self.id], self.mu_r, self.r_roll, self.k_r, self.c_r, self.cap,
-                         float(self.full_direction), float(self.slack_zero)])
 
-    @classmethod
-    def from_array(cls, a) -> "RollingLaw":
-        ids = {v: k for k, v in FAMILIES.items()}
-        return cls(ids[int(a[RL_FAMILY])], float(a[RL_MU]), float(a[RL_R]), float(a[RL_K]), float(a[RL_C]),
-                   int(a[RL_CAP]), bool(a[RL_FULL_DIRECTION]), bool(a[RL_SLACK_ZERO]))
+@dataclass(frozen=True)
+class EpsdRolling(SubModel):
+    slot: ClassVar[str] = "rolling"
+    id: ClassVar[str] = "epsd"
+    history_size: ClassVar[int] = 3  # the spring torque Mk
+    title: ClassVar[str] = "elastic-plastic spring-dashpot rolling resistance (Ai et al. 2011 type C)"
+    mu_r: float = 0.0
+    r_roll: float = 0.0
+    k_r: float = 0.0  # N·m/rad
+    c_r: float = 0.0  # N·m·s/rad
+    cap: int = CAP_SPRING
+    slack_zero: bool = False
 
 
 def equivalent_inertia(m0: float, r0: float, m1: float = math.inf, r1: float = 1.0) -> float:
@@ -80,40 +84,58 @@ def epsd_damping(eta_r: float, i_r: float, k_r: float) -> float:
     return eta_r * 2.0 * math.sqrt(i_r * k_r)
 
 
-@njit(cache=KERNEL_CACHE)
-def rolling_torque(p, w, n, fn_abs, dt, hist):
-    """(M on body 0, new spring torque) for the relative angular velocity w = ω0 − ω1 and the unit normal n.
-
-    ``hist`` is the spring torque Mk before this step (type C; ignored otherwise); |Fn| sets the limit."""
-    family = p[RL_FAMILY]
+@njit(cache=KERNEL_CACHE, inline="always")
+def _rolling_part(w, n):
     wn = w[0] * n[0] + w[1] * n[1] + w[2] * n[2]
-    wt = w - wn * n
-    out = np.zeros(3)
-    new = hist.copy()
-    cap = p[RL_MU] * p[RL_R] * fn_abs
-    if family == CONSTANT_TORQUE:
-        if p[RL_FULL_DIRECTION] != 0.0:
-            wm = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-            return (-cap / wm) * wt if wm > 0.0 else out, new
-        wm = math.sqrt(wt[0] * wt[0] + wt[1] * wt[1] + wt[2] * wt[2])
-        return (-cap / wm) * wt if wm > 0.0 else out, new
-    if family == VISCOUS:
-        return -p[RL_C] * wt, new
-    if family == EPSD:
-        spring = hist - (p[RL_K] * dt) * wt
-        damp = -p[RL_C] * wt
-        if p[RL_CAP] == CAP_TOTAL:
-            total = spring + damp
-            mag = math.sqrt(total[0] ** 2 + total[1] ** 2 + total[2] ** 2)
-            if mag > cap:
-                if p[RL_SLACK_ZERO] != 0.0 and not (spring[0] != 0.0 or spring[1] != 0.0 or spring[2] != 0.0):
-                    return out, spring  # the engine's rule: no stored rolling, no torque (seen at its setup step)
-                total = total * (cap / mag)
-                spring = total - damp
-            return total, spring
-        mag = math.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
-        if mag > cap:  # full mobilisation: the spring saturates, the dashpot is off (Ai et al.'s f = 0)
-            spring = spring * (cap / mag)
-            return spring, spring
-        return spring + damp, spring
-    return out, new
+    return w - wn * n
+
+
+@njit(cache=KERNEL_CACHE)
+def constant_torque_rolling_force(c, w, n, fn_abs, dt, history):
+    wt = _rolling_part(w, n)
+    d = w if c[2] != 0.0 else wt  # full_direction
+    dm = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    if dm == 0.0:
+        return np.zeros(3), history
+    return (-c[0] * c[1] * fn_abs / dm) * wt, history
+
+
+@njit(cache=KERNEL_CACHE)
+def viscous_rolling_force(c, w, n, fn_abs, dt, history):
+    return -c[0] * _rolling_part(w, n), history
+
+
+@njit(cache=KERNEL_CACHE)
+def epsd_rolling_force(c, w, n, fn_abs, dt, history):
+    mu_r, r_roll, k_r, c_r, cap_rule, slack_zero = c[0], c[1], c[2], c[3], c[4], c[5]
+    wt = _rolling_part(w, n)
+    cap = mu_r * r_roll * fn_abs
+    spring = history - (k_r * dt) * wt
+    damp = -c_r * wt
+    if cap_rule == CAP_TOTAL:
+        total = spring + damp
+        mag = math.sqrt(total[0] ** 2 + total[1] ** 2 + total[2] ** 2)
+        if mag > cap:
+            if slack_zero != 0.0 and spring[0] == 0.0 and spring[1] == 0.0 and spring[2] == 0.0:
+                return np.zeros(3), spring  # the engine's rule: no stored rolling, no torque
+            total = total * (cap / mag)
+            spring = total - damp
+        return total, spring
+    mag = math.sqrt(spring[0] ** 2 + spring[1] ** 2 + spring[2] ** 2)
+    if mag > cap:  # full mobilisation: the spring saturates, the dashpot is off (Ai et al.'s f = 0)
+        spring = spring * (cap / mag)
+        return spring, spring
+    return spring + damp, spring
+
+
+FORCES = {"constant_torque": constant_torque_rolling_force, "viscous": viscous_rolling_force,
+          "epsd": epsd_rolling_force}
+
+
+def rolling_torque(law, w, n, fn_abs: float, dt: float, history=None):
+    """(torque on body 0, new history) of a rolling record (any, or None: no torque)."""
+    history = np.zeros(3) if history is None else np.asarray(history, dtype=np.float64)
+    if law is None or law.id not in FORCES:
+        return np.zeros(3), history
+    return FORCES[law.id](law.array(), np.asarray(w, dtype=np.float64), np.asarray(n, dtype=np.float64),
+                          float(fn_abs), float(dt), history)

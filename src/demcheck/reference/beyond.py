@@ -28,10 +28,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from ..laws.adhesion import AdhesionLaw, adhesive_force
-from ..laws.heat import HeatLaw, conductance
-from ..laws.rolling import RollingLaw, rolling_torque
-from ..laws.twisting import TwistingLaw
+from ..laws.adhesion import adhesive_force
+from ..laws.heat import conductance, heat_flow
+from ..laws.rolling import rolling_torque
+from ..laws.twisting import twisting_torque
 
 RTOL = 1e-11
 N_DOWN = np.array([0.0, 0.0, -1.0])  # from the sphere into the plane
@@ -93,7 +93,7 @@ def heat_time_constant_closed(h: float, c0: float, c1: float) -> float:
 # ----------------------------------------------------------------------------- rolling and incline
 
 
-def rolling_on_plane(law: RollingLaw, mass: float, radius: float, v0: float, g: float, theta: float = 0.0,
+def rolling_on_plane(law, mass: float, radius: float, v0: float, g: float, theta: float = 0.0,
                      t_end: float = 10.0) -> dict:
     """A sphere rolling without slip along x on a plane tilted by θ (gravity pulls it towards +x). The rolling
     law is evaluated by its compiled force function (type C's spring torque integrated as a state; its limit by
@@ -101,11 +101,10 @@ def rolling_on_plane(law: RollingLaw, mass: float, radius: float, v0: float, g: 
     fn = mass * g * math.cos(theta)
     drive = mass * g * math.sin(theta)
     m_eff = mass + 0.4 * mass  # m + I/R²
-    p = law.array()
-    cap = law.mu_r * law.r_roll * fn
+    cap = getattr(law, "mu_r", 0.0) * getattr(law, "r_roll", 0.0) * fn
 
     def torque_y(v, mk, dt=0.0):
-        m, _ = rolling_torque(p, np.array([0.0, v / radius, 0.0]), N_DOWN, fn, dt, np.array([0.0, mk, 0.0]))
+        m, _ = rolling_torque(law, np.array([0.0, v / radius, 0.0]), N_DOWN, fn, dt, np.array([0.0, mk, 0.0]))
         return m[1]
 
     def rhs_free(t, y):  # y = x, v, Mk (Mk only for type C)
@@ -136,7 +135,7 @@ def _stop_event():
     return ev
 
 
-def incline_critical_angle(law: RollingLaw, mass: float, radius: float, g: float) -> float:
+def incline_critical_angle(law, mass: float, radius: float, g: float) -> float:
     """The tilt at which a sphere at rest starts to roll: the static torque m g sin θ R reaches the law's limit
     μr Rr m g cos θ (type A, C). Found by bisection on the static balance, not from the closed form."""
     def excess(theta):
@@ -149,7 +148,7 @@ def incline_critical_angle(law: RollingLaw, mass: float, radius: float, g: float
 # ----------------------------------------------------------------------------- twist
 
 
-def twist_decay(law: TwistingLaw, mass: float, radius: float, omega0: float, fn: float, t_end: float,
+def twist_decay(law, mass: float, radius: float, omega0: float, fn: float, t_end: float,
                 preloaded: bool = True) -> dict:
     """A sphere spinning about the plane's normal, its twisting spring preloaded at the limit (slipping from the
     start; the closed form's assumption) or unstretched (it winds up first, as in an engine run that starts
@@ -181,37 +180,35 @@ def _stop_event_index(k):
 # ----------------------------------------------------------------------------- adhesion
 
 
-def pull_off(law: AdhesionLaw, delta0: float = None) -> dict:
+def pull_off(law, delta0: float | None = None) -> dict:
     """Two bodies pulled apart quasi-statically (imposed displacement) from overlap δ0: the largest tension on the
     way (by minimising the law's force over δ) and the overlap at which the law reports the contact broken
     (bisection on its ``touching`` state)."""
-    p = law.array()
     if delta0 is None:
         delta0 = 10.0 * abs(law.separation_at_pull_off("displacement")) + 1e-9
 
     def f(d):
-        return adhesive_force(p, d, 1.0)[0]
+        return adhesive_force(law, d, 1.0)[0]
 
     if law.id == "jkr":
         lo, hi = law.separation_at_pull_off("displacement") * (1 - 1e-9), delta0
         r = minimize_scalar(f, bounds=(lo * 0.999999, hi), method="bounded", options={"xatol": 1e-18})
         tension = -r.fun
-        brk = brentq(lambda d: adhesive_force(p, d, 1.0)[1] - 0.5, 2 * lo, 0.0, xtol=1e-22, rtol=1e-15)
+        brk = brentq(lambda d: adhesive_force(law, d, 1.0)[1] - 0.5, 2 * lo, 0.0, xtol=1e-22, rtol=1e-15)
     else:
         tension = -f(0.0)
         brk = 0.0
     return {"pull_off_force": tension, "separation_at_pull_off": brk}
 
 
-def adhesive_impact(law: AdhesionLaw, m_eff: float, v: float, t_end: float = None) -> dict:
+def adhesive_impact(law, m_eff: float, v: float, t_end: float | None = None) -> dict:
     """A head-on impact at approach speed v of two bodies interacting by an elastic JKR (or DMT) law: free
     flight to δ = 0, contact until the law breaks it (δ_f) or t_end. Returns the restitution (0 if captured)."""
-    p = law.array()
-    brk = law.separation_at_pull_off("displacement" if law.break_at == 0 else "load") if law.id == "jkr" else 0.0
+    brk = law.separation_at_pull_off()
     t_end = t_end if t_end is not None else 200.0 * _contact_time_scale(law, m_eff, v)
 
     def rhs(t, y):
-        return [y[1], -adhesive_force(p, y[0], 1.0)[0] / m_eff]
+        return [y[1], -adhesive_force(law, y[0], 1.0)[0] / m_eff]
 
     def out(t, y):
         return y[0] - brk
@@ -232,10 +229,10 @@ def _contact_time_scale(law, m_eff, v):
 # ----------------------------------------------------------------------------- conduction
 
 
-def conduction(law: HeatLaw, delta: float, c0: float, c1: float, t0: float, t1: float, t_end: float) -> dict:
+def conduction(law, delta: float, c0: float, c1: float, t0: float, t1: float, t_end: float) -> dict:
     """Two bodies at fixed overlap δ, heat capacities C0, C1: integrated, and τ read as the time at which the
     temperature difference has fallen by e."""
-    h = conductance(law.array(), delta)
+    h = conductance(law, delta)
 
     def rhs(t, y):
         q = h * (y[1] - y[0])
@@ -253,22 +250,17 @@ def conduction(law: HeatLaw, delta: float, c0: float, c1: float, t0: float, t1: 
 
 
 def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, omega1, dt: float, steps: int, *,
-                kn: float = 0.0, adhesion: AdhesionLaw | None = None, rolling: RollingLaw | None = None,
-                twisting: TwistingLaw | None = None, marshall_t: tuple[float, float] | None = None,
-                heat: HeatLaw | None = None, cp: float = 0.0, temps=(300.0, 400.0),
-                setup_increment: bool = False) -> dict:
+                kn: float = 0.0, adhesion=None, rolling=None, twisting=None, heat=None, cp: float = 0.0,
+                temps=(300.0, 400.0), setup_increment: bool = False) -> dict:
     """Two like spheres, body 0 at the origin, body 1 at (x1, 0, 0) moving at (v1, 0, 0), stepped the way the
     engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
     half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
-    step). The normal force is a linear spring kn·δ (plus a cohesion law's force), or the adhesion law's when it
-    replaces the normal law; the
-    limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄| for jkr: the engine's critical force).
-    ``marshall_t`` = (kt, μt) gives Marshall's twisting law at each step's contact radius √(R̄δ).
+    step). The normal force is a linear spring kn·δ (plus a cohesion record's force), or the adhesion record's
+    when it replaces the normal law; the limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄|
+    for jkr: the engine's critical force); the twisting law sees the contact radius √(R̄δ).
     ``setup_increment``: the set-up force call already adds one step's spring increment to the torques it applies
     (and forgets it: the history still starts at step 1), as LIGGGHTS's rolling models do.
-    Returns per step (after it): x, v, ω, f, τ (2×3 each), T (2) and the heat flow Q into body 0."""
-    from ..laws.twisting import marshall, twisting_torque
-
+    Returns per step (after it): x, v, ω, f, τ (steps×2×3 each), T (steps×2) and the heat flow Q into body 0."""
     mass = density * 4.0 / 3.0 * math.pi * radius ** 3
     inertia = 0.4 * mass * radius * radius
     rbar = radius / 2.0
@@ -277,8 +269,16 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
     w = np.array([omega0, omega1], dtype=float)
     temp = np.array(temps, dtype=float)
     state = {"roll": np.zeros(3), "twist": 0.0, "touch": 0.0}
-    arrays = {k: (law.array() if law is not None else None) for k, law in
-              (("adhesion", adhesion), ("rolling", rolling), ("twisting", twisting), ("heat", heat))}
+
+    def normal(delta):
+        if adhesion is not None and adhesion.replaces_normal:
+            fn, touch = adhesive_force(adhesion, delta, state["touch"])
+            crit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
+            return fn, crit, touch
+        fn, touch = kn * delta, float(delta > 0.0)
+        if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
+            fn += adhesive_force(adhesion, delta, 1.0)[0]
+        return fn, abs(fn), touch
 
     def forces(update):
         d = x[1] - x[0]
@@ -286,14 +286,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         n = d / dist
         delta = 2.0 * radius - dist
         f, tq = np.zeros((2, 3)), np.zeros((2, 3))
-        if adhesion is not None and adhesion.replaces_normal:
-            fn, touch = adhesive_force(arrays["adhesion"], delta, state["touch"])
-            fcrit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
-        else:
-            fn, touch = kn * delta, float(delta > 0.0)
-            if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
-                fn += adhesive_force(arrays["adhesion"], delta, 1.0)[0]
-            fcrit = abs(fn)
+        fn, fcrit, touch = normal(delta)
         if not touch:
             state.update(roll=np.zeros(3), twist=0.0, touch=0.0)
             return f, tq, 0.0
@@ -301,19 +294,13 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         f[0], f[1] = -fn * n, fn * n
         wrel = w[0] - w[1]
         h = dt if update or setup_increment else 0.0
-        if rolling is not None:
-            m, hist = rolling_torque(arrays["rolling"], wrel, n, fcrit, h, state["roll"])
-            state["roll"] = hist if update else state["roll"]
-            tq[0] += m
-            tq[1] -= m
-        tl = marshall(marshall_t[0], 0.0, marshall_t[1], math.sqrt(rbar * delta)) if marshall_t else twisting
-        if tl is not None:
-            m, phi = twisting_torque(tl.array(), wrel, n, fcrit, h, state["twist"])
-            state["twist"] = phi if update else state["twist"]
-            tq[0] += m
-            tq[1] -= m
-        q = conductance(arrays["heat"], delta) * (temp[1] - temp[0]) if heat is not None else 0.0
-        return f, tq, q
+        m_roll, hist = rolling_torque(rolling, wrel, n, fcrit, h, state["roll"])
+        m_tw, phi = twisting_torque(twisting, wrel, n, fcrit, math.sqrt(rbar * max(delta, 0.0)), h, state["twist"])
+        if update:
+            state.update(roll=hist, twist=phi)
+        tq[0] += m_roll + m_tw
+        tq[1] -= m_roll + m_tw
+        return f, tq, heat_flow(heat, delta, temp[0], temp[1])
 
     f, tq, q = forces(False)
     out = {k: [] for k in ("x", "v", "omega", "f", "torque", "T", "Q")}
