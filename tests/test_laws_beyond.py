@@ -292,3 +292,9 @@ def test_twist_from_an_unstretched_spring_against_its_closed_form():
     out = b.twist_decay(law, M, R, w0, fn, 10 * closed, preloaded=False)
     assert rel(out["twist_stop_time"], closed) < SOLVER
     assert out["twist_stop_time"] > b.twist_decay(law, M, R, w0, fn, 10 * closed)["twist_stop_time"]
+
+
+def test_the_two_lens_areas_agree():
+    from demcheck.laws import adhesion, heat
+    for args in ((1e-3, 1e-3, 1e-6, False), (1e-3, 2e-3, 3e-5, False), (1e-3, 0.0, 1e-6, True)):
+        assert adhesion.lens_area(*args) == heat.lens_area(*args)

@@ -24,7 +24,6 @@ from typing import ClassVar
 from numba import njit
 
 from .. import KERNEL_CACHE
-from .adhesion import lens_area
 from .base import SubModel
 
 
@@ -60,6 +59,16 @@ class LensHeat(SubModel):
 def series_conductivity(k0: float, k1: float) -> float:
     """2k0k1/(k0+k1): the conductivity of two half-spaces in series (k for like materials)."""
     return 2.0 * k0 * k1 / (k0 + k1)
+
+
+@njit(cache=KERNEL_CACHE)
+def lens_area(r0, r1, delta, wall):
+    """The circle where two undeformed spheres (or a sphere and a plane) intersect. (adhesion.py has the same
+    function: numba's cache keys a kernel by its own file only, so a kernel here does not call one there.)"""
+    if wall:
+        return math.pi * (2.0 * r0 * delta - delta * delta)
+    d = r0 + r1 - delta
+    return -0.25 * math.pi * (d - r0 - r1) * (d + r0 - r1) * (d - r0 + r1) * (d + r0 + r1) / (d * d)
 
 
 @njit(cache=KERNEL_CACHE)
