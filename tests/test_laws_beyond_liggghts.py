@@ -124,3 +124,34 @@ def test_heat_gran_conduction_is_the_lens_conductance(tmp_path):
     bo = pair_run([0, 0, 0], [0, 0, 0], heat=RadiusHeat(10.0, RBAR), cp=800.0)
     ratio = eng[0, 0, 17] / bo["Q"][0]
     assert abs(ratio - math.sqrt(2 * math.pi)) < 0.05 * math.sqrt(2 * math.pi)
+
+
+@pytest.mark.parametrize("model,area", [("sjkr", AREA_LENS), ("sjkr2", AREA_BAND)])
+def test_sjkr_cohesion_on_a_wall(tmp_path, model, area):
+    """A sphere held 1e-5 m into a primitive wall, forces at set-up (`run 0`: the exact state): sjkr's lens area
+    is π(2Rδ − δ²), sjkr2's band 2πRδ — equal to each other on a wall, where between like spheres the band is
+    twice the lens (measured with the pair test above)."""
+    pairs = "peratomtypepair 2 {0} {0} {0} {0}".format
+    props = [f"fix m1 all property/global kn {pairs(KN)}", f"fix m2 all property/global kt {pairs(KT)}",
+             f"fix m3 all property/global gamman {pairs(0)}", f"fix m4 all property/global gammat {pairs(0)}",
+             f"fix m5 all property/global coefficientFriction {pairs(0)}",
+             f"fix m9 all property/global cohesionEnergyDensity {pairs(1e6)}"]
+    delta = 1e-5
+    lines = ["units si", "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+             "communicate single vel yes", "read_data data.lmp", "neighbor 0.001 bin", "neigh_modify delay 0", *props,
+             f"pair_style gran model hooke/stiffness tangential history cohesion {model}", "pair_coeff * *",
+             f"fix wall all wall/gran model hooke/stiffness tangential history cohesion {model} primitive type 2 "
+             "zplane 0.0", "fix integrate all nve/sphere", "timestep 1e-9", "dump d all custom 1 out.dump id fz",
+             'dump_modify d format "%d %.17g"', "run 0"]
+    (tmp_path / "in.deck").write_text("\n".join(lines) + "\n")
+    (tmp_path / "data.lmp").write_text("c\n\n1 atoms\n2 atom types\n\n-0.01 0.01 xlo xhi\n-0.01 0.01 ylo yhi\n"
+                                       f"-0.01 0.01 zlo zhi\n\nAtoms\n\n1 1 {2 * R!r} {RHO!r} 0 0 {R - delta!r}\n")
+    r = subprocess.run([discovery.find("liggghts").executable, "-in", "in.deck", "-log", "log.txt", "-screen", "none"],
+                       cwd=tmp_path, env=discovery.engine_env(), capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, (tmp_path / "log.txt").read_text(errors="replace")[-2000:]
+    fz = float((tmp_path / "out.dump").read_text().strip().split("\n")[-1].split()[1])
+    from demcheck.laws.adhesion import adhesive_force
+
+    d = R - float(repr(R - delta))  # the overlap the engine sees
+    want = KN * d + adhesive_force(SjkrAdhesion(1e6, area, True, R, 0.0), d, 1.0)[0]
+    assert abs(fz - want) <= 1e-9 * abs(want)
