@@ -169,3 +169,43 @@ def test_jkr_quasi_static_pull_off(tmp_path):
     textbook = JkrAdhesion(RBAR, E_STAR, 2 * GAMMA).separation_at_pull_off()  # δ_f
     assert abs(ref["separation_at_pull_off"] / textbook - 9 ** (-1 / 3)) < 1e-12  # δ_c/δ_f = (1/9)(a_c/a_f)²
     assert rows[touching[-1] + 1, 0] > textbook  # the engine broke well before δ_f
+
+
+def test_heat_time_constant_of_two_held_spheres(tmp_path):
+    """Two spheres held at δ = 1e-4 m (fix move), `heat radius 10`, c_p = 800: the temperature difference decays
+    by (1 − dt/τ) a step (explicit Euler, to 1e-12) and so follows the conduction scenario's exp(−t/τ),
+    τ = 1/(H(1/C0 + 1/C1)) = 0.937 s, to dt/(2τ)·t/τ (here < 2e-4)."""
+    from demcheck.reference.beyond import conduction, heat_time_constant_closed
+
+    dt, steps, every = 1e-4, 20000, 1000
+    lines = ["units si", "atom_style sphere", "atom_modify map array", "boundary f f f", "comm_modify vel yes",
+             "newton off", "region box block -0.01 0.01 -0.01 0.01 -0.01 0.01", "create_box 1 box",
+             "fix prop all property/atom temperature heatflow ghost yes",
+             "create_atoms 1 single 0 0 0", f"create_atoms 1 single {2 * R - 1e-4!r} 0 0",
+             f"set atom * diameter {2 * R!r} density {RHO!r}", "set atom 1 temperature 300",
+             "set atom 2 temperature 400", "pair_style granular",
+             "pair_coeff * * hooke 1e4 0 tangential linear_nohistory 0 0 heat radius 10",
+             "fix m all move linear 0 0 0", "fix h all heat/flow constant 800",
+             "compute th all property/atom temperature", f"timestep {dt!r}",
+             f"dump d all custom {every} out.dump id c_th", "dump_modify d format float %.17g sort id",
+             f"run {steps}"]
+    (tmp_path / "in.deck").write_text("\n".join(lines) + "\n")
+    r = subprocess.run([discovery.find("lammps").executable, "-in", "in.deck", "-log", "log.txt", "-screen", "none"],
+                       cwd=tmp_path, env=discovery.engine_env(), capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, (tmp_path / "log.txt").read_text()[-2000:]
+    diff = []
+    for block in (tmp_path / "out.dump").read_text().split("ITEM: TIMESTEP\n")[1:]:
+        lines_ = block.strip().split("\n")
+        k = next(i for i, row in enumerate(lines_) if row.startswith("ITEM: ATOMS"))
+        temps = [float(row.split()[1]) for row in lines_[k + 1:]]
+        diff.append(temps[1] - temps[0])
+    diff = np.array(diff)
+    mass = RHO * 4 / 3 * math.pi * R ** 3
+    law = RadiusHeat(10.0, RBAR)
+    scenario = conduction(law, 1e-4, mass * 800, mass * 800, 300.0, 400.0, 10.0)
+    tau = heat_time_constant_closed(scenario["conductance"], mass * 800, mass * 800)
+    assert abs(scenario["heat_time_constant"] / tau - 1) < 1e-9
+    n = np.arange(len(diff)) * every
+    np.testing.assert_allclose(diff, 100.0 * (1 - dt / tau) ** n, rtol=1e-12)
+    t = n * dt
+    assert np.abs(diff / (100.0 * np.exp(-t / tau)) - 1).max() < dt / (2 * tau) * t.max() / tau * 1.01
