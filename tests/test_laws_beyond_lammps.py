@@ -209,3 +209,14 @@ def test_heat_time_constant_of_two_held_spheres(tmp_path):
     np.testing.assert_allclose(diff, 100.0 * (1 - dt / tau) ** n, rtol=1e-12)
     t = n * dt
     assert np.abs(diff / (100.0 * np.exp(-t / tau)) - 1).max() < dt / (2 * tau) * t.max() / tau * 1.01
+
+
+def test_the_rolling_limit_uses_the_total_normal_force_with_its_dashpot(tmp_path):
+    """`damping velocity 0.05` (F = kδ + 0.05 δ̇): the rolling limit is μ|F_ntot| with the dashpot, not μkδ."""
+    w0, w1, mu = [0.0, 30.0, 5.0], [0.0, -10.0, 40.0], 0.002
+    coeff = f"hooke 1e4 0.05 tangential linear_nohistory 0 0 rolling sds 2e3 0.3 {mu} damping velocity"
+    eng = run_lammps(tmp_path, coeff, 0.0019, 0.0, w0, w1, 300)
+    law = EpsdRolling(mu, RBAR, 2e3 * RBAR ** 2, 0.3 * RBAR ** 2, CAP_TOTAL, slack_zero=True)
+    assert_twin(eng, verlet_pair(R, RHO, 0.0019, 0.0, w0, w1, DT, 300, kn=1e4, eta_n=0.05, rolling=law))
+    elastic = verlet_pair(R, RHO, 0.0019, 0.0, w0, w1, DT, 300, kn=1e4, eta_n=0.05, rolling=law, elastic_limit=True)
+    assert np.abs(elastic["torque"] - eng[:, :, 13:16]).max() > 1e-6 * np.abs(eng[:, :, 13:16]).max()

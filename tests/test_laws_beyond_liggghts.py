@@ -155,3 +155,15 @@ def test_sjkr_cohesion_on_a_wall(tmp_path, model, area):
     d = R - float(repr(R - delta))  # the overlap the engine sees
     want = KN * d + adhesive_force(SjkrAdhesion(1e6, area, True, R, 0.0), d, 1.0)[0]
     assert abs(fz - want) <= 1e-9 * abs(want)
+
+
+@pytest.mark.parametrize("model", ["cdt", "epsd2"])
+def test_which_normal_force_sets_the_rolling_limit_under_damping(tmp_path, model):
+    """gamman = 2e4 /s (γn = m̄·gamman): cdt's limit is the elastic kn δ, epsd2's the total |Fn| with the dashpot."""
+    props = [p.replace("gamman peratomtypepair 1 0", "gamman peratomtypepair 1 2e4") for p in ROLL]
+    eng = run_liggghts(tmp_path, f"model hooke/stiffness tangential history rolling_friction {model}", props, W0, W1)
+    law = ConstantTorqueRolling(MU_R, RBAR, True) if model == "cdt" else EpsdRolling(MU_R, RBAR, KT * RBAR ** 2)
+    eta = MASS / 2 * 2e4
+    kw = dict(eta_n=eta, rolling=law, setup_increment=model != "cdt")
+    assert max(gap(eng, pair_run(elastic_limit=model == "cdt", **kw)).values()) <= 1e-9
+    assert gap(eng, pair_run(elastic_limit=model != "cdt", **kw))["torque"] > 1e-6

@@ -250,14 +250,16 @@ def conduction(law, delta: float, c0: float, c1: float, t0: float, t1: float, t_
 
 
 def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, omega1, dt: float, steps: int, *,
-                kn: float = 0.0, adhesion=None, rolling=None, twisting=None, heat=None, cp: float = 0.0,
-                temps=(300.0, 400.0), setup_increment: bool = False) -> dict:
+                kn: float = 0.0, eta_n: float = 0.0, elastic_limit: bool = False, adhesion=None, rolling=None,
+                twisting=None, heat=None, cp: float = 0.0, temps=(300.0, 400.0),
+                setup_increment: bool = False) -> dict:
     """Two like spheres, body 0 at the origin, body 1 at (x1, 0, 0) moving at (v1, 0, 0), stepped the way the
     engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
     half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
     step). The normal force is a linear spring kn·δ (plus a cohesion record's force), or the adhesion record's
     when it replaces the normal law; the limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄|
-    for jkr: the engine's critical force); the twisting law sees the contact radius √(R̄δ).
+    for jkr: the engine's critical force; the elastic kn·δ alone with ``elastic_limit``); a linear dashpot
+    eta_n·δ̇ (δ̇ > 0 approaching) joins the linear spring; the twisting law sees the contact radius √(R̄δ).
     ``setup_increment``: the set-up force call already adds one step's spring increment to the torques it applies
     (and forgets it: the history still starts at step 1), as LIGGGHTS's rolling models do.
     Returns per step (after it): x, v, ω, f, τ (steps×2×3 each), T (steps×2) and the heat flow Q into body 0."""
@@ -270,15 +272,15 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
     temp = np.array(temps, dtype=float)
     state = {"roll": np.zeros(3), "twist": 0.0, "touch": 0.0}
 
-    def normal(delta):
+    def normal(delta, rate):
         if adhesion is not None and adhesion.replaces_normal:
             fn, touch = adhesive_force(adhesion, delta, state["touch"])
             crit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
             return fn, crit, touch
-        fn, touch = kn * delta, float(delta > 0.0)
+        fn, touch = kn * delta + eta_n * rate, float(delta > 0.0)
         if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
             fn += adhesive_force(adhesion, delta, 1.0)[0]
-        return fn, abs(fn), touch
+        return fn, abs(kn * delta) if elastic_limit else abs(fn), touch
 
     def forces(update):
         d = x[1] - x[0]
@@ -286,7 +288,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         n = d / dist
         delta = 2.0 * radius - dist
         f, tq = np.zeros((2, 3)), np.zeros((2, 3))
-        fn, fcrit, touch = normal(delta)
+        fn, fcrit, touch = normal(delta, -((v[1] - v[0]) @ n))
         if not touch:
             state.update(roll=np.zeros(3), twist=0.0, touch=0.0)
             return f, tq, 0.0
