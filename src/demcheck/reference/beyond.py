@@ -1,0 +1,320 @@
+"""Scenarios beyond sliding, each solved by integration over the laws' force functions (scipy's solve_ivp,
+DOP853, with events) and each with its closed form:
+
+* ``rolling``: a sphere rolling without slip on a horizontal plane under a rolling-resistance law — stopping time
+  and distance (type A: a = −(5/7)μr g, t = 7v0/(5μr g), s = 7v0²/(10μr g) for Rr = R);
+* ``incline``: the same sphere on a plane tilted by θ — it stays (type A or C) while tan θ ≤ μr Rr/R, and rolls
+  down with a = (5/7) g (sin θ − μr cos θ) (Rr = R) once the torque is fully mobilised;
+* ``twist``: a sphere spinning about the normal of a plane, its twisting torque at its limit μtw|Fn|: it stops at
+  t = I ω0/(μtw |Fn|) (I = (2/5) m R²);
+* ``pull_off``: two adhesive bodies pulled apart quasi-statically — the largest tension (pull_off_force: JKR
+  (3/2)πwR̄, DMT 2πwR̄) and the overlap where the contact breaks (separation_at_pull_off: JKR −3a_f²/R̄ under an
+  imposed displacement, a_f³ = πwR̄²/(8E*));
+* ``adhesive_impact``: a head-on impact of elastic JKR bodies (Thornton & Ning 1998): the energy of the
+  hysteresis loop W = −∫_{δf}^{0} F dδ captures them below v_s = √(2W/m̄) (capture_velocity) and leaves
+  e = √(1 − (v_s/v)²) above;
+* ``conduction``: two bodies held at a fixed overlap exchange heat: T1 − T0 decays as exp(−t/τ),
+  τ = 1/(H(1/C0 + 1/C1)) (heat_time_constant), C = m c_p, towards (C0T0 + C1T1)/(C0 + C1).
+
+The sphere on a plane: m, R, I = (2/5)mR², gravity g; the plane's normal is z, the sphere rolls along x with
+ω_y = v/R (no slip is assumed: the tangential friction must hold |Ft| ≤ μ|Fn|, which ``rolling_on_plane`` checks).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq, minimize_scalar
+
+from ..laws.adhesion import adhesive_force
+from ..laws.heat import conductance, heat_flow
+from ..laws.rolling import rolling_torque
+from ..laws.twisting import twisting_torque
+
+RTOL = 1e-11
+N_DOWN = np.array([0.0, 0.0, -1.0])  # from the sphere into the plane
+
+
+# ----------------------------------------------------------------------------- closed forms
+
+
+def rolling_stop_closed(mu_r: float, r_roll: float, radius: float, v0: float, g: float) -> tuple[float, float]:
+    """(rolling_stop_time, rolling_distance) under a type A torque μr Rr m g on a level plane."""
+    a = 5.0 / 7.0 * mu_r * g * r_roll / radius
+    return v0 / a, v0 * v0 / (2.0 * a)
+
+
+def rolling_viscous_closed(c_r: float, mass: float, radius: float, v0: float) -> tuple[float, float]:
+    """(time constant, distance to rest) under a type B torque −Cr ω: v = v0 exp(−t/T), T = (7/5) m R²/Cr."""
+    tau = 1.4 * mass * radius * radius / c_r
+    return tau, v0 * tau
+
+
+def incline_closed(mu_r: float, r_roll: float, radius: float, theta: float, g: float) -> tuple[float, float]:
+    """(incline_critical_angle, the acceleration down the slope at θ: 0 below the critical angle)."""
+    crit = math.atan(mu_r * r_roll / radius)
+    acc = 5.0 / 7.0 * g * (math.sin(theta) - mu_r * r_roll / radius * math.cos(theta))
+    return crit, max(acc, 0.0)
+
+
+def twist_stop_closed(mass: float, radius: float, omega0: float, mu_tw: float, fn: float) -> float:
+    return 0.4 * mass * radius * radius * abs(omega0) / (mu_tw * fn)
+
+
+def jkr_loop_energy(r: float, e: float, w: float, break_at: str = "displacement") -> float:
+    """W = −∫ F dδ from the break (δ_f, or δ_c when the law breaks at the load-controlled pull-off) to δ = 0
+    along JKR's branch, by its antiderivative in a."""
+    c = math.sqrt(2.0 * math.pi * w / e)
+    k1, k2 = 4.0 * e / (3.0 * r), math.sqrt(8.0 * math.pi * w * e)
+
+    def g(a):  # ∫ F(a) δ'(a) da
+        return (2.0 * k1 * a ** 5 / (5.0 * r) - (k1 * c / 7.0 + 4.0 * k2 / (7.0 * r)) * a ** 3.5
+                + k2 * c / 4.0 * a * a)
+
+    a0 = (c * r) ** (2.0 / 3.0)
+    af = ((1.0 if break_at == "displacement" else 9.0) * math.pi * w * r * r / (8.0 * e)) ** (1.0 / 3.0)
+    return -(g(a0) - g(af))
+
+
+def capture_velocity_closed(r: float, e: float, w: float, m_eff: float, break_at: str = "displacement") -> float:
+    return math.sqrt(2.0 * jkr_loop_energy(r, e, w, break_at) / m_eff)
+
+
+def adhesive_restitution_closed(v: float, v_capture: float) -> float:
+    return math.sqrt(1.0 - (v_capture / v) ** 2) if v > v_capture else 0.0
+
+
+def heat_time_constant_closed(h: float, c0: float, c1: float) -> float:
+    return 1.0 / (h * (1.0 / c0 + (1.0 / c1 if math.isfinite(c1) else 0.0)))
+
+
+# ----------------------------------------------------------------------------- rolling and incline
+
+
+def rolling_on_plane(law, mass: float, radius: float, v0: float, g: float, theta: float = 0.0,
+                     t_end: float = 10.0) -> dict:
+    """A sphere rolling without slip along x on a plane tilted by θ (gravity pulls it towards +x). The rolling
+    law is evaluated by its compiled force function (type C's spring torque integrated as a state; its limit by
+    events). Returns the stop time, the distance to the stop, and the acceleration at the end."""
+    fn = mass * g * math.cos(theta)
+    drive = mass * g * math.sin(theta)
+    m_eff = mass + 0.4 * mass  # m + I/R²
+    cap = getattr(law, "mu_r", 0.0) * getattr(law, "r_roll", 0.0) * fn
+
+    def torque_y(v, mk, dt=0.0):
+        m, _ = rolling_torque(law, np.array([0.0, v / radius, 0.0]), N_DOWN, fn, dt, np.array([0.0, mk, 0.0]))
+        return m[1]
+
+    def rhs_free(t, y):  # y = x, v, Mk (Mk only for type C)
+        v, mk = y[1], y[2]
+        if law.id == "epsd":
+            mk_rate = -law.k_r * v / radius if abs(mk) < cap or mk * v > 0.0 else 0.0
+            m_tot = np.clip(mk, -cap, cap) + (-law.c_r * v / radius if abs(mk) < cap else 0.0)
+            return [v, (drive + m_tot / radius) / m_eff, mk_rate]
+        return [v, (drive + torque_y(v, 0.0) / radius) / m_eff, 0.0]
+
+    stopped = _stop_event()
+    stops = law.id == "constant_torque"  # type A stops in finite time; B decays; C rocks
+    sol = solve_ivp(rhs_free, (0.0, t_end), [0.0, v0, 0.0], method="DOP853", rtol=RTOL, atol=1e-14,
+                    events=[stopped] if stops else None, dense_output=False)
+    out = {"t": sol.t, "x": sol.y[0], "v": sol.y[1]}
+    if stops and sol.t_events[0].size:
+        out["rolling_stop_time"] = float(sol.t_events[0][0])
+        out["rolling_distance"] = float(sol.y_events[0][0][0])
+    out["acceleration"] = float(rhs_free(sol.t[-1], sol.y[:, -1])[1])
+    return out
+
+
+def _stop_event():
+    def ev(t, y):
+        return y[1]
+    ev.terminal = True
+    ev.direction = -1
+    return ev
+
+
+def incline_critical_angle(law, mass: float, radius: float, g: float) -> float:
+    """The tilt at which a sphere at rest starts to roll: the static torque m g sin θ R reaches the law's limit
+    μr Rr m g cos θ (type A, C). Found by bisection on the static balance, not from the closed form."""
+    def excess(theta):
+        fn = mass * g * math.cos(theta)
+        limit = law.mu_r * law.r_roll * fn
+        return mass * g * math.sin(theta) * radius - limit
+    return brentq(excess, 0.0, 0.5 * math.pi - 1e-9, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
+# ----------------------------------------------------------------------------- twist
+
+
+def twist_decay(law, mass: float, radius: float, omega0: float, fn: float, t_end: float,
+                preloaded: bool = True) -> dict:
+    """A sphere spinning about the plane's normal, its twisting spring preloaded at the limit (slipping from the
+    start; the closed form's assumption) or unstretched (it winds up first, as in an engine run that starts
+    there): integrated with the law's limit as a state constraint; the stop is the event ω = 0."""
+    inertia = 0.4 * mass * radius * radius
+    cap = law.mu_tw * fn
+
+    def rhs(t, y):
+        w = y[0]
+        m = -law.k_tw * y[1] - law.gamma_tw * w
+        if abs(m) >= cap * (1.0 - 1e-12):  # on the slip surface: the torque stays at the limit
+            m = math.copysign(cap, m)
+            return [m / inertia, -law.gamma_tw * (m / inertia) / law.k_tw if law.k_tw > 0 else 0.0]
+        return [m / inertia, w]
+
+    phi0 = (cap - law.gamma_tw * omega0) / law.k_tw if law.k_tw > 0 and preloaded else 0.0
+    ev = _stop_event_index(0)
+    sol = solve_ivp(rhs, (0.0, t_end), [omega0, phi0], method="DOP853", rtol=RTOL, atol=1e-14, events=[ev])
+    return {"twist_stop_time": float(sol.t_events[0][0]) if sol.t_events[0].size else math.nan}
+
+
+def _stop_event_index(k):
+    def ev(t, y):
+        return y[k]
+    ev.terminal = True
+    return ev
+
+
+# ----------------------------------------------------------------------------- adhesion
+
+
+def pull_off(law, delta0: float | None = None) -> dict:
+    """Two bodies pulled apart quasi-statically (imposed displacement) from overlap δ0: the largest tension on the
+    way (by minimising the law's force over δ) and the overlap at which the law reports the contact broken
+    (bisection on its ``touching`` state)."""
+    if delta0 is None:
+        delta0 = 10.0 * abs(law.separation_at_pull_off("displacement")) + 1e-9
+
+    def f(d):
+        return adhesive_force(law, d, 1.0)[0]
+
+    if law.id == "jkr":
+        lo, hi = law.separation_at_pull_off("displacement") * (1 - 1e-9), delta0
+        r = minimize_scalar(f, bounds=(lo * 0.999999, hi), method="bounded", options={"xatol": 1e-18})
+        tension = -r.fun
+        brk = brentq(lambda d: adhesive_force(law, d, 1.0)[1] - 0.5, 2 * lo, 0.0, xtol=1e-22, rtol=1e-15)
+    else:
+        tension = -f(0.0)
+        brk = 0.0
+    return {"pull_off_force": tension, "separation_at_pull_off": brk}
+
+
+def adhesive_impact(law, m_eff: float, v: float, t_end: float | None = None) -> dict:
+    """A head-on impact at approach speed v of two bodies interacting by an elastic JKR (or DMT) law: free
+    flight to δ = 0, contact until the law breaks it (δ_f) or t_end. Returns the restitution (0 if captured)."""
+    brk = law.separation_at_pull_off()
+    t_end = t_end if t_end is not None else 200.0 * _contact_time_scale(law, m_eff, v)
+
+    def rhs(t, y):
+        return [y[1], -adhesive_force(law, y[0], 1.0)[0] / m_eff]
+
+    def out(t, y):
+        return y[0] - brk
+    out.terminal, out.direction = True, -1
+    sol = solve_ivp(rhs, (0.0, t_end), [0.0, v], method="DOP853", rtol=RTOL, atol=1e-18, events=[out])
+    if not sol.t_events[0].size:
+        return {"restitution": 0.0, "captured": True}
+    v_out = float(sol.y_events[0][0][1])
+    # after the break the bodies fly apart freely: the speed at the break is the rebound speed
+    return {"restitution": abs(v_out) / v, "captured": False}
+
+
+def _contact_time_scale(law, m_eff, v):
+    k = 4.0 / 3.0 * law.e_eff * math.sqrt(law.r_eff)
+    return (m_eff ** 2 / (k * k * max(v, 1e-6))) ** 0.2
+
+
+# ----------------------------------------------------------------------------- conduction
+
+
+def conduction(law, delta: float, c0: float, c1: float, t0: float, t1: float, t_end: float) -> dict:
+    """Two bodies at fixed overlap δ, heat capacities C0, C1: integrated, and τ read as the time at which the
+    temperature difference has fallen by e."""
+    h = conductance(law, delta)
+
+    def rhs(t, y):
+        q = h * (y[1] - y[0])
+        return [q / c0, -q / c1]
+
+    def efold(t, y):
+        return (y[1] - y[0]) - (t1 - t0) / math.e
+    efold.terminal = True
+    sol = solve_ivp(rhs, (0.0, t_end), [t0, t1], method="DOP853", rtol=RTOL, atol=1e-14, events=[efold])
+    return {"heat_time_constant": float(sol.t_events[0][0]) if sol.t_events[0].size else math.nan,
+            "conductance": h}
+
+
+# ----------------------------------------------------------------------------- the engines' discrete scheme
+
+
+def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, omega1, dt: float, steps: int, *,
+                kn: float = 0.0, eta_n: float = 0.0, elastic_limit: bool = False, adhesion=None, rolling=None,
+                twisting=None, heat=None, cp: float = 0.0, temps=(300.0, 400.0),
+                setup_increment: bool = False) -> dict:
+    """Two like spheres, body 0 at the origin, body 1 at (x1, 0, 0) moving at (v1, 0, 0), stepped the way the
+    engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
+    half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
+    step). The normal force is a linear spring kn·δ (plus a cohesion record's force), or the adhesion record's
+    when it replaces the normal law; the limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄|
+    for jkr: the engine's critical force; the elastic kn·δ alone with ``elastic_limit``); a linear dashpot
+    eta_n·δ̇ (δ̇ > 0 approaching) joins the linear spring; the twisting law sees the contact radius √(R̄δ).
+    ``setup_increment``: the set-up force call already adds one step's spring increment to the torques it applies
+    (and forgets it: the history still starts at step 1), as LIGGGHTS's rolling models do.
+    Returns per step (after it): x, v, ω, f, τ (steps×2×3 each), T (steps×2) and the heat flow Q into body 0."""
+    mass = density * 4.0 / 3.0 * math.pi * radius ** 3
+    inertia = 0.4 * mass * radius * radius
+    rbar = radius / 2.0
+    x = np.array([[0.0, 0.0, 0.0], [x1, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, 0.0], [v1, 0.0, 0.0]])
+    w = np.array([omega0, omega1], dtype=float)
+    temp = np.array(temps, dtype=float)
+    state = {"roll": np.zeros(3), "twist": 0.0, "touch": 0.0}
+
+    def normal(delta, rate):
+        if adhesion is not None and adhesion.replaces_normal:
+            fn, touch = adhesive_force(adhesion, delta, state["touch"])
+            crit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
+            return fn, crit, touch
+        fn, touch = kn * delta + eta_n * rate, float(delta > 0.0)
+        if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
+            fn += adhesive_force(adhesion, delta, 1.0)[0]
+        return fn, abs(kn * delta) if elastic_limit else abs(fn), touch
+
+    def forces(update):
+        d = x[1] - x[0]
+        dist = math.sqrt(d @ d)
+        n = d / dist
+        delta = 2.0 * radius - dist
+        f, tq = np.zeros((2, 3)), np.zeros((2, 3))
+        fn, fcrit, touch = normal(delta, -((v[1] - v[0]) @ n))
+        if not touch:
+            state.update(roll=np.zeros(3), twist=0.0, touch=0.0)
+            return f, tq, 0.0
+        state["touch"] = 1.0
+        f[0], f[1] = -fn * n, fn * n
+        wrel = w[0] - w[1]
+        h = dt if update or setup_increment else 0.0
+        m_roll, hist = rolling_torque(rolling, wrel, n, fcrit, h, state["roll"])
+        m_tw, phi = twisting_torque(twisting, wrel, n, fcrit, math.sqrt(rbar * max(delta, 0.0)), h, state["twist"])
+        if update:
+            state.update(roll=hist, twist=phi)
+        tq[0] += m_roll + m_tw
+        tq[1] -= m_roll + m_tw
+        return f, tq, heat_flow(heat, delta, temp[0], temp[1])
+
+    f, tq, q = forces(False)
+    out = {k: [] for k in ("x", "v", "omega", "f", "torque", "T", "Q")}
+    for _ in range(steps):
+        v += 0.5 * dt * f / mass
+        x += dt * v
+        w += 0.5 * dt * tq / inertia
+        f, tq, q = forces(True)
+        v += 0.5 * dt * f / mass
+        w += 0.5 * dt * tq / inertia
+        if heat is not None:
+            temp += dt * np.array([q, -q]) / (mass * cp)
+        for k, val in (("x", x), ("v", v), ("omega", w), ("f", f), ("torque", tq), ("T", temp), ("Q", q)):
+            out[k].append(np.copy(val))
+    return {k: np.array(val) for k, val in out.items()}
