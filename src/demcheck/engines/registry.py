@@ -55,14 +55,29 @@ def _load() -> None:
             logging.getLogger("demcheck.engines").warning("engine plug-in %s not loaded: %s", ep.name, exc)
 
 
+def _rank(engine: Engine) -> int:
+    """A built-in's place in BUILTIN (its package, whatever imported it first); a plug-in's after them all."""
+    module = type(engine).__module__
+    for k, package in enumerate(BUILTIN):
+        if module == package or module.startswith(package + "."):
+            return k
+    return len(BUILTIN)
+
+
+def _ordered() -> tuple[Engine, ...]:
+    """The built-ins in BUILTIN's order, then plug-ins in registration order: a test or a user that imports
+    one engine's package before the registry loads must not reorder a report's columns."""
+    return tuple(sorted(_ENGINES.values(), key=_rank))
+
+
 def names() -> tuple[str, ...]:
     _load()
-    return tuple(_ENGINES)
+    return tuple(e.name for e in _ordered())
 
 
 def all_engines() -> tuple[Engine, ...]:
     _load()
-    return tuple(_ENGINES.values())
+    return _ordered()
 
 
 def get(name: str) -> Engine:
