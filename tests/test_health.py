@@ -33,7 +33,7 @@ from demcheck.engines.cache import Cache
 from demcheck.engines.collide import META_KEYS as COLLIDE_META
 from demcheck.reference import health as H
 from demcheck.reference.collision import characteristic_time, collide
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 from demcheck.result import Result
 
 from .conftest import CASES

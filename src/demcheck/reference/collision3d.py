@@ -11,8 +11,8 @@ from ..case import Case
 from ..errors import ConfigError
 from ..result import Result
 from . import kernels, kernels3d as k3
-from .model import ResolvedModel
-from .tangential import WALTON
+from ..laws.model import ResolvedModel
+from ..laws.tangential import WALTON
 
 # The seed's own rules: lever arms to the contact point (R − δ/2) for slip velocity and torque; in the
 # verlet method the history is rotated into the new tangent plane keeping its length. A wall's slip arm is the
@@ -64,7 +64,7 @@ def initial_state(case: Case) -> np.ndarray:
 
 def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = None, rtol: float | None = None,
             rules: dict | None = None) -> Result:
-    from .model import characteristic_time
+    from ..laws.model import characteristic_time
     from .outcome import MESSAGES, ROW_BYTES_3D, STATUS, auto_dt, judge, time_to_contact, verlet_capacity
 
     t_c = characteristic_time(model)

@@ -29,7 +29,7 @@ from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_RELOAD, 
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
                          illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
                          stage6)
-from .tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_FAMILY, T_KT,
+from ..laws.tangential import (LTH, NONE, SLIDING, SPRING, T_ETA, T_ETA_NORMAL, T_ETA1, T_FORCE, T_G, T_K0, T_FAMILY, T_KT,
                          T_RESCALE,
                          T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_R, T_TRUNC, T_XI, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING,
                          VISCOUS, VISCOUS_SLIDING, WALTON, ZZY)

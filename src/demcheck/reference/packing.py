@@ -30,7 +30,7 @@ from .kernels import L_LIMIT, normal_force
 from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
                         kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
                         turn_history, wall_arm, walton_reverses, walton_stiffness)
-from .tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
+from ..laws.tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
 
 # per contact (a row beside its neighbour-list entry): the tangential history (3); a spring law with μk < μs
 # also its slip state (1); Walton's the load at the last reversal (3) and the last nonzero slip velocity (3).
@@ -700,9 +700,9 @@ def species_of(case) -> tuple[np.ndarray, list[int]]:
 def resolve_laws(case):
     """Per species pair (and per species against the walls) the normal and tangential law arrays."""
     from ..errors import ConfigError
-    from .contact import pair_of
-    from .model import models_of
-    from .normal import NormalLaw
+    from ..laws.contact import pair_of
+    from ..laws.model import models_of
+    from ..laws.normal import NormalLaw
 
     normal, tangential = models_of(case)
     sp, rep = species_of(case)

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 
-from .normal import VISCOELASTIC, NormalLaw
-from .tangential import NONE, SPRING, TRUNC_MAW, TRUNC_SPRING, VISCOUS_SLIDING, TangentialLaw
+from ..laws.normal import VISCOELASTIC, NormalLaw
+from ..laws.tangential import NONE, SPRING, TRUNC_MAW, TRUNC_SPRING, VISCOUS_SLIDING, TangentialLaw
 
 
 def damping_ratio(e: float) -> float:

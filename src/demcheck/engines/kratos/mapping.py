@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import NONE, TangentialLaw
+from ...laws.model import ResolvedModel
+from ...laws.normal import HYSTERETIC, NormalLaw
+from ...laws.tangential import NONE, TangentialLaw
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 
 HERTZ = "DEM_D_Hertz_viscous_Coulomb"

@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
+from ...laws.model import ResolvedModel
+from ...laws.normal import HYSTERETIC, NormalLaw
+from ...laws.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
                                      VISCOUS_SLIDING, WALTON, ZZY, TangentialLaw)
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst

@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import NONE, SPRING, TRUNC_SPRING, VISCOUS, TangentialLaw
+from ...laws.model import ResolvedModel
+from ...laws.normal import HYSTERETIC, NormalLaw
+from ...laws.tangential import NONE, SPRING, TRUNC_SPRING, VISCOUS, TangentialLaw
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import mu_of
 
