@@ -478,7 +478,8 @@ def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncati
     at μ|Fn| while the spring keeps every increment — its extension grows as v t without bound (in the
     Hertz packing it reached 68 μm, 38 largest overlaps, and kept the bed rattling: docs/packing.md); Maw's limited
     overlap (LAMMPS) holds it at the cap's extension."""
-    from demcheck.reference.kernels3d import ROT_RESCALE, kt_of
+    from demcheck.laws.tangential_force import kt_of
+    from demcheck.reference.kernels3d import ROT_RESCALE
     from demcheck.laws.model import resolve
 
     from .helpers import oblique_case

@@ -193,7 +193,7 @@ def law_shortfall(model, contact: dict, events) -> float:
     short of the cap where η_t|v_t| < μ|F_n|. Every other Coulomb law's force reaches the cap under a sustained
     slip (0: its first stick is the stick a source's force history measures). ``model``: the case's
     ResolvedModel."""
-    from ..reference.kernels3d import eta_of
+    from ..laws.tangential_force import eta_of
     from ..laws.tangential import VISCOUS_SLIDING
 
     law = model.tangential_law

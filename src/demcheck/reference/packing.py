@@ -26,10 +26,11 @@ from numba import njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .. import KERNEL_CACHE
-from .kernels import L_LIMIT, normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
-                        kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
-                        turn_history, wall_arm, walton_reverses, walton_stiffness)
+from ..laws.normal_force import L_LIMIT, normal_force
+from ..laws.tangential_force import (eta_of, kt_of, return_map, slip_surface, tangential_force, walton_reverses,
+                                     walton_stiffness)
+from .kernels3d import ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, wall_arm
+from .verlet3d import project_history, spring_slip, turn_history
 from ..laws.tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
 
 # per contact (a row beside its neighbour-list entry): the tangential history (3); a spring law with μk < μs
