@@ -8,8 +8,10 @@ import math
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import HYSTERETIC, NormalLaw
-from ...laws.tangential import SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS_SLIDING, TangentialLaw
+from ...laws.damping import NoDamping
+from ...laws.normal import HysteresisNormal, NormalLaw
+from ...laws.tangential import (TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, SpringTangential, SqrtSpringTangential,
+                                TangentialLaw, ViscousSlidingTangential)
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import HUGE_MU, SLIDING_XT, mu_of
@@ -238,7 +240,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     p = nat.props
     if nat.normal == "luding":  # δ_max < δ_lim: K_U = k1 + (r − 1)k1 δ_max/δ_lim, i.e. S = (r − 1)/δ_lim
         s = (p["unloading"] - 1.0) / luding_limit(p, r)
-        return NormalLaw(HYSTERETIC, kl=p["loading"], ku=0.0, s=s, limit=nat.limit), twins.no_friction()
+        return (NormalLaw.from_slots(HysteresisNormal(kl=p["loading"], ku=0.0, s=s), NoDamping(), nat.limit),
+                twins.no_friction())
     if nat.normal == "hooke/stiffness":
         k_el, a = p["kn"], 1.0
         c, b = damping("stiffness_hooke", p["gamman"], k_el, a, m, r)
@@ -254,7 +257,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         kt, sqrt_law, eta_t = k_el, False, c
     elif nat.normal == "edinburgh":
         kl = p["kl"]
-        return (NormalLaw(HYSTERETIC, kl=kl, ku=kl * p["unloading"], limit=nat.limit), twins.no_friction())
+        return (NormalLaw.from_slots(HysteresisNormal(kl=kl, ku=kl * p["unloading"]), NoDamping(), nat.limit),
+                twins.no_friction())
     elif nat.normal == "hertz":
         y_eff, g_eff = p["youngs_eff"], p["shear_eff"]
         k_el, a = 4.0 / 3.0 * y_eff * math.sqrt(r), 1.5
@@ -280,13 +284,14 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if factor is not None and math.isnan(factor):
         raise ValueError("hertz/stiffness with gammat > 0 and gamman = 0 has no twin")
 
-    def law(family, **kw):
+    def law(record, **kw):
         if factor is None:
-            return TangentialLaw(family, eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
-        return TangentialLaw(family, eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+            return TangentialLaw.from_slot(record(eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m,
+                                                  **kw))
+        return TangentialLaw.from_slot(record(eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw))
 
     if nat.tangential == "no_history":
-        return nl, law(VISCOUS_SLIDING)
-    return nl, law(SPRING, kt=kt, kt_sqrt=sqrt_law, truncation=TRUNC_SPRING)
+        return nl, law(ViscousSlidingTangential)
+    return nl, law(SqrtSpringTangential if sqrt_law else SpringTangential, kt=kt, truncation=TRUNC_SPRING)
 
 

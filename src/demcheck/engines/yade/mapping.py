@@ -25,7 +25,8 @@ import math
 from ...reference import twins
 from ...laws.model import ResolvedModel
 from ...laws.normal import NormalLaw
-from ...laws.tangential import SPRING, TRUNC_SPRING, VISCOUS, TangentialLaw
+from ...laws.tangential import (TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw,
+                                ViscousTangential)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import mu_of
 
@@ -118,18 +119,18 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if nat.normal == VISCEL:
         nl = twins.normal_law(p["kn"], 1.0, p["cn"], 0.0, True)
         if nat.tangential == "viscous":
-            return nl, TangentialLaw(VISCOUS, eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m)
+            return nl, TangentialLaw.from_slot(ViscousTangential(eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m))
         if nat.tangential == "spring":
-            return nl, TangentialLaw(SPRING, kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
-                                     r_eff=r, m_eff=m)
+            return nl, TangentialLaw.from_slot(SpringTangential(kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu,
+                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m))
         return nl, twins.no_friction()
     if nat.normal == MINDLIN:
         c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
         nl = twins.normal_law(p["kno"], 1.5, c, 0.25, nat.limit)
         if nat.tangential == "mindlin":
             factor = (2.0 * p["betas"] * math.sqrt(m * p["kso"]) / c) if c > 0.0 else 0.0
-            return nl, TangentialLaw(SPRING, kt=p["kso"] / math.sqrt(r), kt_sqrt=True, eta=factor, eta_normal=True,
-                                     mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING, force_history=True, r_eff=r,
-                                     m_eff=m)
+            return nl, TangentialLaw.from_slot(SqrtSpringTangential(
+                kt=p["kso"] / math.sqrt(r), eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
+                force_history=True, r_eff=r, m_eff=m))
         return nl, twins.no_friction()
     raise ValueError(f"no twin for Yade physics {nat.normal!r}")
