@@ -143,3 +143,51 @@ def test_an_engine_refuses_a_record_it_cannot_express_by_its_id():
     lammps = mapping.map_model(odd, "lammps", {})
     assert lammps.fidelity == "none" and "δ^0 law" in lammps.reasons[0]
     assert mapping.map_model(odd, "liggghts", {}).fidelity == "none"
+
+
+@pytest.mark.parametrize("nid,tid,extra", _combos(), ids=lambda v: v if isinstance(v, str) else "")
+def test_the_kernels_tangential_array_reads_back_exactly(nid, tid, extra):
+    tl = _model(nid, tid, extra).tangential_law
+    assert tangential.TangentialLaw.from_array(tl.array()) == tl
+
+
+def test_the_packing_rows_are_as_wide_as_the_records_histories():
+    """The packing's contact-state row: the widest record history (Walton 9, a displacement 3, at least 3), and a
+    spring's slip state where μk < μs."""
+    from demcheck.reference.packing import history_width
+
+    spring = tangential.SpringTangential(kt=1.0, mu_s=0.5, mu_k=0.5)
+    assert history_width([tangential.NoTangential()]) == 3
+    assert history_width([spring, tangential.LthTangential()]) == 3
+    assert history_width([dataclasses.replace(spring, mu_k=0.4)]) == 4
+    assert history_width([dataclasses.replace(spring, mu_k=0.4), tangential.WaltonTangential(k0=1.0)]) == 9
+
+
+@dataclasses.dataclass(frozen=True)
+class _TestOnlyNormal(normal.NormalSubModel):
+    """A normal record no engine knows (registered by this test module only)."""
+
+    id: ClassVar[str] = "test_only_cubic"
+    k: float = 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class _TestOnlyTangential(tangential.TangentialSubModel):
+    id: ClassVar[str] = "test_only_glue"
+    history_size: ClassVar[int] = 2
+    c: float = 0.0
+
+
+@pytest.mark.parametrize("slot", ["normal", "tangential"])
+@pytest.mark.parametrize("engine", registry.names())
+def test_a_record_an_engine_does_not_know_is_refused(engine, slot):
+    """A new law's record reaches every engine's vocabulary, which refuses what it has no branch for — with no
+    edit to the engine (never mistaken for a known record of the same shape)."""
+    model = _model("lsd", "none", {})
+    contact = model.contact
+    new = dataclasses.replace(contact, normal=_TestOnlyNormal(k=1e6)) if slot == "normal" else \
+        dataclasses.replace(contact, tangential=_TestOnlyTangential(c=1.0))
+    odd = dataclasses.replace(model)
+    odd.__dict__["contact"] = new  # the cached slots of this model (ResolvedModel.contact)
+    assert mapping.map_model(odd, engine, {}).fidelity == "none"
+    assert new.history_size == contact.history_size + (2 if slot == "tangential" else 0)

@@ -27,7 +27,7 @@ examples, and ``rolling``, ``twisting``, ``adhesion`` and ``heat`` laws write th
   declaration order as float64 (a bool as 0.0/1.0, an int as its float) and back, exactly.
 
 * **The engines map records by their ids** (``contact.damping.id == "quarter"``), never by exponents or by the
-  kernels' family numbers: an engine that cannot express a record refuses it by naming its slot and id.
+  kernels' family numbers: an engine that cannot express a record refuses the mapping with its reason.
 
 * **The compiled force function** of a new law lives in the law's module (or, where the records must import
   without numba, in ``<family>_force.py`` beside it), ``@njit(cache=KERNEL_CACHE)``, named

@@ -69,6 +69,15 @@ class TangentialLaw:
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
                          self.k0, float(self.force_history), float(self.rescale_history)])
 
+    @classmethod
+    def from_array(cls, law) -> "TangentialLaw":
+        """The law of an ``array()`` (the inverse, exactly)."""
+        (family, kt, kt_sqrt, eta, eta_normal, mu_s, mu_k, truncation, r_eff, m_eff, xi_coef, eta1, g_i, k0,
+         force_history, rescale_history) = (float(x) for x in law)
+        return cls(int(family), kt=kt, kt_sqrt=kt_sqrt != 0.0, eta=eta, eta_normal=eta_normal != 0.0, mu_s=mu_s,
+                   mu_k=mu_k, truncation=int(truncation), r_eff=r_eff, m_eff=m_eff, xi_coef=xi_coef, eta1=eta1,
+                   g_i=g_i, k0=k0, force_history=force_history != 0.0, rescale_history=rescale_history != 0.0)
+
     @property
     def has_history(self) -> bool:
         return self.family in (SPRING, LTH, ZZY, WALTON)

@@ -53,6 +53,8 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     fid = EXACT
     if normal.id == "hls":
         return refused("kratos", "Kratos DEM 10.4.4 has no linear hysteretic (HLS) discontinuum law")
+    if normal.id not in ("hooke", "hertz"):
+        return refused("kratos", f"no Kratos DEM discontinuum law for the normal record '{normal.id}'")
     if contact.tangential.id != "none":
         return refused("kratos", f"Kratos' tangential force is part of its normal law (incremental spring Kt = "
                                   f"4G*Kn/E*, dashpot 2γ√(m̄Kt), μ decaying with the slip speed, the Coulomb cap "

@@ -37,6 +37,8 @@ def _map_normal(model: ResolvedModel, contact, cp: dict, nat: Native, comments: 
     eta = getattr(damp, "eta", 0.0)
     if normal.id == "hls":
         return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
+    if normal.id not in ("hooke", "hertz"):
+        return refused("lammps", f"no LAMMPS normal model for the normal record '{normal.id}'")
     if normal.id == "hooke" and eta > 0.0 and damp.id not in ("none", "constant"):
         return refused("lammps", f"no LAMMPS normal model has the δ^{normal.exponent:g} spring with a "
                                   f"δ^{damp.exponent:g} dashpot")
