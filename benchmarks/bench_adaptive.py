@@ -26,7 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 from demcheck.reference import kernels  # noqa: E402
 from demcheck.reference.collision import Geometry1D, characteristic_time, collide  # noqa: E402
-from demcheck.reference.model import resolve  # noqa: E402
+from demcheck.laws.model import resolve  # noqa: E402
 from demcheck.reference import collision3d  # noqa: E402
 from tests.helpers import glass_case, oblique_case  # noqa: E402
 

@@ -67,7 +67,7 @@ def load_old_kernels(old_src: Path):
 def one_d_inputs(path):
     from demcheck.case import expand
     from demcheck.reference.collision import Geometry1D, characteristic_time
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
     from demcheck.reference.outcome import time_to_contact
 
     case = expand(ROOT / path)[0]

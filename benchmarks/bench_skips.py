@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from demcheck.reference import collision3d, kernels  # noqa: E402
 from demcheck.reference.collision import Geometry1D, auto_dt, characteristic_time, collide  # noqa: E402
-from demcheck.reference.model import resolve  # noqa: E402
+from demcheck.laws.model import resolve  # noqa: E402
 from tests.helpers import glass_case, oblique_case  # noqa: E402
 
 

@@ -45,7 +45,7 @@ def _toml(v):
 def oblique_case(tangential, params=None, *, normal="lsd", normal_params=None, wall=True, speed=1.0, angle=45.0,
                  spin=0.0, restitution=0.9, friction=0.3, overrides=()):
     """An oblique impact of a glass sphere on a rigid wall (or a pair) with a tangential law."""
-    from demcheck.reference import normal as _normal, tangential as _tangential
+    from demcheck.laws import normal as _normal, tangential as _tangential
 
     nparams = dict(_normal.REGISTRY[normal].example if normal_params is None else normal_params)
     tparams = dict(_tangential.REGISTRY[tangential].example if params is None else params)

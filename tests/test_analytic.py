@@ -6,11 +6,11 @@ import math
 import pytest
 from scipy.integrate import quad
 
-from demcheck.reference import analytic
+from demcheck.laws import analytic
 from demcheck.reference.collision import collide
-from demcheck.reference.contact import pair_of
+from demcheck.laws.contact import pair_of
 from demcheck.reference.expected import closed_form_metrics
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 
 from .helpers import glass_case
 

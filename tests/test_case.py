@@ -6,7 +6,7 @@ import pytest
 
 from demcheck import case as C
 from demcheck.errors import ConfigError
-from demcheck.reference.contact import pair_of
+from demcheck.laws.contact import pair_of
 
 BASE = """
 [materials.glass]

@@ -239,7 +239,7 @@ def _gravity_wall_case(gravity=G):
 
 
 def _hertz_force(case, delta):
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     return resolve(case).normal_law.k * delta ** 1.5
 
@@ -298,7 +298,7 @@ def test_the_twin_read_off_its_states_gives_its_own_contact_force_under_gravity(
     from demcheck.engines import registry
     from demcheck.reference import collision3d
     from demcheck.reference.collision import auto_dt
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     case = _gravity_wall_case((3.0, -4.0, -9.81))
     model = resolve(case)

@@ -20,8 +20,9 @@ import pytest
 from demcheck import case as C
 from demcheck.engines import mapping, registry
 from demcheck.engines.base import APPROXIMATE, EXACT, FIDELITIES, NONE_
-from demcheck.reference import collision3d, normal
-from demcheck.reference.model import resolve
+from demcheck.reference import collision3d
+from demcheck.laws import normal
+from demcheck.laws.model import resolve
 
 METRICS = ("restitution", "contact_time", "max_overlap", "peak_force", "tangential_restitution",
            "rebound_angular_velocity")
@@ -39,7 +40,7 @@ def _rows():
 
 
 def _tangential_ids():
-    from demcheck.reference import tangential
+    from demcheck.laws import tangential
 
     return list(tangential.REGISTRY)
 
@@ -49,7 +50,7 @@ def _case(normal_id: str, tangential_id: str, extra: dict, oblique: bool) -> C.C
     tangential law acts (so that the tangential claim is exercised), head-on otherwise."""
     import tomllib
 
-    from demcheck.reference.tangential import REGISTRY as T
+    from demcheck.laws.tangential import REGISTRY as T
 
     base = tomllib.loads(mapping._TABLE_CASE)
     params = {**normal.REGISTRY[normal_id].example, **T[tangential_id].example, **extra}

@@ -183,7 +183,7 @@ def test_liggghts_luding_is_hls_with_variable_unloading(wall):
     """luding (δ_max < δ_lim, r free) computes HLS's K_U = K_L + S·F_max: the engine meets the seed law (its
     twin is the seed law itself) at equal dt to the bar, the maximum overlap included, and the closed forms
     δ_max = v√(m̄/K_L), F_max = K_L δ_max, ε = [1 + S v √(m̄/K_L)]^{-½} to the scheme's O(dt)."""
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     case = _plastic_case(wall)
     nat = mapping.contact_mapping(case, "liggghts").require()
@@ -261,7 +261,7 @@ def test_lammps_mindlin_variants_match_their_twins(style, wall):
 def test_liggghts_hooke_with_characteristic_velocity_matches_its_twin(wall):
     """LIGGGHTS hooke: Kn from Hertz's energy at characteristicVelocity — the notes' equal-energy
     calibration of LSD (1.053 = (16/15)^{4/5}) — with Kt = Kn and γt = γn."""
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     case = oblique_case("spring_sliding", None, normal="lsd", wall=wall, angle=30.0, spin=500.0)
     model = resolve(case)

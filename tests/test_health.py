@@ -33,7 +33,7 @@ from demcheck.engines.cache import Cache
 from demcheck.engines.collide import META_KEYS as COLLIDE_META
 from demcheck.reference import health as H
 from demcheck.reference.collision import characteristic_time, collide
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 from demcheck.result import Result
 
 from .conftest import CASES
@@ -649,7 +649,7 @@ def test_a_touch_at_the_top_of_a_throw_is_found(tangential, eps):
 def test_an_adaptive_run_that_ends_before_any_touch_is_no_contact(solver):
     """The kernels' own status when the run ends in free flight (a t_max shorter than the free flight):
     'the bodies never touched', not 'the contact did not end'."""
-    from demcheck.reference import collision3d, kernels, kernels3d as k3
+    from demcheck.reference import adaptive3d, collision3d, kernels
     from demcheck.reference.collision import STATUS
 
     case = glass_case("hertz", {}, wall=True)  # 1.59 µs of free flight at 1 m/s
@@ -660,7 +660,7 @@ def test_an_adaptive_run_that_ends_before_any_touch_is_no_contact(solver):
                                       t_c, 1.0, t_max, 1000)
     else:
         rules = collision3d.rules_array()
-        out = k3.adaptive_3d(collision3d.initial_state(case), model.normal_law.array(),
+        out = adaptive3d.adaptive_3d(collision3d.initial_state(case), model.normal_law.array(),
                              model.tangential_law.array(), collision3d.geometry(case, t_c), rules, 1e-10,
                              np.full(21, 1e-3), t_max, 1000)
     assert STATUS[out[0]] == "no-contact"

@@ -17,8 +17,8 @@ from demcheck import case as C
 from demcheck.engines import collide as CO, mapping, registry
 from demcheck.engines.base import APPROXIMATE, EXACT, NONE_
 from demcheck.errors import UnsupportedByEngine
-from demcheck.reference import normal as N
-from demcheck.reference.model import resolve
+from demcheck.laws import normal as N
+from demcheck.laws.model import resolve
 
 METRICS = ("restitution", "contact_time", "max_overlap", "peak_force")
 

@@ -9,7 +9,7 @@ import pytest
 from demcheck.case import load
 from demcheck.metrics import compute
 from demcheck.reference.collision import collide
-from demcheck.reference.model import characteristic_time, resolve
+from demcheck.laws.model import characteristic_time, resolve
 
 CASE = "cases/suite/oblique-lth.toml"
 

@@ -12,7 +12,7 @@ import pytest
 
 from demcheck.engines import mapping, registry
 from demcheck.reference import collision3d
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 
 from .helpers import glass_case, oblique_case
 
@@ -92,7 +92,7 @@ def test_tangential_mapping_claims(normal, nparams, tangential, tparams, engine)
 
 
 def test_every_registered_model_has_a_mapping_row():
-    from demcheck.reference import normal, tangential
+    from demcheck.laws import normal, tangential
 
     rows = mapping.by_model()
     assert {("normal", m) for m in normal.REGISTRY} | {("tangential", m) for m in tangential.REGISTRY} == set(rows)

@@ -10,9 +10,10 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from demcheck.metrics import NORMAL_METRICS
-from demcheck.reference import kernels, normal
+from demcheck.reference import kernels
+from demcheck.laws import normal
 from demcheck.reference.collision import auto_dt, collide
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 
 from .helpers import glass_case
 

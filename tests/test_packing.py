@@ -258,7 +258,7 @@ def test_a_slip_with_a_lower_kinetic_friction_goes_on_as_in_the_two_body_verlet_
 
 def _same_as_two_body(case, dt, rules):
     from demcheck.reference import collision3d
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     two = collision3d.collide(case, resolve(case), "verlet", dt=dt, rules=rules)
     steps = int(round(two.contact["t"].iloc[-1] / dt))
@@ -478,8 +478,9 @@ def test_the_seed_min_cap_lets_the_tangential_spring_grow_without_bound(truncati
     at μ|Fn| while the spring keeps every increment — its extension grows as v t without bound (in the
     Hertz packing it reached 68 μm, 38 largest overlaps, and kept the bed rattling: docs/packing.md); Maw's limited
     overlap (LAMMPS) holds it at the cap's extension."""
-    from demcheck.reference.kernels3d import ROT_RESCALE, kt_of
-    from demcheck.reference.model import resolve
+    from demcheck.laws.tangential_force import kt_of
+    from demcheck.reference.kernels3d import ROT_RESCALE
+    from demcheck.laws.model import resolve
 
     from .helpers import oblique_case
 

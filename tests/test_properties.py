@@ -4,7 +4,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from demcheck.reference import normal
+from demcheck.laws import normal
 from demcheck.reference.collision import collide
 
 from .helpers import glass_case

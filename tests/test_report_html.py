@@ -534,8 +534,8 @@ def _mappings():
 
     from demcheck.case import apply_overrides, expand, from_dict
     from demcheck.engines import mapping, registry
-    from demcheck.reference import normal, tangential
-    from demcheck.reference.model import resolve
+    from demcheck.laws import normal, tangential
+    from demcheck.laws.model import resolve
 
     out = []
     for f in sorted(CASES.rglob("*.toml")):

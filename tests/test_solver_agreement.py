@@ -11,7 +11,7 @@ import pytest
 
 from demcheck import case as C
 from demcheck.reference import collision, collision3d
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 
 from .conftest import CASES
 

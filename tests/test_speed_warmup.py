@@ -12,16 +12,16 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_warmup_compiles_every_entry_kernel_of_the_suite():
     from demcheck.comparisons.warmup import warm
-    from demcheck.reference import kernels, kernels3d, packing
+    from demcheck.reference import adaptive3d, kernels, packing, verlet3d
 
     labels = [label for label, _ in warm()]  # in this process (jobs = 1)
     assert len(labels) == len(set(labels)) == 9
-    for kernel in (kernels.adaptive_normal, kernels.verlet_normal, kernels3d.adaptive_3d, kernels3d.verlet_3d,
+    for kernel in (kernels.adaptive_normal, kernels.verlet_normal, adaptive3d.adaptive_3d, verlet3d.verlet_3d,
                    packing.run):
         assert isinstance(kernel, CPUDispatcher) and kernel.signatures, kernel
     # one specialisation per entry kernel: the suite's call sites pass one set of argument types
     assert all(len(k.signatures) == 1 for k in (kernels.adaptive_normal, kernels.verlet_normal,
-                                               kernels3d.adaptive_3d, kernels3d.verlet_3d, packing.run))
+                                               adaptive3d.adaptive_3d, verlet3d.verlet_3d, packing.run))
 
 
 def test_the_command_lists_its_scenes():
@@ -33,10 +33,11 @@ def test_the_command_lists_its_scenes():
 SPECIALISATIONS = r"""
 import importlib, json, pkgutil
 from numba.core.registry import CPUDispatcher
-import demcheck.reference
+import demcheck.laws, demcheck.reference
 from demcheck.comparisons.warmup import warm
 warm()
-mods = [importlib.import_module(f"demcheck.reference.{m.name}") for m in pkgutil.iter_modules(demcheck.reference.__path__)]
+mods = [importlib.import_module(f"{p.__name__}.{m.name}") for p in (demcheck.laws, demcheck.reference)
+        for m in pkgutil.iter_modules(p.__path__)]
 seen = {}
 for m in [importlib.import_module("demcheck.metrics"), *mods]:  # every compiled function, wherever it is imported
     for v in vars(m).values():
@@ -59,8 +60,8 @@ def test_the_kernels_compile_one_specialisation_each(tmp_path):
     p = subprocess.run([sys.executable, "-c", SPECIALISATIONS], cwd=ROOT, env=env, capture_output=True, text=True,
                        timeout=900)
     assert p.returncode == 0, p.stderr[-2000:]
-    assert json.loads(p.stdout.strip().splitlines()[-1]) == {"demcheck.reference.kernels.viscoelastic_force": 2,
-                                                             "demcheck.reference.kernels.normal_force": 2}
+    assert json.loads(p.stdout.strip().splitlines()[-1]) == {"demcheck.laws.normal_force.viscoelastic_force": 2,
+                                                             "demcheck.laws.normal_force.normal_force": 2}
 
 
 def test_warmup_in_two_processes_fills_the_cache_the_suite_loads(tmp_path):

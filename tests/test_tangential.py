@@ -9,9 +9,10 @@ from hypothesis import strategies as st
 
 from demcheck import case as C
 from demcheck.errors import ConfigError
-from demcheck.reference import collision3d, tangential
+from demcheck.reference import collision3d
+from demcheck.laws import tangential
 from demcheck.reference.collision import auto_dt, collide
-from demcheck.reference.model import resolve
+from demcheck.laws.model import resolve
 
 from .conftest import CASES
 from .helpers import oblique_case
@@ -199,7 +200,7 @@ def test_maw_truncation_a_dissipative_slip_at_onset_that_unloads_sticks():
     and slips that way, as the verlet method shows at every step: 0.90772, 0.907945, 0.907952 at t_c/500, /5000,
     /20000. The adaptive answer must be the last within 2e-5 (the verlet's own change from /5000 to /20000 is
     7e-6; the old error was 0.055)."""
-    from demcheck.reference.model import characteristic_time
+    from demcheck.laws.model import characteristic_time
 
     case = next(c for c in C.expand(CASES / "benchmarks" / "thornton-e025-tti-overlap.toml")
                 if c.name.endswith("[angle=45]"))
@@ -286,7 +287,7 @@ def test_static_and_kinetic_friction():
 
 
 def test_walton_returns_to_k0_at_reversal_and_saturates():
-    from demcheck.reference.kernels3d import walton_stiffness
+    from demcheck.laws.tangential_force import walton_stiffness
 
     tl = resolve(law_case("walton")).tangential_law.array()
     k0 = tl[tangential.T_K0]

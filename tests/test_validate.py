@@ -21,7 +21,7 @@ def _reference(path: Path, bench=None, cases=None):
     law's own shortfall of its cap (validate reads it off the same adaptive run)."""
     import dataclasses
 
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     rows = []
     for case in cases or expand(path):
@@ -164,7 +164,7 @@ def test_law_shortfall_is_the_laws_rule_on_the_kinematics():
     from scipy.integrate import quad
     from scipy.optimize import brentq
 
-    from demcheck.reference import tangential as T
+    from demcheck.laws import tangential as T
 
     table, (force, tc, v, mu, ramp) = _lsd_contact(4000, 0.4, 1e6)
     vt = 0.05  # a constant slip speed: η_t vt = 20 N, below μ|F| in the middle of the contact only
@@ -610,7 +610,7 @@ ENGINES = ("lammps", "liggghts", "kratos", "yade")
 
 
 def _hertz_by_hand(path: Path) -> dict:
-    """Test 1's Hertz closed forms worked from the case file's numbers alone (not reference/analytic.py): δ_max
+    """Test 1's Hertz closed forms worked from the case file's numbers alone (not laws/analytic.py): δ_max
     from the energy balance ½ m̄ v² = (8/15) Ē √R̄ δ_max^{5/2}, F_max = (4/3) Ē √R̄ δ_max^{3/2}, and the contact
     time 2 ∫ dδ/δ̇ = 2 (δ_max/v) ∫₀¹ du/√(1 − u^{5/2}) by quadrature."""
     import tomllib

@@ -11,7 +11,7 @@ import pytest
 
 from demcheck.case import load
 from demcheck.reference.collision import collide
-from demcheck.reference.model import characteristic_time, resolve
+from demcheck.laws.model import characteristic_time, resolve
 
 CASE = "cases/suite/oblique-walton.toml"
 

@@ -109,7 +109,7 @@ class Case:
     # [engine.NAME] tables: an engine's own settings for the contact ({name: {key: text}}), parsed by that
     # engine's package (engines.base.Engine.native_from_case); here only their shape is checked
     natives: dict = field(compare=False, default_factory=dict)
-    # the case prepared once: reference.model.resolve keeps each pair's resolved model here (a Case is frozen,
+    # the case prepared once: laws.model.resolve keeps each pair's resolved model here (a Case is frozen,
     # so what is resolved from it never changes)
     prepared: dict = field(repr=False, compare=False, default_factory=dict, init=False)
 
@@ -620,7 +620,7 @@ def from_dict(raw: dict) -> Case:
 
     case = build(parts)
     # Model ids and parameters are checked here too, so that nothing runs on a bad case.
-    from .reference import model as _model
+    from .laws import model as _model
 
     with _computable(case):
         _model.check_contact(case)
@@ -634,7 +634,7 @@ def from_dict(raw: dict) -> Case:
 def _collision_scales(case: Case, build, impact) -> Case:
     """The collision moved near its contact, and its run length checked (run_length) — the case's own numbers
     must give a contact time, a flight and a step a double can hold."""
-    from .reference import model as _model
+    from .laws import model as _model
 
     near = _near_contact(case)
     if near is not None:
@@ -758,7 +758,7 @@ def _near_contact(case: Case) -> tuple[Particle, ...] | None:
     tau, touches = free_flight(case)
     if not touches:
         return None
-    from .reference.model import characteristic_time, resolve
+    from .laws.model import characteristic_time, resolve
 
     shift = tau - MAX_FLIGHT * characteristic_time(resolve(case))
     if not shift > 0:
@@ -1016,7 +1016,7 @@ def run_length(case: Case, dt: float | None = None, length: float = 1.0, model=N
     steps is a ConfigError naming what makes the run long: the free flight (``flight``: its key and value,
     default the first particle's position) or the step (``dt`` given here: --dt; run.dt; the auto dt's
     run.steps_per_contact)."""
-    from .reference.model import characteristic_time, resolve
+    from .laws.model import characteristic_time, resolve
 
     model = model or resolve(case)
     t_c = characteristic_time(model)
@@ -1063,8 +1063,8 @@ def packing_step(case: Case, steps_per_contact: int | None = None) -> float:
     of run.dt)."""
     if case.run.dt and steps_per_contact is None:
         return case.run.dt
-    from .reference.contact import pair_of
-    from .reference.model import models_of
+    from .laws.contact import pair_of
+    from .laws.model import models_of
 
     normal, _ = models_of(case)
     g = float(np.linalg.norm(case.run.gravity)) or 9.81

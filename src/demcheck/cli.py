@@ -279,7 +279,7 @@ def models(model_id, as_json, engine, radius, density, speed):
             sys.exit(1)
         return
     from .engines import mapping, registry as engine_registry
-    from .reference import normal, tangential
+    from .laws import normal, tangential
 
     def rows(registry, slot):
         return [{"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),

@@ -18,7 +18,7 @@ def main(argv: list[str]) -> int:
     from demcheck import case as C
     from demcheck.inputs.common import DUMP_COLUMNS, DUMP_FILE
     from demcheck.reference import collision3d
-    from demcheck.reference.model import resolve
+    from demcheck.laws.model import resolve
 
     case = C.from_dict(d["case"])
     res = collision3d.collide(case, resolve(case), "verlet", dt=d["dt"],

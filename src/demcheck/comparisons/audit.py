@@ -25,9 +25,9 @@ from ..errors import ConfigError, DemcheckError
 from ..io import number
 from ..inputs import script as deck_script
 from ..reference import collision3d
-from ..reference.model import resolve
-from ..reference.normal import HYSTERETIC
-from ..reference.tangential import NONE, SPRING, VISCOUS_SLIDING
+from ..laws.model import resolve
+from ..laws.normal import HYSTERETIC
+from ..laws.tangential import NONE, SPRING, VISCOUS_SLIDING
 from ..engines import registry
 from ..engines.collide import collide, twin_states
 from ..engines.mapping import native_summary, twin_model

@@ -32,7 +32,7 @@ from ..case import Case
 from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted, UnsupportedByEngine
 from ..reference.collision import characteristic_time, collide
-from ..reference.model import resolve
+from ..laws.model import resolve
 
 METRICS = ("restitution", "contact_time", "max_overlap", "peak_force")
 OBLIQUE_METRICS = ("tangential_restitution", "rebound_angular_velocity")  # in the suite's units
@@ -397,7 +397,7 @@ def rayleigh_time(case: Case) -> float:
 
 def hertz_time(case: Case) -> float:
     """The exact elastic Hertz contact time at the case's impact speed (2.868266 (m̄²/(R̄Ē²v))^{1/5})."""
-    from ..reference.analytic import HERTZ_DURATION_CONSTANT
+    from ..laws.analytic import HERTZ_DURATION_CONSTANT
 
     model = resolve(case)
     p = model.pair

@@ -33,7 +33,7 @@ CLOSED_FORM_RTOL = 1e-6
 def static_overlaps(case, x) -> list[tuple[float, float]] | None:
     """(overlap, closed form) of every load-bearing contact of a settled column or floor layer: each contact
     carries the weight above it, δ = (F/k)^{1/a} on the law's loading branch. None for other layouts."""
-    from ..reference.normal import NormalLaw
+    from ..laws.normal import NormalLaw
     from ..reference.packing import resolve_laws
 
     layout = case.packing.layout if case.packing else None
@@ -140,7 +140,7 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry = {"case": case.name, "file": str(file), "kind": "packing", "case_hash": case.hash, "sources": {},
              "comparisons": [],
              "curves": {}, "series": [], "packing": {}}
-    from ..reference.model import models_of
+    from ..laws.model import models_of
 
     normal, tangential = models_of(case)
     entry["model"] = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}

@@ -28,7 +28,7 @@ from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference import health
-from ..reference.model import resolve
+from ..laws.model import resolve
 
 # steps per elastic contact time, coarse to fine: the search grid
 GRID = (1, 1.5, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 100)

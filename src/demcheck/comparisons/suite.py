@@ -34,7 +34,7 @@ from ..errors import DemcheckError, EngineInterrupted
 from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
-from ..reference.model import resolve
+from ..laws.model import resolve
 from . import curves, dispatch, verdicts
 
 SERIES_POINTS = 400

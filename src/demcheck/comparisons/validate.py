@@ -77,7 +77,7 @@ def impact_of(case) -> Impact:
     ``contact.friction_kinetic``, ``contact.friction``, else the materials' mixed): the e the laws are
     calibrated to and the μ the force history measures the Coulomb cap with."""
     from ..case import incidence
-    from ..reference.model import models_of, resolve
+    from ..laws.model import models_of, resolve
 
     p0 = case.particles[0]
     vn, vt = incidence(case)
@@ -193,8 +193,8 @@ def law_shortfall(model, contact: dict, events) -> float:
     short of the cap where η_t|v_t| < μ|F_n|. Every other Coulomb law's force reaches the cap under a sustained
     slip (0: its first stick is the stick a source's force history measures). ``model``: the case's
     ResolvedModel."""
-    from ..reference.kernels3d import eta_of
-    from ..reference.tangential import VISCOUS_SLIDING
+    from ..laws.tangential_force import eta_of
+    from ..laws.tangential import VISCOUS_SLIDING
 
     law = model.tangential_law
     if law.family != VISCOUS_SLIDING:
@@ -293,7 +293,7 @@ class Limit:
 
 
 def _hertz(metric: str):
-    from ..reference import analytic
+    from ..laws import analytic
 
     def value(c: Impact, m: dict, s: float = 0.0) -> float:
         p = c.pair  # the case's resolved pair
@@ -737,8 +737,8 @@ def _needs_history(bench: Benchmark, imp: Impact) -> bool:
 def _law_short(case, run_of) -> float:
     """law_shortfall of the case's law on the reference's adaptive run (run only for a law that can fall short of
     its cap: viscous sliding); NaN without a run to read."""
-    from ..reference.model import resolve
-    from ..reference.tangential import VISCOUS_SLIDING
+    from ..laws.model import resolve
+    from ..laws.tangential import VISCOUS_SLIDING
 
     model = resolve(case)
     if model.tangential_law.family != VISCOUS_SLIDING:

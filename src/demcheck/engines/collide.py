@@ -53,7 +53,7 @@ def setting(case: Case, engine: str, dt: float | None = None):
     API's collide all take it from here, so that the deck written is the deck run."""
     native = registry.get(engine).case_native(case)
     if native is not None and not dt and not case.run.dt:
-        from ..reference.model import characteristic_time, resolve
+        from ..laws.model import characteristic_time, resolve
 
         dt = characteristic_time(twin_model(resolve(case), native)) / case.run.steps_per_contact
     return native, dt or None
@@ -228,7 +228,7 @@ def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
     off its states exactly as an engine's is (states.restate: the bodies' forces with their weights, as an
     engine dumps them, read back less the weights)."""
     from ..reference import collision3d
-    from ..reference.model import resolve
+    from ..laws.model import resolve
 
     mp = contact_mapping(case, engine, native)
     model = twin_model(resolve(case), mp.require())

@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..case import Case
-from ..reference.model import ResolvedModel, resolve
+from ..laws.model import ResolvedModel, resolve
 from . import registry
 from .base import APPROXIMATE, EXACT, NATIVE, NONE_, Mapping, Native, refused, worst
 
@@ -91,8 +91,8 @@ def table(examples: list[tuple[str, str]] | None = None) -> list[dict]:
     """The mapping of every registered model for ``demcheck models`` and docs/models.md: each normal model
     with tangential none, each tangential model with its natural normal partner, on the glass pair."""
     from ..case import apply_overrides, from_dict
-    from ..reference import normal, tangential
-    from ..reference.model import resolve
+    from ..laws import normal, tangential
+    from ..laws.model import resolve
 
     import copy
     import tomllib

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..case import Case, run_length
 from ..errors import DemcheckError, UnsupportedByEngine
-from ..reference.model import ResolvedModel, resolve
+from ..laws.model import ResolvedModel, resolve
 
 DUMP_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
                 "fx", "fy", "fz", "tqx", "tqy", "tqz")

@@ -27,9 +27,10 @@ examples, and ``rolling``, ``twisting``, ``adhesion`` and ``heat`` laws write th
   declaration order as float64 (a bool as 0.0/1.0, an int as its float) and back, exactly.
 
 * **The engines map records by their ids** (``contact.damping.id == "quarter"``), never by exponents or by the
-  kernels' family numbers: an engine that cannot express a record refuses it by naming its slot and id.
+  kernels' family numbers: an engine that cannot express a record refuses the mapping with its reason.
 
-* **The compiled force function** of a law lives in the law's module, ``@njit(cache=KERNEL_CACHE)``, named
+* **The compiled force function** of a new law lives in the law's module (or, where the records must import
+  without numba, in ``<family>_force.py`` beside it), ``@njit(cache=KERNEL_CACHE)``, named
   ``<id>_<slot>_force``, and takes the record's ``array()`` first, then the contact's scalars and its history
   slice, and returns its contribution:
 
@@ -42,6 +43,11 @@ examples, and ``rolling``, ``twisting``, ``adhesion`` and ``heat`` laws write th
 
   Numba compiles a function once per set of argument types: pass numbers as float64 and arrays as arrays
   (docs/architecture.md, "Compiled kernels, one specialisation each").
+
+  The seed's normal, damping and tangential laws predate this convention: their compiled functions
+  (``normal_force.py``, ``tangential_force.py``) read the kernels' composed arrays, ``NormalLaw.array()``
+  (normal + damping) and ``TangentialLaw.array()``, which ``NormalLaw.from_slots`` / ``TangentialLaw.from_slot``
+  build from the records and ``slots()`` / ``slot()`` turn back into them, exactly.
 
 A law module registers its record classes (the subclass statement does it) and, for the users' names, its
 seed models in its slot's :class:`~demcheck.laws.registry.Registry`.

@@ -19,7 +19,7 @@ from ..errors import ConfigError, DemcheckError
 from ..metrics import NORMAL_METRICS, from_stepped, rate_energy
 from . import health, kernels as K
 from .collision import Geometry1D, collide, is_one_dimensional
-from .model import characteristic_time, resolve
+from ..laws.model import characteristic_time, resolve
 from .outcome import MESSAGES, ROW_BYTES_1D, STATUS, auto_dt, time_to_contact, verlet_capacity
 
 

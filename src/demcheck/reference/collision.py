@@ -22,7 +22,7 @@ from ..case import Case
 from ..errors import ConfigError
 from ..result import Result
 from . import health, kernels
-from .model import ResolvedModel, characteristic_time, resolve
+from ..laws.model import ResolvedModel, characteristic_time, resolve
 from .outcome import (MESSAGES, ROW_BYTES_1D, STATUS, auto_dt, judge, time_to_contact,  # noqa: F401 - the solvers'
                       verlet_capacity)  # shared names, re-exported for callers of this module
 

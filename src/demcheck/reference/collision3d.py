@@ -10,9 +10,9 @@ import numpy as np
 from ..case import Case
 from ..errors import ConfigError
 from ..result import Result
-from . import kernels, kernels3d as k3
-from .model import ResolvedModel
-from .tangential import WALTON
+from . import adaptive3d, kernels, kernels3d as k3, verlet3d
+from ..laws.model import ResolvedModel
+from ..laws.tangential import WALTON
 
 # The seed's own rules: lever arms to the contact point (R − δ/2) for slip velocity and torque; in the
 # verlet method the history is rotated into the new tangent plane keeping its length. A wall's slip arm is the
@@ -64,7 +64,7 @@ def initial_state(case: Case) -> np.ndarray:
 
 def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = None, rtol: float | None = None,
             rules: dict | None = None) -> Result:
-    from .model import characteristic_time
+    from ..laws.model import characteristic_time
     from .outcome import MESSAGES, ROW_BYTES_3D, STATUS, auto_dt, judge, time_to_contact, verlet_capacity
 
     t_c = characteristic_time(model)
@@ -89,7 +89,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         f_scale = model.pair.m_eff * v / t_c
         scales = np.concatenate([np.full(3, l_scale), np.full(3, v_scale), np.full(3, v_scale / r0)] * 2
                                 + [np.full(3, f_scale if model.tangential_law.family == WALTON else l_scale)])
-        status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
+        status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
         asked = rtol
         floor = _round_off_floor(rec[:n], l_scale)
         while STATUS[status] == "too-many-steps" and rtol < floor <= RTOL_RELAX_CEILING:
@@ -97,7 +97,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
             # above the round-off floor (then a decade more while the points still run out). A floor above the
             # ceiling (a tiny impact speed) is the user's to decide: the message says to raise run.rtol
             rtol = min(max(10.0 * rtol, 10.0 ** math.ceil(math.log10(floor))), RTOL_RELAX_CEILING)
-            status, n, rec, ne, ev_t, ev_c = k3.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
+            status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
             floor = max(floor, _round_off_floor(rec[:n], l_scale))
         names = {**kernels.EVENT_NAMES, **k3.EVENT_NAMES_3D}
         idx = np.searchsorted(rec[:, k3.C_T], ev_t)
@@ -111,7 +111,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         if not (dt > 0) or not math.isfinite(dt):
             raise ConfigError("--dt", dt, "must be > 0 (s) and finite")
         capacity = verlet_capacity(case, dt, dt_given, t_contact, t_c, t_max, ROW_BYTES_3D)
-        status, n, rec = k3.verlet_3d(y0, nl, tl, geo, rul, dt, t_max, capacity)
+        status, n, rec = verlet3d.verlet_3d(y0, nl, tl, geo, rul, dt, t_max, capacity)
         events, used_dt, rtol = None, dt, None
     else:
         raise ConfigError("--method", method, "must be adaptive or verlet")

@@ -5,9 +5,9 @@ Used by the tests (closed form against converged integration) and by the verific
 
 from __future__ import annotations
 
-from . import analytic
-from .model import ResolvedModel
-from .normal import HYSTERETIC
+from ..laws import analytic
+from ..laws.model import ResolvedModel
+from ..laws.normal import HYSTERETIC
 
 
 def closed_form_metrics(model: ResolvedModel) -> dict:

@@ -118,7 +118,7 @@ def check(result, case, model=None, min_steps: int = MIN_STEPS) -> tuple[str, st
     """:func:`health` of a time-stepped result of ``case``: the elastic contact time of its seed model, its
     smaller radius, and its impact energy (translation, tangential motion and spin: the units of the
     suite's energy metric, :func:`impact_scales`)."""
-    from .model import characteristic_time, resolve
+    from ..laws.model import characteristic_time, resolve
 
     model = model or resolve(case)
     return health(result, characteristic_time(model), smallest_radius(case), min_steps,

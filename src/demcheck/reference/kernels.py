@@ -1,6 +1,7 @@
-"""Compiled (numba, cached on disk) pure force laws and the 1-D normal-impact integrators.
+"""Compiled (numba, cached on disk) 1-D normal-impact integrators, adaptive and verlet, and many collisions at once.
 
-The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, limit].
+The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, limit]; its force is
+laws/normal_force.py's.
 
 State of the 1-D problem: δ (overlap, > 0 in contact) and r = δ̇ (approach rate); m̄ δ̈ = −F + m̄ a_n.
 """
@@ -13,13 +14,14 @@ import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
+from ..laws.normal_force import (L_A, L_B, L_ETA, L_FAMILY, L_K, L_KL, L_LIMIT, hls_unloading, normal_force, spow,
+                                 viscoelastic_force)
 from ..metrics import stepped
 from .health import reading
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
                          illinois_step, illinois_trial, resume, shrink, solution, stage2, stage3, stage4, stage5,
                          stage6)
 
-L_FAMILY, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
 
 # modes of the piecewise-smooth normal law (adaptive method)
 M_PRE, M_VE, M_LOAD, M_UNLOAD, M_FREE = 0, 1, 2, 3, 4
@@ -30,56 +32,6 @@ EVENT_NAMES = {EV_START: "contact_start", EV_END: "contact_end", EV_FORCE_END: "
                EV_REENTER: "force_restart"}
 # status codes
 ST_OK, ST_TOLERANCE, ST_STEPS, ST_NO_CONTACT, ST_NO_SEPARATION, ST_UNRESOLVED = 0, 1, 2, 3, 4, 5
-
-
-@njit(cache=KERNEL_CACHE, inline="always")
-def spow(x, p):
-    """Sign-preserving power; p = 0 gives 1 (so LSD's dashpot stays linear through δ = 0). The exponents the
-    laws use (1, 1/2, 3/2, 1/4) without a pow call: the packing solver's inner loop calls this per contact
-    (sqrt is correctly rounded, pow to within an ulp: the results agree to that)."""
-    if p == 0.0:
-        return 1.0
-    a = abs(x)
-    if p == 1.0:
-        y = a
-    elif p == 0.5:
-        y = math.sqrt(a)
-    elif p == 1.5:
-        y = a * math.sqrt(a)
-    elif p == 0.25:
-        y = math.sqrt(math.sqrt(a))
-    else:
-        y = a**p
-    return y if x >= 0.0 else -y
-
-
-@njit(cache=KERNEL_CACHE, inline="always")
-def hls_unloading(law, dmax):
-    """(K_U, δ₀) for the largest overlap reached so far."""
-    kl = law[L_KL]
-    ku = law[L_KU] if law[L_KU] > 0.0 else kl + law[L_S] * kl * dmax
-    return ku, dmax * (1.0 - kl / ku)
-
-
-@njit(cache=KERNEL_CACHE)
-def viscoelastic_force(law, delta, rate):
-    return law[L_K] * spow(delta, law[L_A]) + law[L_ETA] * spow(delta, law[L_B]) * rate
-
-
-@njit(cache=KERNEL_CACHE)
-def normal_force(law, delta, rate, dmax):
-    """Total normal force (+ repulsive) of a contact with overlap δ > 0, approach rate δ̇ and, for the
-    hysteretic law, the largest overlap so far (the history). No force without overlap."""
-    if delta <= 0.0:
-        return 0.0
-    if law[L_FAMILY] == 1.0:
-        ku, d0 = hls_unloading(law, dmax)
-        f = min(law[L_KL] * delta, ku * (delta - d0))
-        return max(f, 0.0)
-    f = viscoelastic_force(law, delta, rate)
-    if law[L_LIMIT] != 0.0 and f < 0.0:
-        return 0.0
-    return f
 
 
 # ----------------------------------------------------------------------------- adaptive (DP5(4))

@@ -9,7 +9,7 @@ from ..case import Case, free_flight
 from ..errors import ConfigError
 from ..result import Result
 from . import health, kernels
-from .model import ResolvedModel, characteristic_time, resolve
+from ..laws.model import ResolvedModel, characteristic_time, resolve
 
 STATUS = {
     kernels.ST_OK: "ok",

@@ -26,16 +26,27 @@ from numba import njit, prange
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .. import KERNEL_CACHE
-from .kernels import L_LIMIT, normal_force
-from .kernels3d import (ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, eta_of,
-                        kt_of, project_history, return_map, slip_surface, spring_slip, tangential_force,
-                        turn_history, wall_arm, walton_reverses, walton_stiffness)
-from .tangential import LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON, ZZY
+from ..laws.normal_force import L_LIMIT, normal_force
+from ..laws.tangential_force import (eta_of, kt_of, return_map, slip_surface, tangential_force, walton_reverses,
+                                     walton_stiffness)
+from .kernels3d import ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, wall_arm
+from .verlet3d import project_history, spring_slip, turn_history
+from ..laws.tangential import (LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON,
+                               ZZY, TangentialLaw)
 
-# per contact (a row beside its neighbour-list entry): the tangential history (3); a spring law with μk < μs
-# also its slip state (1); Walton's the load at the last reversal (3) and the last nonzero slip velocity (3).
-# Rows are only as wide as the packing's laws need (memory and bandwidth)
-HIST_WIDTH, SLIP_HIST_WIDTH, WALTON_HIST_WIDTH = 3, 4, 9
+# per contact (a row beside its neighbour-list entry): the tangential record's history (history_size: the
+# displacement's 3; Walton's 9 with the load at the last reversal and the last nonzero slip velocity), at least 3;
+# a spring law with μk < μs also its slip state (1). Rows are only as wide as the packing's laws need (memory
+# and bandwidth)
+HIST_WIDTH, SLIP_HIST_WIDTH = 3, 4
+
+
+def history_width(records) -> int:
+    """The columns of a contact's state row for the packing's tangential records (laws/tangential.py)."""
+    width = max([HIST_WIDTH, *(r.history_size for r in records)])
+    if any(r.id in ("spring", "sqrt_spring") and r.mu_k != r.mu_s for r in records):
+        width = max(width, SLIP_HIST_WIDTH)
+    return width
 
 
 @njit(cache=KERNEL_CACHE)
@@ -700,9 +711,9 @@ def species_of(case) -> tuple[np.ndarray, list[int]]:
 def resolve_laws(case):
     """Per species pair (and per species against the walls) the normal and tangential law arrays."""
     from ..errors import ConfigError
-    from .contact import pair_of
-    from .model import models_of
-    from .normal import NormalLaw
+    from ..laws.contact import pair_of
+    from ..laws.model import models_of
+    from ..laws.normal import NormalLaw
 
     normal, tangential = models_of(case)
     sp, rep = species_of(case)
@@ -752,12 +763,8 @@ class PackState:
         self.rad = np.array([p.radius for p in case.particles], float)
         self.mass = np.array([case.mass(i) for i in range(n)], float)
         _, _, laws_t, _, wall_t = resolve_laws(case)
-        def any_law(test):
-            return bool(np.any(test(laws_t)) or (case.walls and np.any(test(wall_t))))
-
-        walton = any_law(lambda t: t[..., T_FAMILY] == WALTON)
-        two_mu = any_law(lambda t: (t[..., T_FAMILY] == SPRING) & (t[..., T_MU_K] != t[..., T_MU_S]))
-        width = WALTON_HIST_WIDTH if walton else SLIP_HIST_WIDTH if two_mu else HIST_WIDTH
+        rows = [*laws_t.reshape(-1, T_SIZE), *(wall_t if case.walls else ())]
+        width = history_width([TangentialLaw.from_array(t).slot() for t in rows])
         # the contact states (history, largest overlap): particle i's with wall k in row i·n_walls + k, then
         # each pair of the Verlet list (compressed rows; built by run()) beside its entry
         self.start = np.zeros(n + 1, np.int64)

@@ -2,8 +2,9 @@
 
 The engines' normal force is F = F_ne(δ) + η(δ) δ̇ with F_ne = k δ^a; their damping styles differ only in
 η(δ) = c δ^b, and their tangential dashpots reuse η(δ) times a factor. These helpers turn an engine's
-coefficients into the reference's :class:`NormalLaw` / :class:`TangentialLaw` numbers, formula by formula
-as the engines' documentation states them (and as the engine tests check against the binaries). Which
+coefficients into records of the contact's slots (laws/base.py) and those into the reference's
+:class:`NormalLaw` / :class:`TangentialLaw` numbers, formula by formula as the engines' documentation states
+them (and as the engine tests check against the binaries). Which
 engine keyword maps to which helper is the engine package's business (engines/<name>/mapping.py; the
 damping styles in engines/damping.py).
 """
@@ -12,8 +13,10 @@ from __future__ import annotations
 
 import math
 
-from .normal import VISCOELASTIC, NormalLaw
-from .tangential import NONE, SPRING, TRUNC_MAW, TRUNC_SPRING, VISCOUS_SLIDING, TangentialLaw
+from ..laws.damping import damping_of
+from ..laws.normal import ELASTIC_BY_EXPONENT, NormalLaw
+from ..laws.tangential import (TRUNC_MAW, TRUNC_SPRING, NoTangential, SpringTangential, SqrtSpringTangential,
+                               TangentialLaw, ViscousSlidingTangential)
 
 
 def damping_ratio(e: float) -> float:
@@ -24,7 +27,8 @@ def damping_ratio(e: float) -> float:
 
 
 def normal_law(k_el: float, a: float, c: float, b: float, limit: bool) -> NormalLaw:
-    return NormalLaw(VISCOELASTIC, k=k_el, a=a, eta=c, b=b, limit=limit)
+    """F_ne = k_el δ^a (the hooke or hertz record) with the dashpot c δ^b δ̇ (its damping record)."""
+    return NormalLaw.from_slots(ELASTIC_BY_EXPONENT[a](k=k_el), damping_of(c, b), limit)
 
 
 def restitution_for_eta(c_over_root: float, factor: float) -> float:
@@ -40,18 +44,20 @@ def restitution_for_eta(c_over_root: float, factor: float) -> float:
 
 def tangential_viscous_sliding(x_t: float, mu: float, r_eff: float, m_eff: float) -> TangentialLaw:
     """F_t = −min(x_t η(δ)|v_t|, μ|Fn|) v̂_t with the normal law's damping η(δ)."""
-    return TangentialLaw(VISCOUS_SLIDING, eta=x_t, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r_eff, m_eff=m_eff)
+    return TangentialLaw.from_slot(ViscousSlidingTangential(eta=x_t, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r_eff,
+                                                            m_eff=m_eff))
 
 
 def tangential_spring(kt: float, sqrt_law: bool, x_t: float, mu: float, truncation: int, r_eff: float,
                       m_eff: float) -> TangentialLaw:
     """−Kt ξ − x_t η(δ) v_t with Kt = kt (constant) or kt √(R̄δ), Coulomb-limited by ``truncation``."""
-    return TangentialLaw(SPRING, kt=kt, kt_sqrt=sqrt_law, eta=x_t, eta_normal=True, mu_s=mu, mu_k=mu,
-                         truncation=truncation, r_eff=r_eff, m_eff=m_eff)
+    record = SqrtSpringTangential if sqrt_law else SpringTangential
+    return TangentialLaw.from_slot(record(kt=kt, eta=x_t, eta_normal=True, mu_s=mu, mu_k=mu, truncation=truncation,
+                                          r_eff=r_eff, m_eff=m_eff))
 
 
 def no_friction() -> TangentialLaw:
-    return TangentialLaw(NONE)
+    return TangentialLaw.from_slot(NoTangential())
 
 
 __all__ = ["TRUNC_MAW", "TRUNC_SPRING", "damping_ratio", "normal_law", "no_friction", "restitution_for_eta",

@@ -23,9 +23,9 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import NONE, TangentialLaw
+from ...laws.model import ResolvedModel
+from ...laws.normal import NormalLaw
+from ...laws.tangential import TangentialLaw
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 
 HERTZ = "DEM_D_Hertz_viscous_Coulomb"
@@ -42,34 +42,40 @@ def linear_kn(young_eff: float, r_eff: float, wall: bool) -> float:
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    """The contact's slot records, by id: normal hertz with damping none | quarter, or hooke with none |
+    constant; tangential none."""
+    contact, pair = model.contact, model.pair
+    normal, damp = contact.normal, contact.damping
+    eta = getattr(damp, "eta", 0.0)
     m, r = pair.m_eff, pair.r_eff
     nid = model.normal.id
     reasons: list[str] = []
     fid = EXACT
-    if nl.family == HYSTERETIC:
+    if normal.id == "hls":
         return refused("kratos", "Kratos DEM 10.4.4 has no linear hysteretic (HLS) discontinuum law")
-    if tl.family != NONE:
+    if normal.id not in ("hooke", "hertz"):
+        return refused("kratos", f"no Kratos DEM discontinuum law for the normal record '{normal.id}'")
+    if contact.tangential.id != "none":
         return refused("kratos", f"Kratos' tangential force is part of its normal law (incremental spring Kt = "
                                   f"4G*Kn/E*, dashpot 2γ√(m̄Kt), μ decaying with the slip speed, the Coulomb cap "
                                   f"split between spring and dashpot in its own way); no seed tangential law, "
                                   f"'{model.tangential.id}' included, has that form")
-    if nl.a == 1.5 and (nl.eta == 0.0 or nl.b == 0.25):
+    if normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "quarter")):
         law = HERTZ
-        young_eff = nl.k / (4.0 / 3.0 * math.sqrt(r))  # F = (4/3)E*√R̄ δ^3/2
-        gamma = nl.eta / (2.0 * math.sqrt(2.0 * m * young_eff * math.sqrt(r))) if nl.eta > 0 else 0.0
+        young_eff = normal.k / (4.0 / 3.0 * math.sqrt(r))  # F = (4/3)E*√R̄ δ^3/2
+        gamma = eta / (2.0 * math.sqrt(2.0 * m * young_eff * math.sqrt(r))) if eta > 0 else 0.0
         kn_note = f"E* = {young_eff:.10g} Pa (Kn = 2E*√(R̄δ), F = ⅔Knδ)"
-    elif nl.a == 1.0 and nl.b == 0.0:
+    elif normal.id == "hooke" and damp.id in ("none", "constant"):
         law = LINEAR
-        young_eff = nl.k / linear_kn(1.0, r, pair.wall)
-        gamma = nl.eta / (2.0 * math.sqrt(m * nl.k)) if nl.eta > 0 else 0.0
+        young_eff = normal.k / linear_kn(1.0, r, pair.wall)
+        gamma = eta / (2.0 * math.sqrt(m * normal.k)) if eta > 0 else 0.0
         kn_note = (f"E* = {young_eff:.10g} Pa, chosen so that Kratos' Kn = "
-                   f"{'' if pair.wall else '1.432·'}π·0.31225·R̄·E* is the seed's k = {nl.k:.10g} N/m")
+                   f"{'' if pair.wall else '1.432·'}π·0.31225·R̄·E* is the seed's k = {normal.k:.10g} N/m")
     else:
-        return refused("kratos", f"no Kratos DEM discontinuum law has the δ^{nl.a:g} spring with a δ^{nl.b:g} "
-                                  "dashpot (Hertz_viscous_Coulomb damps with 2γ√(m̄Kn) ∝ δ^1/4, "
+        return refused("kratos", f"no Kratos DEM discontinuum law has the δ^{normal.exponent:g} spring with a "
+                                  f"δ^{damp.exponent:g} dashpot (Hertz_viscous_Coulomb damps with 2γ√(m̄Kn) ∝ δ^1/4, "
                                   "Linear_viscous_Coulomb with a constant)")
-    if nl.eta > 0.0 and not nl.limit:
+    if eta > 0.0 and not contact.limit_force:
         fid = APPROXIMATE
         reasons.append("Kratos holds the total normal force at ≥ 0 (its dashpot is cut where it would pull); "
                        f"the seed's '{nid}' without limit_force lets it pull at the end of the contact")

@@ -8,76 +8,93 @@ import math
 from dataclasses import replace
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
-                                     VISCOUS_SLIDING, WALTON, ZZY, TangentialLaw)
+from ...laws.model import ResolvedModel
+from ...laws.normal import NormalLaw
+from ...laws.tangential import TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, TangentialLaw
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import HUGE_MU, SLIDING_XT, mu_of
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
-    m, r = pair.m_eff, pair.r_eff
-    reasons: list[str] = []
-    keywords: dict[str, str] = {}  # an approximate reason → the pair_coeff keyword it is about
-    comments: list[str] = []
-    nid = model.normal.id
-    if nl.family == HYSTERETIC:
-        return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
+    """The contact's slot records, by id: normal hooke | hertz, damping none | constant | sqrt | quarter,
+    tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
+    contact = model.contact
     nat = Native("lammps", normal="", limit=model.limit_force)
-    fid = EXACT
-    # the law's shape picks the style, never its id: F = k δ^a + c δ^b δ̇
-    if nl.a not in (1.0, 1.5) or (nl.a == 1.0 and nl.eta > 0.0 and nl.b != 0.0):
-        return refused("lammps", f"no LAMMPS normal model has the δ^{nl.a:g} spring with a δ^{nl.b:g} dashpot")
-    if nl.a == 1.0:
-        nat.normal, nat.normal_args = "hooke", (nl.k,)
-        if nid == "lsd" and "eta_n" not in cp and pair.restitution is not None and nl.eta > 0:
-            nat.damping, nat.damping_coeff = "coeff_restitution", pair.restitution
-            comments.append(f"hooke Kn = {nl.k:.10g} N/m; damping coeff_restitution e = {pair.restitution:g} "
-                            "gives ηn = 2β(e)√(m̄Kn), LSD's own")
-        else:
-            nat.damping, nat.damping_coeff = "velocity", nl.eta
-            comments.append(f"hooke Kn = {nl.k:.10g} N/m; damping velocity η0 = ηn = {nl.eta:.10g} N·s/m")
-    else:
-        k_hz_coef = nl.k / math.sqrt(r)  # (4/3)Ē
-        nat.normal, nat.normal_args = "hertz", (k_hz_coef,)
-        comments.append(f"hertz k = (4/3)Ē = {k_hz_coef:.10g} Pa, so that F = k√R̄ δ^3/2")
-        if nl.eta == 0.0:
-            nat.damping, nat.damping_coeff = "velocity", 0.0
-        elif nl.b == 0.5:
-            eta0 = nl.eta / (m * math.sqrt(r))
-            nat.damping, nat.damping_coeff = "viscoelastic", eta0
-            comments.append(f"damping viscoelastic η0 = ηn/(m̄√R̄) = {eta0:.10g} 1/(s·m), per pair "
-                            f"(m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
-        elif nl.b == 0.25:
-            e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
-            if not (0.0 < e_prime < 1.0):
-                return refused("lammps", f"TTIn's ηn = {nl.eta:g} is at or above what coeff_restitution "
-                                          "can express (e′ would be ≤ 0)")
-            nat.damping, nat.damping_coeff = "coeff_restitution", e_prime
-            comments.append(f"damping coeff_restitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} "
-                            "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of docs/models.md, Engine twins)")
-        else:
-            return refused("lammps", f"no LAMMPS damping style has the δ^{nl.b:g} law")
+    comments: list[str] = []
+    refusal = _map_normal(model, contact, cp, nat, comments)
+    if refusal is not None:
+        return refusal
     if model.limit_force:
         comments.append("limit_damping: total normal force ≥ 0 (the collision-time reduction)")
-    # tangential: LAMMPS's dashpot is x_t times the normal damping prefactor η(δ)
-    family = tl.family
-    tid = model.tangential.id
-    eta_n_const = nl.b == 0.0 and nl.eta > 0.0
-    if family == NONE:
+    return _map_tangential(model, contact, nat, comments)
+
+
+def _map_normal(model: ResolvedModel, contact, cp: dict, nat: Native, comments: list[str]) -> Mapping | None:
+    """The normal and damping slots into ``nat`` (None), or the refusal."""
+    normal, damp, pair = contact.normal, contact.damping, model.pair
+    m, r = pair.m_eff, pair.r_eff
+    eta = getattr(damp, "eta", 0.0)
+    if normal.id == "hls":
+        return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
+    if normal.id not in ("hooke", "hertz"):
+        return refused("lammps", f"no LAMMPS normal model for the normal record '{normal.id}'")
+    if normal.id == "hooke" and eta > 0.0 and damp.id not in ("none", "constant"):
+        return refused("lammps", f"no LAMMPS normal model has the δ^{normal.exponent:g} spring with a "
+                                  f"δ^{damp.exponent:g} dashpot")
+    if normal.id == "hooke":
+        nat.normal, nat.normal_args = "hooke", (normal.k,)
+        if model.normal.id == "lsd" and "eta_n" not in cp and pair.restitution is not None and eta > 0:
+            nat.damping, nat.damping_coeff = "coeff_restitution", pair.restitution
+            comments.append(f"hooke Kn = {normal.k:.10g} N/m; damping coeff_restitution e = {pair.restitution:g} "
+                            "gives ηn = 2β(e)√(m̄Kn), LSD's own")
+        else:
+            nat.damping, nat.damping_coeff = "velocity", eta
+            comments.append(f"hooke Kn = {normal.k:.10g} N/m; damping velocity η0 = ηn = {eta:.10g} N·s/m")
+        return None
+    k_hz_coef = normal.k / math.sqrt(r)  # (4/3)Ē
+    nat.normal, nat.normal_args = "hertz", (k_hz_coef,)
+    comments.append(f"hertz k = (4/3)Ē = {k_hz_coef:.10g} Pa, so that F = k√R̄ δ^3/2")
+    if eta == 0.0:
+        nat.damping, nat.damping_coeff = "velocity", 0.0
+    elif damp.id == "sqrt":
+        eta0 = eta / (m * math.sqrt(r))
+        nat.damping, nat.damping_coeff = "viscoelastic", eta0
+        comments.append(f"damping viscoelastic η0 = ηn/(m̄√R̄) = {eta0:.10g} 1/(s·m), per pair "
+                        f"(m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
+    elif damp.id == "quarter":
+        e_prime = twins.restitution_for_eta(eta / math.sqrt(m * normal.k), math.sqrt(5.0))
+        if not (0.0 < e_prime < 1.0):
+            return refused("lammps", f"TTIn's ηn = {eta:g} is at or above what coeff_restitution "
+                                      "can express (e′ would be ≤ 0)")
+        nat.damping, nat.damping_coeff = "coeff_restitution", e_prime
+        comments.append(f"damping coeff_restitution e′ = {e_prime:.17g}: TTIn's ηn = {eta:.10g} "
+                        "N·s/m^5/4 through √5 β(e′)√(m̄K_HZ) (the input transform of docs/models.md, Engine twins)")
+    else:
+        return refused("lammps", f"no LAMMPS damping style has the δ^{damp.exponent:g} law")
+    return None
+
+
+def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[str]) -> Mapping:
+    """The tangential slot into ``nat``: LAMMPS's dashpot is x_t times the normal damping prefactor η(δ)."""
+    tl, damp = contact.tangential, contact.damping
+    eta = getattr(damp, "eta", 0.0)
+    reasons: list[str] = []
+    keywords: dict[str, str] = {}  # an approximate reason → the pair_coeff keyword it is about
+    fid = EXACT
+    nid, tid = model.normal.id, model.tangential.id
+    eta_n_const = damp.id == "constant" and eta > 0.0
+    if tl.id == "none":
         nat.tangential, nat.tangential_args = "linear_nohistory", (0.0, 0.0)
-    elif family in (LTH, ZZY, WALTON):
+    elif tl.id in ("lth", "zzy", "walton"):
         return refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
                                   "(nearest: mindlin_rescale/force, a different law)")
     else:
         mu, f_mu = mu_of(model, reasons)
         mu_reason = reasons[-1] if f_mu == APPROXIMATE else None
         fid = worst(fid, f_mu)
-        if family == SLIDING:
-            if nl.eta == 0.0:
+        if tl.id == "sliding":
+            if eta == 0.0:
                 return refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
                                           "is x_t × the normal damping, and this normal law has none")
             nat.tangential, nat.tangential_args = "linear_nohistory", (SLIDING_XT, mu)
@@ -85,34 +102,34 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             reasons.append(f"simple sliding friction as linear_nohistory with x_t = {SLIDING_XT:g}: "
                            "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
             keywords[reasons[-1]] = "tangential linear_nohistory"
-        elif family in (VISCOUS, VISCOUS_SLIDING):
+        elif tl.id in ("viscous", "viscous_sliding"):
             if tl.eta_normal or not eta_n_const:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
-                                          f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}"
-                                          + (" and has no damping" if nl.eta == 0 else ""))
-            x_t = tl.eta / nl.eta
-            if family == VISCOUS and model.limit_force:
+                                          f"x_t η(δ)); normal '{nid}' damps with δ^{damp.exponent:g}"
+                                          + (" and has no damping" if eta == 0 else ""))
+            x_t = tl.eta / eta
+            if tl.id == "viscous" and model.limit_force:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append("with limit_damping the Coulomb cap μ|Fn| is 0 wherever the normal force is held "
                                "at 0, so the viscous force vanishes there too")
                 keywords[reasons[-1]] = "limit_damping"
             nat.tangential = "linear_nohistory"
-            nat.tangential_args = (x_t, HUGE_MU if family == VISCOUS else mu)
+            nat.tangential_args = (x_t, HUGE_MU if tl.id == "viscous" else mu)
             comments.append(f"linear_nohistory x_t = ηt/ηn = {x_t:.10g}"
-                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if family == VISCOUS else ""))
-        elif family == SPRING:
+                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if tl.id == "viscous" else ""))
+        elif tl.id in ("spring", "sqrt_spring"):
             if tl.eta_normal:  # TTIt: ηt = ηn
-                if not (nl.a == 1.5 and nl.b == 0.25):
+                if not (contact.normal.id == "hertz" and damp.id == "quarter"):
                     return refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")
                 x_t = tl.eta
             elif tl.eta == 0.0:
                 x_t = 0.0
             elif eta_n_const:
-                x_t = tl.eta / nl.eta
+                x_t = tl.eta / eta
             else:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
-                                          f"x_t η(δ)); normal '{nid}' damps with δ^{nl.b:g}")
-            if tl.kt_sqrt:
+                                          f"x_t η(δ)); normal '{nid}' damps with δ^{damp.exponent:g}")
+            if tl.id == "sqrt_spring":
                 nat.tangential, nat.tangential_args = "mindlin", (tl.kt, x_t, mu)
                 comments.append(f"mindlin k_t = {tl.kt:.10g} Pa (Kt = k_t √(R̄δ)), x_t = {x_t:.10g}")
             else:

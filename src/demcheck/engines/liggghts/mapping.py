@@ -7,74 +7,96 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import (LTH, NONE, SLIDING, SPRING, TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, VISCOUS,
-                                     VISCOUS_SLIDING, WALTON, ZZY, TangentialLaw)
+from ...laws.model import ResolvedModel
+from ...laws.damping import NoDamping
+from ...laws.normal import HysteresisNormal, NormalLaw
+from ...laws.tangential import (TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, SpringTangential, SqrtSpringTangential,
+                                TangentialLaw, ViscousSlidingTangential)
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import HUGE_MU, SLIDING_XT, mu_of
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
-    m, r = pair.m_eff, pair.r_eff
-    reasons: list[str] = []
-    keywords: dict[str, str] = {}  # an approximate reason → the pair_style gran keyword it is about
-    comments: list[str] = []
-    nid = model.normal.id
+    """The contact's slot records, by id: normal hooke | hertz | hls, damping none | constant | sqrt | quarter,
+    tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
+    contact = model.contact
     nat = Native("liggghts", normal="", limit=model.limit_force)
-    fid = EXACT
-    p = nat.props
-    if nl.family == HYSTERETIC:
-        if nl.ku == 0.0:
-            return _luding(model, nat)
-        # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
-        nat.normal = "edinburgh"
-        p.update(kl=nl.kl, unloading=nl.ku / nl.kl, adhesion=0.0, pulloff=0.0, surface_energy=0.0,
-                 restitution=1.0)
-        comments.append(f"edinburgh (fixKc on, overlapExponent 1, no adhesion, coefficientRestitution 1): "
-                        f"K_L = 2E*R̄ = {nl.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
-                        f"K_U/K_L = {nl.ku / nl.kl:.17g}")
-        if tl.family != NONE:
-            return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
-                                        "no seed tangential law shares it")
-        nat.tangential = "off"
-        nat.comments = comments
-        return Mapping("liggghts", fid, reasons, nat)
-    # the law's shape picks the model, never its id: F = k δ^a + c δ^b δ̇
-    if nl.a == 1.0 and (nl.eta == 0.0 or nl.b == 0.0):
+    comments: list[str] = []
+    if contact.normal.id == "hls":
+        return _hysteretic(model, nat, comments)
+    refusal = _map_normal(model, contact, nat, comments)
+    if refusal is not None:
+        return refusal
+    if model.limit_force:
+        comments.append("limitForce on: total normal force ≥ 0")
+    return _map_tangential(model, contact, nat, comments)
+
+
+def _hysteretic(model: ResolvedModel, nat: Native, comments: list[str]) -> Mapping:
+    normal, tl = model.contact.normal, model.contact.tangential
+    if normal.ku == 0.0:
+        return _luding(model, nat)
+    # edinburgh, linear (overlapExponent 1), no adhesion, e = 1: loading K_L = 2E*R̄, unloading r·K_L
+    nat.normal = "edinburgh"
+    nat.props.update(kl=normal.kl, unloading=normal.ku / normal.kl, adhesion=0.0, pulloff=0.0,
+                     surface_energy=0.0, restitution=1.0)
+    comments.append(f"edinburgh (fixKc on, overlapExponent 1, no adhesion, coefficientRestitution 1): "
+                    f"K_L = 2E*R̄ = {normal.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
+                    f"K_U/K_L = {normal.ku / normal.kl:.17g}")
+    if tl.id != "none":
+        return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
+                                    "no seed tangential law shares it")
+    nat.tangential = "off"
+    nat.comments = comments
+    return Mapping("liggghts", EXACT, [], nat)
+
+
+def _map_normal(model: ResolvedModel, contact, nat: Native, comments: list[str]) -> Mapping | None:
+    """The normal and damping slots into ``nat`` (None), or the refusal."""
+    normal, damp, pair, p = contact.normal, contact.damping, model.pair, nat.props
+    m, r = pair.m_eff, pair.r_eff
+    eta = getattr(damp, "eta", 0.0)
+    if normal.id == "hooke" and (eta == 0.0 or damp.id in ("none", "constant")):
         nat.normal = "hooke/stiffness"
-        p.update(kn=nl.k, gamman=nl.eta / m, kt=0.0, gammat=0.0)
-        comments.append(f"hooke/stiffness kn = {nl.k:.10g} N/m, gamman = ηn/m̄ = {nl.eta / m:.10g} 1/s (per pair, "
+        p.update(kn=normal.k, gamman=eta / m, kt=0.0, gammat=0.0)
+        comments.append(f"hooke/stiffness kn = {normal.k:.10g} N/m, gamman = ηn/m̄ = {eta / m:.10g} 1/s (per pair, "
                         f"m̄ = {m:.10g} kg)")
-    elif nl.a == 1.5 and (nl.eta == 0.0 or nl.b == 0.5):
+    elif normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "sqrt")):
         nat.normal = "hertz/stiffness"
-        gamman = nl.eta / (m * math.sqrt(r))
-        p.update(kn=nl.k / math.sqrt(r), gamman=gamman, kt=0.0, gammat=0.0)
-        comments.append(f"hertz/stiffness kn = (4/3)Ē = {nl.k / math.sqrt(r):.10g} Pa, gamman = ηn/(m̄√R̄) = "
+        gamman = eta / (m * math.sqrt(r))
+        p.update(kn=normal.k / math.sqrt(r), gamman=gamman, kt=0.0, gammat=0.0)
+        comments.append(f"hertz/stiffness kn = (4/3)Ē = {normal.k / math.sqrt(r):.10g} Pa, gamman = ηn/(m̄√R̄) = "
                         f"{gamman:.10g} (per pair, m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
-    elif nl.a == 1.5 and nl.b == 0.25:
+    elif normal.id == "hertz" and damp.id == "quarter":
         nat.normal = "hertz"
-        e_prime = twins.restitution_for_eta(nl.eta / math.sqrt(m * nl.k), math.sqrt(5.0))
+        e_prime = twins.restitution_for_eta(eta / math.sqrt(m * normal.k), math.sqrt(5.0))
         if not (0.05 < e_prime <= 1.0):
-            return refused("liggghts", f"TTIn's ηn = {nl.eta:g} needs coefficientRestitution e′ = "
+            return refused("liggghts", f"TTIn's ηn = {eta:g} needs coefficientRestitution e′ = "
                                         f"{e_prime:.4g}, outside LIGGGHTS's 0.05 < e ≤ 1")
         # E*, G* as LIGGGHTS mixes the types' moduli (a rigid wall is a type of modulus 1e30 Pa: the same
         # to round-off)
         p.update(restitution=e_prime, youngs_eff=pair.e_eff, shear_eff=pair.g_eff)
-        comments.append(f"hertz coefficientRestitution e′ = {e_prime:.17g}: TTIn's ηn = {nl.eta:.10g} through "
+        comments.append(f"hertz coefficientRestitution e′ = {e_prime:.17g}: TTIn's ηn = {eta:.10g} through "
                         "√5 β(e′)√(m̄K_HZ) (docs/models.md, Engine twins)")
     else:
-        return refused("liggghts", f"no LIGGGHTS model for normal '{nid}'")
-    if model.limit_force:
-        comments.append("limitForce on: total normal force ≥ 0")
-    family = tl.family
-    tid = model.tangential.id
+        return refused("liggghts", f"no LIGGGHTS model for normal '{model.normal.id}'")
+    return None
+
+
+def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[str]) -> Mapping:
+    """The tangential slot into ``nat``."""
+    tl, damp, pair, p = contact.tangential, contact.damping, model.pair, nat.props
+    m = pair.m_eff
+    eta = getattr(damp, "eta", 0.0)
+    reasons: list[str] = []
+    keywords: dict[str, str] = {}  # an approximate reason → the pair_style gran keyword it is about
+    fid = EXACT
+    nid, tid = model.normal.id, model.tangential.id
     stiff = nat.normal == "hooke/stiffness"
-    if family == NONE:
+    if tl.id == "none":
         nat.tangential = "off"
-    elif family in (LTH, ZZY, WALTON):
+    elif tl.id in ("lth", "zzy", "walton"):
         return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
     else:
         mu, f_mu = mu_of(model, reasons)
@@ -82,20 +104,20 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             keywords[reasons[-1]] = "coefficientFriction"
         fid = worst(fid, f_mu)
         p["friction"] = mu
-        if family in (SLIDING, VISCOUS, VISCOUS_SLIDING):
+        if tl.id in ("sliding", "viscous", "viscous_sliding"):
             if not stiff:
                 return refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
                                             f"needs hooke/stiffness, i.e. normal 'lsd' (not '{nid}')")
             nat.tangential = "no_history"
-            if family == SLIDING:
-                p["gammat"] = SLIDING_XT * max(nl.eta, 1.0) / m
+            if tl.id == "sliding":
+                p["gammat"] = SLIDING_XT * max(eta, 1.0) / m
                 fid = worst(fid, APPROXIMATE)
                 reasons.append(f"simple sliding friction as no_history with gammat = {p['gammat']:.4g} 1/s: a "
                                "regularised slider near v_t = 0")
                 keywords[reasons[-1]] = "tangential no_history"
             else:
                 p["gammat"] = tl.eta / m
-                if family == VISCOUS:
+                if tl.id == "viscous":
                     p["friction"] = HUGE_MU
                     if model.limit_force:
                         fid = worst(fid, APPROXIMATE)
@@ -103,53 +125,68 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                                        "held at 0, so the viscous force vanishes there too")
                         keywords[reasons[-1]] = "limitForce on"
                 comments.append(f"no_history gammat = ηt/m̄ = {p['gammat']:.10g} 1/s"
-                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if family == VISCOUS
+                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if tl.id == "viscous"
                                    else ""))
-        elif family == SPRING:
-            nat.tangential = "history"
-            if tl.eta_normal and nl.eta > 0.0:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot
-                # outside the cap (undamped, ηt = ηn = 0, it is DDt's case below on hertz/stiffness)
-                if not (nl.a == 1.5 and nl.b == 0.25):
-                    return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
-                fid = worst(fid, APPROXIMATE)
-                ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
-                reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
-                               "the dashpot lies outside the Coulomb cap (spring-only truncation)")
-                keywords[reasons[-1]] = "model hertz tangential history"
-            elif tl.kt_sqrt:  # DDt on hertz/stiffness
-                if nat.normal != "hertz/stiffness":
-                    return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
-                                                f"Hertz-type; normal '{nid}' is not")
-                if tl.eta > 0.0 and not tl.eta_normal:
-                    return refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
-                p["kt"] = tl.kt
-                nat.tangential_damping = False
-                if tl.truncation == TRUNC_CAP:
-                    fid = worst(fid, APPROXIMATE)
-                    reasons.append("LIGGGHTS truncates the spring at μ|Fn|; the case's truncation = force is the "
-                                   "seed's min() cap, which keeps the spring's extension (they part after a slip "
-                                   "that reverses)")
-                    keywords[reasons[-1]] = "tangential history"
-                comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
-            else:
-                if not stiff:
-                    return refused("liggghts", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' "
-                                                f"(not '{nid}')")
-                p["kt"] = tl.kt
-                p["gammat"] = tl.eta / m
-                nat.tangential_damping = tl.eta > 0.0
-                comments.append(f"hooke/stiffness kt = {tl.kt:.10g} N/m, gammat = ηt/m̄ = {p['gammat']:.10g} 1/s")
-                if tl.truncation != TRUNC_SPRING and tl.eta > 0.0:
-                    fid = worst(fid, APPROXIMATE)
-                    name = {TRUNC_CAP: "force", TRUNC_MAW: "overlap"}[tl.truncation]
-                    reasons.append("LIGGGHTS caps the spring only (truncation = spring: the dashpot is added "
-                                   f"uncapped while sticking and dropped while slipping); the case asks for "
-                                   f"truncation = {name}")
-                    keywords[reasons[-1]] = "tangential history"
+        elif tl.id in ("spring", "sqrt_spring"):
+            spring = _map_spring(model, contact, nat, comments, reasons, keywords)
+            if isinstance(spring, Mapping):
+                return spring
+            fid = worst(fid, spring)
         else:
             return refused("liggghts", f"no LIGGGHTS equivalent of tangential '{tid}'")
     nat.comments = comments
     return Mapping("liggghts", fid, reasons, nat, keywords)
+
+
+def _map_spring(model: ResolvedModel, contact, nat: Native, comments: list[str], reasons: list[str],
+                keywords: dict[str, str]):
+    """A spring tangential record as LIGGGHTS ``tangential history``: its fidelity, or the refusal."""
+    tl, damp, pair, p = contact.tangential, contact.damping, model.pair, nat.props
+    m, nid = pair.m_eff, model.normal.id
+    eta = getattr(damp, "eta", 0.0)
+    stiff = nat.normal == "hooke/stiffness"
+    fid = EXACT
+    nat.tangential = "history"
+    if tl.eta_normal and eta > 0.0:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot
+        # outside the cap (undamped, ηt = ηn = 0, it is DDt's case below on hertz/stiffness)
+        if not (contact.normal.id == "hertz" and damp.id == "quarter"):
+            return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
+        fid = APPROXIMATE
+        ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
+        reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
+                       "the dashpot lies outside the Coulomb cap (spring-only truncation)")
+        keywords[reasons[-1]] = "model hertz tangential history"
+    elif tl.id == "sqrt_spring":  # DDt on hertz/stiffness
+        if nat.normal != "hertz/stiffness":
+            return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
+                                        f"Hertz-type; normal '{nid}' is not")
+        if tl.eta > 0.0 and not tl.eta_normal:
+            return refused("liggghts", "DDt's constant ηt: hertz/stiffness damps with √(R̄δ)")
+        p["kt"] = tl.kt
+        nat.tangential_damping = False
+        if tl.truncation == TRUNC_CAP:
+            fid = APPROXIMATE
+            reasons.append("LIGGGHTS truncates the spring at μ|Fn|; the case's truncation = force is the "
+                           "seed's min() cap, which keeps the spring's extension (they part after a slip "
+                           "that reverses)")
+            keywords[reasons[-1]] = "tangential history"
+        comments.append(f"hertz/stiffness kt = {tl.kt:.10g} Pa (Kt = kt √(R̄δ)), tangential_damping off")
+    else:
+        if not stiff:
+            return refused("liggghts", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' "
+                                        f"(not '{nid}')")
+        p["kt"] = tl.kt
+        p["gammat"] = tl.eta / m
+        nat.tangential_damping = tl.eta > 0.0
+        comments.append(f"hooke/stiffness kt = {tl.kt:.10g} N/m, gammat = ηt/m̄ = {p['gammat']:.10g} 1/s")
+        if tl.truncation != TRUNC_SPRING and tl.eta > 0.0:
+            fid = APPROXIMATE
+            name = {TRUNC_CAP: "force", TRUNC_MAW: "overlap"}[tl.truncation]
+            reasons.append("LIGGGHTS caps the spring only (truncation = spring: the dashpot is added "
+                           f"uncapped while sticking and dropped while slipping); the case asks for "
+                           f"truncation = {name}")
+            keywords[reasons[-1]] = "tangential history"
+    return fid
 
 
 def luding_limit(props: dict, r: float) -> float:
@@ -166,11 +203,11 @@ def _luding(model: ResolvedModel, nat: Native) -> Mapping:
     k2 (δ − δ_max) + k1 δ_max ≥ 0 with k2 = k1 + (r − 1) k1 δ_max/δ_lim: HLS's K_U = K_L + S·K_L·δ_max
     exactly when (r − 1)/δ_lim = S. r is free: δ_lim is chosen above the largest overlap the impact can reach
     (and r ≥ 2, so that k2Max − k1 = (r − 1)k1 loses no digits), and phiF follows."""
-    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
-    if tl.family != NONE:
+    normal, tl, pair = model.contact.normal, model.contact.tangential, model.pair
+    if tl.id != "none":
         return refused("liggghts", "luding's tangential stiffness is its loading stiffness (kt = kn); no seed "
                                     "tangential law shares it")
-    kl, s, r_eff, m = nl.kl, nl.s, pair.r_eff, pair.m_eff
+    kl, s, r_eff, m = normal.kl, normal.s, pair.r_eff, pair.m_eff
     v = pair.impact_speed
     if not math.isfinite(v):
         v = model.params.get("reference_velocity", math.nan)
@@ -203,7 +240,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     p = nat.props
     if nat.normal == "luding":  # δ_max < δ_lim: K_U = k1 + (r − 1)k1 δ_max/δ_lim, i.e. S = (r − 1)/δ_lim
         s = (p["unloading"] - 1.0) / luding_limit(p, r)
-        return NormalLaw(HYSTERETIC, kl=p["loading"], ku=0.0, s=s, limit=nat.limit), twins.no_friction()
+        return (NormalLaw.from_slots(HysteresisNormal(kl=p["loading"], ku=0.0, s=s), NoDamping(), nat.limit),
+                twins.no_friction())
     if nat.normal == "hooke/stiffness":
         k_el, a = p["kn"], 1.0
         c, b = damping("stiffness_hooke", p["gamman"], k_el, a, m, r)
@@ -219,7 +257,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         kt, sqrt_law, eta_t = k_el, False, c
     elif nat.normal == "edinburgh":
         kl = p["kl"]
-        return (NormalLaw(HYSTERETIC, kl=kl, ku=kl * p["unloading"], limit=nat.limit), twins.no_friction())
+        return (NormalLaw.from_slots(HysteresisNormal(kl=kl, ku=kl * p["unloading"]), NoDamping(), nat.limit),
+                twins.no_friction())
     elif nat.normal == "hertz":
         y_eff, g_eff = p["youngs_eff"], p["shear_eff"]
         k_el, a = 4.0 / 3.0 * y_eff * math.sqrt(r), 1.5
@@ -245,13 +284,14 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if factor is not None and math.isnan(factor):
         raise ValueError("hertz/stiffness with gammat > 0 and gamman = 0 has no twin")
 
-    def law(family, **kw):
+    def law(record, **kw):
         if factor is None:
-            return TangentialLaw(family, eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
-        return TangentialLaw(family, eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw)
+            return TangentialLaw.from_slot(record(eta=const, eta_normal=False, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m,
+                                                  **kw))
+        return TangentialLaw.from_slot(record(eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, r_eff=r, m_eff=m, **kw))
 
     if nat.tangential == "no_history":
-        return nl, law(VISCOUS_SLIDING)
-    return nl, law(SPRING, kt=kt, kt_sqrt=sqrt_law, truncation=TRUNC_SPRING)
+        return nl, law(ViscousSlidingTangential)
+    return nl, law(SqrtSpringTangential if sqrt_law else SpringTangential, kt=kt, truncation=TRUNC_SPRING)
 
 

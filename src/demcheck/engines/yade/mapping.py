@@ -23,9 +23,10 @@ from __future__ import annotations
 import math
 
 from ...reference import twins
-from ...reference.model import ResolvedModel
-from ...reference.normal import HYSTERETIC, NormalLaw
-from ...reference.tangential import NONE, SPRING, TRUNC_SPRING, VISCOUS, TangentialLaw
+from ...laws.model import ResolvedModel
+from ...laws.normal import NormalLaw
+from ...laws.tangential import (TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw,
+                                ViscousTangential)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import mu_of
 
@@ -37,39 +38,42 @@ CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashp
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    nl, tl, pair = model.normal_law, model.tangential_law, model.pair
+    """The contact's slot records, by id: normal hooke | hertz, damping none | constant (hooke) or none |
+    quarter (hertz), tangential none | viscous | spring."""
+    contact, pair = model.contact, model.pair
+    normal, damp, tl = contact.normal, contact.damping, contact.tangential
     m, r = pair.m_eff, pair.r_eff
+    eta = getattr(damp, "eta", 0.0)
     reasons: list[str] = []
     keywords: dict[str, str] = {}  # an approximate reason → the Yade class or attribute it is about
     comments: list[str] = []
     fid = EXACT
-    if nl.family == HYSTERETIC:
+    if normal.id == "hls":
         return refused("yade", "no linear hysteretic law is mapped for Yade (its nearest, "
                                "Law2_ScGeom6D_NormalInelasticityPhys_NormalInelasticity, is unverified here)")
-    if nl.a == 1.0 and (nl.eta == 0.0 or nl.b == 0.0):
+    if normal.id == "hooke" and (eta == 0.0 or damp.id in ("none", "constant")):
         nat = Native("yade", normal=VISCEL, limit=True)
-        nat.props.update(kn=nl.k, cn=nl.eta, ks=0.0, cs=0.0, mu=0.0)
-        comments.append(f"ViscElMat kn, cn given directly: the pair's kn = {nl.k:.10g} N/m, cn = {nl.eta:.10g} "
+        nat.props.update(kn=normal.k, cn=eta, ks=0.0, cs=0.0, mu=0.0)
+        comments.append(f"ViscElMat kn, cn given directly: the pair's kn = {normal.k:.10g} N/m, cn = {eta:.10g} "
                         "kg/s (each material carries twice: Yade combines them in series)")
-    elif nl.a == 1.5 and (nl.eta == 0.0 or nl.b == 0.25):
-        nat = Native("yade", normal=MINDLIN, limit=nl.eta > 0.0 or model.limit_force)
+    elif normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "quarter")):
+        nat = Native("yade", normal=MINDLIN, limit=eta > 0.0 or model.limit_force)
         # cn = 2 betan √(m̄ · 3/2 kno) δ^¼ = η δ^¼
-        betan = nl.eta / (2.0 * math.sqrt(1.5 * m * nl.k)) if nl.eta > 0.0 else 0.0
-        nat.props.update(kno=nl.k, betan=betan, betas=0.0, kso=0.0, mu=0.0, r_eff=r)
-        comments.append(f"MindlinPhys kno = (4/3)E*√R̄ = {nl.k:.10g} N/m^1.5 (Young's modulus set for Yade's "
+        betan = eta / (2.0 * math.sqrt(1.5 * m * normal.k)) if eta > 0.0 else 0.0
+        nat.props.update(kno=normal.k, betan=betan, betas=0.0, kso=0.0, mu=0.0, r_eff=r)
+        comments.append(f"MindlinPhys kno = (4/3)E*√R̄ = {normal.k:.10g} N/m^1.5 (Young's modulus set for Yade's "
                         f"R̄_Y), betan = {betan:.17g}")
-    elif nl.a == 1.5:
+    elif normal.id == "hertz":
         return refused("yade", f"Yade's Hertz–Mindlin dashpots grow as δ^¼ (alpha from en, or betan); the "
-                               f"normal law '{model.normal.id}' damps as δ^{nl.b:g}")
+                               f"normal law '{model.normal.id}' damps as δ^{damp.exponent:g}")
     else:
         return refused("yade", f"no Yade law for normal '{model.normal.id}'")
-    if nat.limit and nl.eta > 0.0 and not model.limit_force:
+    if nat.limit and eta > 0.0 and not model.limit_force:
         fid = APPROXIMATE
         reasons.append(CLAMP.format(law=nat.normal))
         keywords[reasons[-1]] = LAW2[nat.normal]
     p = nat.props
-    family = tl.family
-    if family == NONE:
+    if tl.id == "none":
         nat.tangential = "none"
     else:
         mu, f_mu = mu_of(model, reasons)
@@ -77,12 +81,12 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             keywords[reasons[-1]] = "frictionAngle"
         fid = worst(fid, f_mu)
         p["mu"] = mu
-        if nat.normal == VISCEL and family == VISCOUS:
+        if nat.normal == VISCEL and tl.id == "viscous":
             # ks = 0: the elastic part stays 0, never above μ|Fn|, so cs v_t is added uncapped
             nat.tangential = "viscous"
             p["cs"] = tl.eta
             comments.append(f"ViscElMat ks = 0, cs = {tl.eta:.10g} kg/s: Ft = cs v_t, never capped")
-        elif nat.normal == VISCEL and family == SPRING and not tl.kt_sqrt and not tl.eta_normal:
+        elif nat.normal == VISCEL and tl.id == "spring" and not tl.eta_normal:
             nat.tangential = "spring"
             p["ks"], p["cs"] = tl.kt, tl.eta
             comments.append(f"ViscElMat ks = {tl.kt:.10g} N/m, cs = {tl.eta:.10g} kg/s, frictionAngle = atan μ")
@@ -96,7 +100,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                            "contact point on the wall's plane), and it turns the history with ScGeom's first-order "
                            "rotation")
             keywords[reasons[-1]] = "ScGeom (Ig2_Wall_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom)"
-        elif nat.normal == MINDLIN and family == SPRING and tl.kt_sqrt:
+        elif nat.normal == MINDLIN and tl.id == "sqrt_spring":
             # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
             # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
             return refused("yade", "not mapped yet: Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t "
@@ -115,18 +119,18 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if nat.normal == VISCEL:
         nl = twins.normal_law(p["kn"], 1.0, p["cn"], 0.0, True)
         if nat.tangential == "viscous":
-            return nl, TangentialLaw(VISCOUS, eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m)
+            return nl, TangentialLaw.from_slot(ViscousTangential(eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m))
         if nat.tangential == "spring":
-            return nl, TangentialLaw(SPRING, kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
-                                     r_eff=r, m_eff=m)
+            return nl, TangentialLaw.from_slot(SpringTangential(kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu,
+                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m))
         return nl, twins.no_friction()
     if nat.normal == MINDLIN:
         c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
         nl = twins.normal_law(p["kno"], 1.5, c, 0.25, nat.limit)
         if nat.tangential == "mindlin":
             factor = (2.0 * p["betas"] * math.sqrt(m * p["kso"]) / c) if c > 0.0 else 0.0
-            return nl, TangentialLaw(SPRING, kt=p["kso"] / math.sqrt(r), kt_sqrt=True, eta=factor, eta_normal=True,
-                                     mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING, force_history=True, r_eff=r,
-                                     m_eff=m)
+            return nl, TangentialLaw.from_slot(SqrtSpringTangential(
+                kt=p["kso"] / math.sqrt(r), eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
+                force_history=True, r_eff=r, m_eff=m))
         return nl, twins.no_friction()
     raise ValueError(f"no twin for Yade physics {nat.normal!r}")

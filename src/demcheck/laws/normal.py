@@ -15,13 +15,15 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, ClassVar
 
 import numpy as np
 
 from ..errors import ConfigError
 from . import analytic
+from .base import SubModel
 from .contact import Pair
+from .damping import Damping, NoDamping, damping_of
 from .registry import Registry, contact_number
 
 VISCOELASTIC = 0
@@ -61,6 +63,72 @@ class NormalLaw:
         if self.family == HYSTERETIC:
             return analytic.power_law_duration(self.kl, 1.0, m, v)
         return analytic.power_law_duration(self.k, self.a, m, v)
+
+    def slots(self) -> tuple[NormalSubModel, Damping]:
+        """The law as the records of its two slots, normal and damping (ValueError for a spring or dashpot
+        exponent no record has)."""
+        if self.family == HYSTERETIC:
+            if self.eta != 0.0:
+                raise ValueError("a hysteretic normal law has no dashpot")
+            return HysteresisNormal(kl=self.kl, ku=self.ku, s=self.s), NoDamping()
+        if self.a not in ELASTIC_BY_EXPONENT:
+            raise ValueError(f"no normal record has the δ^{self.a:g} spring (known: hooke δ^1, hertz δ^1.5)")
+        return ELASTIC_BY_EXPONENT[self.a](k=self.k), damping_of(self.eta, self.b)
+
+    @classmethod
+    def from_slots(cls, normal: NormalSubModel, damping: Damping, limit: bool) -> "NormalLaw":
+        """The kernels' law of a normal and a damping record (the inverse of :meth:`slots`)."""
+        if isinstance(normal, HysteresisNormal):
+            if not isinstance(damping, NoDamping):
+                raise ValueError(f"the hysteretic normal law takes no dashpot (damping {damping.id!r})")
+            return cls(HYSTERETIC, kl=normal.kl, ku=normal.ku, s=normal.s, limit=limit)
+        return cls(VISCOELASTIC, k=normal.k, a=normal.exponent, eta=getattr(damping, "eta", 0.0),
+                   b=damping.exponent, limit=limit)
+
+
+# ----------------------------------------------------------------------------- the normal slot's records
+
+
+@dataclass(frozen=True)
+class NormalSubModel(SubModel):
+    slot: ClassVar[str] = "normal"
+
+
+@dataclass(frozen=True)
+class HookeNormal(NormalSubModel):
+    """F = k δ (a linear spring)."""
+
+    id: ClassVar[str] = "hooke"
+    title: ClassVar[str] = "linear spring k δ"
+    exponent: ClassVar[float] = 1.0
+    k: float = 0.0  # N/m
+
+
+@dataclass(frozen=True)
+class HertzNormal(NormalSubModel):
+    """F = k δ^{3/2}, k = (4/3) Ē √R̄ for the seed's Hertz law."""
+
+    id: ClassVar[str] = "hertz"
+    title: ClassVar[str] = "Hertz spring k δ^{3/2}"
+    exponent: ClassVar[float] = 1.5
+    k: float = 0.0  # N/m^1.5
+
+
+@dataclass(frozen=True)
+class HysteresisNormal(NormalSubModel):
+    """F = min(K_L δ, K_U (δ − δ₀)) ≥ 0 with K_U = ku (> 0), or K_L + s·F_max (ku = 0); its history is the
+    largest overlap δ_max."""
+
+    id: ClassVar[str] = "hls"
+    title: ClassVar[str] = "hysteretic linear spring"
+    history_size: ClassVar[int] = 1
+    kl: float = 0.0  # N/m
+    ku: float = 0.0  # N/m; 0: variable unloading
+    s: float = 0.0  # 1/m
+
+
+# the elastic records by their exponent (the one place an exponent names a record: NormalLaw.slots)
+ELASTIC_BY_EXPONENT = {cls.exponent: cls for cls in (HookeNormal, HertzNormal)}
 
 
 @dataclass(frozen=True)

@@ -20,13 +20,15 @@ limits the force while slipping.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, ClassVar
 
 import numpy as np
 
 from ..errors import ConfigError
+from .base import SubModel
 from .contact import Pair, kinetic_rule
 from .registry import Registry, contact_number
 from .normal import HYSTERETIC, NormalLaw, Param, contact_choice
@@ -67,6 +69,15 @@ class TangentialLaw:
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
                          self.k0, float(self.force_history), float(self.rescale_history)])
 
+    @classmethod
+    def from_array(cls, law) -> "TangentialLaw":
+        """The law of an ``array()`` (the inverse, exactly)."""
+        (family, kt, kt_sqrt, eta, eta_normal, mu_s, mu_k, truncation, r_eff, m_eff, xi_coef, eta1, g_i, k0,
+         force_history, rescale_history) = (float(x) for x in law)
+        return cls(int(family), kt=kt, kt_sqrt=kt_sqrt != 0.0, eta=eta, eta_normal=eta_normal != 0.0, mu_s=mu_s,
+                   mu_k=mu_k, truncation=int(truncation), r_eff=r_eff, m_eff=m_eff, xi_coef=xi_coef, eta1=eta1,
+                   g_i=g_i, k0=k0, force_history=force_history != 0.0, rescale_history=rescale_history != 0.0)
+
     @property
     def has_history(self) -> bool:
         return self.family in (SPRING, LTH, ZZY, WALTON)
@@ -90,6 +101,170 @@ class TangentialLaw:
     def caps(self) -> bool:
         """Whether the law limits |Ft| by Coulomb (μ|Fn|) in its slip state."""
         return self.family in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
+
+    def slot(self) -> "TangentialSubModel":
+        """The law as its tangential slot's record; ValueError where the law sets a number its record has no
+        field for (the record would lose it)."""
+        cls = RECORDS[(self.family, self.kt_sqrt if self.family == SPRING else False)]
+        names = set(cls.param_names())
+        default = TangentialLaw()
+        lost = [f.name for f in dataclasses.fields(self) if f.name not in names | {"family", "kt_sqrt"}
+                and getattr(self, f.name) != getattr(default, f.name)]
+        if lost:
+            raise ValueError(f"tangential record {cls.id!r} has no field for {', '.join(lost)}")
+        return cls(**{name: getattr(self, name) for name in names})
+
+    @classmethod
+    def from_slot(cls, record: "TangentialSubModel") -> "TangentialLaw":
+        """The kernels' law of a tangential record (the inverse of :meth:`slot`)."""
+        fields = {name: getattr(record, name) for name in record.param_names()}
+        return cls(record.family, kt_sqrt=record.kt_sqrt, **fields)
+
+
+# ----------------------------------------------------------------------------- the tangential slot's records
+
+
+@dataclass(frozen=True)
+class TangentialSubModel(SubModel):
+    slot: ClassVar[str] = "tangential"
+    family: ClassVar[int] = NONE  # the kernels' family (read by TangentialLaw.from_slot only)
+    kt_sqrt: ClassVar[bool] = False
+
+
+@dataclass(frozen=True)
+class NoTangential(TangentialSubModel):
+    id: ClassVar[str] = "none"
+    title: ClassVar[str] = "frictionless"
+
+
+@dataclass(frozen=True)
+class SlidingTangential(TangentialSubModel):
+    """F = −μk|Fn| t̂ while sliding; the constraint force (≤ μs|Fn|) while stuck."""
+
+    id: ClassVar[str] = "sliding"
+    family: ClassVar[int] = SLIDING
+    title: ClassVar[str] = "simple sliding friction"
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class ViscousTangential(TangentialSubModel):
+    """F = −ηt v_t (ηt constant, or ``eta`` times the normal dashpot's η(δ) with ``eta_normal``); the friction
+    coefficients are carried (an engine twin's) but not read."""
+
+    id: ClassVar[str] = "viscous"
+    family: ClassVar[int] = VISCOUS
+    title: ClassVar[str] = "viscous damping"
+    eta: float = 0.0
+    eta_normal: bool = False
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class ViscousSlidingTangential(TangentialSubModel):
+    """F = −min(ηt|v_t|, μk|Fn|) t̂."""
+
+    id: ClassVar[str] = "viscous_sliding"
+    family: ClassVar[int] = VISCOUS_SLIDING
+    title: ClassVar[str] = "viscous damping with sliding friction"
+    eta: float = 0.0
+    eta_normal: bool = False
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class SpringTangential(TangentialSubModel):
+    """Trial F = −Kt ξ − ηt v_t on the history ξ, Kt = kt constant, Coulomb-limited by ``truncation``
+    (TRUNCATIONS); the engine twins' variants keep the elastic force as the history (``force_history``) or
+    rescale it as the contact radius shrinks (``rescale_history``)."""
+
+    id: ClassVar[str] = "spring"
+    family: ClassVar[int] = SPRING
+    title: ClassVar[str] = "linear spring (and dashpot) with Coulomb truncation"
+    history_size: ClassVar[int] = 3
+    kt: float = 0.0
+    eta: float = 0.0
+    eta_normal: bool = False
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    truncation: int = TRUNC_MAW
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+    force_history: bool = False
+    rescale_history: bool = False
+
+
+@dataclass(frozen=True)
+class SqrtSpringTangential(SpringTangential):
+    """As ``spring`` with Kt = kt √(R̄ δn) (Mindlin's no-slip stiffness: DDt, TTIt; LAMMPS mindlin)."""
+
+    id: ClassVar[str] = "sqrt_spring"
+    kt_sqrt: ClassVar[bool] = True
+    title: ClassVar[str] = "spring Kt = kt √(R̄δ) (and dashpot) with Coulomb truncation"
+
+
+@dataclass(frozen=True)
+class LthTangential(TangentialSubModel):
+    """Langston, Tüzün & Heyes on the history ξ, δt_max = xi_coef · δn."""
+
+    id: ClassVar[str] = "lth"
+    family: ClassVar[int] = LTH
+    title: ClassVar[str] = "Langston, Tüzün & Heyes"
+    history_size: ClassVar[int] = 3
+    eta: float = 0.0
+    xi_coef: float = 0.0
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class ZzyTangential(TangentialSubModel):
+    """Zheng, Zhu & Yu on the history ξ (viscosity η₁ = eta1, shear modulus G_i = g_i)."""
+
+    id: ClassVar[str] = "zzy"
+    family: ClassVar[int] = ZZY
+    title: ClassVar[str] = "Zheng, Zhu & Yu"
+    history_size: ClassVar[int] = 3
+    eta1: float = 0.0
+    g_i: float = 0.0
+    xi_coef: float = 0.0
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+@dataclass(frozen=True)
+class WaltonTangential(TangentialSubModel):
+    """Walton & Braun's incrementally slipping friction; its history is the load L, the load at the last
+    reversal L* and the last nonzero slip velocity (3 each)."""
+
+    id: ClassVar[str] = "walton"
+    family: ClassVar[int] = WALTON
+    title: ClassVar[str] = "incrementally slipping friction"
+    history_size: ClassVar[int] = 9
+    k0: float = 0.0
+    mu_s: float = 0.0
+    mu_k: float = 0.0
+    r_eff: float = 0.0
+    m_eff: float = 0.0
+
+
+# (family, kt_sqrt) → record: the one place a kernel family names a record (TangentialLaw.slot)
+RECORDS = {(cls.family, cls.kt_sqrt): cls for cls in (
+    NoTangential, SlidingTangential, ViscousTangential, ViscousSlidingTangential, SpringTangential,
+    SqrtSpringTangential, LthTangential, ZzyTangential, WaltonTangential)}
 
 
 @dataclass(frozen=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass
+from functools import cached_property
 
 from typing import TYPE_CHECKING
 
@@ -12,6 +13,7 @@ if TYPE_CHECKING:  # the case layer sits above the laws: types only
 from ..errors import ConfigError
 from . import normal as _normal
 from . import tangential as _tangential
+from .base import Contact
 from .contact import PAIR_RULES, Pair, pair_of, pair_params
 
 # keys of [contact] that belong to the pair rather than to a model (allowed where a model of the case reads them:
@@ -32,6 +34,12 @@ class ResolvedModel:
 
     def describe(self) -> dict:
         return {"normal": self.normal.id, "tangential": self.tangential.id, "limit_force": self.limit_force}
+
+    @cached_property
+    def contact(self) -> Contact:
+        """The resolved laws as slot records (laws/base.py): what the engines' vocabularies map, by id."""
+        normal, damping = self.normal_law.slots()
+        return Contact(normal, damping, self.tangential_law.slot(), limit_force=self.limit_force)
 
 
 def _lookup(registry_lookup, names, slot: str, value: str):

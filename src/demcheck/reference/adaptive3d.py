@@ -1,0 +1,667 @@
+"""The 3-D two-body contact in continuous time (kernels3d.py's state and kinematics): the right-hand side with the
+history's flow on and off the slip surface, the stick/slip and normal events, and the adaptive DP5(4) driver
+that locates them (integrator.py's core).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .. import KERNEL_CACHE
+from ..laws.normal_force import (hls_unloading, L_ETA, L_FAMILY, L_KL, L_LIMIT, viscoelastic_force)
+from ..laws.tangential import (LTH, NONE, SLIDING, SPRING, T_FAMILY, T_MU_K, T_MU_S, T_TRUNC, TRUNC_CAP,
+                               VISCOUS_SLIDING, WALTON, ZZY)
+from ..laws.tangential_force import (_cross, _dot, eta_of, _norm, return_map, slip_surface, tangential_force,
+                                     walton_margin, WALTON_NEAR_LIMIT, WALTON_RIDE, walton_stiffness)
+from .integrator import (crossed, ended_with_it, error, grow, H_MIN, H_START, illinois_step, illinois_trial,
+                         LOCATE_ITERATIONS, resume, shrink, solution, stage2, stage3, stage4, stage5, stage6,
+                         THETA_TOL)
+from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_REENTER, EV_RELOAD, EV_START, M_FREE, M_LOAD,
+                      M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE)
+from .kernels3d import (A_DMAX, A_LSTAR, A_NMODE, A_SIZE, A_TMODE, A_TREF, ARM_RADIUS, ARM_SURFACE, C_D, C_E, C_FN,
+                        C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, energy, EV_KINK, EV_REVERSAL, EV_SLIP_STICK,
+                        EV_STICK_SLIP, G_GX, G_I0, G_I1, G_M0, G_M1, G_TS, G_WALL, kinematics, NCOL, R_SLIP_ARM,
+                        R_WALL_SLIP_ARM, SLIP, STICK)
+
+# ----------------------------------------------------------------------------- the continuous system
+
+
+@njit(cache=KERNEL_CACHE)
+def _normal_mode_force(nl, nmode, delta, rate, dmax):
+    if nmode == M_VE:
+        return viscoelastic_force(nl, delta, rate)
+    if nmode == M_LOAD:
+        return nl[L_KL] * delta
+    if nmode == M_UNLOAD:
+        ku, d0 = hls_unloading(nl, dmax)
+        return ku * (delta - d0)
+    return 0.0
+
+
+@njit(cache=KERNEL_CACHE)
+def _contact_force(nl, nmode, delta, rate, dmax):
+    """The normal force the contact applies: the mode's law, held at 0 where limit_force forbids attraction."""
+    fn = _normal_mode_force(nl, nmode, delta, rate, dmax)
+    if nl[L_LIMIT] != 0.0 and nmode == M_VE and fn < 0.0:
+        return 0.0
+    return fn
+
+
+@njit(cache=KERNEL_CACHE)
+def _accelerations(y, geo, fvec0, tau0, tau1, dy):
+    g = geo[G_GX:G_GX + 3]
+    dy[0:3] = y[3:6]
+    dy[3:6] = fvec0 / geo[G_M0] + g
+    dy[6:9] = tau0 / geo[G_I0]
+    if geo[G_WALL] == 0.0:
+        dy[9:12] = y[12:15]
+        dy[12:15] = -fvec0 / geo[G_M1] + g
+        dy[15:18] = tau1 / geo[G_I1]
+    else:
+        dy[9:18] = 0.0
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _tangent_history(y, n):
+    """The history in the current tangent plane: exact in continuous time, and immune to numerical drift."""
+    xi = y[18:21]
+    return xi - _dot(xi, n) * n
+
+
+@njit(cache=KERNEL_CACHE)
+def _psi_at(y, aux, nl, tl, geo, rules, mu, fsign):
+    """ψ at a nearby state, with |Fn| taken on the branch of the base point (fsign·Fn), so that a one-sided
+    difference does not straddle the kink of |Fn| where a viscous normal force changes sign."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
+    return psi
+
+
+@njit(cache=KERNEL_CACHE)
+def _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    return return_map(tl, nl, _tangent_history(y, n), vt, fsign * fn, delta, mu)
+
+
+@njit(cache=KERNEL_CACHE)
+def _fn_at(y, aux, nl, geo, rules):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    return _normal_mode_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+
+
+@njit(cache=KERNEL_CACHE)
+def _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s):
+    """Tangential part of dv_t/dt with no tangential force (the normal force and gravity act along n for a
+    pair; a wall sees gravity's tangential part): b in v̇_t = A F_t + b."""
+    vr_n = rate
+    arm = rules[R_WALL_SLIP_ARM] if geo[G_WALL] != 0.0 else rules[R_SLIP_ARM]
+    adot0 = 0.0 if arm == ARM_RADIUS else (-rate if arm == ARM_SURFACE else -0.5 * rate)
+    acc = _cross(y[6:9], adot0 * n + a0s * ndot)
+    if geo[G_WALL] != 0.0:
+        acc = acc + geo[G_GX:G_GX + 3]
+    else:
+        acc = acc + _cross(y[15:18], adot0 * n + a1s * ndot)
+    b = acc - _dot(acc, n) * n - vr_n * ndot
+    return b
+
+
+@njit(cache=KERNEL_CACHE)
+def rhs(y, aux, nl, tl, geo, rules, dy):
+    """dy ← f(y). Returns (λ, Fn, |F_req| − μs|Fn| for SLIDING in stick, the tangential force (3))."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    nmode = aux[A_NMODE]
+    contact = nmode != M_PRE
+    fn = _contact_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
+    fabs = abs(fn)
+    family = tl[T_FAMILY]
+    slipping = aux[A_TMODE] == SLIP
+    xi = _tangent_history(y, n)
+    ft = np.zeros(3)
+    req_margin = -1.0
+    lam = 0.0
+    ts = geo[G_TS]
+    if contact and family != NONE:
+        if family == SLIDING and not slipping:
+            # constraint force keeping v_t = 0: v̇_t = A F + b
+            amob = 1.0 / geo[G_M0] + a0t * a0s / geo[G_I0]
+            if geo[G_WALL] == 0.0:
+                amob += 1.0 / geo[G_M1] + a1t * a1s / geo[G_I1]
+            b = _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s)
+            ft = -b / amob
+            req_margin = _norm(ft) - tl[T_MU_S] * fabs
+        elif slipping and (family == LTH or family == ZZY):
+            # a slipping history lies on its surface |ξ| = ξm by definition: the force reads it there, not the
+            # integrated value, which is not error-controlled while slipping (below) and would drift off it —
+            # a drift the viscous term's (1 − |ξ|/ξm)^{1/4} magnifies a thousandfold
+            ft = tangential_force(tl, nl, return_map(tl, nl, xi, vt, fabs, delta, tl[T_MU_K]), vt, fabs, delta,
+                                  slipping, aux[A_TREF:A_TREF + 3])
+        else:
+            ft = tangential_force(tl, nl, xi, vt, fabs, delta, slipping, aux[A_TREF:A_TREF + 3])
+    fvec0 = -fn * n + ft
+    tau0 = _cross(a0t * n, ft)
+    tau1 = _cross(a1t * n, ft)
+    _accelerations(y, geo, fvec0, tau0, tau1, dy)
+    dy[18:21] = 0.0
+    if contact and (family == SPRING or family == LTH or family == ZZY or family == WALTON):
+        rot = _dot(xi, ndot) * n
+        if family == WALTON:
+            dh = walton_stiffness(tl, xi, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+            hn = _norm(xi)
+            cap = tl[T_MU_K] * fabs
+            if hn > 0.0 and cap > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
+                # at the Coulomb limit the load rides it, |L|/μ|Fn| held — within WALTON_NEAR_LIMIT of a falling
+                # limit, which carries the load down with it (the verlet method truncates it after each
+                # increment, slip_surface; a load above the limit is put back on it after each step,
+                # _walton_truncate), and within WALTON_RIDE of a rising one: there Kt ∝ x^{1/3} makes the
+                # approach infinitely stiff, while farther below the lag x of the load behind a rising limit
+                # is physics (the verlet plateau test) and is integrated as it is. The limit's rate by a
+                # one-sided difference along the flow, on the branch of |Fn| of the base point
+                capdot = _limit_rate(y, aux, nl, tl, geo, rules, fn, dy)
+                if capdot < 0.0 or hn >= (1.0 - WALTON_RIDE) * cap:
+                    most = (hn / cap) * capdot
+                    u = xi / hn
+                    radial = _dot(u, dh)
+                    if radial > most:
+                        dh = dh - (radial - most) * u
+            dy[18:21] = dh
+        else:
+            dy[18:21] = vt - rot
+        if slipping and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            mu = tl[T_MU_K]
+            psi, w, dpsi = slip_surface(tl, nl, xi, vt, fabs, delta, mu)
+            # one-sided (forward, second order) along the flow: |ξ| has a kink at ξ = 0, where every slip
+            # begins at contact start, and a central difference would straddle it
+            s = 1e-7 * ts
+            fsign = 1.0 if fn >= 0.0 else -1.0
+            psid = (-3.0 * psi + 4.0 * _psi_at(y + s * dy, aux, nl, tl, geo, rules, mu, fsign)
+                    - _psi_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu, fsign)) / (2.0 * s)
+            # λ = ψ̇/D: the rate at which sticking would push past the surface; its sign decides stick or
+            # slip. While slipping the history follows its return-mapped value along the flow (the
+            # continuous limit of the engines' "increment, then truncate"), differentiated one-sidedly;
+            # unlike ξ̇ = v_t − λw this does not divide by Kt, which vanishes with δ for DDt and TTIt.
+            lam = psid / dpsi if dpsi > 0.0 else psid
+            h0 = _mapped_at(y, aux, nl, tl, geo, rules, mu, fsign)
+            ha = _mapped_at(y + s * dy, aux, nl, tl, geo, rules, mu, fsign)
+            hb = _mapped_at(y + 2.0 * s * dy, aux, nl, tl, geo, rules, mu, fsign)
+            dy[18:21] = (-3.0 * h0 + 4.0 * ha - hb) / (2.0 * s)
+    return lam, fn, req_margin, ft
+
+
+@njit(cache=KERNEL_CACHE)
+def _dp5_3(y, aux, nl, tl, geo, rules, h):
+    """One Dormand–Prince 5(4) step of the state (integrator.py's stages); returns the 5th-order state and the
+    error estimate."""
+    n = y.shape[0]
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    rhs(y, aux, nl, tl, geo, rules, k1)
+    rhs(stage2(y, h, k1), aux, nl, tl, geo, rules, k2)
+    rhs(stage3(y, h, k1, k2), aux, nl, tl, geo, rules, k3)
+    rhs(stage4(y, h, k1, k2, k3), aux, nl, tl, geo, rules, k4)
+    rhs(stage5(y, h, k1, k2, k3, k4), aux, nl, tl, geo, rules, k5)
+    rhs(stage6(y, h, k1, k2, k3, k4, k5), aux, nl, tl, geo, rules, k6)
+    yn = solution(y, h, k1, k3, k4, k5, k6)
+    rhs(yn, aux, nl, tl, geo, rules, k7)
+    return yn, error(h, k1, k3, k4, k5, k6, k7)
+
+
+N_EVENTS = 8
+# of a step: two events located this close are taken as simultaneous (LSDn with a spring law at 5°: the slip
+# ended where the force did, located 1e-16 of a step before it, and the force's end went unrecorded)
+SIMULTANEOUS_THETA = 1e-9
+# of the time scale: a stick→slip graze retaken within this of the last one is at the same instant (LTH at the
+# end of an LSDn contact, Chung & Ooi Test 4 at 30°: a graze retaken every 6.5e-20 s ran out of output points)
+GRAZE_SAME_INSTANT = 1e-12
+# LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
+# of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
+# the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
+# whose force, μ|Fn|, is the slip state's). A slip of these laws therefore ends only when sticking would
+# unload the history by more than this fraction of |v_t| (λ < −UNLOAD_MARGIN |v_t|); below it the contact
+# stays on the surface, where stick and slip give the same force, instead of chattering between the two.
+UNLOAD_MARGIN = 1e-4
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _margin(tl, vt):
+    family = tl[T_FAMILY]
+    return UNLOAD_MARGIN * _norm(vt) if (family == LTH or family == ZZY) else 0.0
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _unloads(tl, lam, vt):
+    """Whether a slip whose stick flow has multiplier λ sticks again (λ < 0, past the margin above)."""
+    return lam < -_margin(tl, vt)
+
+
+@njit(cache=KERNEL_CACHE)
+def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
+    """d(μk|Fn|)/dt by a one-sided (forward, second-order) difference along the flow ``dy``, on the branch of
+    |Fn| of the base point."""
+    s = 1e-7 * geo[G_TS]
+    fsign = 1.0 if fn >= 0.0 else -1.0
+    fa = fsign * _fn_at(y + s * dy, aux, nl, geo, rules)
+    fb = fsign * _fn_at(y + 2.0 * s * dy, aux, nl, geo, rules)
+    return tl[T_MU_K] * (-3.0 * fsign * fn + 4.0 * fa - fb) / (2.0 * s)
+
+
+# _walton_truncate, _onto_surface and _settle are inlined into adaptive_3d (one or two call sites each): a function
+# numba compiles on its own is a library that links, and optimises once more, the whole right-hand side it calls;
+# inlined, the 3-D solver compiles in ~3/4 of the time (docs/performance.md, "Cold start")
+@njit(cache=KERNEL_CACHE, inline="always")
+def _walton_truncate(y, aux, nl, tl, geo, rules):
+    """Walton's stored load back onto the Coulomb limit where it lies above it (the verlet method's truncation),
+    and onto it where it rides within WALTON_NEAR_LIMIT below a falling limit (rhs): a load that close to a
+    falling limit meets it at once, and snapping it there keeps the answer from depending on where a step
+    happened to enter the band."""
+    if aux[A_NMODE] == M_PRE:
+        return
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    xi = _tangent_history(y, n)
+    hn = _norm(xi)
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    cap = tl[T_MU_K] * abs(fn)
+    if hn > cap:
+        y[18:21] = xi * (cap / hn)
+    elif hn > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
+        dy = np.empty(y.shape[0])
+        rhs(y, aux, nl, tl, geo, rules, dy)
+        if _limit_rate(y, aux, nl, tl, geo, rules, fn, dy) < 0.0:
+            y[18:21] = xi * (cap / hn)
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _onto_surface(y, aux, nl, tl, geo, rules):
+    """A slipping spring's history back onto its slip surface after each step. While slipping it follows the
+    return map's rate (rhs) and is not error-controlled (the map is unbounded where Kt ∝ √δ → 0 under a
+    finite cap: TTIt's ξ ∝ −δ^{-1/4} at onset); left to drift, the slip→stick multiplier λ is read off a history
+    beside the surface — TTIt at 85° on alumina stayed on the slip surface's non-dissipative root (force along
+    the slip) until δ = 7.9e-8 m where λ < 0 from 1e-8 m on it, as the engines' step finds (docs/benchmarks.md)."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = _contact_force(nl, aux[A_NMODE], delta, rate, aux[A_DMAX])
+    y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+    # a slip whose stick flow unloads the history (λ < 0) sticks — also where λ has been negative since the slip
+    # began, so that no crossing of it can be seen: TTIt's slip at contact onset, dissipative there, whose stick
+    # swings the trial force round to push along the slip, as the engines' step does (Thornton e 0.25 at 45°: a
+    # 6 % error in e_t while it went on slipping). Returns whether it stuck.
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    if _unloads(tl, lam, vt) and fn != 0.0:
+        aux[A_TMODE] = STICK
+        return True
+    return False
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _settle(y, aux, nl, tl, geo, rules):
+    """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
+    is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
+    fall inside one step there)."""
+    family = tl[T_FAMILY]
+    if aux[A_NMODE] == M_PRE or family == NONE:
+        return
+    if family == WALTON:  # no slip state: its load rides the limit (rhs), and is truncated to it
+        _walton_truncate(y, aux, nl, tl, geo, rules)
+        return
+    if not (family == SPRING or family == LTH or family == ZZY or family == SLIDING):
+        return
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    if aux[A_TMODE] == SLIP:
+        if family != SLIDING and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            # back onto the slip surface (the multiplier is least accurate at |Fn|'s kink); a slip that
+            # would unload the history (λ < 0) sticks from there
+            y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            if _unloads(tl, lam, vt) and fn != 0.0:
+                aux[A_TMODE] = STICK
+        return
+    if family == SLIDING:
+        if req > 0.0:
+            aux[A_TMODE] = SLIP
+            fnorm = _norm(ft)
+            if fnorm > 0.0:
+                aux[A_TREF:A_TREF + 3] = -ft / fnorm
+        return
+    psi = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])[0]
+    if psi > 1e-12 * max(tl[T_MU_S] * abs(fn), 1e-300):
+        aux[A_TMODE] = SLIP
+        y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
+        if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+            # as at a stick→slip event: from the surface, a slip that would unload the history sticks
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            if _unloads(tl, lam, vt) and fn != 0.0:
+                aux[A_TMODE] = STICK
+
+
+@njit(cache=KERNEL_CACHE)
+def _event_direction(nl, tl, aux, event):
+    nmode = aux[A_NMODE]
+    family = tl[T_FAMILY]
+    slipping = aux[A_TMODE] == SLIP
+    in_contact = nmode != M_PRE
+    if event == 0:
+        return 1 if nmode == M_PRE else -1
+    if not in_contact:
+        return 0
+    if event == 1:
+        if nmode == M_VE or nmode == M_UNLOAD:
+            return -1
+        if nmode == M_FREE:
+            return 1
+        return 0
+    if event == 2:
+        return -1 if (nmode == M_VE or nmode == M_LOAD) else 0
+    if event == 3:
+        return -1 if (nmode == M_VE and nl[L_ETA] != 0.0) else 0
+    if event == 4:
+        return 1 if nmode == M_UNLOAD else 0
+    history = family == SPRING or family == LTH or family == ZZY
+    if event == 5:
+        return 1 if ((history or family == SLIDING) and not slipping) else 0
+    if event == 6:
+        return -1 if ((history or family == SLIDING) and slipping) else 0
+    if event == 7:
+        return 2 if (family == WALTON or family == VISCOUS_SLIDING) else 0
+    return 0
+
+
+@njit(cache=KERNEL_CACHE)
+def _event_value(y, aux, nl, tl, geo, rules, event):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    nmode = aux[A_NMODE]
+    if event == 0:
+        return delta
+    if event == 1:
+        if nmode == M_FREE:
+            if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
+                return -1.0
+            if nl[L_FAMILY] == 1.0:
+                # (a float: aux holds the modes as floats, and the other call site passes one)
+                return _normal_mode_force(nl, np.float64(M_UNLOAD), delta, rate, aux[A_DMAX])
+            return viscoelastic_force(nl, delta, rate)
+        return _normal_mode_force(nl, nmode, delta, rate, aux[A_DMAX])
+    if event == 2:
+        return rate
+    if event == 4:
+        return delta - aux[A_DMAX]
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    if event == 3:
+        s = 1e-7 * geo[G_TS]
+        return (_fn_at(y + s * dy, aux, nl, geo, rules) - _fn_at(y - s * dy, aux, nl, geo, rules)) / (2 * s)
+    family = tl[T_FAMILY]
+    if event == 5:
+        if family == SLIDING:
+            return req
+        psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])
+        return psi
+    if event == 6:
+        if family == SLIDING:
+            return _dot(vt, aux[A_TREF:A_TREF + 3])
+        if family == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
+            return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
+        if fn == 0.0:  # a zero cap (limit_force, force ended) admits only the slip state's zero force
+            return 1.0
+        return lam + _margin(tl, vt)  # falls through 0 where the slip ends (_unloads)
+    if event == 7:
+        if family == WALTON:  # a reversal of the slip (walton_reverses)
+            return _dot(vt, aux[A_TREF:A_TREF + 3])
+        return eta_of(tl, nl, delta) * _norm(vt) - tl[T_MU_K] * abs(fn)
+    return 1.0
+
+
+@njit(cache=KERNEL_CACHE)
+def _locate(y, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
+    lo, hi, glo, ghi = 0.0, 1.0, g0, g1
+    side = 0
+    for _ in range(LOCATE_ITERATIONS):
+        if hi - lo <= THETA_TOL:
+            break
+        theta = illinois_trial(lo, hi, glo, ghi)
+        yt, _ = _dp5_3(y, aux, nl, tl, geo, rules, theta * h)
+        g = _event_value(yt, aux, nl, tl, geo, rules, event)
+        lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
+    return hi
+
+
+@njit(cache=KERNEL_CACHE)
+def _record(rec, i, t, y, aux, nl, tl, geo, rules):
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    dy = np.empty(y.shape[0])
+    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    rec[i, C_T] = t
+    rec[i, C_X0:C_X0 + 18] = y[0:18]
+    rec[i, C_D] = delta
+    rec[i, C_R] = rate
+    rec[i, C_FN] = fn
+    rec[i, C_FT:C_FT + 3] = ft
+    rec[i, C_VT:C_VT + 3] = vt
+    rec[i, C_N:C_N + 3] = n
+    rec[i, C_E] = energy(y, geo)
+    rec[i, C_SLIP] = aux[A_TMODE]
+
+
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
+def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
+    """Integrate to relative tolerance ``rtol`` with event location (contact start/end, force end, maximum
+    overlap, peak force, loading/unloading, stick→slip, slip→stick, slip reversal). ``scales`` (21) are the
+    absolute scales of the state components. Returns (status, n, rec, ne, ev_t, ev_code)."""
+    rec = np.empty((capacity, NCOL))
+    ev_t = np.empty(256)
+    ev_c = np.empty(256, dtype=np.int64)
+    aux = np.zeros(A_SIZE)
+    y = y0.copy()
+    delta0 = kinematics(y, geo, rules)[0]
+    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_FAMILY] == 1.0 else M_VE)
+    t = 0.0
+    # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
+    # and so would a counter's first, literal, value while the loop's types are being inferred)
+    _record(rec, np.int64(0), t, y, aux, nl, tl, geo, rules)
+    n, ne = np.int64(1), np.int64(0)
+    ts = geo[G_TS]
+    hstep = H_START * ts
+    status = ST_NO_SEPARATION
+    force_ended = False
+    graze_t = -1.0  # the time of the last stick→slip graze
+    for _ in range(10_000_000):
+        if t >= t_max:
+            break
+        if n >= capacity - 2 or ne >= 250:
+            status = ST_STEPS
+            break
+        hstep = min(hstep, t_max - t)
+        yn, err = _dp5_3(y, aux, nl, tl, geo, rules, hstep)
+        emax = 0.0
+        # absolute, physical scales (positions are ~10³ times the overlap). While slipping the history is
+        # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
+        # so only the bodies' state is error-controlled then.
+        n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
+        if tl[T_FAMILY] == WALTON and aux[A_NMODE] != M_PRE:
+            # within 1e-6 of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely stiff as x → 0
+            # with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
+            # integration error, and is left out of the error control (else the steps shrink without end)
+            kin = kinematics(y, geo, rules)
+            fnow = abs(_contact_force(nl, aux[A_NMODE], kin[0], kin[1], aux[A_DMAX]))
+            if walton_margin(tl, _tangent_history(y, kin[2]), kin[4], fnow, aux[A_LSTAR:A_LSTAR + 3]) \
+                    < WALTON_NEAR_LIMIT:
+                n_ctrl = 18
+        for i in range(n_ctrl):
+            sc = scales[i] * rtol
+            if sc > 0.0:
+                emax = max(emax, abs(err[i]) / sc)
+        if not (emax <= 1.0):
+            hstep *= shrink(emax)
+            if hstep < H_MIN * ts:
+                status = ST_TOLERANCE
+                break
+            continue
+        best_theta, best_event, best_dir = 2.0, -1, 0
+        for event in range(N_EVENTS):
+            direction = _event_direction(nl, tl, aux, event)
+            if direction == 0:
+                continue
+            g0 = _event_value(y, aux, nl, tl, geo, rules, event)
+            g1 = _event_value(yn, aux, nl, tl, geo, rules, event)
+            if crossed(g0, g1, direction):
+                theta = _locate(y, aux, nl, tl, geo, rules, hstep, event, direction, g0, g1)
+                # events within SIMULTANEOUS_THETA of each other are one instant: the first in index order
+                # is taken (the force's end before a slip→stick its collapsing cap brings about)
+                if theta < best_theta - SIMULTANEOUS_THETA:
+                    best_theta, best_event, best_dir = theta, event, direction
+        if best_event < 0 and aux[A_NMODE] == M_PRE:
+            # a graze: the gap may close and open again inside one free-flight step (δ < 0 at both ends,
+            # its maximum inside, where the approach δ̇ turns into recession)
+            r0 = _event_value(y, aux, nl, tl, geo, rules, np.int64(2))
+            r1 = _event_value(yn, aux, nl, tl, geo, rules, np.int64(2))
+            if r0 > 0.0 and r1 <= 0.0:
+                tm = _locate(y, aux, nl, tl, geo, rules, hstep, np.int64(2), np.int64(-1), r0, r1)
+                ym, _ = _dp5_3(y, aux, nl, tl, geo, rules, tm * hstep)
+                dm = kinematics(ym, geo, rules)[0]
+                if dm > 0.0:
+                    d0 = kinematics(y, geo, rules)[0]
+                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, np.int64(0), np.int64(1), d0,
+                                              dm)
+                    best_event, best_dir = 0, 1
+        if best_event < 0 and tl[T_FAMILY] == SPRING and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
+                and _event_value(yn, aux, nl, tl, geo, rules, np.int64(5)) > 0.0:
+            # a spring's stick that ends past the slip surface with no crossing seen: it began on the surface
+            # (a slip→stick switch puts it there), dipped inside and came back out within the step — the trial
+            # force reversing through 0, a kink of |F| that the state's error control does not see (TTIt at
+            # 85°: |F_t| reached 124 μ|Fn| in stick). Halve the step until its end lies inside; at H_MIN the
+            # contact slips from here (_settle)
+            if hstep > H_MIN * ts:
+                hstep *= 0.5
+                continue
+            t += hstep
+            y = yn
+            _settle(y, aux, nl, tl, geo, rules)
+            _record(rec, n, t, y, aux, nl, tl, geo, rules)
+            n += 1
+            continue
+        if best_event < 0:
+            t += hstep
+            y = yn
+            if aux[A_NMODE] == M_LOAD:
+                aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
+            if tl[T_FAMILY] == WALTON:
+                _walton_truncate(y, aux, nl, tl, geo, rules)
+            elif tl[T_FAMILY] == SPRING and aux[A_TMODE] == SLIP and tl[T_TRUNC] != TRUNC_CAP:
+                if _onto_surface(y, aux, nl, tl, geo, rules):
+                    ev_t[ne], ev_c[ne] = t, EV_SLIP_STICK
+                    ne += 1
+            if (tl[T_FAMILY] == SLIDING and aux[A_TMODE] == SLIP) or tl[T_FAMILY] == WALTON:
+                # the slip direction: SLIDING's force direction, Walton's reference for a reversal
+                vt = kinematics(y, geo, rules)[4]
+                vn = _norm(vt)
+                if vn > 0.0:
+                    aux[A_TREF:A_TREF + 3] = vt / vn
+            _record(rec, n, t, y, aux, nl, tl, geo, rules)
+            n += 1
+            hstep *= grow(emax)
+            continue
+        he = best_theta * hstep
+        y, _ = _dp5_3(y, aux, nl, tl, geo, rules, he)
+        t += he
+        delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+        code = 0
+        terminal = False
+        family = tl[T_FAMILY]
+        if best_event == 0 and best_dir > 0:
+            code = EV_START
+            aux[A_NMODE] = M_LOAD if nl[L_FAMILY] == 1.0 else M_VE
+            aux[A_DMAX] = 0.0
+            y[18:21] = 0.0
+            aux[A_LSTAR:A_LSTAR + 3] = 0.0
+            aux[A_TMODE] = STICK
+            vn = _norm(vt)
+            aux[A_TREF:A_TREF + 3] = 0.0
+            if (family == SLIDING or family == WALTON) and vn > 0.0:
+                aux[A_TREF:A_TREF + 3] = vt / vn
+            if family == SLIDING and vn > 0.0:
+                aux[A_TMODE] = SLIP
+        elif best_event == 0:
+            code = EV_END
+            terminal = True
+        elif best_event == 1 and best_dir < 0:
+            code = EV_FORCE_END if not force_ended else -EV_FORCE_END
+            force_ended = True
+            if nl[L_FAMILY] == 1.0 or nl[L_LIMIT] != 0.0:
+                aux[A_NMODE] = M_FREE
+        elif best_event == 1:
+            code = EV_REENTER
+            aux[A_NMODE] = M_UNLOAD if nl[L_FAMILY] == 1.0 else M_VE
+        elif best_event == 2:
+            code = EV_MAX_OVERLAP
+            if aux[A_NMODE] == M_LOAD:
+                aux[A_DMAX] = delta
+                aux[A_NMODE] = M_UNLOAD
+        elif best_event == 3:
+            code = EV_PEAK
+        elif best_event == 4:
+            code = EV_RELOAD
+            aux[A_NMODE] = M_LOAD
+            aux[A_DMAX] = delta
+        elif best_event == 5:
+            code = EV_STICK_SLIP
+            dy = np.empty(21)
+            lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+            aux[A_TMODE] = SLIP
+            if family == SLIDING:
+                fnorm = _norm(ft)
+                if fnorm > 0.0:
+                    aux[A_TREF:A_TREF + 3] = -ft / fnorm
+            else:
+                y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
+                if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+                    # slip only where sticking would push past the surface (λ > 0); else it is a graze —
+                    # unless a graze was taken at this very instant already (within GRAZE_SAME_INSTANT: each
+                    # retaken graze advances t by an ulp or so): then the first-order test
+                    # contradicts the step it predicts (near contact end |Fn| ∝ δ^{1/4} has an unbounded
+                    # rate), sticking would re-cross at θ = 0 for ever, and the contact slips
+                    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+                    if _unloads(tl, lam, vt) and t - graze_t > GRAZE_SAME_INSTANT * ts:
+                        aux[A_TMODE] = STICK
+                        graze_t = t
+        elif best_event == 6:
+            code = EV_SLIP_STICK
+            if family != SLIDING:  # stick from exactly on the surface
+                dy = np.empty(21)
+                lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+                y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
+            aux[A_TMODE] = STICK
+        elif best_event == 7:
+            if family == WALTON:
+                code = EV_REVERSAL
+                aux[A_LSTAR:A_LSTAR + 3] = _tangent_history(y, nvec)
+                aux[A_TREF:A_TREF + 3] = -aux[A_TREF:A_TREF + 3]  # the slip now runs the other way
+            else:
+                code = EV_KINK
+        if not terminal and code != EV_STICK_SLIP and code != EV_SLIP_STICK:
+            _settle(y, aux, nl, tl, geo, rules)
+        _record(rec, n, t, y, aux, nl, tl, geo, rules)
+        if code == EV_END:
+            rec[n, C_FN] = 0.0
+            rec[n, C_FT:C_FT + 3] = 0.0
+        n += 1
+        ev_t[ne], ev_c[ne] = t, code
+        ne += 1
+        if ended_with_it(terminal, code == EV_START, aux[A_NMODE] != M_PRE, delta, rate):
+            ev_t[ne], ev_c[ne] = t, EV_END
+            ne += 1
+            terminal = True
+        if terminal:
+            status = ST_OK
+            break
+        hstep = resume(hstep, best_theta, ts)
+    if status == ST_NO_SEPARATION and aux[A_NMODE] == M_PRE:
+        status = ST_NO_CONTACT
+    return status, n, rec[:n].copy(), ne, ev_t[:ne].copy(), ev_c[:ne].copy()

@@ -1,0 +1,253 @@
+"""The engines' discrete scheme on the 3-D two-body contact (kernels3d.py's state and kinematics): velocity
+Verlet as ``fix nve/sphere``, the history rules of one step (turn, project, the spring family's slip and
+truncation) that the packing loop shares, and the two-body verlet kernel.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .. import KERNEL_CACHE
+from ..laws.normal_force import (normal_force)
+from ..laws.tangential import (LTH, NONE, SPRING, T_FAMILY, T_FORCE, T_MU_K, T_MU_S, T_R, T_RESCALE, T_TRUNC,
+                               TRUNC_MAW, TRUNC_SPRING, WALTON, ZZY)
+from ..laws.tangential_force import (_cross, eta_of, kt_of, _norm, return_map, slip_surface, tangential_force,
+                                     walton_reverses, walton_stiffness)
+from .kernels import (M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED)
+from .kernels3d import (A_NMODE, A_SIZE, A_TREF, C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, energy,
+                        G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION, ROT_PROJECT, ROT_RESCALE,
+                        ROT_RESCALE_SIGNIFICANT)
+
+# ----------------------------------------------------------------------------- velocity Verlet (engines)
+
+
+ROTATION_THRESHOLD = 1e-10  # of μ|Fn|: a history whose normal part is below it is left as it is
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def normal_part_matters(normal_part, scale, mu, fabs):
+    """The rescale_significant rule (LAMMPS's): a history is turned into the new tangent plane only when its
+    normal part matters, |ξ·n| scale > ROTATION_THRESHOLD μ|Fn| (``scale`` turns the history into a force: Kt,
+    or 1). The one rule of the two-body verlet kernel and the packing loop; the callers test the mode first, so
+    that nothing is computed for the other modes."""
+    return abs(normal_part) * scale > ROTATION_THRESHOLD * mu * fabs
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def turn_history(xi0, xi1, xi2, n, rot, scale, mu, fabs):
+    """The verlet history rule before the increment: LAMMPS turns the history (xi0, xi1, xi2) into the new tangent
+    plane and rescales it to its old length — always (ROT_RESCALE) or only where its normal part matters
+    (ROT_RESCALE_SIGNIFICANT, ``normal_part_matters`` with ``scale``, ``mu`` and ``fabs``). The one rule of the
+    two-body verlet kernel and the packing loop (scalars: it is inlined into the packing's force loop)."""
+    if rot == ROT_RESCALE or rot == ROT_RESCALE_SIGNIFICANT:
+        hn = xi0 * n[0] + xi1 * n[1] + xi2 * n[2]
+        if rot == ROT_RESCALE or normal_part_matters(hn, scale, mu, fabs):
+            old = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
+            xi0, xi1, xi2 = xi0 - hn * n[0], xi1 - hn * n[1], xi2 - hn * n[2]
+            new = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
+            if new > 0.0:
+                r = old / new
+                xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
+    return xi0, xi1, xi2
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def project_history(xi0, xi1, xi2, n, rot):
+    """The verlet history rule after the increment: LIGGGHTS projects the history onto the tangent plane
+    (ROT_PROJECT), with no rescale."""
+    if rot == ROT_PROJECT:
+        hn = xi0 * n[0] + xi1 * n[1] + xi2 * n[2]
+        xi0, xi1, xi2 = xi0 - hn * n[0], xi1 - hn * n[1], xi2 - hn * n[2]
+    return xi0, xi1, xi2
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
+    """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
+    trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
+    force) exceeds ``mu_test`` |Fn|, and is then cut to ``mu_k`` |Fn|: along the trial force with the history
+    kept (force cap), along it with the history put back on the limit (Maw: spring + dashpot = μ|Fn|), or the
+    spring shortened to the limit and the dashpot dropped. Returns (xi0, xi1, xi2, f0, f1, f2, sliding). The one
+    rule of the two-body verlet kernel and the packing loop."""
+    s0, s1, s2 = -kt * xi0 - eta * vt[0], -kt * xi1 - eta * vt[1], -kt * xi2 - eta * vt[2]
+    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    hm = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
+    cap_test = mu_test * fabs
+    psi = kt * hm - cap_test if trunc == TRUNC_SPRING else sn - cap_test
+    if psi <= 0.0:
+        return xi0, xi1, xi2, s0, s1, s2, False
+    cap = mu_k * fabs
+    if kt <= 0.0:  # no spring, no history
+        xi0 = xi1 = xi2 = 0.0
+        hm = 0.0
+    if trunc == TRUNC_SPRING:
+        if hm > 0.0:
+            r = cap / (kt * hm)
+            xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
+            return xi0, xi1, xi2, -kt * xi0, -kt * xi1, -kt * xi2, True
+        return xi0, xi1, xi2, 0.0, 0.0, 0.0, True
+    r = cap / sn if sn > 0.0 else 0.0
+    f0, f1, f2 = s0 * r, s1 * r, s2 * r
+    if trunc == TRUNC_MAW and kt > 0.0:
+        xi0, xi1, xi2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
+    return xi0, xi1, xi2, f0, f1, f2, True
+
+
+@njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
+def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
+    """The engines' scheme (fix nve/sphere, I = 0.4 m R²): half kick, drift, forces from full-step positions
+    and half-step velocities with the history updated once per step (not at setup), half kick. History
+    rules: rotation of ξ into the new tangent plane (none, project after the increment as LIGGGHTS, or
+    project and rescale before it as LAMMPS), then ξ += v_t dt, then the law's Coulomb truncation.
+    Stops at the first step after the contact has ended."""
+    rec = np.empty((capacity, NCOL))
+    y = y0.copy()
+    aux = np.zeros(A_SIZE)
+    aux[A_NMODE] = M_VE
+    hist = np.zeros(3)
+    lstar = np.zeros(3)
+    prev_vt = np.zeros(3)
+    a_prev = 0.0
+    dmax = 0.0
+    sliding = np.bool_(False)  # (not a literal: see adaptive_3d)
+    family = tl[T_FAMILY]
+    wall = geo[G_WALL] != 0.0
+    touched = False
+    status = ST_NO_SEPARATION
+
+    fvec0 = np.zeros(3)
+    tau0 = np.zeros(3)
+    tau1 = np.zeros(3)
+    # setup: forces of the initial state, no history update
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = 0.0
+    if delta > 0.0:
+        fn = normal_force(nl, delta, rate, delta)
+        fvec0 = -fn * n
+    rec[0, C_T] = 0.0
+    rec[0, C_X0:C_X0 + 18] = y[0:18]
+    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, fn
+    rec[0, C_FT:C_FT + 3] = 0.0
+    rec[0, C_VT:C_VT + 3] = vt
+    rec[0, C_N:C_N + 3] = n
+    rec[0, C_E] = energy(y, geo)
+    rec[0, C_SLIP] = 0.0
+    g = geo[G_GX:G_GX + 3]
+    i = 1
+    step = 0
+    while i < capacity:
+        step += 1
+        t = step * dt
+        if t > t_max:
+            status = ST_NO_SEPARATION if touched else ST_NO_CONTACT
+            break
+        # initial_integrate
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        y[0:3] += dt * y[3:6]
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            y[9:12] += dt * y[12:15]
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+        # forces
+        delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+        ft = np.zeros(3)
+        fn = 0.0
+        if delta > 0.0:
+            if delta > dmax:
+                dmax = delta
+            fn = normal_force(nl, delta, rate, dmax)
+            fabs = abs(fn)
+            force_hist = family == SPRING and tl[T_FORCE] != 0.0
+            if family == SPRING and tl[T_RESCALE] != 0.0:
+                # mindlin_rescale: a shrinking contact radius scales the history by a/a_prev first
+                a_now = math.sqrt(tl[T_R] * delta)
+                if a_now < a_prev:
+                    hist = hist * (a_now / a_prev)
+            if family == SPRING or family == LTH or family == ZZY or family == WALTON:
+                # (a force history's normal part is a force already: its scale is 1)
+                hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION],
+                                                         1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)
+            if force_hist:
+                # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the
+                # history keeps the elastic part of the capped force
+                eta = eta_of(tl, nl, delta)
+                hist = hist - kt_of(tl, delta) * dt * vt
+                if tl[T_RESCALE] != 0.0:
+                    a_prev = math.sqrt(tl[T_R] * delta)
+                ft = hist - eta * vt
+                fm = _norm(ft)
+                cap = tl[T_MU_K] * fabs
+                sliding = fm > cap
+                if sliding:
+                    if _norm(hist) != 0.0:
+                        ft = ft * (cap / fm)
+                        hist = ft + eta * vt
+                    else:
+                        ft = np.zeros(3)
+            elif family == SPRING or family == LTH or family == ZZY or family == WALTON:
+                if family == WALTON:
+                    if walton_reverses(vt, prev_vt):
+                        lstar = hist.copy()
+                    if _norm(vt) != 0.0:
+                        prev_vt = vt.copy()
+                    hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
+                else:
+                    hist = hist + vt * dt
+                if family == SPRING and tl[T_RESCALE] != 0.0:
+                    a_prev = math.sqrt(tl[T_R] * delta)
+                hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION])
+                mu = tl[T_MU_K] if sliding else tl[T_MU_S]  # a slip goes on while the force exceeds μk|Fn|
+                if family == SPRING:
+                    hist[0], hist[1], hist[2], ft[0], ft[1], ft[2], sliding = spring_slip(
+                        hist[0], hist[1], hist[2], vt, kt_of(tl, delta), eta_of(tl, nl, delta), tl[T_TRUNC], mu,
+                        tl[T_MU_K], fabs)
+                else:
+                    psi, w, d = slip_surface(tl, nl, hist, vt, fabs, delta, mu)
+                    if psi > 0.0:
+                        sliding = True
+                        hist = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
+                    else:
+                        sliding = False
+                    ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
+            elif family != NONE:
+                ft = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), aux[A_TREF:A_TREF + 3])
+        else:
+            hist[:] = 0.0
+            lstar[:] = 0.0
+            a_prev = 0.0
+            prev_vt = np.zeros(3)
+            dmax = 0.0
+            sliding = False
+        fvec0 = -fn * n + ft
+        tau0 = _cross(a0t * n, ft)
+        tau1 = _cross(a1t * n, ft)
+        # final_integrate
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+        rec[i, C_T] = t
+        rec[i, C_X0:C_X0 + 18] = y[0:18]
+        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
+        rec[i, C_FT:C_FT + 3] = ft
+        rec[i, C_VT:C_VT + 3] = vt
+        rec[i, C_N:C_N + 3] = n
+        rec[i, C_E] = energy(y, geo)
+        rec[i, C_SLIP] = 1.0 if sliding else 0.0
+        i += 1
+        if not np.all(np.isfinite(y[0:18])):
+            status = ST_UNRESOLVED
+            break
+        if delta > 0.0:
+            touched = True
+        elif touched:
+            status = ST_OK
+            break
+    else:
+        status = ST_STEPS
+    return status, i, rec[:i].copy()
