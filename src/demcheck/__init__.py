@@ -8,11 +8,17 @@ from pathlib import Path as _Path
 __version__ = "0.1.0"
 
 
+KERNEL_PACKAGES = ("laws", "reference")  # every compiled kernel lives in one of these
+
+
 def reference_fingerprint() -> str:
-    """A hash of the reference package's source (every compiled kernel lives there)."""
+    """A hash of the source of every package that holds compiled kernels (the laws' force functions and the
+    reference's solvers, which inline them)."""
     h = _hashlib.sha256()
-    for f in sorted((_Path(__file__).parent / "reference").glob("*.py")):
-        h.update(f.name.encode() + b"\0" + f.read_bytes())
+    root = _Path(__file__).parent
+    for package in KERNEL_PACKAGES:
+        for f in sorted((root / package).glob("*.py")):
+            h.update(f"{package}/{f.name}".encode() + b"\0" + f.read_bytes())
     return h.hexdigest()[:16]
 
 
@@ -22,7 +28,7 @@ def _numba_cache_dir() -> bool:
     Numba's on-disk cache keys a compiled function by its own file's timestamp only: a kernel that inlines a
     function of another module would be served stale after that module changed (seen here: the suite passed on
     stale 3-D kernels while fresh ones stalled; docs/performance.md). So the kernels cache under a directory
-    named by the fingerprint of the whole reference package (``$XDG_CACHE_HOME/demcheck/numba/<fingerprint>``,
+    named by the fingerprint of the laws' and the reference's sources (``$XDG_CACHE_HOME/demcheck/numba/<fingerprint>``,
     ``~/.cache`` by default): any change to any kernel source starts afresh. A NUMBA_CACHE_DIR set by the user
     is used as it is. Never the install tree: where no cache directory takes a file (a read-only home, a
     locked-down container), the kernels are compiled without a cache and one warning line says so."""
