@@ -1,5 +1,6 @@
-"""Package-wide invariants: the engines' order (a report's columns, docs/models.md's mapping table) does not depend on which
-was imported first: test_docs failed when test_engine_traps_yade_kratos ran before it in the same process."""
+"""Package-wide invariants: the engines' order (a report's columns, docs/models.md's mapping table) does not depend on
+which engine package was imported first (test_docs failed when test_engine_traps_yade_kratos ran before it in the
+same process), and the compiled kernels' cache key covers every package that holds kernels."""
 
 import subprocess
 import sys
