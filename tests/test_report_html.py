@@ -20,6 +20,7 @@ import pytest
 
 from demcheck.comparisons import packing_metrics, plots, report, suite, verdicts as V
 from demcheck.engines.base import APPROXIMATE
+from demcheck.comparisons.sources import plan
 from demcheck.comparisons.styles import style
 from demcheck.engines.cache import Cache
 from demcheck.errors import ConfigError
@@ -643,8 +644,8 @@ def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
     assert (c.verdict, c.setting) == (V.EXPECTED, "tangential linear_nohistory")
     entry, comps = {"sources": {}}, []
     found = {e: {"found": True} for e in ("lammps", "yade")}
-    for e in ("lammps", "yade"):
-        V.unavailable(entry, comps, e, contact_mapping(case, e), found)
+    for planned in plan(case, ("lammps", "yade"), found):
+        V.unavailable(entry, comps, planned)
     assert entry["settings"] == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     assert entry["sources"]["yade"]["status"] == "not expressible"
 

@@ -174,10 +174,11 @@ def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keywo
 
 def sources() -> tuple[str, ...]:
     """The names :func:`collide` takes as ``source``: reference, each registered engine, and its twin."""
+    from .comparisons.sources import Source
     from .engines import registry
 
-    names = registry.names()
-    return ("reference", *names, *(f"{n}-twin" for n in names))
+    engines = registry.all_engines()
+    return ("reference", *(Source.of(e).label for e in engines), *(Source.of(e, twin=True).label for e in engines))
 
 
 def collide(case, source: str = "reference", method: str | None = None, dt: float | None = None,
@@ -189,6 +190,8 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     engine's formulas with its scheme at ``dt``). A case's ``[engine.NAME]`` native settings are used by that
     engine and its twin, by default at the native law's own step (run.dt, else its twin's elastic contact time
     over run.steps_per_contact). Overrides as :func:`load` takes them."""
+    from .comparisons.sources import REFERENCE, Source
+
     c = load(case, overrides, **keyword)
     _positive("dt", dt, "s")
     _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
@@ -197,25 +200,14 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     known = sources()
     if not isinstance(source, str) or source not in known:
         raise ConfigError("source", _shown(source), f"must be one of {', '.join(known)}")
-    if source == "reference":
-        from .reference.collision import collide as run
-
-        return _framed(run(c, method=method, dt=dt))
+    src = Source.parse(source, "source")
+    if src.kind == REFERENCE:
+        return _framed(Source.reference(method).run(c, dt))
     if method is not None:
         raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
                                             "velocity Verlet at dt")
-    from .engines.collide import setting
-
-    engine = source.removesuffix("-twin")
-    native, dt = setting(c, engine, dt)  # the native law's own step (its twin's contact time / run.steps_per_contact)
-    if source.endswith("-twin"):
-        from .engines.collide import twin_states
-
-        step = dt or _case.run_length(c)[0]
-        return _framed(twin_states(c, engine, step, native=native))
-    from .engines.collide import collide as run_engine
-
-    return _framed(run_engine(c, engine, dt=dt, native=native, timeout=timeout))
+    # the case's [engine.NAME] setting at the native law's own step (its twin's contact time / run.steps_per_contact)
+    return _framed(src.run(c, dt, timeout=timeout))
 
 
 def collide_many(cases: Iterable, method: str | None = None, dt: float | None = None):

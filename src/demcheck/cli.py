@@ -364,8 +364,8 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
                    "yade-float128, yade-mpfr150), e.g. to show a difference is the scheme's and not round-off")
 def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout, precision):
     """Solve one collision case and print its metrics (per source, side by side)."""
+    from .comparisons.sources import Source
     from .errors import EngineNotFound, UnsupportedByEngine
-    from .reference.collision import collide as run
 
     if engine == "all" and precision:
         raise ConfigError("--precision", precision, "names the builds of engines given by name (--engine yade), "
@@ -391,17 +391,10 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
     case = _load(case_path, overrides)
     results, skipped = {}, {}
     for src in sources:
-        if src == "reference":
-            results[src] = run(case, method=method, dt=dt)
-            continue
-        from .engines.collide import collide as run_engine
-
-        try:
-            from .engines.collide import setting
-
-            # [engine.NAME] (a build reads its engine's table) at the native law's own step: what `deck` writes
-            native, step = setting(case, src, dt)
-            results[src] = run_engine(case, src, dt=step, timeout=timeout, native=native)
+        source = Source.reference(method) if src == "reference" else Source.parse(src, "--engine")
+        try:  # an engine: [engine.NAME] (a build reads its engine's table) at the native law's own step, what
+            # `deck` writes
+            results[src] = source.run(case, dt, timeout=timeout)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
                 raise
@@ -475,15 +468,15 @@ def deck(case_path, engine, output, dt, overrides):
     """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
     (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
     reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
+    from .comparisons.sources import Source
     from .engines.collide import finite, setting_deck
 
     case = _load(case_path, overrides)
+    source = Source.of(engine)
     if case.kind == "packing":
-        from .engines import registry
-
-        dk = finite(registry.get(engine).packing_deck(case, dt=dt), case)
+        dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
-        dk = setting_deck(case, engine, dt)
+        dk = setting_deck(case, source.engine, dt)
     if output:  # the files the deck reads go beside it: each checked before any is written
         check_output("--output", output, files=list(dk.files))
         for path in dk.write(output):
@@ -545,24 +538,12 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     a materials.* key the setting does not read is refused: it would not change the law that runs."""
     from rich.progress import Progress
 
-    from .comparisons.sweep import check_source, native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points
+    from .comparisons.sweep import native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points, sweep_source
 
-    if "=" not in source:
-        check_source(source, method)
-    if source != "reference" and not source.endswith("-twin"):
-        from .engines import discovery
-        from .errors import EngineNotFound
-
-        labels = discovery.resolve(source, "--engine")  # an engine, or a build registered under its label
-        if len(labels) != 1:
-            raise ConfigError("--engine", source, "a sweep runs one source (collide and verify compare several)")
-        source = labels[0]
-        if discovery.find(source) is None:
-            raise EngineNotFound(discovery.missing(source))
-    check_source(source, method)
+    source, engine = sweep_source(source, method)  # the source's label and its engine (or build), before any work
     points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
     native_vary_rule(points, source)
-    with _campaign(jobs, scheduler, [source.removesuffix("-twin")]) as campaign, \
+    with _campaign(jobs, scheduler, [engine] if engine else []) as campaign, \
             Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("sweep", total=len(points))
         table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source, campaign=campaign)

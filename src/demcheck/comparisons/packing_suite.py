@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..errors import EngineInterrupted, UnsupportedByEngine
-from . import packing_metrics, verdicts
+from . import packing_metrics, sources, verdicts
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
 TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
@@ -155,9 +155,10 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry["packing"]["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
                                      "profile": packing_metrics.profile(x, rad, box) if box else None}
 
-    for engine in opts.engines:
-        if verdicts.unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
+    for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
+        if verdicts.unavailable(entry, comps, planned):
             continue
+        engine = planned.source.label
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
         except EngineInterrupted:

@@ -19,9 +19,14 @@ from .mapping import contact_mapping, native_summary, twin_model
 
 
 
-def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, native=None,
+def as_engine(engine):
+    """The Engine ``engine`` names (an Engine is returned as it is): the functions here take either."""
+    return registry.get(engine) if isinstance(engine, str) else engine
+
+
+def deck(case: Case, engine, dt: float | None = None, length: float = 1.0, native=None,
          **options) -> common.Deck:
-    return finite(registry.get(engine).collision_deck(case, dt, length, native=native, **options), case)
+    return finite(as_engine(engine).collision_deck(case, dt, length, native=native, **options), case)
 
 
 # a number an engine cannot read (NaN, inf), as a word of a deck's command (comments aside)
@@ -45,13 +50,13 @@ def finite(dk: common.Deck, case: Case) -> common.Deck:
     return dk
 
 
-def setting(case: Case, engine: str, dt: float | None = None):
+def setting(case: Case, engine, dt: float | None = None):
     """(native, dt): what ``engine`` (or a build of it) runs for the case — the case's ``[engine.NAME]`` setting
     (None: the engine's mapping of the seed model) and its step: ``dt`` (--dt), else the case's run.dt, else, for a
     native law, its twin's elastic contact time over run.steps_per_contact (the seed model's contact time would
     leave a stiffer native law unresolved; None: the deck's own auto step). ``demcheck collide``, ``deck`` and the
     API's collide all take it from here, so that the deck written is the deck run."""
-    native = registry.get(engine).case_native(case)
+    native = as_engine(engine).case_native(case)
     if native is not None and not dt and not case.run.dt:
         from ..reference.model import characteristic_time, resolve
 
@@ -59,7 +64,7 @@ def setting(case: Case, engine: str, dt: float | None = None):
     return native, dt or None
 
 
-def setting_deck(case: Case, engine: str, dt: float | None = None) -> common.Deck:
+def setting_deck(case: Case, engine, dt: float | None = None) -> common.Deck:
     """The deck ``collide(case, engine, *setting(case, engine, dt))`` runs first: what ``demcheck deck`` writes."""
     native, step = setting(case, engine, dt)
     return deck(case, engine, step, native=native)
@@ -80,7 +85,7 @@ def _every_body(bodies: int):
     return check
 
 
-def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
+def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | None = None,
             timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, worker: bool = False,
             **options) -> Result:
     """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
@@ -95,6 +100,8 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     not "ok" is kept and named."""
     from . import discovery
 
+    eng = as_engine(engine)  # an Engine, or its registered name
+    engine = eng.name
     mp = contact_mapping(case, engine, native)
     mp.require()  # the decks get ``native`` as given (None: the seed model's mapping, type pair by type pair), so
     # that the deck run is the deck `demcheck deck` writes
@@ -107,13 +114,13 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     for attempt in range(4):
         if attempt:
             try:  # a longer run past the step bound: the contact did not end within what may be run
-                longer = deck(case, engine, dt, length * 4.0, native=native, **options)
+                longer = deck(case, eng, dt, length * 4.0, native=native, **options)
             except ConfigError:
                 break
             length *= 4.0
             dk = longer
         else:
-            dk = deck(case, engine, dt, length, native=native, **options)
+            dk = deck(case, eng, dt, length, native=native, **options)
         text = dk.text
         hit = None
         if cache is not None:
@@ -223,16 +230,17 @@ def _native_summary(native) -> dict:
     return {"engine": native.engine, "config": native_summary(native)}
 
 
-def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
+def twin_states(case: Case, engine, dt: float, native=None) -> Result:
     """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
     off its states exactly as an engine's is (states.restate: the bodies' forces with their weights, as an
     engine dumps them, read back less the weights)."""
     from ..reference import collision3d
     from ..reference.model import resolve
 
-    mp = contact_mapping(case, engine, native)
+    eng = as_engine(engine)
+    mp = contact_mapping(case, eng.name, native)
     model = twin_model(resolve(case), mp.require())
-    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=registry.get(engine).rules), case)
-    res.source = f"{engine}-twin"
+    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=eng.rules), case)
+    res.source = f"{eng.name}-twin"
     res.meta["fidelity"] = mp.fidelity
     return res
