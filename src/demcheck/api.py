@@ -270,52 +270,101 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
 
 
 def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path | None = None, jobs: int = 1,
-           cache: bool = True, timeout: float = 600.0) -> dict:
-    """The verification suite over case files (paths of files or directories) → its results dict (the
-    ``results.json`` of a report: ``cases``, each with its ``sources``, ``comparisons`` and ``status``, and
-    ``failed``, the count of failing cases). ``engines``: names, or None for every registered one, or ``()`` /
-    ``"none"`` for the reference alone. ``report``: a directory for the report (``<report>/<run-id>/``), or None
-    to write none."""
-    import shutil
-    import tempfile
+           cache: bool = True, timeout: float = 600.0, *, refresh: bool = False, scheduler: str | None = None,
+           baseline: str | Path | None = None, precision: str | None = None, junit: str | Path | None = None,
+           quiet: bool = True, argv: list[str] | None = None, keys: Mapping[str, str] | None = None) -> dict:
+    """The verification suite over case files (paths of files or directories; a directory without its optin/ and
+    benchmarks/ folders: resources.case_files) → its results dict (the ``results.json`` of a report: ``cases``,
+    each with its ``sources``, ``comparisons`` and ``status``, and ``failed``, the count of failing cases).
+    ``demcheck verify`` is this function: the same files, engines, builds and expected differences give the same
+    results.
 
+    ``engines``: names or builds (``"lammps,lammps@2024=/opt/lmp-2024/lmp"``, or a list of them: a build's
+    expected differences follow its version), None for every registered one (one not found is reported
+    missing), or ``()`` / ``"none"`` for the reference alone; an engine named must be found. ``report``: a
+    directory for the report (``<report>/<run-id>/``), or None to write none. ``cache``: read and write the
+    engine-run cache (``refresh``: run every deck again, the fresh runs replacing the cached ones). ``scheduler``:
+    a Dask cluster's address (``jobs`` then left at 1); ``baseline``: a stored earlier run every source is judged
+    against too; ``precision``: each listed engine that has one run as its build in this precision (Yade:
+    float128, mpfr150); ``junit``: also write JUnit XML here. ``keys``: the names the errors give the arguments
+    (the command line's options)."""
     from .comparisons.suite import Options, run_suite
-    from .engines import registry
 
-    names = _engines(engines, registry.names())
+    key = {"paths": "paths", "engines": "engines", "baseline": "baseline", "precision": "precision",
+           **(keys or {})}
     if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
         raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
     _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
     _flag("cache", cache)
+    _flag("refresh", refresh)
     _report_dir(_path("report", report, optional=True))
-    files = _case_files(paths)
-    opts = Options(engines=names, jobs=jobs, timeout=timeout)
+    names = _engines(engines, precision, key)
+    opts = Options(engines=names, jobs=jobs, scheduler=scheduler, timeout=timeout,
+                   expected=_expected(names))
     if cache:
-        from .engines.cache import Cache
+        from .engines.cache import Cache, default_dir
 
-        opts.cache = Cache()
+        _writable_cache(default_dir())
+        opts.cache = Cache(refresh=refresh)
+    files = _case_files(paths, key["paths"])
+    if baseline is not None:
+        from .comparisons import diff
+
+        opts.baseline = diff.load(_path(key["baseline"], baseline), key["baseline"])  # before any work
+    argv = argv if argv is not None else ["demcheck.verify"]
+    junit = Path(_path("junit", junit)) if junit is not None else None
     if report is not None:
-        return run_suite(files, Path(report), opts, quiet=True, argv=["demcheck.verify"])
+        return run_suite(files, Path(report), opts, quiet=quiet, junit=junit, argv=argv)
+    import shutil
+    import tempfile
+
     tmp = Path(tempfile.mkdtemp(prefix="demcheck-verify-"))
     try:
-        out = run_suite(files, tmp, opts, quiet=True, argv=["demcheck.verify"])
+        out = run_suite(files, tmp, opts, quiet=quiet, junit=junit, argv=argv)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     out["report"] = None
     return out
 
 
-def _engines(engines, registered) -> tuple[str, ...]:
+def _engines(engines, precision, key) -> tuple[str, ...]:
+    """The engines and builds of ``engines`` (verify's argument) as the command line reads its --engines: a build
+    registered under its label, an engine named required to be found (engines.discovery.resolve)."""
+    from .engines import builds, discovery, registry
+
     if engines is None:
-        return tuple(registered)
-    if isinstance(engines, str):
-        engines = [] if engines == "none" else [e.strip() for e in engines.split(",") if e.strip()]
-    out = tuple(_sequence("engines", engines, "must be engine names (a list, or one text 'lammps,yade'), "
-                                              "'none' or None"))
-    for e in out:
-        if not isinstance(e, str) or e not in registered:
-            raise ConfigError("engines", _shown(e), f"is not a registered engine ({', '.join(registered)})")
-    return out
+        text, required = ",".join(n for n in registry.names() if "@" not in n), False
+    else:
+        if isinstance(engines, str):
+            items = [engines]
+        else:
+            items = _sequence(key["engines"], engines, "must be engine names or builds (a list, or one text "
+                                                       "'lammps,yade'), 'none' or None")
+        for e in items:
+            if not isinstance(e, str):
+                raise ConfigError(key["engines"], _shown(e), "must be engine names or builds (text), 'none' or None")
+        text, required = ",".join(items) or "none", None
+    if precision is not None:
+        if not isinstance(precision, str):
+            raise ConfigError(key["precision"], _shown(precision), "must be float128 or mpfr150")
+        text = builds.with_precision(text, precision, key["precision"])  # yade → yade@float128=…
+    return tuple(discovery.resolve(text, key["engines"], required))
+
+
+def _expected(names) -> list:
+    """The expected differences (data/expected_differences.toml), each repeated for every labelled build of its
+    engine among ``names``: a build's differences follow its own version."""
+    from .comparisons import verdicts
+    from .engines import builds
+
+    return builds.expected_for(verdicts.load_expected(), names)
+
+
+def _writable_cache(where) -> None:
+    """The engine-run cache's directory can be made and written (checked before any work)."""
+    from .io import check_output
+
+    check_output("DEMCHECK_CACHE", where, directory=True)
 
 
 def _report_dir(report) -> None:
@@ -330,14 +379,15 @@ def _report_dir(report) -> None:
         raise ConfigError("report", str(report), f"{latest} is not the symlink demcheck moves to each new run")
 
 
-def _case_files(paths) -> list[Path]:
+def _case_files(paths, key: str = "paths") -> list[Path]:
+    """The case files of verify's ``paths`` (resources.case_files: the one case discovery of every command)."""
     from .resources import case_files
 
     rule = "must be a case file's or directory's path, or a list of them"
-    paths = [paths] if isinstance(paths, (str, Path)) else _sequence("paths", paths, rule)
+    paths = [paths] if isinstance(paths, (str, Path)) else _sequence(key, paths, rule)
     for p in paths:
-        _path("paths", p)
-    return case_files(paths, "paths")
+        _path(key, p)
+    return case_files(paths, key)
 
 
 def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:

@@ -16,7 +16,7 @@ import click
 from . import __version__
 from .errors import ConfigError, DemcheckError
 from . import resources
-from .io import console, number as as_text, plain
+from .io import check_output, console, number as as_text, plain
 
 
 
@@ -83,38 +83,6 @@ class Number(click.ParamType):
 
 def _option_name(param) -> str:
     return max(param.opts, key=len) if param is not None and param.opts else "value"
-
-
-def check_output(key: str, path, directory: bool = False, files=(), link: str | None = None) -> None:
-    """An output path demcheck can write (a file, or a ``directory`` it creates or fills), checked before any
-    work: nothing on the way is a file, the path is not of the other kind, and its first existing directory
-    takes a new file. So are the files derived from it: ``files``, names written in the directory (or beside
-    the file), each not a directory; and ``link``, the symlink demcheck moves in the directory (``latest``),
-    which is demcheck's: absent or a symlink, never a real file or directory. Else ConfigError naming ``key``,
-    the path and the rule."""
-    import tempfile
-
-    p = Path(path).absolute()
-    if p.is_dir() != directory and p.exists():
-        raise ConfigError(key, str(path), "is a file, not a directory" if directory else "is a directory, not a file")
-    where = p if directory and p.is_dir() else p.parent
-    while not where.exists() and not where.is_symlink() and where != where.parent:
-        where = where.parent
-    if not where.is_dir():
-        raise ConfigError(key, str(path), f"{where} is a file, not a directory")
-    beside = Path(path) if directory else Path(path).parent
-    for name in files:
-        if (beside / name).is_dir():
-            raise ConfigError(key, str(path), f"{beside / name} is a directory, not a file")
-    if link is not None and (beside / link).exists() and not (beside / link).is_symlink():
-        what = "directory" if (beside / link).is_dir() else "file"
-        raise ConfigError(key, str(path), f"{beside / link} is a {what}, not the symlink demcheck moves to each "
-                                          "new run (move it away, or choose another --report)")
-    try:
-        with tempfile.TemporaryFile(dir=where):
-            pass
-    except OSError as exc:
-        raise ConfigError(key, str(path), f"cannot write in {where} ({exc.strerror or exc})") from None
 
 
 class OutputPath(click.ParamType):
@@ -666,24 +634,17 @@ def verify(paths, engines, jobs, scheduler, report_dir, junit, as_json, no_cache
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
-    from .comparisons.suite import Options, run_suite
+    from . import api
+    from .comparisons import diff
     from .engines import run as runner
-    from .engines.cache import Cache, default_dir
-
-    from .comparisons import diff, verdicts
-    from .engines import builds, discovery
 
     _check_jobs(jobs, scheduler)
-    engines = builds.with_precision(engines, precision) if precision else engines  # yade → yade@float128=…
-    names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
-    check_output("DEMCHECK_CACHE", default_dir(), directory=True)
-    files = _case_files(paths)
-    base = diff.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
-    opts = Options(engines=tuple(names), jobs=jobs, scheduler=scheduler, cache=Cache(refresh=no_cache), timeout=timeout,
-                   baseline=base, expected=builds.expected_for(verdicts.load_expected(), names))
     try:
-        summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
-                            argv=["demcheck", "verify", *sys.argv[2:]])
+        summary = api.verify(list(paths), engines, report_dir, jobs, True, timeout, refresh=no_cache,
+                             scheduler=scheduler, baseline=baseline, precision=precision, junit=junit,
+                             quiet=as_json, argv=["demcheck", "verify", *sys.argv[2:]],
+                             keys={"paths": "CASE", "engines": "--engines", "baseline": "--baseline",
+                                   "precision": "--precision"})
     except KeyboardInterrupt as exc:
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
                    f"report {Path(report_dir) / 'latest'}", err=True)
