@@ -28,8 +28,8 @@ from . import case as _case
 from .errors import ConfigError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result",
-           "ConfigError"]
+__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "models",
+           "Result", "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
 MAX_TIMEOUT = 1e6  # s, as the command line's --timeout (the pipes' poll() takes at most ~2.1e6 s)
@@ -170,6 +170,41 @@ def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keywo
     if isinstance(case, _case.Case) and not overrides and not keyword:
         return case
     return _build(case, _overrides(overrides, keyword))
+
+
+def models(model_id: str | None = None, key: str = "model_id") -> list[dict]:
+    """The registered contact models (``demcheck models``) as rows: slot, id, seed name, aliases, title, formula,
+    source, parameters and each engine's mapping of it (fidelity, with, config, reason). ``model_id``: one id or
+    alias (in either slot: ``tti`` names a normal and a tangential model), else ConfigError naming ``key``."""
+    from .engines import mapping
+    from .reference import normal, tangential
+
+    def rows(registry, slot):
+        return [{"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
+                 "title": m.title, "formula": m.formula, "source": m.source,
+                 "params": {p.name: p.meaning for p in m.params}} for m in registry.values()]
+
+    _text(key, model_id, "must be a model's id or alias (text) or None", optional=True)
+    table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
+    if model_id is not None:
+        found = set()
+        for slot, reg in (("normal", normal.REGISTRY), ("tangential", tangential.REGISTRY)):
+            try:
+                found.add((slot, reg.lookup(model_id).id))
+            except KeyError:
+                pass
+        table = [r for r in table if (r["slot"], r["id"]) in found]
+        if not table:
+            import difflib
+
+            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names()]
+            near = difflib.get_close_matches(model_id.strip().lower(), known, n=1)
+            raise ConfigError(key, model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
+                                                                            else f"; known: {', '.join(known)}"))
+    engines = mapping.by_model()
+    for row in table:
+        row["engines"] = engines[(row["slot"], row["id"])]
+    return table
 
 
 def sources() -> tuple[str, ...]:
