@@ -94,3 +94,22 @@ def test_a_bad_engine_list_is_named_by_each_face(tmp_path):
     with pytest.raises(ConfigError, match="^engines = .lammpz.: must be lammps"):
         demcheck.verify(CASES / "hertz-wall.toml", engines="lammpz")
     assert builds  # the builds module is what both faces parse the list with
+
+
+@pytest.mark.parametrize("named", [True, False])
+def test_a_dask_worker_lacking_a_named_engine_fails_the_case(monkeypatch, named):
+    """Issue 32: an engine the user named is never skipped — on a Dask worker that lacks it the case fails (the
+    worker named); an engine of default discovery is reported missing there, as on the client."""
+    from demcheck.case import load
+    from demcheck.comparisons import dispatch, verdicts
+
+    why = "lammps is missing on the Dask worker tcp://w:1 (host w): lammps is not installed"
+    monkeypatch.setattr(dispatch, "missing_here", lambda engines: {e: why for e in engines if e == "lammps"})
+    found = {"lammps": {"found": True, "version": "x", "executable": "lmp", "how_to_install": "", "why": None}}
+    opts = suite.Options(engines=("lammps",), named=named, cache=None)
+    entry = suite.case_task(load(CASES / "hertz-wall.toml"), str(CASES / "hertz-wall.toml"), opts, found)
+    if named:
+        assert entry["status"] == "failed" and why in entry["message"]
+    else:
+        assert entry["sources"]["lammps"] == {"status": verdicts.MISSING, "message": why}
+        assert entry["status"] == "ok"

@@ -333,9 +333,9 @@ def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path
     _flag("cache", cache)
     _flag("refresh", refresh)
     _report_dir(_path("report", report, optional=True))
-    names = _engines(engines, precision, key)
-    opts = Options(engines=names, jobs=jobs, scheduler=scheduler, timeout=timeout,
-                   expected=_expected(names))
+    names, named = _engines(engines, precision, key)
+    opts = Options(engines=names, jobs=jobs, scheduler=scheduler, timeout=timeout, expected=_expected(names),
+                   named=named)
     if cache:
         from .engines.cache import Cache, default_dir
 
@@ -362,9 +362,10 @@ def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path
     return out
 
 
-def _engines(engines, precision, key) -> tuple[str, ...]:
+def _engines(engines, precision, key) -> tuple[tuple[str, ...], bool]:
     """The engines and builds of ``engines`` (verify's argument) as the command line reads its --engines: a build
-    registered under its label, an engine named required to be found (engines.discovery.resolve)."""
+    registered under its label, an engine named required to be found (engines.discovery.resolve); and whether they
+    were named (not the default list: an engine a Dask worker lacks then fails its case)."""
     from .engines import builds, discovery, registry
 
     if engines is None:
@@ -383,7 +384,8 @@ def _engines(engines, precision, key) -> tuple[str, ...]:
         if not isinstance(precision, str):
             raise ConfigError(key["precision"], _shown(precision), "must be float128 or mpfr150")
         text = builds.with_precision(text, precision, key["precision"])  # yade → yade@float128=…
-    return tuple(discovery.resolve(text, key["engines"], required))
+    named = required if required is not None else discovery.named(key["engines"])
+    return tuple(discovery.resolve(text, key["engines"], required)), named
 
 
 def _expected(names) -> list:
