@@ -98,8 +98,9 @@ def test_a_bad_engine_list_is_named_by_each_face(tmp_path):
 
 @pytest.mark.parametrize("named", [True, False])
 def test_a_dask_worker_lacking_a_named_engine_fails_the_case(monkeypatch, named):
-    """Issue 32: an engine the user named is never skipped — on a Dask worker that lacks it the case fails (the
-    worker named); an engine of default discovery is reported missing there, as on the client."""
+    """Issue 32: an engine the user named is never skipped — on a Dask worker that lacks it, its source fails in the
+    cases the worker ran (the worker named); an engine of default discovery is reported missing there, as on the
+    client."""
     from demcheck.case import load
     from demcheck.comparisons import dispatch, verdicts
 
@@ -109,7 +110,8 @@ def test_a_dask_worker_lacking_a_named_engine_fails_the_case(monkeypatch, named)
     opts = suite.Options(engines=("lammps",), named=named, cache=None)
     entry = suite.case_task(load(CASES / "hertz-wall.toml"), str(CASES / "hertz-wall.toml"), opts, found)
     if named:
-        assert entry["status"] == "failed" and why in entry["message"]
+        assert entry["sources"]["lammps"] == {"status": verdicts.FAILED, "message": why}
+        assert entry["status"] == "failed" and entry["sources"]["reference"]["status"] == "ok"
     else:
         assert entry["sources"]["lammps"] == {"status": verdicts.MISSING, "message": why}
         assert entry["status"] == "ok"

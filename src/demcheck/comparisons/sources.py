@@ -17,7 +17,7 @@ from typing import Iterable
 from ..case import Case
 from ..errors import ConfigError
 from ..result import Result
-from .verdicts import MISSING, NOT_EXPRESSIBLE  # a Planned's status: the verdict of an engine that cannot run
+from .verdicts import FAILED, MISSING, NOT_EXPRESSIBLE  # a Planned's status: the verdict of an engine that cannot run
 
 REFERENCE, ENGINE, TWIN = "reference", "engine", "twin"
 TWIN_SUFFIX = "-twin"
@@ -145,8 +145,8 @@ ADAPTIVE, VERLET = Source.reference("adaptive"), Source.reference("verlet")
 @dataclass(frozen=True)
 class Planned:
     """An engine source for one case, as :func:`plan` found it: the case's own setting (``native``), the mapping of
-    the case's contact (engines.mapping.Mapping), and, when it cannot run, its ``status`` (NOT_EXPRESSIBLE or
-    MISSING, verdicts') and why."""
+    the case's contact (engines.mapping.Mapping), and, when it cannot run, its ``status`` (NOT_EXPRESSIBLE,
+    MISSING, or FAILED: a named engine a Dask worker lacks — verdicts') and why."""
 
     source: Source
     native: object
@@ -186,7 +186,9 @@ def plan(case: Case, engines: Iterable | None = None, found: dict | None = None,
         if mp.native is None:
             entry = Planned(entry.source, native, mp, NOT_EXPRESSIBLE, "; ".join(mp.reasons))
         elif (why := _missing(engine.name, found)) is not None:
-            entry = Planned(entry.source, native, mp, MISSING, why)
+            # an engine the user named that a Dask worker lacks fails there (the suite's record says "required")
+            required = found is not None and found[engine.name].get("required")
+            entry = Planned(entry.source, native, mp, FAILED if required else MISSING, why)
         out.append(entry)
     return out
 

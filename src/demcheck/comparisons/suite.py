@@ -49,7 +49,7 @@ class Options:
     tolerances: verdicts.Tolerances = field(default_factory=verdicts.Tolerances.load)
     expected: list = field(default_factory=verdicts.load_expected)
     baseline: dict | None = None  # a stored earlier run (comparisons/diff.load): every source judged against it too
-    named: bool = False  # the engines were named (not default discovery): one a Dask worker lacks fails its case
+    named: bool = False  # the engines were named (not default discovery): one a Dask worker lacks fails there
 
 
 def discover(engines) -> dict:
@@ -323,11 +323,9 @@ def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> 
     """One case's entry, where the campaign runs it (comparisons/dispatch.py) with ``cache`` as its run cache. On a
     Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named."""
     lacking = dispatch.missing_here(e for e in opts.engines if found[e]["found"])
-    if lacking and opts.named:  # an engine the user named is never skipped: the case fails, the worker named
-        from ..errors import EngineNotFound
-
-        return _failed(case, Path(file), EngineNotFound("; ".join(lacking.values())))
-    found = {**found, **{e: {**found[e], "found": False, "why": why} for e, why in lacking.items()}}
+    # an engine the user named is never skipped: its source fails here (sources.plan), the worker named
+    found = {**found, **{e: {**found[e], "found": False, "why": why, "required": opts.named}
+                         for e, why in lacking.items()}}
     return _safe_case(case, Path(file), replace(opts, cache=cache), found)
 
 
@@ -337,14 +335,9 @@ def _safe_case(case, path, opts, found) -> dict:
     except EngineInterrupted:
         raise
     except DemcheckError as exc:
-        return _failed(case, path, exc)
-
-
-def _failed(case, path, exc: Exception) -> dict:
-    """The entry of a case that could not be run: failed, with the error."""
-    return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
-            "verdict": verdicts.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
-            "comparisons": [verdicts.status_comparison("reference", verdicts.FAILED, str(exc)).as_dict()]}
+        return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
+                "verdict": verdicts.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
+                "comparisons": [verdicts.status_comparison("reference", verdicts.FAILED, str(exc)).as_dict()]}
 
 
 def _print(console: Console, summary: dict) -> None:

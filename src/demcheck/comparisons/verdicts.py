@@ -272,7 +272,7 @@ def unavailable(entry: dict, comps: list, planned) -> bool:
     if planned.runs:
         return False
     entry["sources"][engine] = {"status": planned.status, "message": planned.why}
-    comps.append(status_comparison(engine, planned.status, planned.why))  # NOT_EXPRESSIBLE or MISSING
+    comps.append(status_comparison(engine, planned.status, planned.why))  # NOT_EXPRESSIBLE, MISSING or FAILED
     return True
 
 
