@@ -88,8 +88,8 @@ def _every_body(bodies: int):
 def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | None = None,
             timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, worker: bool = False,
             **options) -> Result:
-    """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
-    four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
+    """Run the case's deck in ``engine`` (an Engine or its name); if the contact has not ended by the end of the
+    run, run again four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
     ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run; ``worker``
     runs the decks in the engine's long-lived worker where it has one (engines/run.py), the same numbers
     without a process start per run.
@@ -98,8 +98,6 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
     or "failed" (NaN or infinite output: never cached), "unresolved", "unstable", "out-of-range",
     "no-contact", "no-separation", with the reason in its message. The work directory of a run that is
     not "ok" is kept and named."""
-    from . import discovery
-
     eng = as_engine(engine)  # an Engine, or its registered name
     engine = eng.name
     mp = contact_mapping(case, engine, native)
@@ -121,20 +119,7 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
             dk = longer
         else:
             dk = deck(case, eng, dt, length, native=native, **options)
-        text = dk.text
-        hit = None
-        if cache is not None:
-            info = discovery.find(engine)
-            if info is None:
-                from ..errors import EngineNotFound
-
-                raise EngineNotFound(discovery.missing(engine))
-            from .cache import key as cache_key
-
-            k = cache_key(engine, info.version, text, dk.files)
-            bodies = len(case.particles) * copies
-            hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
-                            check=_every_body(bodies))
+        k, hit = _cached(cache, engine, dk, len(case.particles) * copies)
         if attempt and not cached:
             _discard(out.workdir, workdir, engine)  # the shorter run, extended: only the run reported is kept
         cached = hit is not None  # the run reported is this one
@@ -143,7 +128,7 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
             out = runner.RunOutput(engine, meta["version"], Path(meta["workdir"]), "", meta["wall_time"],
                                    meta["warnings"])
         else:
-            out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
+            out = runner.run(engine, dk.text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
@@ -161,20 +146,17 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
         d = contact["delta"].to_numpy()
         if (d > 0).any() and d[-1] <= 0:
             break
-    used_dt = dk.dt
     sc = common.scene(case, dt, length)
-    result = Result(
-        source=engine, method="engine", case_name=case.name, case_hash=case.hash,
-        model={"normal": case.contact.normal, "tangential": case.contact.tangential,
-               "limit_force": case.contact.limit_force},
-        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(mp.native)},
-        contact=contact, particles=particles, dt=used_dt, wall_time=time.perf_counter() - started,
-        engine_version=out.version, status="ok",
-        message="; ".join(mp.reasons),
-        meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": text, "fidelity": mp.fidelity,
-              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons),
-              "copies": copies, "copies_spread": spread if copies > 1 else 0.0},
-    )
+    result = _result(case, engine, sc, mp, out, dk, contact, particles, started, cached,
+                     {"copies": copies, "copies_spread": spread if copies > 1 else 0.0})
+    return _judged(result, case, sc, out, non_finite, fresh, cache, length, workdir)
+
+
+def _judged(result: Result, case: Case, sc, out, non_finite: str, fresh: list, cache, length: float,
+            workdir) -> Result:
+    """The Result judged: failed on NaN or infinite output, else the reference's health rules; the healthy runs
+    made here cached, the work directory of a run that is not "ok" kept and named, a temporary one removed."""
+    engine, cached = result.source, result.meta["cached"]
     if non_finite:
         result.status = "failed"
         result.message = (f"{engine} wrote NaN or infinite values ({non_finite}): the run is not used and not "
@@ -192,6 +174,41 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
     elif not cached:
         _discard(out.workdir, workdir, engine)  # a temporary directory of a run that succeeded
     return result
+
+
+def _cached(cache, engine: str, dk: common.Deck, bodies: int):
+    """(the run cache's key of the deck, its entry: (table, meta) or None); (None, None) without a cache. An
+    engine not found here is EngineNotFound: its version is part of the key."""
+    if cache is None:
+        return None, None
+    from . import discovery
+    from .cache import key as cache_key
+
+    info = discovery.find(engine)
+    if info is None:
+        from ..errors import EngineNotFound
+
+        raise EngineNotFound(discovery.missing(engine))
+    k = cache_key(engine, info.version, dk.text, dk.files)
+    return k, cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
+                        check=_every_body(bodies))
+
+
+def _result(case: Case, engine: str, sc, mp, out, dk: common.Deck, contact, particles, started: float,
+            cached: bool, copies: dict) -> Result:
+    """The engine's Result of a run (``out``, engines.run.RunOutput) of the deck ``dk``: its tables, its mapping's
+    fidelity and reasons, and what a diagnosis needs (work directory, warnings, the deck)."""
+    return Result(
+        source=engine, method="engine", case_name=case.name, case_hash=case.hash,
+        model={"normal": case.contact.normal, "tangential": case.contact.tangential,
+               "limit_force": case.contact.limit_force},
+        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(mp.native)},
+        contact=contact, particles=particles, dt=dk.dt, wall_time=time.perf_counter() - started,
+        engine_version=out.version, status="ok",
+        message="; ".join(mp.reasons),
+        meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": dk.text, "fidelity": mp.fidelity,
+              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons), **copies},
+    )
 
 
 def _discard(wd: Path, workdir, engine: str) -> None:
