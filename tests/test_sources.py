@@ -85,3 +85,22 @@ def test_run_a_source_and_parse_a_label_exist_once():
     for name in ("api.py", "cli.py", "comparisons/sweep.py", "comparisons/bench.py", "comparisons/stress.py",
                  "comparisons/suite.py"):
         assert not runners.search((SRC / name).read_text()), name
+
+
+def test_a_native_step_too_fine_names_what_set_it_not_dt():
+    """Issue 32: an error named --dt when none was given (the step came from the case's native setting)."""
+    import demcheck
+    from demcheck.engines.collide import setting_deck
+
+    from .test_native import TSUJI, _case
+
+    raw = _case({"lammps": {"pair_coeff": TSUJI.replace("63e9", "63e18")}})  # a native law 10^9 times stiffer
+    raw["impact"]["gap"] = 1e-12
+    case = demcheck.load(raw)
+    for run in (lambda: S.Source.parse("lammps").run(case), lambda: setting_deck(case, "lammps")):
+        with pytest.raises(ConfigError) as exc:
+            run()
+        assert exc.value.key == "run.steps_per_contact" and "[engine.lammps]" in exc.value.rule, exc.value
+        assert "--dt" not in str(exc.value).split(":")[0]
+    with pytest.raises(ConfigError, match="^--dt = 9e-12"):  # a step given is named as given
+        S.Source.parse("lammps").run(case, 9e-12)

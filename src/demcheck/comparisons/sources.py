@@ -125,6 +125,9 @@ class Source:
             from ..reference.collision import collide
 
             return collide(case, method=self.method, dt=dt, rtol=rtol)
+        from ..engines.collide import native_step_named
+
+        given = dt
         if native is _SETTING:
             native, dt = self.setting(case, dt)
         if self.kind == TWIN:
@@ -136,7 +139,8 @@ class Source:
 
         if timeout is not None:
             options["timeout"] = timeout
-        return run_engine(case, self.engine, dt=dt, native=native, **options)
+        with native_step_named(case, self.engine, given, dt if native is not None else None):
+            return run_engine(case, self.engine, dt=dt, native=native, **options)
 
 
 ADAPTIVE, VERLET = Source.reference("adaptive"), Source.reference("verlet")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import re
 import time
 from pathlib import Path
@@ -67,7 +68,25 @@ def setting(case: Case, engine, dt: float | None = None):
 def setting_deck(case: Case, engine, dt: float | None = None) -> common.Deck:
     """The deck ``collide(case, engine, *setting(case, engine, dt))`` runs first: what ``demcheck deck`` writes."""
     native, step = setting(case, engine, dt)
-    return deck(case, engine, step, native=native)
+    with native_step_named(case, engine, dt, step):
+        return deck(case, engine, step, native=native)
+
+
+@contextlib.contextmanager
+def native_step_named(case: Case, engine, given: float | None, step: float | None):
+    """A ConfigError about the step ``setting`` chose for a native law (none was given: ``given`` None) names what
+    set it — run.steps_per_contact and the [engine.NAME] setting's own contact time —, never ``--dt``."""
+    try:
+        yield
+    except ConfigError as exc:
+        if given or not step or exc.key != "--dt":
+            raise
+        from .builds import engine_of
+
+        name = engine_of(as_engine(engine).name)
+        raise ConfigError("run.steps_per_contact", case.run.steps_per_contact,
+                          f"gives the case's [engine.{name}] setting a step of {step:.3g} s (its native law's elastic "
+                          f"contact time over run.steps_per_contact; no --dt given), at which {exc.rule}") from None
 
 
 # what a cached run's metadata must hold (engines/cache.py checks each value)
