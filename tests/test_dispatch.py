@@ -211,7 +211,7 @@ def test_verify_on_an_existing_cluster_says_which_worker_lacks_an_engine(cluster
     files = SMALL[:2]
     p = demcheck("verify", *files, "--engines", "lammps,liggghts", "--scheduler", cluster["address"], "--report",
                  tmp_path / "r", "--json", env=env)
-    assert p.returncode == 0, p.stderr[-3000:]
+    assert p.returncode == 1, p.stderr[-3000:]  # a named engine the worker lacks fails there (issue 32)
     there = json.loads(p.stdout)
     # LAMMPS ran on the worker, with the verdicts of one process that has it
     one = demcheck("verify", *files, "--engines", "lammps", "--jobs", "1", "--report", tmp_path / "one", "--json",
@@ -219,10 +219,10 @@ def test_verify_on_an_existing_cluster_says_which_worker_lacks_an_engine(cluster
     assert one.returncode == 0, one.stderr[-3000:]
     lammps = [[k for k in c[2] if k[0] != "liggghts"] for c in verdicts(there)]
     assert lammps == [c[2] for c in verdicts(json.loads(one.stdout))]
-    # LIGGGHTS, found here, is missing on the worker: each case says so and names the worker
+    # LIGGGHTS, found here and named, is missing on the worker: its source fails in each case, the worker named
     for c in there["cases"]:
         src = c["sources"]["liggghts"]
-        assert src["status"] == "engine missing", src
+        assert src["status"] == "failed" and c["status"] == "failed", src
         assert src["message"].startswith(f"liggghts is missing on the Dask worker {cluster['worker']} (host ")
     # the client stored the worker's runs; the worker's own cache directory is not used
     assert entries(tmp_path / "client-cache") == entries(tmp_path / "one-cache") != set()

@@ -20,7 +20,7 @@ LAYERS = [
     ("engines", r"engines(\..*)?"),
     ("comparisons", r"comparisons(\..*)?"),
     ("api", r"api"),
-    ("front ends", r"cli|__main__"),
+    ("front ends", r"cli|cli_text|__main__"),
 ]
 
 

@@ -20,6 +20,7 @@ import pytest
 
 from demcheck.comparisons import packing_metrics, plots, report, suite, verdicts as V
 from demcheck.engines.base import APPROXIMATE
+from demcheck.comparisons.sources import plan
 from demcheck.comparisons.styles import style
 from demcheck.engines.cache import Cache
 from demcheck.errors import ConfigError
@@ -417,11 +418,11 @@ def test_a_plot_that_fails_leaves_a_note_and_the_report(tmp_path, monkeypatch):
 
     s = _summary([_collision(f"c[speed={v}]", "c.toml", {"reference": 0.8 + v / 100}, speed=v) for v in (0.1, 1.0)])
     s["cases"][0]["series"] = [{"source": "reference", "t": [0, 1e-6], "delta": [0, 1e-6], "fn": [0, 1.0]}]
-    monkeypatch.setattr(report, "case_figure", broken)
+    monkeypatch.setattr(report.figures, "case_figure", broken)
     page = report.render_html(s)
     assert "the force curves of c[speed=0.1] could not be drawn (ValueError: Expected \\frac{num}{den})" in page
     assert page.count('<img class="plot"') == 2  # the suite plots still drawn
-    monkeypatch.setattr(report, "suite_figures", broken)
+    monkeypatch.setattr(report.figures, "suite_figures", broken)
     s["cache"] = {"dir": str(tmp_path / "cache"), "hits": 0, "misses": 0}
     report.write_all(s, tmp_path / "run", tmp_path)
     page = (tmp_path / "run" / "report.html").read_text()
@@ -433,7 +434,7 @@ def test_an_interrupt_while_drawing_still_writes_the_page(tmp_path, monkeypatch)
     def interrupted(*a, **k):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(report, "suite_figures", interrupted)
+    monkeypatch.setattr(report.figures, "suite_figures", interrupted)
     s = _summary([_collision(f"c[speed={v}]", "c.toml", {"reference": 0.8}, speed=v) for v in (0.1, 1.0)])
     with pytest.raises(KeyboardInterrupt):
         report.write_all(s, tmp_path / "run", tmp_path)
@@ -643,8 +644,8 @@ def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
     assert (c.verdict, c.setting) == (V.EXPECTED, "tangential linear_nohistory")
     entry, comps = {"sources": {}}, []
     found = {e: {"found": True} for e in ("lammps", "yade")}
-    for e in ("lammps", "yade"):
-        V.unavailable(entry, comps, e, contact_mapping(case, e), found)
+    for planned in plan(case, ("lammps", "yade"), found):
+        V.unavailable(entry, comps, planned)
     assert entry["settings"] == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     assert entry["sources"]["yade"]["status"] == "not expressible"
 

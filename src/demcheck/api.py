@@ -28,8 +28,8 @@ from . import case as _case
 from .errors import ConfigError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "Result",
-           "ConfigError"]
+__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "models",
+           "Result", "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
 MAX_TIMEOUT = 1e6  # s, as the command line's --timeout (the pipes' poll() takes at most ~2.1e6 s)
@@ -172,12 +172,48 @@ def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keywo
     return _build(case, _overrides(overrides, keyword))
 
 
+def models(model_id: str | None = None, key: str = "model_id") -> list[dict]:
+    """The registered contact models (``demcheck models``) as rows: slot, id, seed name, aliases, title, formula,
+    source, parameters and each engine's mapping of it (fidelity, with, config, reason). ``model_id``: one id or
+    alias (in either slot: ``tti`` names a normal and a tangential model), else ConfigError naming ``key``."""
+    from .engines import mapping
+    from .laws import normal, tangential
+
+    def rows(registry, slot):
+        return [{"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
+                 "title": m.title, "formula": m.formula, "source": m.source,
+                 "params": {p.name: p.meaning for p in m.params}} for m in registry.values()]
+
+    _text(key, model_id, "must be a model's id or alias (text) or None", optional=True)
+    table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
+    if model_id is not None:
+        found = set()
+        for slot, reg in (("normal", normal.REGISTRY), ("tangential", tangential.REGISTRY)):
+            try:
+                found.add((slot, reg.lookup(model_id).id))
+            except KeyError:
+                pass
+        table = [r for r in table if (r["slot"], r["id"]) in found]
+        if not table:
+            import difflib
+
+            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names()]
+            near = difflib.get_close_matches(model_id.strip().lower(), known, n=1)
+            raise ConfigError(key, model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
+                                                                            else f"; known: {', '.join(known)}"))
+    engines = mapping.by_model()
+    for row in table:
+        row["engines"] = engines[(row["slot"], row["id"])]
+    return table
+
+
 def sources() -> tuple[str, ...]:
     """The names :func:`collide` takes as ``source``: reference, each registered engine, and its twin."""
+    from .comparisons.sources import Source
     from .engines import registry
 
-    names = registry.names()
-    return ("reference", *names, *(f"{n}-twin" for n in names))
+    engines = registry.all_engines()
+    return ("reference", *(Source.of(e).label for e in engines), *(Source.of(e, twin=True).label for e in engines))
 
 
 def collide(case, source: str = "reference", method: str | None = None, dt: float | None = None,
@@ -189,6 +225,8 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     engine's formulas with its scheme at ``dt``). A case's ``[engine.NAME]`` native settings are used by that
     engine and its twin, by default at the native law's own step (run.dt, else its twin's elastic contact time
     over run.steps_per_contact). Overrides as :func:`load` takes them."""
+    from .comparisons.sources import REFERENCE, Source
+
     c = load(case, overrides, **keyword)
     _positive("dt", dt, "s")
     _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
@@ -197,25 +235,14 @@ def collide(case, source: str = "reference", method: str | None = None, dt: floa
     known = sources()
     if not isinstance(source, str) or source not in known:
         raise ConfigError("source", _shown(source), f"must be one of {', '.join(known)}")
-    if source == "reference":
-        from .reference.collision import collide as run
-
-        return _framed(run(c, method=method, dt=dt))
+    src = Source.parse(source, "source")
+    if src.kind == REFERENCE:
+        return _framed(Source.reference(method).run(c, dt))
     if method is not None:
         raise ConfigError("method", method, "is the reference's (adaptive or verlet); an engine and its twin run "
                                             "velocity Verlet at dt")
-    from .engines.collide import setting
-
-    engine = source.removesuffix("-twin")
-    native, dt = setting(c, engine, dt)  # the native law's own step (its twin's contact time / run.steps_per_contact)
-    if source.endswith("-twin"):
-        from .engines.collide import twin_states
-
-        step = dt or _case.run_length(c)[0]
-        return _framed(twin_states(c, engine, step, native=native))
-    from .engines.collide import collide as run_engine
-
-    return _framed(run_engine(c, engine, dt=dt, native=native, timeout=timeout))
+    # the case's [engine.NAME] setting at the native law's own step (its twin's contact time / run.steps_per_contact)
+    return _framed(src.run(c, dt, timeout=timeout))
 
 
 def collide_many(cases: Iterable, method: str | None = None, dt: float | None = None):
@@ -278,52 +305,103 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
 
 
 def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path | None = None, jobs: int = 1,
-           cache: bool = True, timeout: float = 600.0) -> dict:
-    """The verification suite over case files (paths of files or directories) → its results dict (the
-    ``results.json`` of a report: ``cases``, each with its ``sources``, ``comparisons`` and ``status``, and
-    ``failed``, the count of failing cases). ``engines``: names, or None for every registered one, or ``()`` /
-    ``"none"`` for the reference alone. ``report``: a directory for the report (``<report>/<run-id>/``), or None
-    to write none."""
-    import shutil
-    import tempfile
+           cache: bool = True, timeout: float = 600.0, *, refresh: bool = False, scheduler: str | None = None,
+           baseline: str | Path | None = None, precision: str | None = None, junit: str | Path | None = None,
+           quiet: bool = True, argv: list[str] | None = None, keys: Mapping[str, str] | None = None) -> dict:
+    """The verification suite over case files (paths of files or directories; a directory without its optin/ and
+    benchmarks/ folders: resources.case_files) → its results dict (the ``results.json`` of a report: ``cases``,
+    each with its ``sources``, ``comparisons`` and ``status``, and ``failed``, the count of failing cases).
+    ``demcheck verify`` is this function: the same files, engines, builds and expected differences give the same
+    results.
 
+    ``engines``: names or builds (``"lammps,lammps@2024=/opt/lmp-2024/lmp"``, or a list of them: a build's
+    expected differences follow its version), None for every registered one (one not found is reported
+    missing), or ``()`` / ``"none"`` for the reference alone; an engine named must be found. ``report``: a
+    directory for the report (``<report>/<run-id>/``), or None to write none. ``cache``: read and write the
+    engine-run cache (``refresh``: run every deck again, the fresh runs replacing the cached ones). ``scheduler``:
+    a Dask cluster's address (``jobs`` then left at 1); ``baseline``: a stored earlier run every source is judged
+    against too; ``precision``: each listed engine that has one run as its build in this precision (Yade:
+    float128, mpfr150); ``junit``: also write JUnit XML here. ``keys``: the names the errors give the arguments
+    (the command line's options)."""
     from .comparisons.suite import Options, run_suite
-    from .engines import registry
 
-    names = _engines(engines, registry.names())
+    key = {"paths": "paths", "engines": "engines", "baseline": "baseline", "precision": "precision",
+           **(keys or {})}
     if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
         raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
     _positive("timeout", timeout, "s", MAX_TIMEOUT, optional=False)
     _flag("cache", cache)
+    _flag("refresh", refresh)
     _report_dir(_path("report", report, optional=True))
-    files = _case_files(paths)
-    opts = Options(engines=names, jobs=jobs, timeout=timeout)
+    names, named = _engines(engines, precision, key)
+    opts = Options(engines=names, jobs=jobs, scheduler=scheduler, timeout=timeout, expected=_expected(names),
+                   named=named)
     if cache:
-        from .engines.cache import Cache
+        from .engines.cache import Cache, default_dir
 
-        opts.cache = Cache()
+        _writable_cache(default_dir())
+        opts.cache = Cache(refresh=refresh)
+    files = _case_files(paths, key["paths"])
+    if baseline is not None:
+        from .comparisons import diff
+
+        opts.baseline = diff.load(_path(key["baseline"], baseline), key["baseline"])  # before any work
+    argv = argv if argv is not None else ["demcheck.verify"]
+    junit = Path(_path("junit", junit)) if junit is not None else None
     if report is not None:
-        return run_suite(files, Path(report), opts, quiet=True, argv=["demcheck.verify"])
+        return run_suite(files, Path(report), opts, quiet=quiet, junit=junit, argv=argv)
+    import shutil
+    import tempfile
+
     tmp = Path(tempfile.mkdtemp(prefix="demcheck-verify-"))
     try:
-        out = run_suite(files, tmp, opts, quiet=True, argv=["demcheck.verify"])
+        out = run_suite(files, tmp, opts, quiet=quiet, junit=junit, argv=argv)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     out["report"] = None
     return out
 
 
-def _engines(engines, registered) -> tuple[str, ...]:
+def _engines(engines, precision, key) -> tuple[tuple[str, ...], bool]:
+    """The engines and builds of ``engines`` (verify's argument) as the command line reads its --engines: a build
+    registered under its label, an engine named required to be found (engines.discovery.resolve); and whether they
+    were named (not the default list: an engine a Dask worker lacks then fails its case)."""
+    from .engines import builds, discovery, registry
+
     if engines is None:
-        return tuple(registered)
-    if isinstance(engines, str):
-        engines = [] if engines == "none" else [e.strip() for e in engines.split(",") if e.strip()]
-    out = tuple(_sequence("engines", engines, "must be engine names (a list, or one text 'lammps,yade'), "
-                                              "'none' or None"))
-    for e in out:
-        if not isinstance(e, str) or e not in registered:
-            raise ConfigError("engines", _shown(e), f"is not a registered engine ({', '.join(registered)})")
-    return out
+        text, required = ",".join(n for n in registry.names() if "@" not in n), False
+    else:
+        if isinstance(engines, str):
+            items = [engines]
+        else:
+            items = _sequence(key["engines"], engines, "must be engine names or builds (a list, or one text "
+                                                       "'lammps,yade'), 'none' or None")
+        for e in items:
+            if not isinstance(e, str):
+                raise ConfigError(key["engines"], _shown(e), "must be engine names or builds (text), 'none' or None")
+        text, required = ",".join(items) or "none", None
+    if precision is not None:
+        if not isinstance(precision, str):
+            raise ConfigError(key["precision"], _shown(precision), "must be float128 or mpfr150")
+        text = builds.with_precision(text, precision, key["precision"])  # yade → yade@float128=…
+    named = required if required is not None else discovery.named(key["engines"])
+    return tuple(discovery.resolve(text, key["engines"], required)), named
+
+
+def _expected(names) -> list:
+    """The expected differences (data/expected_differences.toml), each repeated for every labelled build of its
+    engine among ``names``: a build's differences follow its own version."""
+    from .comparisons import verdicts
+    from .engines import builds
+
+    return builds.expected_for(verdicts.load_expected(), names)
+
+
+def _writable_cache(where) -> None:
+    """The engine-run cache's directory can be made and written (checked before any work)."""
+    from .io import check_output
+
+    check_output("DEMCHECK_CACHE", where, directory=True)
 
 
 def _report_dir(report) -> None:
@@ -338,14 +416,15 @@ def _report_dir(report) -> None:
         raise ConfigError("report", str(report), f"{latest} is not the symlink demcheck moves to each new run")
 
 
-def _case_files(paths) -> list[Path]:
+def _case_files(paths, key: str = "paths") -> list[Path]:
+    """The case files of verify's ``paths`` (resources.case_files: the one case discovery of every command)."""
     from .resources import case_files
 
     rule = "must be a case file's or directory's path, or a list of them"
-    paths = [paths] if isinstance(paths, (str, Path)) else _sequence("paths", paths, rule)
+    paths = [paths] if isinstance(paths, (str, Path)) else _sequence(key, paths, rule)
     for p in paths:
-        _path("paths", p)
-    return case_files(paths, "paths")
+        _path(key, p)
+    return case_files(paths, key)
 
 
 def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:

@@ -15,8 +15,9 @@ import click
 
 from . import __version__
 from .errors import ConfigError, DemcheckError
-from . import resources
-from .io import console, number as as_text, plain
+from . import cli_text, resources
+from .cli_text import show
+from .io import check_output, console, plain
 
 
 
@@ -32,11 +33,6 @@ def _engine_names() -> list[str]:
 
 
 ENGINE_NAMES = _engine_names()  # the registered engines (built-ins, then plug-ins): every --engine choice
-
-
-def show(v) -> str:
-    """A value in a CLI table: the reports' formatter, ten significant digits."""
-    return as_text(v, ".10g")
 
 
 def emit_json(obj) -> None:
@@ -83,38 +79,6 @@ class Number(click.ParamType):
 
 def _option_name(param) -> str:
     return max(param.opts, key=len) if param is not None and param.opts else "value"
-
-
-def check_output(key: str, path, directory: bool = False, files=(), link: str | None = None) -> None:
-    """An output path demcheck can write (a file, or a ``directory`` it creates or fills), checked before any
-    work: nothing on the way is a file, the path is not of the other kind, and its first existing directory
-    takes a new file. So are the files derived from it: ``files``, names written in the directory (or beside
-    the file), each not a directory; and ``link``, the symlink demcheck moves in the directory (``latest``),
-    which is demcheck's: absent or a symlink, never a real file or directory. Else ConfigError naming ``key``,
-    the path and the rule."""
-    import tempfile
-
-    p = Path(path).absolute()
-    if p.is_dir() != directory and p.exists():
-        raise ConfigError(key, str(path), "is a file, not a directory" if directory else "is a directory, not a file")
-    where = p if directory and p.is_dir() else p.parent
-    while not where.exists() and not where.is_symlink() and where != where.parent:
-        where = where.parent
-    if not where.is_dir():
-        raise ConfigError(key, str(path), f"{where} is a file, not a directory")
-    beside = Path(path) if directory else Path(path).parent
-    for name in files:
-        if (beside / name).is_dir():
-            raise ConfigError(key, str(path), f"{beside / name} is a directory, not a file")
-    if link is not None and (beside / link).exists() and not (beside / link).is_symlink():
-        what = "directory" if (beside / link).is_dir() else "file"
-        raise ConfigError(key, str(path), f"{beside / link} is a {what}, not the symlink demcheck moves to each "
-                                          "new run (move it away, or choose another --report)")
-    try:
-        with tempfile.TemporaryFile(dir=where):
-            pass
-    except OSError as exc:
-        raise ConfigError(key, str(path), f"cannot write in {where} ({exc.strerror or exc})") from None
 
 
 class OutputPath(click.ParamType):
@@ -237,106 +201,24 @@ def models(model_id, as_json, engine, radius, density, speed):
 
         if model_id is None:
             raise ConfigError("SETTING", None, "--engine needs the native setting to look up")
-        from .comparisons.audit import safe_text
-
         r = reverse(engine, model_id, radius or 1e-3, density or 2500.0, speed or 1.0)
         if as_json:
             emit_json(r)
-            if r["fidelity"] == "failed":
-                sys.exit(1)
-            return
-        pair = r["pair"]
-        click.echo(safe_text(f"{engine}: {r['native']}"))
-        s = r["seed"]
-        if s is None:
-            click.echo("  nearest seed model: none (demcheck has no twin of this law); fidelity none")
-        elif r["fidelity"] == "failed":
-            click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — FAILED: the probes "
-                       "measured no contact to compare: " + "; ".join(r["failures"]))
         else:
-            click.echo(f"  nearest seed model: normal {s['normal']}, tangential {s['tangential']} — {r['fidelity']}"
-                       f" (largest gap {r['gap']:.3g} between its converged contact and the seed model's at "
-                       f"{pair['speed']:g} m/s, " + ", ".join(f"{p['angle']:g}°" for p in r["probes"]) + ")"
-                       + (f"; {'; '.join(s['reasons'])}" if s["reasons"] else ""))
-        if r["asked"]:
-            click.echo("  asks for: " + ", ".join(f"{k} {v:g}" for k, v in r["asked"].items()))
-        if r["implied"]:
-            click.echo(f"  implied (like pair, R = {pair['radius']:g} m, ρ = {pair['density']:g} kg/m³): "
-                       + ", ".join(f"{k} {v:.6g}" if isinstance(v, float) else f"{k} {v}"
-                                   for k, v in r["implied"].items()))
-        for p in r.get("probes", []):
-            tw, sd = p["twin"], p["seed"]
-            click.echo(f"  {p['angle']:>3g}°: e {tw['restitution']:.4f} (seed {sd['restitution']:.4f})"
-                       + (f", et {tw['tangential_restitution']:.4f} (seed {sd['tangential_restitution']:.4f})"
-                          if math.isfinite(tw["tangential_restitution"]) else "")
-                       + f", tc {tw['contact_time']:.4g} s (seed {sd['contact_time']:.4g} s)")
-        for n in r["notes"]:
-            click.echo(safe_text(f"  note: {n}"))
-        for f in r["findings"]:
-            click.echo(safe_text(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}"))
-        click.echo("  `demcheck audit DECK` measures each trap in the engine (docs/audit.md)")
+            click.echo("\n".join(cli_text.reverse_lookup(engine, r)))
         if r["fidelity"] == "failed":
             sys.exit(1)
         return
-    from .engines import mapping, registry as engine_registry
-    from .laws import normal, tangential
+    from . import api
+    from .engines import registry
 
-    def rows(registry, slot):
-        return [{"slot": slot, "id": m.id, "seed_name": m.seed_name, "aliases": list(m.aliases),
-                 "title": m.title, "formula": m.formula, "source": m.source,
-                 "params": {p.name: p.meaning for p in m.params}} for m in registry.values()]
-
-    table = rows(normal.REGISTRY, "normal") + rows(tangential.REGISTRY, "tangential")
-    if model_id is not None:  # an id or alias, in either slot (tti names a normal and a tangential model)
-        found = set()
-        for slot, reg in (("normal", normal.REGISTRY), ("tangential", tangential.REGISTRY)):
-            try:
-                found.add((slot, reg.lookup(model_id).id))
-            except KeyError:
-                pass
-        table = [r for r in table if (r["slot"], r["id"]) in found]
-        if not table:
-            import difflib
-
-            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names()]
-            near = difflib.get_close_matches(model_id.strip().lower(), known, n=1)
-            raise ConfigError("ID", model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
-                                                                             else f"; known: {', '.join(known)}"))
-    engines = mapping.by_model()
-    for row in table:
-        row["engines"] = engines[(row["slot"], row["id"])]
+    table = api.models(model_id, "ID")
     if as_json:
         emit_json({"models": table})
-        return
-    names = engine_registry.names()
-    if model_id is None:  # one line a model: fits 80 columns, plain text when piped
-        def cut(text, width):
-            return text if len(text) < width else text[:width - 2] + "… "
-
-        short = {"approximate": "approx"}
-        widths = {n: max(len(n) + 1, 7) for n in names}  # "approx" and a space, or the engine's name
-        seed_w = max(8, min(15, 80 - 27 - sum(widths.values())))  # the seed name gives way to engine columns
-        click.echo(f"{'slot':<11}{'id':<16}{'seed':<{seed_w}}" + "".join(f"{n:<{widths[n]}}" for n in names).rstrip())
-        for row in table:
-            click.echo((f"{row['slot']:<11}{row['id']:<16}{cut(row['seed_name'], seed_w):<{seed_w}}"
-                        + "".join(f"{short.get(f := row['engines'][n]['fidelity'], f):<{widths[n]}}"
-                                  for n in names)).rstrip())
-        click.echo("\napprox = approximate. `demcheck models ID` shows a model in full, with each\n"
-                   "engine's reasons; --json gives everything.")
-        return
-    for row in table:
-        click.echo(f"{row['id']} ({row['slot']}; seed name {row['seed_name']}"
-                   + (f"; aliases {', '.join(row['aliases'])}" if row["aliases"] else "") + f"): {row['title']}")
-        click.echo(f"  formula: {row['formula']}")
-        click.echo(f"  source:  {row['source']}")
-        for p, meaning in row["params"].items():
-            click.echo(f"  {p}: {meaning}")
-        for e in engine_registry.all_engines():
-            m = row["engines"][e.name]
-            click.echo(f"  {e.release}: {m['fidelity']} (with {m['with']})"
-                       + (f": {m['config']}" if m["config"] else ""))
-            if m["reason"]:
-                click.echo(f"    {m['reason']}")
+    elif model_id is None:  # one line a model: fits 80 columns, plain text when piped
+        click.echo("\n".join(cli_text.models_table(table, registry.names())))
+    else:
+        click.echo("\n".join(cli_text.model_details(table, registry.all_engines())))
 
 
 # ----------------------------------------------------------------------------- collide
@@ -364,8 +246,8 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
                    "yade-float128, yade-mpfr150), e.g. to show a difference is the scheme's and not round-off")
 def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout, precision):
     """Solve one collision case and print its metrics (per source, side by side)."""
+    from .comparisons.sources import Source
     from .errors import EngineNotFound, UnsupportedByEngine
-    from .reference.collision import collide as run
 
     if engine == "all" and precision:
         raise ConfigError("--precision", precision, "names the builds of engines given by name (--engine yade), "
@@ -391,17 +273,10 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
     case = _load(case_path, overrides)
     results, skipped = {}, {}
     for src in sources:
-        if src == "reference":
-            results[src] = run(case, method=method, dt=dt)
-            continue
-        from .engines.collide import collide as run_engine
-
-        try:
-            from .engines.collide import setting
-
-            # [engine.NAME] (a build reads its engine's table) at the native law's own step: what `deck` writes
-            native, step = setting(case, src, dt)
-            results[src] = run_engine(case, src, dt=step, timeout=timeout, native=native)
+        source = Source.reference(method) if src == "reference" else Source.parse(src, "--engine")
+        try:  # an engine: [engine.NAME] (a build reads its engine's table) at the native law's own step, what
+            # `deck` writes
+            results[src] = source.run(case, dt, timeout=timeout)
         except (UnsupportedByEngine, EngineNotFound) as exc:
             if engine != "all":
                 raise
@@ -435,30 +310,9 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
 
 
 def _print_side_by_side(summaries: dict, skipped: dict) -> None:
-    from rich.table import Table
-
     con = console()
-    first = next(iter(summaries.values()), None)
-    if first is not None:
-        m = first["model"]
-        con.print(f"[bold]{first['case']}[/]  normal={m['normal']} tangential={m['tangential']} "
-                  f"limit_force={m['limit_force']}")
-    t = Table(show_header=True)
-    t.add_column("metric")
-    for name, s in summaries.items():
-        label = name if s["source"] == "reference" else f"{name} ({s['engine_version']})"
-        t.add_column(label, justify="right")
-    keys = list(first["metrics"]) if first else []
-    for k in keys:
-        t.add_row(k, *[show(s["metrics"].get(k)) for s in summaries.values()])
-    t.add_row("dt / rtol", *[show(s["dt"] or s["rtol"]) for s in summaries.values()])
-    t.add_row("mapping", *[str(s["params"].get("mapping", "—")) for s in summaries.values()])
-    con.print(t)
-    for name, s in summaries.items():
-        if s["source"] != "reference" and s["message"]:
-            con.print(f"{name}: {s['message']}")
-    for name, why in skipped.items():
-        con.print(f"{name}: skipped — {why}")
+    for item in cli_text.side_by_side(summaries, skipped):
+        con.print(item)
 
 
 # ----------------------------------------------------------------------------- deck
@@ -475,15 +329,15 @@ def deck(case_path, engine, output, dt, overrides):
     """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
     (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
     reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
+    from .comparisons.sources import Source
     from .engines.collide import finite, setting_deck
 
     case = _load(case_path, overrides)
+    source = Source.of(engine)
     if case.kind == "packing":
-        from .engines import registry
-
-        dk = finite(registry.get(engine).packing_deck(case, dt=dt), case)
+        dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
-        dk = setting_deck(case, engine, dt)
+        dk = setting_deck(case, source.engine, dt)
     if output:  # the files the deck reads go beside it: each checked before any is written
         check_output("--output", output, files=list(dk.files))
         for path in dk.write(output):
@@ -496,28 +350,13 @@ def deck(case_path, engine, output, dt, overrides):
 
 
 def _print_summary(s: dict) -> None:
-    from rich.table import Table
-
     con = console()
-    m = s["model"]
-    head = f"[bold]{s['case']}[/]  normal={m['normal']} tangential={m['tangential']}"
-    head += f" limit_force={m['limit_force']}  method={s['method']}"
-    head += f"  dt={show(s['dt'])}" if s["dt"] else f"  rtol={show(s['rtol'])}"
+    head, metrics, params, note = cli_text.summary_tables(s)
     con.print(head)
-    t = Table(show_header=True)
-    t.add_column("metric")
-    t.add_column("value", justify="right")
-    for k, v in s["metrics"].items():
-        t.add_row(k, show(v))
-    p = Table(show_header=True)
-    p.add_column("parameter")
-    p.add_column("value", justify="right")
-    for k, v in s["params"].items():
-        p.add_row(k, show(v))
-    con.print(t)
-    con.print(p)
-    if s.get("message"):
-        click.echo(f"note: {s['message']}")
+    con.print(metrics)
+    con.print(params)
+    if note:
+        click.echo(note)
 
 
 # ----------------------------------------------------------------------------- sweep
@@ -545,24 +384,12 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     a materials.* key the setting does not read is refused: it would not change the law that runs."""
     from rich.progress import Progress
 
-    from .comparisons.sweep import check_source, native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points
+    from .comparisons.sweep import native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points, sweep_source
 
-    if "=" not in source:
-        check_source(source, method)
-    if source != "reference" and not source.endswith("-twin"):
-        from .engines import discovery
-        from .errors import EngineNotFound
-
-        labels = discovery.resolve(source, "--engine")  # an engine, or a build registered under its label
-        if len(labels) != 1:
-            raise ConfigError("--engine", source, "a sweep runs one source (collide and verify compare several)")
-        source = labels[0]
-        if discovery.find(source) is None:
-            raise EngineNotFound(discovery.missing(source))
-    check_source(source, method)
+    source, engine = sweep_source(source, method)  # the source's label and its engine (or build), before any work
     points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
     native_vary_rule(points, source)
-    with _campaign(jobs, scheduler, [source.removesuffix("-twin")]) as campaign, \
+    with _campaign(jobs, scheduler, [engine] if engine else []) as campaign, \
             Progress(transient=True, disable=as_json) as progress:
         task = progress.add_task("sweep", total=len(points))
         table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source, campaign=campaign)
@@ -685,24 +512,17 @@ def verify(paths, engines, jobs, scheduler, report_dir, junit, as_json, no_cache
     """Run the verification suite (default: the built-in cases/) and report where each source agrees with
     the seed model. Exit 0 when everything agrees or differs as expected, 1 on an unexpected difference or
     a failed run, 2 on bad input."""
-    from .comparisons.suite import Options, run_suite
+    from . import api
+    from .comparisons import diff
     from .engines import run as runner
-    from .engines.cache import Cache, default_dir
-
-    from .comparisons import diff, verdicts
-    from .engines import builds, discovery
 
     _check_jobs(jobs, scheduler)
-    engines = builds.with_precision(engines, precision) if precision else engines  # yade → yade@float128=…
-    names = discovery.resolve(engines, "--engines")  # engines and builds: lammps,lammps@2024=/opt/…/lmp
-    check_output("DEMCHECK_CACHE", default_dir(), directory=True)
-    files = _case_files(paths)
-    base = diff.load(baseline, "--baseline") if baseline else None  # a bad file: one line, exit 2, before any work
-    opts = Options(engines=tuple(names), jobs=jobs, scheduler=scheduler, cache=Cache(refresh=no_cache), timeout=timeout,
-                   baseline=base, expected=builds.expected_for(verdicts.load_expected(), names))
     try:
-        summary = run_suite(files, Path(report_dir), opts, quiet=as_json, junit=Path(junit) if junit else None,
-                            argv=["demcheck", "verify", *sys.argv[2:]])
+        summary = api.verify(list(paths), engines, report_dir, jobs, True, timeout, refresh=no_cache,
+                             scheduler=scheduler, baseline=baseline, precision=precision, junit=junit,
+                             quiet=as_json, argv=["demcheck", "verify", *sys.argv[2:]],
+                             keys={"paths": "CASE", "engines": "--engines", "baseline": "--baseline",
+                                   "precision": "--precision"})
     except KeyboardInterrupt as exc:
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
                    f"report {Path(report_dir) / 'latest'}", err=True)
@@ -990,23 +810,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides, jobs, sc
     if not as_json:
         for b in results:
             for engine, law in b["natives"].items():
-                _native_lines(b["case"], engine, law, b["reference"])
-
-
-def _native_lines(case: str, engine: str, law: dict, seed: dict) -> None:
-    """What bench measured a native law against, and how far its converged answer lies from the seed model's
-    (``seed``: its converged metrics): on stdout after the report."""
-    click.echo(f"{case}: {engine} runs the case's own setting ({law['native']}); {engine} and {engine}-twin are "
-               f"measured against {engine}-twin converged ({law['converged_by']})")
-    gap = {k: v for k, v in (law.get("seed_gap") or {}).items() if math.isfinite(v)}
-    if gap:
-        k = max(gap, key=gap.get)
-        e_n, e_s = law["converged"].get("restitution"), seed.get("restitution")
-        click.echo(f"  the seed model of [contact] is another law: converged, they differ by up to {gap[k]:.3g} "
-                   f"({k})" + (f"; restitution {e_n:.4f} native, {e_s:.4f} seed" if e_n is not None and
-                               e_s is not None and math.isfinite(e_n) and math.isfinite(e_s) else ""))
-    if law.get("note"):
-        click.echo(f"  note: {law['note']}")
+                click.echo("\n".join(cli_text.bench_native(b["case"], engine, law, b["reference"])))
 
 
 @cli.command()
@@ -1052,9 +856,7 @@ def stress(paths, engines, only, report_dir, as_json, jobs, scheduler):
     _show_report(data, out_dir, as_json)
     for c in results if not as_json else ():
         for engine, native in c["natives"].items():
-            click.echo(f"{c['case']}: {engine} runs the case's own setting ({native}): {engine} and {engine}-twin's "
-                       f"dt_max / t_c are in that law's elastic contact time, and {engine} is flagged against "
-                       f"{engine}-twin, not the seed model's reference-verlet")
+            click.echo(cli_text.stress_native(c["case"], engine, native))
     if any(c["disagreements"] for c in results):
         sys.exit(1)
 
@@ -1077,29 +879,7 @@ def dt(case_path, target, overrides, as_json):
         if rec["dt"] is None or any(n["dt"] is None for n in rec["natives"].values()):
             sys.exit(1)
         return
-    click.echo(f"{rec['case']}: normal={rec['model']['normal']} tangential={rec['model']['tangential']}")
-    click.echo(f"  elastic contact time t_c = {rec['t_contact']:.4g} s; Hertz time {rec['hertz_time']:.4g} s; "
-               f"Rayleigh time {rec['rayleigh_time']:.4g} s")
-    click.echo(f"  rules of thumb: 0.2 t_Rayleigh = {rec['rules_of_thumb']['0.2 t_Rayleigh']:.4g} s, "
-               f"t_Hertz/50 = {rec['rules_of_thumb']['t_Hertz / 50']:.4g} s")
-    if rec["dt"] is None:
-        click.echo(f"  {rec['message']}")
-    else:
-        click.echo(f"  recommended dt = {rec['dt']:.4g} s ({rec['steps_per_contact']:g} steps per contact, "
-                   f"{rec['dt_over_rayleigh']:.3g} t_Rayleigh): expected error {rec['expected_error']:.2g} "
-                   f"in {rec['limited_by']} (target {target:g}; measured order {rec['order']:.2f}; errors of "
-                   f"{', '.join(rec['metrics'])})")
-    for engine, n in rec["natives"].items():
-        click.echo(f"{engine} (the case's own setting: {n['native']}): elastic contact time {n['t_contact']:.4g} s")
-        if n["dt"] is None:
-            click.echo(f"  {n['message']}")
-        else:
-            click.echo(f"  recommended dt = {n['dt']:.4g} s ({n['steps_per_contact']:g} steps per contact): expected "
-                       f"error {n['expected_error']:.2g} in {n['limited_by']} against {engine}-twin converged "
-                       f"({n['converged_by']}; measured order {n['order']:.2f}; errors of {', '.join(n['metrics'])}; "
-                       "the engine computes its twin's numbers)")
-        if n["note"]:
-            click.echo(f"  note: {n['note']}")
+    click.echo("\n".join(cli_text.recommendation(rec, target)))
     if rec["dt"] is None or any(n["dt"] is None for n in rec["natives"].values()):
         sys.exit(1)
 

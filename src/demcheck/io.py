@@ -98,3 +98,37 @@ def console(stderr: bool = False, **options):
     if "width" not in options and not os.environ.get("COLUMNS") and not stream.isatty():
         options["width"] = 200
     return Console(stderr=stderr, **options)
+
+
+def check_output(key: str, path, directory: bool = False, files=(), link: str | None = None) -> None:
+    """An output path demcheck can write (a file, or a ``directory`` it creates or fills), checked before any
+    work: nothing on the way is a file, the path is not of the other kind, and its first existing directory
+    takes a new file. So are the files derived from it: ``files``, names written in the directory (or beside
+    the file), each not a directory; and ``link``, the symlink demcheck moves in the directory (``latest``),
+    which is demcheck's: absent or a symlink, never a real file or directory. Else ConfigError naming ``key``,
+    the path and the rule."""
+    import tempfile
+
+    from .errors import ConfigError
+
+    p = Path(path).absolute()
+    if p.is_dir() != directory and p.exists():
+        raise ConfigError(key, str(path), "is a file, not a directory" if directory else "is a directory, not a file")
+    where = p if directory and p.is_dir() else p.parent
+    while not where.exists() and not where.is_symlink() and where != where.parent:
+        where = where.parent
+    if not where.is_dir():
+        raise ConfigError(key, str(path), f"{where} is a file, not a directory")
+    beside = Path(path) if directory else Path(path).parent
+    for name in files:
+        if (beside / name).is_dir():
+            raise ConfigError(key, str(path), f"{beside / name} is a directory, not a file")
+    if link is not None and (beside / link).exists() and not (beside / link).is_symlink():
+        what = "directory" if (beside / link).is_dir() else "file"
+        raise ConfigError(key, str(path), f"{beside / link} is a {what}, not the symlink demcheck moves to each "
+                                          "new run (move it away, or choose another --report)")
+    try:
+        with tempfile.TemporaryFile(dir=where):
+            pass
+    except OSError as exc:
+        raise ConfigError(key, str(path), f"cannot write in {where} ({exc.strerror or exc})") from None

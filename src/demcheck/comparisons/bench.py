@@ -154,15 +154,19 @@ class BenchResult:
 
     def against(self, src: str) -> str:
         """What a source's errors are measured against."""
-        engine = src.removesuffix("-twin")
-        if engine in self.natives:
-            return f"{engine}-twin converged ({self.natives[engine].how})"
-        return "reference-adaptive converged (the seed model)"
+        from .sources import ADAPTIVE, Source
+
+        source = Source.parse(src)
+        if source.name in self.natives:
+            return f"{source.twin().label} converged ({self.natives[source.name].how})"
+        return f"{ADAPTIVE.label} converged (the seed model)"
 
     def sources(self) -> list[str]:
         return list(dict.fromkeys(p.source for p in self.points))
 
     def summary(self) -> dict:
+        from .sources import ADAPTIVE
+
         out = {"case": self.case, "model": self.model, "t_contact": self.t_contact, "reference": self.reference,
                "points": [p.as_dict() for p in self.points], "skipped": self.skipped, "sources": {},
                "natives": {e: law.as_dict() for e, law in self.natives.items()}}
@@ -171,8 +175,8 @@ class BenchResult:
             names = _used(pts) if pts else list(METRICS)
             s = {"order": fit_order(pts), "order_per_metric": {m: fit_order(pts, m) for m in names},
                  "against": self.against(src), "cheapest": {}}
-            for tgt in TARGETS + ((1e-7, 1e-8) if src == "reference-adaptive" else ()):
-                if src == "reference-adaptive":
+            for tgt in TARGETS + ((1e-7, 1e-8) if src == ADAPTIVE.label else ()):
+                if src == ADAPTIVE.label:
                     ok = [p for p in pts if math.isfinite(p.error) and p.error <= tgt]
                     c = min(ok, key=lambda p: p.wall_time) if ok else None
                 else:
@@ -209,23 +213,16 @@ class NativeLaw:
 
 
 def native_sources(case: Case, engines) -> dict:
-    """{source: the Native it runs} for each engine (or build of one) among ``engines`` whose engine the case
-    gives its own setting (``[engine.NAME]``)."""
-    out = {}
-    for name in engines:
-        try:
-            eng = registry.get(name)
-        except ValueError:
-            continue
-        nat = eng.case_native(case)
-        if nat is not None:
-            out[name] = nat
-    return out
+    """{source: the Native it runs} for each engine (or build of one) among ``engines`` (Engines or names) whose
+    engine the case gives its own setting (``[engine.NAME]``)."""
+    from .sources import engines_of
+
+    return {e.name: nat for e in engines_of(engines) if (nat := e.case_native(case)) is not None}
 
 
 def native_contact(case: Case, native) -> tuple[object, float]:
     """(the twin's ResolvedModel, its elastic contact time) of a native law for the case: the time a native
-    law's grid of steps (bench, dt, stress) and its default step (``native_step``) are counted in."""
+    law's grid of steps (bench, dt, stress) and its default step (engines.collide.setting) are counted in."""
     from ..engines.mapping import twin_model
 
     model = twin_model(resolve(case), native)
@@ -242,14 +239,7 @@ def native_seen(case: Case, model) -> tuple:
             tuple((tuple(w.point), tuple(w.normal)) for w in case.walls), tuple(case.run.gravity))
 
 
-def native_step(case: Case, native, dt: float | None = None) -> float:
-    """The step a native law runs at: ``dt`` (--dt), else the case's run.dt, else — as ``dt = auto`` is for the
-    seed model — its twin's elastic contact time over the case's run.steps_per_contact (the seed model's
-    contact time would leave a stiffer native law unresolved)."""
-    return dt or case.run.dt or native_contact(case, native)[1] / case.run.steps_per_contact
-
-
-def native_law(case: Case, engine: str, native, seed: dict | None = None) -> NativeLaw:
+def native_law(case: Case, engine, native, seed: dict | None = None) -> NativeLaw:
     """The native law of ``engine`` for the case and its converged answer: the twin solved by the adaptive
     method with the engine's kinematic rules, or — a twin with a force history has no adaptive solve — by its
     own scheme at t_c/CONVERGED_STEPS. ``seed``: the seed model's converged metrics, for ``seed_gap``."""
@@ -257,8 +247,11 @@ def native_law(case: Case, engine: str, native, seed: dict | None = None) -> Nat
     from ..reference import collision3d
     from ..reference.health import impact_scales
 
+    from ..engines.collide import as_engine
+
     model, t_c = native_contact(case, native)
-    rules = registry.get(engine).rules
+    engine = as_engine(engine)  # an Engine, or its name
+    rules = engine.rules
     tl = model.tangential_law
     if tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
         conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),
@@ -270,7 +263,7 @@ def native_law(case: Case, engine: str, native, seed: dict | None = None) -> Nat
     m = conv.metrics()
     # the solver's note on a tangential history concerns a contact that slides: none in a head-on impact
     note = conv.message if _defined(m.get("tangential_restitution")) or conv.status != "ok" else ""
-    law = NativeLaw(engine, native, model, t_c, m, how, conv.status, note)
+    law = NativeLaw(engine.name, native, model, t_c, m, how, conv.status, note)
     if seed is not None:
         law.seed_gap = _errors(law.converged, seed, METRICS + OBLIQUE_METRICS, impact_scales(case, model))
     return law
@@ -303,29 +296,26 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
     and builds to time (default every registered one); an engine the case gives its own setting runs it, as
     its twin does, both against the twin's converged answer. Each point is a task of ``campaign``
     (dispatch.Campaign; default this process), the points in the order planned."""
-    from ..engines import discovery
-    from ..engines.mapping import contact_mapping
     from ..reference.health import impact_scales
+    from . import sources
     from .dispatch import Campaign
 
-    engines = registry.names() if engines is None else tuple(engines)
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = collide(case, "adaptive").metrics()
     res = BenchResult(case.name, model.describe(), t_c, ref)
-    res.natives = {e: native_law(case, e, nat, ref) for e, nat in native_sources(case, engines).items()}
+    planned = sources.plan(case, engines)
+    res.natives = {p.source.name: native_law(case, p.source.engine, p.native, ref) for p in planned
+                   if p.native is not None}
     basis = Basis(case, ref, metrics_of(case, model), impact_scales(case, model), t_c, res.natives, batch)
-    plan = [("reference-adaptive", rtol) for rtol in rtols] + [("reference-verlet", spc) for spc in steps]
-    plan += [(f"{engine}-twin", spc) for engine in res.natives for spc in steps]  # the native law in the reference
-    for engine in engines:
-        law = res.natives.get(engine)
-        mp = contact_mapping(case, engine, law.native if law else None)
-        if mp.native is None:
-            res.skipped[engine] = "not expressible: " + "; ".join(mp.reasons)
-        elif discovery.find(engine) is None:
-            res.skipped[engine] = discovery.missing(engine)
+    plan = [(sources.ADAPTIVE.label, rtol) for rtol in rtols] + [(sources.VERLET.label, spc) for spc in steps]
+    # the native law in the reference
+    plan += [(p.source.twin().label, spc) for p in planned if p.native is not None for spc in steps]
+    for p in planned:
+        if p.runs:
+            plan += [(p.source.label, spc) for spc in steps]
         else:
-            plan += [(engine, spc) for spc in steps]
+            res.skipped[p.source.label] = ("not expressible: " if p.status == sources.NOT_EXPRESSIBLE else "") + p.why
     tick = progress or (lambda: None)
     done = {}
     for i, point in (campaign or Campaign()).completed(point_task, [(i, (basis, *p)) for i, p in enumerate(plan)]):
@@ -343,42 +333,45 @@ def point_task(basis: Basis, source: str, step: float, cache=None) -> Point | st
     """One point of a bench, where the campaign runs it (comparisons/dispatch.py): ``step`` is the adaptive
     method's rtol for reference-adaptive, else steps per elastic contact time (a native law's own for an engine
     with one, and its twin). A str: why it did not run (the engine is missing on the Dask worker it went to)."""
-    from ..engines.collide import collide as run_engine
     from .dispatch import missing_here
+    from .sources import REFERENCE, TWIN, Source
 
     case, ref, metrics, scales = basis.case, basis.ref, basis.metrics, basis.scales
-    if source == "reference-adaptive":
-        wall, r = _timed(lambda: collide(case, "adaptive", rtol=step))
-        return Point(source, None, None, step, wall, None, _errors(r.metrics(), ref, metrics, scales), r.status,
+    src = Source.parse(source)
+    if src.kind == REFERENCE:
+        rtol, spc = (step, None) if src.method == "adaptive" else (None, step)
+        dt = None if spc is None else basis.t_contact / spc
+        wall, r = _timed(lambda: src.run(case, dt, rtol=rtol))
+        return Point(source, spc, dt, rtol, wall, None, _errors(r.metrics(), ref, metrics, scales), r.status,
                      r.message)
-    if source == "reference-verlet":
-        dt = basis.t_contact / step
-        wall, r = _timed(lambda: collide(case, "verlet", dt=dt))
-        return Point(source, step, dt, None, wall, None, _errors(r.metrics(), ref, metrics, scales), r.status,
-                     r.message)
-    engine = source.removesuffix("-twin")
-    law = basis.natives.get(engine)
-    if source.endswith("-twin"):
-        return _twin_point(case, engine, law, step, repeat=3)
-    lacking = missing_here([engine])
+    law = basis.natives.get(src.name)
+    if src.kind == TWIN:
+        return _twin_point(case, src, law, step, repeat=3)
+    lacking = missing_here([src.name])
     if lacking:
-        return lacking[engine]
+        return lacking[src.name]
+    return _engine_point(basis, src, law, step)
+
+
+def _engine_point(basis: Basis, src, law, step: float) -> Point:
+    """An engine's point: one collision per process, and a batch of copies in one."""
+    case, metrics, scales = basis.case, basis.metrics, basis.scales
     dt = (law.t_contact if law else basis.t_contact) / step
     native = law.native if law else None
     try:
-        one = run_engine(case, engine, dt=dt, cache=None, native=native)
+        one = src.run(case, dt, cache=None, native=native)
         try:
-            many = run_engine(case, engine, dt=dt, cache=None, copies=basis.batch, native=native)
+            many = src.run(case, dt, cache=None, copies=basis.batch, native=native)
         except UnsupportedByEngine:  # an engine whose decks hold one collision: no batched time
             many = None
     except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
         raise
     except DemcheckError as exc:
-        return Point(engine, step, dt, None, math.nan, math.nan, {k: math.nan for k in metrics}, "failed",
+        return Point(src.label, step, dt, None, math.nan, math.nan, {k: math.nan for k in metrics}, "failed",
                      str(exc).splitlines()[0])
     # an engine result carries the reference's own checks (reference/health.py)
-    errors = _native_errors(law, one.metrics(), scales) if law else _errors(one.metrics(), ref, metrics, scales)
-    return Point(engine, step, dt, None, one.meta["engine_wall_time"],
+    errors = _native_errors(law, one.metrics(), scales) if law else _errors(one.metrics(), basis.ref, metrics, scales)
+    return Point(src.label, step, dt, None, one.meta["engine_wall_time"],
                  many.meta["engine_wall_time"] / basis.batch if many is not None else math.nan,
                  errors, one.status, one.message if not one.ok else "")
 
@@ -441,8 +434,10 @@ def recommend(case: Case, target: float = 1e-3, engines=None) -> dict:
     For each engine among ``engines`` (default every registered one) the case gives its own setting
     (``[engine.NAME]``), ``natives[NAME]`` is the same for that native law: its twin's error against the twin's
     converged answer (the engine computes what its twin does, to round-off)."""
+    from .sources import VERLET, Source
+
     b = bench_case(case, engines=(), rtols=(), steps=DT_STEPS)
-    pts = [p for p in b.points if p.source == "reference-verlet"]
+    pts = [p for p in b.points if p.source == VERLET.label]
     t_r, t_h = rayleigh_time(case), hertz_time(case)
     out = {"case": case.name, "model": b.model, "target": target, "t_contact": b.t_contact,
            "rayleigh_time": t_r, "hertz_time": t_h, "order": fit_order(pts),
@@ -454,12 +449,12 @@ def recommend(case: Case, target: float = 1e-3, engines=None) -> dict:
     if out["dt"] is not None:
         out.update(dt_over_rayleigh=out["dt"] / t_r, dt_over_hertz=out["dt"] / t_h)
     out["natives"] = {}
-    natives = native_sources(case, registry.names() if engines is None else engines)
+    natives = native_sources(case, engines)
     for engine, nat in natives.items():
         law = native_law(case, engine, nat, b.reference)
         twin = _twin_points(case, engine, law, DT_STEPS)
         entry = {**law.as_dict(), "target": target, "order": fit_order(twin), "metrics": _used(twin),
-                 "against": f"{engine}-twin converged ({law.how})",
+                 "against": f"{Source.of(engine, twin=True).label} converged ({law.how})",
                  "table": [{"steps_per_contact": p.steps_per_contact, "dt": p.dt, "error": p.error,
                             "status": p.status} for p in twin]}
         entry.update(_choose(twin, target))
@@ -467,35 +462,39 @@ def recommend(case: Case, target: float = 1e-3, engines=None) -> dict:
     return out
 
 
-def _twin_points(case: Case, engine: str, law: NativeLaw, steps, repeat: int = 1) -> list[Point]:
+def _twin_points(case: Case, engine, law: NativeLaw, steps, repeat: int = 1) -> list[Point]:
     """The native law's twin over a grid of steps per its elastic contact time (``_twin_point``)."""
-    return [_twin_point(case, engine, law, spc, repeat) for spc in steps]
+    from .sources import Source
+
+    twin = Source.of(engine, twin=True)
+    return [_twin_point(case, twin, law, spc, repeat) for spc in steps]
 
 
-def _twin_point(case: Case, engine: str, law: NativeLaw, spc: float, repeat: int = 1) -> Point:
-    """The native law's twin at ``spc`` steps per its elastic contact time, its error against the twin's converged
-    answer (best wall time of ``repeat`` runs). A step the run cannot hold (too many steps) is that point's
-    failure."""
-    from ..engines.collide import twin_states
+def _twin_point(case: Case, twin, law: NativeLaw, spc: float, repeat: int = 1) -> Point:
+    """The native law's twin (``twin``, a Source) at ``spc`` steps per its elastic contact time, its error against
+    the twin's converged answer (best wall time of ``repeat`` runs). A step the run cannot hold (too many steps) is
+    that point's failure."""
     from ..reference.health import impact_scales
 
     dt = law.t_contact / spc
     try:
-        wall, r = _timed(lambda: twin_states(case, engine, dt, native=law.native), repeat)
+        wall, r = _timed(lambda: twin.run(case, dt, native=law.native), repeat)
     except ConfigError as exc:
-        return Point(f"{engine}-twin", spc, dt, None, math.nan, None, {k: math.nan for k in METRICS}, "failed",
+        return Point(twin.label, spc, dt, None, math.nan, None, {k: math.nan for k in METRICS}, "failed",
                      str(exc).splitlines()[0])
     errors = _native_errors(law, r.metrics(), impact_scales(case, law.model))
-    return Point(f"{engine}-twin", spc, dt, None, wall, None, errors, r.status, r.message)
+    return Point(twin.label, spc, dt, None, wall, None, errors, r.status, r.message)
 
 
 def speed_goal_text(results: list[dict]) -> str:
     """The issue's speed goal, per case: the adaptive method's time to an error of 1e-8 against the time
     each engine needs for 1e-3 (per process and per batched collision), measured in this run."""
+    from .sources import ADAPTIVE
+
     lines = []
     for b in results:
         src = b["sources"]
-        a = (src.get("reference-adaptive") or {}).get("cheapest", {}).get("1e-08")
+        a = (src.get(ADAPTIVE.label) or {}).get("cheapest", {}).get("1e-08")
         if a is None:
             continue
         for e in registry.names():

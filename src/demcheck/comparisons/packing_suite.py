@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from ..errors import EngineInterrupted, UnsupportedByEngine
-from . import packing_metrics, verdicts
+from . import packing_metrics, sources, verdicts
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
 TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
@@ -155,9 +155,10 @@ def run_packing(case, opts, found, file=None) -> dict:
     entry["packing"]["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
                                      "profile": packing_metrics.profile(x, rad, box) if box else None}
 
-    for engine in opts.engines:
-        if verdicts.unavailable(entry, comps, engine, pair_mapping(case, engine, 0, 0), found):
+    for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
+        if verdicts.unavailable(entry, comps, planned):
             continue
+        engine = planned.source.label
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
         except EngineInterrupted:
@@ -181,30 +182,49 @@ def run_packing(case, opts, found, file=None) -> dict:
         entry["packing"][engine] = {"ke": [(step * dt, e) for step, e in run.ke],
                                     "forces": packing_metrics.force_distribution(fn),
                                     "profile": packing_metrics.profile(x, rad, box) if box else None}
-        d, crit = ks_distance(fn, ref_forces)
-        if math.isfinite(d):
+        _judge_engine(case, engine, m, ref_m, fn, ref_forces, x, rad, states, box, comps)
+    _judge_settled(case, entry, states, comps)
+    entry["comparisons"] = [c.as_dict() for c in comps]
+    worst = verdicts.worst(c.verdict for c in comps)
+    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    entry["verdict"] = worst
+    entry["impact"] = {}
+    entry["scales"] = {}
+    return entry
+
+
+def _judge_engine(case, engine: str, m: dict, ref_m: dict, fn, ref_forces, x, rad, states, box, comps) -> None:
+    """An engine's packing against the reference's: the contact-force distribution (Kolmogorov–Smirnov), a
+    poured packing's fabric φ_zz, and each bulk metric within its statistical tolerance."""
+    d, crit = ks_distance(fn, ref_forces)
+    if math.isfinite(d):
+        ok = d <= crit
+        comps.append(verdicts.Comparison(engine, "force_distribution_ks", d, 0.0, d, d, crit,
+                                  verdicts.AGREE if ok else verdicts.UNEXPECTED,
+                                  "" if ok else f"the contact-force distributions P(f/⟨f⟩) differ beyond the "
+                                                f"Kolmogorov–Smirnov critical distance at α = {KS_ALPHA:g}"))
+    if case.packing is not None and case.packing.layout == "poured":
+        d, crit = fabric_zz_distance(normals_zz(x, rad, box), normals_zz(*states["reference"], box))
+        if math.isfinite(d) and crit > 0:
             ok = d <= crit
-            comps.append(verdicts.Comparison(engine, "force_distribution_ks", d, 0.0, d, d, crit,
+            comps.append(verdicts.Comparison(engine, "fabric_zz", m["fabric_zz"], ref_m["fabric_zz"], d, d, crit,
                                       verdicts.AGREE if ok else verdicts.UNEXPECTED,
-                                      "" if ok else f"the contact-force distributions P(f/⟨f⟩) differ beyond the "
-                                                    f"Kolmogorov–Smirnov critical distance at α = {KS_ALPHA:g}"))
-        if case.packing is not None and case.packing.layout == "poured":
-            d, crit = fabric_zz_distance(normals_zz(x, rad, box), normals_zz(*states["reference"], box))
-            if math.isfinite(d) and crit > 0:
-                ok = d <= crit
-                comps.append(verdicts.Comparison(engine, "fabric_zz", m["fabric_zz"], ref_m["fabric_zz"], d, d, crit,
-                                          verdicts.AGREE if ok else verdicts.UNEXPECTED,
-                                          "" if ok else "the contact fabric's vertical component φ_zz differs beyond "
-                                                        f"its sampling error at α = {FABRIC_ALPHA:g}"))
-        for metric, tol in TOLERANCES.items():
-            a, b = m[metric], ref_m[metric]
-            if not (math.isfinite(a) and math.isfinite(b)):
-                continue
-            diff = abs(a - b) / (abs(b) if metric in ("bed_height", "mean_contact_force") else 1.0)
-            verdict = verdicts.AGREE if diff <= tol else verdicts.UNEXPECTED
-            comps.append(verdicts.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
-                                      "" if verdict == verdicts.AGREE else
-                                      f"beyond the statistical tolerance {tol:g} between chaotic packings"))
+                                      "" if ok else "the contact fabric's vertical component φ_zz differs beyond "
+                                                    f"its sampling error at α = {FABRIC_ALPHA:g}"))
+    for metric, tol in TOLERANCES.items():
+        a, b = m[metric], ref_m[metric]
+        if not (math.isfinite(a) and math.isfinite(b)):
+            continue
+        diff = abs(a - b) / (abs(b) if metric in ("bed_height", "mean_contact_force") else 1.0)
+        verdict = verdicts.AGREE if diff <= tol else verdicts.UNEXPECTED
+        comps.append(verdicts.Comparison(engine, metric, a, b, abs(a - b), diff, tol, verdict,
+                                  "" if verdict == verdicts.AGREE else
+                                  f"beyond the statistical tolerance {tol:g} between chaotic packings"))
+
+
+def _judge_settled(case, entry: dict, states: dict, comps: list) -> None:
+    """Each source's settled state: the static overlaps' closed form where there is one, else (a poured packing)
+    the kinetic energy left and each bulk metric within its physical range."""
     for src, (x, rad) in states.items():
         pairs = static_overlaps(case, x)
         if pairs is not None:
@@ -231,10 +251,3 @@ def run_packing(case, opts, found, file=None) -> dict:
                                           verdicts.AGREE if ok else verdicts.EXPECTED,
                                           "" if ok else f"outside the physical range {lo:g}–{hi:g} of a "
                                                         "settled poured packing (not settled, or too small a bulk)"))
-    entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = verdicts.worst(c.verdict for c in comps)
-    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
-    entry["verdict"] = worst
-    entry["impact"] = {}
-    entry["scales"] = {}
-    return entry

@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..case import Case, _read, from_dict, naming_file
-from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
 from ..reference.collision import characteristic_time, collide
 from ..reference import health
@@ -121,12 +120,16 @@ class StressResult:
         """Where an engine and what it computes disagree about stability by more than one grid step: the
         reference's verlet method for a mapped seed model, the engine's twin for its native setting (a twin
         is the native law itself, never flagged against the seed model's run)."""
+        from .sources import ENGINE, VERLET, Source
+
         out = []
         by = {(l.parameter, l.value, l.source): l for l in self.limits}
         for l in self.limits:
-            if l.source == "reference-verlet" or l.source.endswith("-twin"):
+            src = Source.parse(l.source)
+            if src.kind != ENGINE:
                 continue
-            against = f"{l.source}-twin" if (l.parameter, l.value, f"{l.source}-twin") in by else "reference-verlet"
+            twin = src.twin().label
+            against = twin if (l.parameter, l.value, twin) in by else VERLET.label
             r = by.get((l.parameter, l.value, against))
             if r is None:
                 continue
@@ -162,41 +165,30 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
     return status == "ok", why
 
 
-def _stable_engine(case: Case, engine: str, dt: float, t_c: float, native=None, model=None) -> tuple[bool, str]:
-    """An engine run's stability (``native``: the case's own setting, judged with its twin's ``model``)."""
-    from ..engines.collide import collide as run_engine
+def _stable_source(case: Case, src, dt: float, native=None, model=None) -> tuple[bool, str]:
+    """An engine run's or its twin's stability (``src``, a Source; ``native``: the case's own setting, judged with
+    its twin's ``model``): a twin's run that its own checks call neither ok, unresolved nor unstable fails."""
+    from .sources import TWIN
 
     try:
-        r = run_engine(case, engine, dt=dt, timeout=120.0, native=native)
+        r = src.run(case, dt, native=native, **({} if src.kind == TWIN else {"timeout": 120.0}))
     except EngineInterrupted:  # Ctrl-C / SIGTERM stops the command, not one run
         raise
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
-    status, why = health.check(r, case, model, min_steps=1)
-    return status == "ok", why
-
-
-def _stable_twin(case: Case, engine: str, native, model, dt: float) -> tuple[bool, str]:
-    """The native law's stability in the engine's scheme: its twin (engines.collide.twin_states)."""
-    from ..engines.collide import twin_states
-
-    try:
-        r = twin_states(case, engine, dt, native=native)
-    except DemcheckError as exc:
-        return False, str(exc).splitlines()[0]
-    if r.status not in ("ok", "unresolved", "unstable"):
+    if src.kind == TWIN and r.status not in ("ok", "unresolved", "unstable"):
         return False, f"{r.status}: {r.message}"
     status, why = health.check(r, case, model, min_steps=1)
     return status == "ok", why
 
 
-def _native_run(case: Case, engine: str):
-    """(Native, twin model, what the native run sees) of the case's own setting for ``engine``, or None: what
-    it sees is its twin's laws and the bodies' initial state, so that a parameter that leaves it unchanged is
-    known not to move the native run."""
+def _native_run(case: Case, engine):
+    """(Native, twin model, what the native run sees) of the case's own setting for ``engine`` (an Engine), or
+    None: what it sees is its twin's laws and the bodies' initial state, so that a parameter that leaves it
+    unchanged is known not to move the native run."""
     from .bench import native_contact, native_seen
 
-    nat = registry.get(engine).case_native(case)
+    nat = engine.case_native(case)
     if nat is None:
         return None
     model, _ = native_contact(case, nat)
@@ -245,21 +237,18 @@ def limit_task(parameter: str, value, source: str, case: Case, t_c: float, cache
     for an engine when it has one) at one value of a stress parameter, where the campaign runs it
     (comparisons/dispatch.py). A str: why it did not run (the engine is missing on the Dask worker it went to)."""
     from .dispatch import missing_here
+    from .sources import ENGINE, REFERENCE, Source
 
-    if source == "reference-verlet":
+    src = Source.parse(source)
+    if src.kind == REFERENCE:
         spc, why = largest_stable(lambda n: _stable_reference(case, t_c / n, t_c))
         return Limit(parameter, value, source, spc, (1.0 / spc) if spc else None, why, t_c)
-    engine = source.removesuffix("-twin")
-    nat = _native_run(case, engine)
+    nat = _native_run(case, src.engine)
     native, model = (nat[0], nat[1]) if nat is not None else (None, None)
     t = characteristic_time(model) if nat is not None else t_c
-    if source.endswith("-twin"):
-        spc, why = largest_stable(lambda n: _stable_twin(case, engine, native, model, t / n))
-    else:
-        lacking = missing_here([engine])
-        if lacking:
-            return lacking[engine]
-        spc, why = largest_stable(lambda n: _stable_engine(case, engine, t / n, t, native, model))
+    if src.kind == ENGINE and (lacking := missing_here([src.name])):
+        return lacking[src.name]
+    spc, why = largest_stable(lambda n: _stable_source(case, src, t / n, native, model))
     return Limit(parameter, value, source, spc, (1.0 / spc) if spc else None, why, t)
 
 
@@ -267,57 +256,18 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
                 progress=None, campaign=None) -> StressResult:
     """Stress one case (``read_stress``'s raw table and Case) over its parameters, each source's search at each
     value a task of ``campaign`` (dispatch.Campaign; default this process); the limits in the order planned."""
-    from ..engines import discovery
-    from ..engines.builds import engine_of
-    from ..engines.mapping import contact_mapping, native_summary
     from .dispatch import Campaign
+    from .sources import engines_of
 
     res = StressResult(base.name, resolve(base).describe())
     params = parameters(raw0)
     if only:
         params = {k: v for k, v in params.items() if any(o in k for o in only)}
-    engines = registry.names() if engines is None else tuple(engines)
+    engines = engines_of(engines)
     tick = progress or (lambda: None)
     plan: list = []  # a Limit known without a run (an invalid value), or the arguments of a limit_task
     for name, values in params.items():
-        points = []  # (value, case, t_c, {engine: _native_run}) or (value, None, why, {})
-        for value, transform in values:
-            try:
-                case = from_dict(transform(copy.deepcopy(raw0)))
-                t_c = characteristic_time(resolve(case))
-                natives = {e: n for e in engines if (n := _native_run(case, e)) is not None}
-            except DemcheckError as exc:
-                points.append((value, None, f"invalid: {exc}", {}))
-                continue
-            points.append((value, case, t_c, natives))
-            res.natives.update({e: native_summary(n[0]) for e, n in natives.items()})
-        # an engine whose native run no value of this parameter moves: left out for it and its twin
-        still = set()
-        for e in engines:
-            seen = {n[e][2] for _, c, _, n in points if c is not None and e in n}
-            if len(seen) == 1 and all(c is None or e in n for _, c, _, n in points):
-                still.add(e)
-                res.skipped[f"{e} and {e}-twin × {name}"] = (
-                    f"the case's [engine.{engine_of(e)}] setting is run, and {name} changes neither it nor the "
-                    "bodies: its stability is the same at every value")
-        for value, case, t_c, natives in points:
-            if case is None:
-                plan.append(Limit(name, value, "reference-verlet", None, None, t_c))
-                continue
-            plan.append((name, value, "reference-verlet", case, t_c))
-            for e in engines:
-                nat = natives.get(e)
-                if e in still:
-                    continue
-                if nat is not None:
-                    plan.append((name, value, f"{e}-twin", case, t_c))
-                mp = contact_mapping(case, e, nat[0] if nat else None)
-                if mp.native is None:
-                    res.skipped[e] = "not expressible: " + "; ".join(mp.reasons)
-                elif discovery.find(e) is None:
-                    res.skipped[e] = discovery.missing(e)
-                else:
-                    plan.append((name, value, e, case, t_c))
+        plan += _plan_parameter(res, name, values, raw0, engines)
     tasks = [(i, args) for i, args in enumerate(plan) if not isinstance(args, Limit)]
     done = {}
     for i, limit in (campaign or Campaign()).completed(limit_task, tasks):
@@ -330,3 +280,54 @@ def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = N
         else:
             res.limits.append(item)
     return res
+
+
+def _points(res: StressResult, values, raw0: dict, engines) -> list:
+    """Each value of a parameter as (value, case, t_c, {engine name: _native_run}), or (value, None, why, {}) for
+    a value that makes no valid case; the native settings seen noted in ``res``."""
+    from ..engines.mapping import native_summary
+
+    points = []
+    for value, transform in values:
+        try:
+            case = from_dict(transform(copy.deepcopy(raw0)))
+            t_c = characteristic_time(resolve(case))
+            natives = {e.name: n for e in engines if (n := _native_run(case, e)) is not None}
+        except DemcheckError as exc:
+            points.append((value, None, f"invalid: {exc}", {}))
+            continue
+        points.append((value, case, t_c, natives))
+        res.natives.update({e: native_summary(n[0]) for e, n in natives.items()})
+    return points
+
+
+def _plan_parameter(res: StressResult, name: str, values, raw0: dict, engines) -> list:
+    """The searches of one parameter: per value the reference's verlet method, and each engine that can run it
+    (sources.plan) with, for a native setting, its twin. An engine whose native run no value of the parameter
+    moves is left out, with its twin, and said so in ``res.skipped``."""
+    from ..engines.builds import engine_of
+    from .sources import NOT_EXPRESSIBLE, VERLET, Source, plan as which
+
+    points = _points(res, values, raw0, engines)
+    still = set()
+    for e in engines:
+        seen = {n[e.name][2] for _, c, _, n in points if c is not None and e.name in n}
+        if len(seen) == 1 and all(c is None or e.name in n for _, c, _, n in points):
+            still.add(e.name)
+            res.skipped[f"{e.name} and {Source.of(e, twin=True).label} × {name}"] = (
+                f"the case's [engine.{engine_of(e.name)}] setting is run, and {name} changes neither it nor the "
+                "bodies: its stability is the same at every value")
+    out: list = []
+    for value, case, t_c, natives in points:
+        if case is None:
+            out.append(Limit(name, value, VERLET.label, None, None, t_c))
+            continue
+        out.append((name, value, VERLET.label, case, t_c))
+        for p in which(case, [e for e in engines if e.name not in still]):
+            if p.source.name in natives:
+                out.append((name, value, p.source.twin().label, case, t_c))
+            if p.runs:
+                out.append((name, value, p.source.label, case, t_c))
+            else:
+                res.skipped[p.source.name] = ("not expressible: " if p.status == NOT_EXPRESSIBLE else "") + p.why
+    return out

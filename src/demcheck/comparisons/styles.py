@@ -17,13 +17,17 @@ UNKNOWN = Style(colour="#8c564b", marker="x", linestyle="-")
 
 
 def style(source: str) -> Style:
+    from ..errors import ConfigError
+    from .sources import TWIN, Source
+
     if source in REFERENCE:
         return REFERENCE[source]
-    name, _, twin = source.partition("-twin")
-    if name in registry.names():
-        s = registry.get(name).style
-        return Style(s.colour, s.marker, ":") if twin == "" and source.endswith("-twin") else s
-    return UNKNOWN
+    try:
+        src = Source.parse(source, methods=False)
+    except ConfigError:  # a source of an older report, no longer registered
+        return UNKNOWN
+    s = src.engine.style
+    return Style(s.colour, s.marker, ":") if src.kind == TWIN else s
 
 
 def engine_sources() -> tuple[str, ...]:

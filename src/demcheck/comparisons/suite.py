@@ -31,11 +31,10 @@ from ..case import Case, expand, naming_file
 from ..engines import registry
 from ..engines.base import case_natives
 from ..errors import DemcheckError, EngineInterrupted
-from ..reference.collision import collide
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..laws.model import resolve
-from . import curves, dispatch, verdicts
+from . import curves, dispatch, sources, verdicts
 
 SERIES_POINTS = 400
 
@@ -50,6 +49,7 @@ class Options:
     tolerances: verdicts.Tolerances = field(default_factory=verdicts.Tolerances.load)
     expected: list = field(default_factory=verdicts.load_expected)
     baseline: dict | None = None  # a stored earlier run (comparisons/diff.load): every source judged against it too
+    named: bool = False  # the engines were named (not default discovery): one a Dask worker lacks fails there
 
 
 def discover(engines) -> dict:
@@ -79,12 +79,6 @@ def _series(contact, source: str) -> dict | None:
 
 
 def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
-    from ..engines import states
-    from ..engines.collide import collide as run_engine, twin_states
-    from ..engines.mapping import contact_mapping
-    from ..reference import collision3d
-
-    tol = opts.tolerances
     entry = {"case": case.name, "file": str(file), "case_hash": case.hash, "kind": case.kind,
              "sources": {}, "comparisons": [], "curves": {}, "series": []}
     entry["walls"] = len(case.walls)  # a wall impact or a pair: the report's panels say which
@@ -98,13 +92,30 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     v_in = model.pair.impact_speed
     entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution, **_incidence(case)}
-    adaptive = collide(case, "adaptive")
     # energy in units of the bodies' kinetic energy at impact (translation, spin, and the tangential motion
     # a grazing impact carries: the normal part alone vanishes at 90°)
-    scales = impact_scales(case, model)
-    entry["scales"] = scales
+    entry["scales"] = impact_scales(case, model)
     comps: list[verdicts.Comparison] = []
+    adaptive, ref = _reference_sources(case, model, entry, comps, opts.tolerances)
+    seed_cache: dict = {}
+    for planned in sources.plan(case, opts.engines, found):
+        if verdicts.unavailable(entry, comps, planned):
+            continue
+        _engine_source(case, model, planned, (adaptive, ref), entry, comps, opts, seed_cache)
+    entry["series"] = [s for s in entry["series"] if s]
+    entry["comparisons"] = [c.as_dict() for c in comps]
+    worst = verdicts.worst(c.verdict for c in comps)
+    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    entry["verdict"] = worst
+    return entry
 
+
+def _reference_sources(case: Case, model, entry: dict, comps: list, tol) -> tuple:
+    """The reference's two methods in ``entry`` and their comparisons in ``comps``: the adaptive one (the seed
+    model's converged answer: returned with its metrics) against the closed forms, the verlet one at the case's
+    step against it."""
+    adaptive = sources.ADAPTIVE.run(case)
+    scales = entry["scales"]
     ref = adaptive.metrics()
     entry["sources"]["reference"] = _source(adaptive)
     entry["series"].append(_series(adaptive.contact, "reference"))
@@ -112,60 +123,60 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
         comps.append(verdicts.judge_closed_form(metric, ref[metric], exact, scales, tol))
-
-    verlet = collide(case, "verlet")
+    verlet = sources.VERLET.run(case)
     mv = verlet.metrics()
-    entry["sources"]["reference-verlet"] = _source(verlet)
-    entry["series"].append(_series(verlet.contact, "reference-verlet"))
-    entry["curves"]["reference-verlet"] = curves.distances(verlet.contact, adaptive.contact, adaptive.events)
+    label = sources.VERLET.label
+    entry["sources"][label] = _source(verlet)
+    entry["series"].append(_series(verlet.contact, label))
+    entry["curves"][label] = curves.distances(verlet.contact, adaptive.contact, adaptive.events)
     spc = case.run.steps_per_contact
     if verlet.status != "ok":
         # the case's own time step does not give a healthy run (docs/reliability.md): the case fails, whatever
         # the engines do at that step
-        comps.append(verdicts.status_comparison("reference-verlet", verdicts.FAILED, f"{verlet.status}: {verlet.message}"))
+        comps.append(verdicts.status_comparison(label, verdicts.FAILED, f"{verlet.status}: {verlet.message}"))
     else:
         tol_v = replace(tol, verlet_rtol=case.run.verlet_rtol) if case.run.verlet_rtol else tol
         for metric in ref:
             comps.append(verdicts.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
+    return adaptive, ref
 
-    seed_cache: dict = {}
-    for engine in opts.engines:
-        native = registry.get(engine).case_native(case)  # the case's [engine.NAME] setting, if any
-        mp = contact_mapping(case, engine, native)
-        if verdicts.unavailable(entry, comps, engine, mp, found):
-            continue
-        try:
-            res = run_engine(case, engine, cache=opts.cache, timeout=opts.timeout, native=native)
-        except EngineInterrupted:
-            raise  # the case did not finish: it is left out of the (partial) report
-        except DemcheckError as exc:
-            entry["sources"][engine] = {"status": "failed", "message": str(exc)}
-            comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
-            continue
-        if not res.ok:  # a run its health checks refuse (unstable, unresolved, failed): its metrics mean nothing
-            entry["sources"][engine] = {"status": res.status, "message": res.message, "fidelity": mp.fidelity,
-                                        "engine_version": res.engine_version}
-            comps.append(verdicts.status_comparison(engine, verdicts.FAILED, f"{res.status}: {res.message}"))
-            continue
-        me = res.metrics()
-        twin = twin_states(case, engine, res.dt, native=native).metrics()
-        if res.dt not in seed_cache:
-            seed_cache[res.dt] = states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
-        seed_v = seed_cache[res.dt]
-        entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
-                                    "twin_metrics": twin, "seed_verlet_metrics": seed_v}
-        entry["series"].append(_series(res.contact, engine))
-        entry["curves"][engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
-        for metric in ref:
-            comps.append(verdicts.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
-                                        twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons), scales, tol,
-                                        opts.expected, setting=verdicts.mapping_setting(mp)))
-    entry["series"] = [s for s in entry["series"] if s]
-    entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = verdicts.worst(c.verdict for c in comps)
-    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
-    entry["verdict"] = worst
-    return entry
+
+def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, comps: list, opts: Options,
+                   seed_cache: dict) -> None:
+    """One engine that can run the case (``planned``, sources.plan): its run (from the cache where it was run
+    before), its twin and the seed model's verlet run at its dt, and each metric judged."""
+    from ..engines import states
+    from ..reference import collision3d
+
+    src, mp, native = planned.source, planned.mapping, planned.native
+    engine, (adaptive, ref) = src.label, converged
+    try:
+        res = src.run(case, None, native=native, cache=opts.cache, timeout=opts.timeout)
+    except EngineInterrupted:
+        raise  # the case did not finish: it is left out of the (partial) report
+    except DemcheckError as exc:
+        entry["sources"][engine] = {"status": "failed", "message": str(exc)}
+        comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
+        return
+    if not res.ok:  # a run its health checks refuse (unstable, unresolved, failed): its metrics mean nothing
+        entry["sources"][engine] = {"status": res.status, "message": res.message, "fidelity": mp.fidelity,
+                                    "engine_version": res.engine_version}
+        comps.append(verdicts.status_comparison(engine, verdicts.FAILED, f"{res.status}: {res.message}"))
+        return
+    me = res.metrics()
+    twin = src.twin().run(case, res.dt, native=native).metrics()
+    if res.dt not in seed_cache:
+        seed_cache[res.dt] = states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
+    seed_v = seed_cache[res.dt]
+    entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                                "twin_metrics": twin, "seed_verlet_metrics": seed_v}
+    entry["series"].append(_series(res.contact, engine))
+    entry["curves"][engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
+    for metric in ref:
+        comps.append(verdicts.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
+                                           twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons),
+                                           entry["scales"], opts.tolerances, opts.expected,
+                                           setting=verdicts.mapping_setting(mp)))
 
 
 def variant_labels(name: str, file) -> list[list[str]]:
@@ -312,7 +323,9 @@ def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> 
     """One case's entry, where the campaign runs it (comparisons/dispatch.py) with ``cache`` as its run cache. On a
     Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named."""
     lacking = dispatch.missing_here(e for e in opts.engines if found[e]["found"])
-    found = {**found, **{e: {**found[e], "found": False, "why": why} for e, why in lacking.items()}}
+    # an engine the user named is never skipped: its source fails here (sources.plan), the worker named
+    found = {**found, **{e: {**found[e], "found": False, "why": why, "required": opts.named}
+                         for e, why in lacking.items()}}
     return _safe_case(case, Path(file), replace(opts, cache=cache), found)
 
 

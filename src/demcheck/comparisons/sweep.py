@@ -2,7 +2,7 @@
 source: the reference (the seed model of ``[contact]``), an engine (its deck run for real) or an engine's twin.
 
 An engine or its twin runs the case's own setting for that engine (``[engine.NAME]``) when it has one, by
-default at that law's own step (bench.native_step: its twin's contact time over run.steps_per_contact). A
+default at that law's own step (engines.collide.setting: its twin's contact time over run.steps_per_contact). A
 ``contact.*`` key, varied or set, does not change that native law (``[contact]`` is the seed model it is judged
 against), nor does a ``materials.*`` key the setting does not read (LAMMPS's ``pair_coeff`` gives its own modulus
 and restitution): such a sweep is refused before any work, rather than a table of one law repeated."""
@@ -86,17 +86,32 @@ def check_source(source: str, method=None, keys: tuple[str, str, str] = ("--engi
     """``source`` as a sweep runs it: reference, a registered engine (or build), or ``NAME-twin``; ``method``
     is the reference's. Else ConfigError naming the option, before any work: ``keys`` are the names of the
     source, the method and the step (the command's options; the API's ``source``, ``method``, ``dt``)."""
-    from ..engines import registry
+    from .sources import REFERENCE, Source
 
-    names = [n for n in registry.names() if "@" not in n]  # a build's label is a source too, once registered
-    engine = source.removesuffix("-twin") if isinstance(source, str) else None
-    if source != "reference" and engine not in registry.names():
-        raise ConfigError(keys[0], source, "must be reference, an engine (" + ", ".join(names) + ") or an "
-                          "engine's twin (" + ", ".join(f"{n}-twin" for n in names) + ")")
-    if source != "reference" and method is not None:
+    src = Source.parse(source, keys[0], methods=False)
+    if src.kind != REFERENCE and method is not None:
         raise ConfigError(keys[1], method, "is the reference's (adaptive or verlet); an engine and its twin "
                                            f"run velocity Verlet at {keys[2]}")
     return source
+
+
+def sweep_source(text: str, method=None, key: str = "--engine") -> tuple[str, str | None]:
+    """The command line's ``--engine`` of a sweep: (the source's label, the name of the engine or build it runs,
+    None for the reference) — one source: reference, an engine or a build of one (registered under its label and
+    required to be found: EngineNotFound), or an engine's twin; ``method`` the reference's (check_source)."""
+    from ..engines import discovery
+    from ..errors import EngineNotFound
+    from .sources import ENGINE, Source
+
+    if "=" not in text and Source.parse(check_source(text, method), key, methods=False).kind != ENGINE:
+        return text, Source.parse(text).name
+    labels = discovery.resolve(text, key)  # an engine, or a build registered under its label
+    if len(labels) != 1:
+        raise ConfigError(key, text, "a sweep runs one source (collide and verify compare several)")
+    if discovery.find(labels[0]) is None:
+        raise EngineNotFound(discovery.missing(labels[0]))
+    check_source(labels[0], method)
+    return labels[0], labels[0]
 
 
 def _contact_key(key: str) -> bool:
@@ -111,17 +126,17 @@ def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str 
     sees (bench.native_seen: its law, the masses, …) unchanged at every point. The error's key is ``where`` +
     the case key (``--vary contact.kn``; the API's ``vary.contact.kn``), or ``set_where`` + it for an override
     (``--set contact.kn``; the API's ``overrides.contact.kn``)."""
-    from ..engines import registry
     from ..engines.builds import engine_of
     from .bench import native_contact, native_seen
+    from .sources import REFERENCE, Source
 
-    if source == "reference" or not points:
+    if source == REFERENCE or not points:
         return
-    engine = registry.get(source.removesuffix("-twin"))
+    engine = Source.parse(source).engine
     base = points[0][1]
     if engine.case_native(base) is None:
         return
-    table = f"[engine.{engine_of(source.removesuffix('-twin'))}]"
+    table = f"[engine.{engine_of(engine.name)}]"
     why = (f"{source} runs the case's {table} setting, which {{key}} does not change ([contact] is the seed "
            f"model it is judged against)")
     for item in getattr(points, "overrides", ()):
@@ -147,27 +162,20 @@ def _plain(v):
 
 
 def _run(case, source: str, method, dt):
-    """One point's Result from ``source`` (check_source)."""
-    if source == "reference":
-        return collide(case, method=method, dt=dt)
-    from ..case import run_length
-    from ..engines import registry
-    from ..engines.collide import collide as run_engine, twin_states
+    """One point's Result from ``source`` (check_source): an engine and its twin run the case's own setting at
+    its own step (bench and dt count in it too)."""
     from ..errors import EngineNotFound
-    from .bench import native_step
     from .dispatch import missing_here
+    from .sources import ENGINE, Source
 
-    engine = source.removesuffix("-twin")
-    native = registry.get(engine).case_native(case)
-    if native is not None:  # the native law's own step, not the seed model's (bench and dt count in it too)
-        dt = native_step(case, native, dt)
-    if source.endswith("-twin"):
-        return twin_states(case, engine, dt or run_length(case)[0], native=native)
-    lacking = missing_here([engine])  # on a Dask worker without the engine: this point's error names the worker
+    src = Source.reference(method) if source == "reference" else Source.parse(source, "--engine")
+    if src.kind != ENGINE:
+        return src.run(case, dt)
+    lacking = missing_here([src.name])  # on a Dask worker without the engine: this point's error names the worker
     if lacking:
-        raise EngineNotFound(lacking[engine])
+        raise EngineNotFound(lacking[src.name])
     # a sweep runs one engine many times: in its long-lived worker where it has one (no start-up per point)
-    return run_engine(case, engine, dt=dt, native=native, worker=True)
+    return src.run(case, dt, worker=True)
 
 
 def point_task(values: dict, case, source: str, method, dt, cache=None) -> dict:

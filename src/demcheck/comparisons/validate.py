@@ -55,8 +55,8 @@ class Impact:
     vt: float  # tangential speed of the centres (m/s)
     spin: float  # |ω0| of particle 0 (rad/s)
     angle: float  # incidence from the normal (degrees)
-    normal: str = ""  # the case's normal law (its id in reference/normal.py): which exact limit applies
-    tangential: str = ""  # the case's tangential law (its id in reference/tangential.py)
+    normal: str = ""  # the case's normal law (its id in laws/normal.py): which exact limit applies
+    tangential: str = ""  # the case's tangential law (its id in laws/tangential.py)
     # the share of μ∫|F_n|dt by which the law itself holds its force below the Coulomb cap in this case (viscous
     # sliding where η_t|v_t| < μ|F_n|: law_shortfall, on the reference's adaptive run); a contact short of it by more
     # than SHORTFALL_MAX does not slide, whatever a source's run does
@@ -408,9 +408,12 @@ SPIN_KEPT = Limit("spin_ratio", "ω' = ω0", lambda c, m: 1.0, lambda c: True, l
                   "no slip at the contact: no tangential force, the spin is kept exactly (reference 1e-9; engines "
                   "1e-6: round-off in their output)")
 
-_DIGITISED = "digitisation of the paper's figure (≈1% of the axis) and the spread between the paper's codes"
-_FEM = ("the paper's finite-element reference (its block names no material: judged for both), digitised; below "
-        "the gross-sliding threshold it lies 0.85–1.43 from the paper's own DEM curves")
+# the exact limits a benchmark of the catalogue (data/benchmarks.toml) names
+LIMITS: dict[str, Limit] = {
+    **{f"hertz:{k}": _hertz(k) for k in ("contact_time", "max_overlap", "peak_force")},
+    "given_e": GIVEN_E, "tti_e": TTI_E, "slide_et": SLIDE_ET, "slide_spin": SLIDE_SPIN, "t5_angle": T5_ANGLE,
+    "t5_spin": T5_SPIN, "beta": BETA, "spin_kept": SPIN_KEPT, "psi2": PSI2, "omega": OMEGA,
+}
 
 
 @dataclass(frozen=True)
@@ -426,44 +429,52 @@ class Benchmark:
     quick: str = ""  # the case file (its stem) of the quick subset (validate's quick run): one per benchmark
 
 
-BENCHMARKS: tuple[Benchmark, ...] = (
-    Benchmark("chung-ooi-1", "Chung & Ooi Test 1: elastic normal impact of two identical spheres", "chung-ooi-1-",
-              "none", ("contact_time", "max_overlap", "peak_force"),
-              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force")),
-              quick="chung-ooi-1-glass"),
-    Benchmark("chung-ooi-2", "Chung & Ooi Test 2: elastic normal impact of a sphere on a rigid plane", "chung-ooi-2-",
-              "none", ("contact_time", "max_overlap", "peak_force"),
-              limits=tuple(_hertz(k) for k in ("contact_time", "max_overlap", "peak_force")),
-              quick="chung-ooi-2-al-alloy"),
-    Benchmark("chung-ooi-3", "Chung & Ooi Test 3: normal impact with a given restitution", "chung-ooi-3-", "e",
-              ("restitution",), limits=(GIVEN_E, TTI_E), quick="chung-ooi-3-al-oxide-lsd"),
-    Benchmark("chung-ooi-4", "Chung & Ooi Test 4: oblique impact at constant speed, incidence 5°–85°", "chung-ooi-4-",
-              "angle", ("et", "spin_paper", "contact_angle"),
-              curves=(Curve("et", "chung-ooi-4-et.dat", 0.03, "e_t ± 0.03: " + _DIGITISED),
-                      Curve("spin_paper", "chung-ooi-4-spin.dat", 30.0, "ω' ± 30 rad/s (5% of the axis): " + _DIGITISED),
-                      Curve("contact_angle", "chung-ooi-4-angle.dat", 2.0, "± 2°: " + _DIGITISED)),
-              limits=(SLIDE_ET, SLIDE_SPIN), quick="chung-ooi-4-al-oxide-tti"),
-    Benchmark("chung-ooi-5", "Chung & Ooi Test 5: constant normal, varied tangential velocity", "chung-ooi-5-", "psi",
-              ("t5_angle", "t5_spin"),
-              curves=(Curve("t5_angle", "chung-ooi-5-angle.dat", 0.3, "± 0.3 (3% of the axis): " + _DIGITISED),
-                      Curve("t5_spin", "chung-ooi-5-spin.dat", 0.2, "± 0.2 (4% of the axis): " + _DIGITISED),
-                      Curve("t5_angle", "chung-ooi-5-angle.dat", 0.3, "± 0.3 (3% of the axis): " + _FEM, key="fem"),
-                      Curve("t5_spin", "chung-ooi-5-spin.dat", 0.2, "± 0.2 (4% of the axis): " + _FEM, key="fem")),
-              limits=(T5_ANGLE, T5_SPIN), quick="chung-ooi-5-steel-spring-sliding"),
-    Benchmark("chung-ooi-6", "Chung & Ooi Test 6: normal impact of a spinning sphere on a plane", "chung-ooi-6-",
-              "beta1", ("beta",), curves=(Curve("beta", "chung-ooi-6-beta.dat", 0.05, "β ± 0.05: " + _DIGITISED),),
-              limits=(BETA,), quick="chung-ooi-6-al-alloy-spring-sliding"),
-    Benchmark("chung-ooi-7", "Chung & Ooi Test 7: two identical spheres spinning in opposite senses", "chung-ooi-7-",
-              "spin", ("spin_ratio",), limits=(SPIN_KEPT,), final_spin=True, quick="chung-ooi-7-al-alloy-spring-sliding"),
-    Benchmark("chung-ooi-8", "Chung & Ooi Test 8: a spinning sphere on a large, heavy sphere", "chung-ooi-8-",
-              "beta1", ("beta",), curves=(Curve("beta", "chung-ooi-8-beta.dat", 0.05, "β ± 0.05: " + _DIGITISED),),
-              limits=(BETA,), quick="chung-ooi-8-al-alloy-spring-sliding"),
-    Benchmark("thornton", "Thornton, Cummins & Cleary: oblique impacts, elastic (2011) and inelastic (2013)",
-              "thornton-", "psi1", ("psi2", "omega"),
-              curves=(Curve("psi2", "thornton-psi2.dat", 0.3, "Ψ2 ± 0.3 (2% of the axis): " + _DIGITISED),
-                      Curve("omega", "thornton-omega.dat", 0.2, "Ω ± 0.2 (4% of the axis): " + _DIGITISED)),
-              limits=(PSI2, OMEGA), quick="thornton-e050-tti"),
-)
+CATALOGUE = resources.data_dir() / "benchmarks.toml"
+
+
+def catalogue(path: Path = CATALOGUE, data: Path = DATA, cases: Path | None = None) -> tuple[Benchmark, ...]:
+    """The benchmarks of the catalogue ``path`` (data/benchmarks.toml), checked as they are read: each limit one
+    of LIMITS, each x one of X_AXES, each curve's file in ``data`` with a tolerance > 0, each quick file in
+    ``cases`` (default the shipped cases/benchmarks/); else ConfigError naming the catalogue's key."""
+    import tomllib
+
+    from ..errors import ConfigError
+
+    cases = cases or resources.cases_dir() / "benchmarks"
+    raw = tomllib.loads(path.read_text())
+    notes = raw.get("notes", {})
+    out = []
+    for i, b in enumerate(raw.get("benchmark", [])):
+        where = f"{path.name}: benchmark.{i}"
+        try:
+            limits = tuple(LIMITS[n] for n in b.get("limits", ()))
+            curves = tuple(_curve(c, notes, data, f"{where}.curves.{k}") for k, c in enumerate(b.get("curves", ())))
+            bench = Benchmark(b["name"], b["title"], b["prefix"], b["x"], tuple(b["quantities"]), curves, limits,
+                              bool(b.get("final_spin", False)), b["quick"])
+        except KeyError as exc:
+            raise ConfigError(where, b.get("name"), f"names {exc} — not a limit ({', '.join(LIMITS)}) nor a key it "
+                                                   "may leave out") from None
+        if bench.x not in X_AXES:
+            raise ConfigError(f"{where}.x", bench.x, f"must be one of {', '.join(X_AXES)}")
+        if not (cases / f"{bench.quick}.toml").is_file() or not bench.quick.startswith(bench.prefix):
+            raise ConfigError(f"{where}.quick", bench.quick, f"must name a case file {bench.prefix}*.toml in {cases}")
+        out.append(bench)
+    return tuple(out)
+
+
+def _curve(c: dict, notes: dict, data: Path, where: str) -> Curve:
+    """One curve of the catalogue, checked: its file in ``data``, its tolerance a number > 0."""
+    from ..errors import ConfigError
+
+    tol = c.get("tolerance")
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not math.isfinite(tol) or tol <= 0:
+        raise ConfigError(f"{where}.tolerance", tol, "must be a number > 0 (in the quantity's units)")
+    if not (data / c["file"]).is_file():
+        raise ConfigError(f"{where}.file", c["file"], f"is not a data file of {data}")
+    return Curve(c["quantity"], c["file"], float(tol), c["why"].format(**notes), c.get("key", ""))
+
+
+BENCHMARKS: tuple[Benchmark, ...] = catalogue()
 
 
 # The quick subset (``run(..., quick=True)``): one case file per benchmark, 68 cases of the 614 — every test's

@@ -261,22 +261,19 @@ def worst(verdicts) -> str:
     return max(vs, key=order.__getitem__) if vs else AGREE
 
 
-def unavailable(entry: dict, comps: list, engine: str, mp, found: dict) -> bool:
-    """Record an engine that cannot run this case (the model is not expressible, or it is not installed). For
-    one that can express it, the native configuration its mapping chose, in one line of the engine's own words
-    (``entry["settings"][engine]``): the setting the report's traps section names for an approximate mapping."""
+def unavailable(entry: dict, comps: list, planned) -> bool:
+    """Record an engine that cannot run this case (``planned``, comparisons/sources.plan: the model is not
+    expressible, or it is not installed). For one that can express it, the native configuration its mapping chose,
+    in one line of the engine's own words (``entry["settings"][engine]``): the setting the report's traps section
+    names for an approximate mapping."""
+    engine, mp = planned.source.label, planned.mapping
     if mp.native is not None:
         entry.setdefault("settings", {})[engine] = native_setting(mp.native)
-    if mp.native is None:
-        entry["sources"][engine] = {"status": "not expressible", "message": "; ".join(mp.reasons)}
-        comps.append(status_comparison(engine, NOT_EXPRESSIBLE, "; ".join(mp.reasons)))
-        return True
-    if not found[engine]["found"]:
-        why = found[engine].get("why") or f"{engine} is not installed: {found[engine]['how_to_install']}"
-        entry["sources"][engine] = {"status": "engine missing", "message": why}
-        comps.append(status_comparison(engine, MISSING, why))
-        return True
-    return False
+    if planned.runs:
+        return False
+    entry["sources"][engine] = {"status": planned.status, "message": planned.why}
+    comps.append(status_comparison(engine, planned.status, planned.why))  # NOT_EXPRESSIBLE, MISSING or FAILED
+    return True
 
 
 def mapping_setting(mp) -> str:

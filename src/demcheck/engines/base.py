@@ -173,7 +173,7 @@ class Engine(ABC):
 
     @abstractmethod
     def map(self, model, contact_params: dict) -> Mapping:
-        """A resolved seed model (reference.model.ResolvedModel) of one type pair in the engine's terms."""
+        """A resolved seed model (laws.model.ResolvedModel) of one type pair in the engine's terms."""
 
     @abstractmethod
     def twin(self, native: Native, m_eff: float, r_eff: float):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import re
 import time
 from pathlib import Path
@@ -19,9 +20,14 @@ from .mapping import contact_mapping, native_summary, twin_model
 
 
 
-def deck(case: Case, engine: str, dt: float | None = None, length: float = 1.0, native=None,
+def as_engine(engine):
+    """The Engine ``engine`` names (an Engine is returned as it is): the functions here take either."""
+    return registry.get(engine) if isinstance(engine, str) else engine
+
+
+def deck(case: Case, engine, dt: float | None = None, length: float = 1.0, native=None,
          **options) -> common.Deck:
-    return finite(registry.get(engine).collision_deck(case, dt, length, native=native, **options), case)
+    return finite(as_engine(engine).collision_deck(case, dt, length, native=native, **options), case)
 
 
 # a number an engine cannot read (NaN, inf), as a word of a deck's command (comments aside)
@@ -45,13 +51,13 @@ def finite(dk: common.Deck, case: Case) -> common.Deck:
     return dk
 
 
-def setting(case: Case, engine: str, dt: float | None = None):
+def setting(case: Case, engine, dt: float | None = None):
     """(native, dt): what ``engine`` (or a build of it) runs for the case — the case's ``[engine.NAME]`` setting
     (None: the engine's mapping of the seed model) and its step: ``dt`` (--dt), else the case's run.dt, else, for a
     native law, its twin's elastic contact time over run.steps_per_contact (the seed model's contact time would
     leave a stiffer native law unresolved; None: the deck's own auto step). ``demcheck collide``, ``deck`` and the
     API's collide all take it from here, so that the deck written is the deck run."""
-    native = registry.get(engine).case_native(case)
+    native = as_engine(engine).case_native(case)
     if native is not None and not dt and not case.run.dt:
         from ..laws.model import characteristic_time, resolve
 
@@ -59,10 +65,28 @@ def setting(case: Case, engine: str, dt: float | None = None):
     return native, dt or None
 
 
-def setting_deck(case: Case, engine: str, dt: float | None = None) -> common.Deck:
+def setting_deck(case: Case, engine, dt: float | None = None) -> common.Deck:
     """The deck ``collide(case, engine, *setting(case, engine, dt))`` runs first: what ``demcheck deck`` writes."""
     native, step = setting(case, engine, dt)
-    return deck(case, engine, step, native=native)
+    with native_step_named(case, engine, dt, step):
+        return deck(case, engine, step, native=native)
+
+
+@contextlib.contextmanager
+def native_step_named(case: Case, engine, given: float | None, step: float | None):
+    """A ConfigError about the step ``setting`` chose for a native law (none was given: ``given`` None) names what
+    set it — run.steps_per_contact and the [engine.NAME] setting's own contact time —, never ``--dt``."""
+    try:
+        yield
+    except ConfigError as exc:
+        if given or not step or exc.key != "--dt":
+            raise
+        from .builds import engine_of
+
+        name = engine_of(as_engine(engine).name)
+        raise ConfigError("run.steps_per_contact", case.run.steps_per_contact,
+                          f"gives the case's [engine.{name}] setting a step of {step:.3g} s (its native law's elastic "
+                          f"contact time over run.steps_per_contact; no --dt given), at which {exc.rule}") from None
 
 
 # what a cached run's metadata must hold (engines/cache.py checks each value)
@@ -80,11 +104,11 @@ def _every_body(bodies: int):
     return check
 
 
-def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Path | None = None,
+def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | None = None,
             timeout: float = runner.DEFAULT_TIMEOUT, native=None, cache=None, worker: bool = False,
             **options) -> Result:
-    """Run the case's deck in ``engine``; if the contact has not ended by the end of the run, run again
-    four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
+    """Run the case's deck in ``engine`` (an Engine or its name); if the contact has not ended by the end of the
+    run, run again four times longer (a strongly damped or plastic contact outlasts its elastic estimate). ``native`` and
     ``options`` go to the deck writer; ``cache`` (engines.cache.Cache) skips decks already run; ``worker``
     runs the decks in the engine's long-lived worker where it has one (engines/run.py), the same numbers
     without a process start per run.
@@ -93,8 +117,8 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     or "failed" (NaN or infinite output: never cached), "unresolved", "unstable", "out-of-range",
     "no-contact", "no-separation", with the reason in its message. The work directory of a run that is
     not "ok" is kept and named."""
-    from . import discovery
-
+    eng = as_engine(engine)  # an Engine, or its registered name
+    engine = eng.name
     mp = contact_mapping(case, engine, native)
     mp.require()  # the decks get ``native`` as given (None: the seed model's mapping, type pair by type pair), so
     # that the deck run is the deck `demcheck deck` writes
@@ -107,27 +131,14 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     for attempt in range(4):
         if attempt:
             try:  # a longer run past the step bound: the contact did not end within what may be run
-                longer = deck(case, engine, dt, length * 4.0, native=native, **options)
+                longer = deck(case, eng, dt, length * 4.0, native=native, **options)
             except ConfigError:
                 break
             length *= 4.0
             dk = longer
         else:
-            dk = deck(case, engine, dt, length, native=native, **options)
-        text = dk.text
-        hit = None
-        if cache is not None:
-            info = discovery.find(engine)
-            if info is None:
-                from ..errors import EngineNotFound
-
-                raise EngineNotFound(discovery.missing(engine))
-            from .cache import key as cache_key
-
-            k = cache_key(engine, info.version, text, dk.files)
-            bodies = len(case.particles) * copies
-            hit = cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
-                            check=_every_body(bodies))
+            dk = deck(case, eng, dt, length, native=native, **options)
+        k, hit = _cached(cache, engine, dk, len(case.particles) * copies)
         if attempt and not cached:
             _discard(out.workdir, workdir, engine)  # the shorter run, extended: only the run reported is kept
         cached = hit is not None  # the run reported is this one
@@ -136,7 +147,7 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
             out = runner.RunOutput(engine, meta["version"], Path(meta["workdir"]), "", meta["wall_time"],
                                    meta["warnings"])
         else:
-            out = runner.run(engine, text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
+            out = runner.run(engine, dk.text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
             table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
@@ -154,20 +165,17 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
         d = contact["delta"].to_numpy()
         if (d > 0).any() and d[-1] <= 0:
             break
-    used_dt = dk.dt
     sc = common.scene(case, dt, length)
-    result = Result(
-        source=engine, method="engine", case_name=case.name, case_hash=case.hash,
-        model={"normal": case.contact.normal, "tangential": case.contact.tangential,
-               "limit_force": case.contact.limit_force},
-        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(mp.native)},
-        contact=contact, particles=particles, dt=used_dt, wall_time=time.perf_counter() - started,
-        engine_version=out.version, status="ok",
-        message="; ".join(mp.reasons),
-        meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": text, "fidelity": mp.fidelity,
-              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons),
-              "copies": copies, "copies_spread": spread if copies > 1 else 0.0},
-    )
+    result = _result(case, engine, sc, mp, out, dk, contact, particles, started, cached,
+                     {"copies": copies, "copies_spread": spread if copies > 1 else 0.0})
+    return _judged(result, case, sc, out, non_finite, fresh, cache, length, workdir)
+
+
+def _judged(result: Result, case: Case, sc, out, non_finite: str, fresh: list, cache, length: float,
+            workdir) -> Result:
+    """The Result judged: failed on NaN or infinite output, else the reference's health rules; the healthy runs
+    made here cached, the work directory of a run that is not "ok" kept and named, a temporary one removed."""
+    engine, cached = result.source, result.meta["cached"]
     if non_finite:
         result.status = "failed"
         result.message = (f"{engine} wrote NaN or infinite values ({non_finite}): the run is not used and not "
@@ -185,6 +193,41 @@ def collide(case: Case, engine: str, dt: float | None = None, workdir: str | Pat
     elif not cached:
         _discard(out.workdir, workdir, engine)  # a temporary directory of a run that succeeded
     return result
+
+
+def _cached(cache, engine: str, dk: common.Deck, bodies: int):
+    """(the run cache's key of the deck, its entry: (table, meta) or None); (None, None) without a cache. An
+    engine not found here is EngineNotFound: its version is part of the key."""
+    if cache is None:
+        return None, None
+    from . import discovery
+    from .cache import key as cache_key
+
+    info = discovery.find(engine)
+    if info is None:
+        from ..errors import EngineNotFound
+
+        raise EngineNotFound(discovery.missing(engine))
+    k = cache_key(engine, info.version, dk.text, dk.files)
+    return k, cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
+                        check=_every_body(bodies))
+
+
+def _result(case: Case, engine: str, sc, mp, out, dk: common.Deck, contact, particles, started: float,
+            cached: bool, copies: dict) -> Result:
+    """The engine's Result of a run (``out``, engines.run.RunOutput) of the deck ``dk``: its tables, its mapping's
+    fidelity and reasons, and what a diagnosis needs (work directory, warnings, the deck)."""
+    return Result(
+        source=engine, method="engine", case_name=case.name, case_hash=case.hash,
+        model={"normal": case.contact.normal, "tangential": case.contact.tangential,
+               "limit_force": case.contact.limit_force},
+        params={**sc.model.params, "mapping": mp.fidelity, "native": _native_summary(mp.native)},
+        contact=contact, particles=particles, dt=dk.dt, wall_time=time.perf_counter() - started,
+        engine_version=out.version, status="ok",
+        message="; ".join(mp.reasons),
+        meta={"workdir": str(out.workdir), "warnings": out.warnings, "deck": dk.text, "fidelity": mp.fidelity,
+              "cached": cached, "engine_wall_time": out.wall_time, "reasons": list(mp.reasons), **copies},
+    )
 
 
 def _discard(wd: Path, workdir, engine: str) -> None:
@@ -223,16 +266,17 @@ def _native_summary(native) -> dict:
     return {"engine": native.engine, "config": native_summary(native)}
 
 
-def twin_states(case: Case, engine: str, dt: float, native=None) -> Result:
+def twin_states(case: Case, engine, dt: float, native=None) -> Result:
     """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
     off its states exactly as an engine's is (states.restate: the bodies' forces with their weights, as an
     engine dumps them, read back less the weights)."""
     from ..reference import collision3d
     from ..laws.model import resolve
 
-    mp = contact_mapping(case, engine, native)
+    eng = as_engine(engine)
+    mp = contact_mapping(case, eng.name, native)
     model = twin_model(resolve(case), mp.require())
-    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=registry.get(engine).rules), case)
-    res.source = f"{engine}-twin"
+    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=eng.rules), case)
+    res.source = f"{eng.name}-twin"
     res.meta["fidelity"] = mp.fidelity
     return res

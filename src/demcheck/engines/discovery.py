@@ -16,6 +16,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import re
 import signal
 import subprocess
 import tempfile
@@ -131,12 +132,22 @@ def find(name: str) -> EngineInfo | None:
     for exe in engine.candidates():
         out, why = _banner(exe, seconds)
         match = engine.banner.search(out) if out is not None else None
-        if match:
-            return EngineInfo(name, exe, match.group(1).strip())
+        if match and (version := plain_version(match.group(1))):
+            return EngineInfo(name, exe, version)
         problems.append(f"{exe} {why or f'prints no {name} banner for `-h`'}")
     if problems:
         _WHY[name] = "; ".join(problems)
     return None
+
+
+# a terminal's escape sequences (CSI: colours, cursor moves; OSC: titles) and other control characters
+_ESCAPES = re.compile(r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x1b[@-Z\\-_]|[\x00-\x1f\x7f-\x9f]")
+
+
+def plain_version(text: str) -> str:
+    """A version read off a banner as plain text: a build that colours its banner (ANSI escapes) or prints control
+    characters in it gives its version without them — it goes into reports, cache keys and expected differences."""
+    return " ".join(_ESCAPES.sub(" ", text).split())
 
 
 def resolve(text: str, key: str = "--engines", required: bool | None = None) -> list[str]:
