@@ -22,6 +22,7 @@ import tempfile
 from dataclasses import dataclass
 
 from . import registry
+from .serve import plain_text
 
 DISCOVERY_TIMEOUT = 5.0  # s: a banner takes well under a second
 # the environment of every engine process (discovery's ``-h``, runs and workers: engines/run.py): one thread each
@@ -100,7 +101,8 @@ def output_of(argv: list[str], seconds: float, what: str = "") -> tuple[str | No
     """(what ``argv`` printed, stdout and stderr, "") or (None, why) if it does not start or end within
     ``seconds``: an engine's question (its banner, its version), asked in a temporary directory with ENGINE_ENV.
     Its answer is judged by the process's exit, not by its output pipe's end (its output goes to a file: a helper
-    it leaves behind may hold a pipe open); whatever it leaves running in its process group is killed."""
+    it leaves behind may hold a pipe open); whatever it leaves running in its process group is killed. The text is
+    ``serve.plain_text``'s: no escape sequence of the engine's reaches a report or a terminal."""
     with tempfile.TemporaryDirectory(prefix="demcheck-discovery-") as cwd:
         out_path = os.path.join(cwd, "output.txt")
         try:
@@ -117,7 +119,7 @@ def output_of(argv: list[str], seconds: float, what: str = "") -> tuple[str | No
             end_group(proc.pid)
             proc.wait()
         with open(out_path, encoding="utf-8", errors="replace") as fh:
-            return fh.read(), ""
+            return plain_text(fh.read()), ""
 
 
 @functools.lru_cache(maxsize=None)

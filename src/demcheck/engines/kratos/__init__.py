@@ -5,7 +5,6 @@ script after script in this Python's worker: worker.py)."""
 from __future__ import annotations
 
 import re
-import subprocess
 import sys
 
 from .. import registry
@@ -32,12 +31,10 @@ class _Banner:
         usage = USAGE.search(text or "")
         if not usage:
             return None
-        try:
-            out = subprocess.run([usage.group(1), "-c", VERSION_QUERY], capture_output=True, text=True,
-                                 timeout=self.timeout, stdin=subprocess.DEVNULL).stdout
-        except (OSError, subprocess.SubprocessError):
-            return None
-        m = VERSION.search(out)
+        from ..discovery import output_of
+
+        out, _ = output_of([usage.group(1), "-c", VERSION_QUERY], self.timeout, "its version query")
+        m = VERSION.search(out) if out is not None else None
         if not m:
             return None
         from .worker import version_words

@@ -15,7 +15,6 @@ import os
 import re
 import shlex
 import shutil
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -82,12 +81,10 @@ class _Banner:
         exe = shutil.which(usage.group(1)) if usage else None
         if not exe:
             return None
-        try:
-            out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=self.timeout,
-                                 stdin=subprocess.DEVNULL).stdout
-        except (OSError, subprocess.SubprocessError):
-            return None
-        return self.VERSION.search(out)
+        from ..discovery import output_of
+
+        out, _ = output_of([exe, "--version"], self.timeout, "`--version`")  # judged by its exit (discovery)
+        return self.VERSION.search(out) if out is not None else None
 
 
 class Yade(PackageEngine):
