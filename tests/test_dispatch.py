@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -206,27 +207,48 @@ def fake_liggghts(tmp_path, monkeypatch):
 
 
 @pytest.mark.engine("lammps")
-def test_verify_on_an_existing_cluster_says_which_worker_lacks_an_engine(cluster, fake_liggghts, tmp_path):
+def test_verify_on_an_existing_cluster_runs_on_its_worker_and_the_client_stores_the_runs(cluster, tmp_path):
     env = dict(os.environ, DEMCHECK_CACHE=str(tmp_path / "client-cache"))
     files = SMALL[:2]
-    p = demcheck("verify", *files, "--engines", "lammps,liggghts", "--scheduler", cluster["address"], "--report",
+    p = demcheck("verify", *files, "--engines", "lammps", "--scheduler", cluster["address"], "--report",
                  tmp_path / "r", "--json", env=env)
     assert p.returncode == 0, p.stderr[-3000:]
-    there = json.loads(p.stdout)
     # LAMMPS ran on the worker, with the verdicts of one process that has it
     one = demcheck("verify", *files, "--engines", "lammps", "--jobs", "1", "--report", tmp_path / "one", "--json",
                    env=dict(os.environ, DEMCHECK_CACHE=str(tmp_path / "one-cache")))
     assert one.returncode == 0, one.stderr[-3000:]
-    lammps = [[k for k in c[2] if k[0] != "liggghts"] for c in verdicts(there)]
-    assert lammps == [c[2] for c in verdicts(json.loads(one.stdout))]
-    # LIGGGHTS, found here, is missing on the worker: each case says so and names the worker
-    for c in there["cases"]:
-        src = c["sources"]["liggghts"]
-        assert src["status"] == "engine missing", src
-        assert src["message"].startswith(f"liggghts is missing on the Dask worker {cluster['worker']} (host ")
+    assert verdicts(json.loads(p.stdout)) == verdicts(json.loads(one.stdout))
     # the client stored the worker's runs; the worker's own cache directory is not used
     assert entries(tmp_path / "client-cache") == entries(tmp_path / "one-cache") != set()
     assert not entries(cluster["worker_cache"])
+
+
+@pytest.mark.engine("lammps")
+def test_verify_on_an_existing_cluster_fails_when_its_worker_lacks_a_named_engine(cluster, fake_liggghts, tmp_path):
+    """LIGGGHTS, found by the client, is missing on the worker: the run fails naming the worker and the engine, as
+    a named engine the client lacks fails it (discovery.require) — never "engine missing" for those cases."""
+    p = demcheck("verify", *SMALL[:2], "--engines", "lammps,liggghts", "--scheduler", cluster["address"], "--report",
+                 tmp_path / "r", "--json", env=dict(os.environ, DEMCHECK_CACHE=str(tmp_path / "client-cache")))
+    assert p.returncode == 1, p.stderr[-3000:]
+    assert f"liggghts is missing on the Dask worker {cluster['worker']} (host " in p.stderr, p.stderr[-3000:]
+    assert "Traceback" not in p.stderr and "engine missing" not in p.stdout
+
+
+# a LIGGGHTS banner for the client only: a local cluster's worker (a multiprocessing child) finds none
+FAKE_LIGGGHTS_CLIENT_ONLY = """#!/bin/sh
+case "$(tr '\\0' ' ' < /proc/$PPID/cmdline)" in *multiprocessing*) exit 1;; esac
+echo "LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0, compiled 2026-01-01 by a test: never run)"
+"""
+
+
+def test_verify_on_a_local_cluster_fails_when_a_worker_lacks_a_named_engine(tmp_path):
+    fake = _executable(tmp_path / "bin" / "liggghts", FAKE_LIGGGHTS_CLIENT_ONLY)
+    env = dict(os.environ, DEMCHECK_LIGGGHTS=str(fake), DEMCHECK_DISCOVERY_TIMEOUT="20")
+    p = demcheck("verify", SMALL[0], "--engines", "liggghts", "--jobs", "2", "--report", tmp_path / "r", "--json",
+                 env=env)
+    assert p.returncode == 1, p.stderr[-3000:]
+    assert re.search(r"liggghts is missing on the Dask worker tcp://127\.0\.0\.1:\d+ \(host ", p.stderr), p.stderr
+    assert "Traceback" not in p.stderr and "engine missing" not in p.stdout
 
 
 def test_a_sweep_point_on_a_worker_without_the_engine_names_it(cluster, fake_liggghts):
@@ -239,17 +261,18 @@ def test_a_sweep_point_on_a_worker_without_the_engine_names_it(cluster, fake_lig
                for r in rows), rows
 
 
-def test_stress_bench_and_calibrate_on_a_worker_without_the_engine_say_so(cluster, fake_liggghts):
+def test_stress_bench_and_calibrate_on_a_worker_without_the_engine_fail_naming_it(cluster, fake_liggghts):
     raw, case = stress.read_stress(CASES / "suite" / "normal-hertz-wall.toml")
-    with Campaign(scheduler=cluster["address"], sources=["liggghts"]) as there:
-        s = stress.stress_case(raw, case, engines=("liggghts",), only=["speed"], campaign=there)
-        b = bench.bench_case(case, engines=("liggghts",), steps=(10,), rtols=(), campaign=there)
-        native = {"liggghts": {"pair_style": "gran model hertz tangential history"}}
-        with pytest.raises(EngineNotFound, match=f"liggghts is missing on the Dask worker {cluster['worker']}"):
-            calibrate.calibrate(demcheck_api.load(_case(native)), "liggghts", {"restitution": 0.6}, campaign=there)
-    worker = f"liggghts is missing on the Dask worker {cluster['worker']}"
-    assert s.skipped["liggghts"].startswith(worker) and {l.source for l in s.limits} == {"reference-verlet"}
-    assert b.skipped["liggghts"].startswith(worker) and {p.source for p in b.points} == {"reference-verlet"}
+    native = {"liggghts": {"pair_style": "gran model hertz tangential history"}}
+    runs = [lambda there: stress.stress_case(raw, case, engines=("liggghts",), only=["speed"], campaign=there),
+            lambda there: bench.bench_case(case, engines=("liggghts",), steps=(10,), rtols=(), campaign=there),
+            lambda there: calibrate.calibrate(demcheck_api.load(_case(native)), "liggghts", {"restitution": 0.6},
+                                              campaign=there)]
+    worker = re.escape(f"liggghts is missing on the Dask worker {cluster['worker']} (host ")
+    for run in runs:
+        with Campaign(scheduler=cluster["address"], sources=["liggghts"]) as there:
+            with pytest.raises(EngineNotFound, match=worker):
+                run(there)
 
 
 # ----------------------------------------------------------------------------- bad addresses

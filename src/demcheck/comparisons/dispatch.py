@@ -19,9 +19,9 @@ names, dataclasses of them: no open handle, no closure). :meth:`Campaign.complet
 tasks finish; the callers put the results back in their own order, so that no report depends on which finished
 first. At most as many tasks are out on the cluster as it has threads; the others wait here.
 
-On a worker a task runs the engines that worker's own discovery finds; :func:`missing_here` names the engines of
-the campaign it lacks, with the worker, for the task to report (the engines a campaign runs are those the client
-found). The task reads the client's engine-run cache where the worker sees its directory (the same machine, or a
+On a worker a task runs the engines that worker's own discovery finds; :func:`missing_here` requires there the
+engines of the campaign (those the client found), and one the worker lacks fails the task with EngineNotFound
+naming the worker. The task reads the client's engine-run cache where the worker sees its directory (the same machine, or a
 shared filesystem) and sends back the entries it would have written, which the client stores (engines/cache.py:
 atomically; a failed run is never among them), with its hits and misses and its ``demcheck`` log lines (a damaged
 cache entry: each line once).
@@ -269,15 +269,23 @@ def _local_worker() -> None:
 
 
 def missing_here(engines: Iterable[str]) -> dict[str, str]:
-    """On a Dask worker: the engines among ``engines`` its discovery does not find, each with the line that names
-    the worker and why. {} in the client's own process (each command says what the client lacks)."""
+    """On a Dask worker: each of ``engines`` (the client found them: the campaign runs them) is required here as
+    in the client's own process (``discovery.require``: tried twice); one the worker lacks is EngineNotFound
+    naming the worker and why — the run fails, never "engine missing" for the cases that landed there. {} (in the
+    client's own process too: each command checks what the client lacks)."""
     worker = _worker()
     if worker is None:
         return {}
     from ..engines import discovery
+    from ..errors import EngineNotFound
 
-    return {e: f"{e} is missing on the Dask worker {worker.address} (host {socket.gethostname()}): "
-               f"{discovery.missing(e)}" for e in engines if discovery.find(e) is None}
+    for e in engines:
+        try:
+            discovery.require(e)
+        except EngineNotFound:
+            raise EngineNotFound(f"{e} is missing on the Dask worker {worker.address} (host "
+                                 f"{socket.gethostname()}): {discovery.missing(e)}") from None
+    return {}
 
 
 def _worker():
