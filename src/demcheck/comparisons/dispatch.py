@@ -20,8 +20,8 @@ tasks finish; the callers put the results back in their own order, so that no re
 first. At most as many tasks are out on the cluster as it has threads; the others wait here.
 
 On a worker a task runs the engines that worker's own discovery finds; :func:`missing_here` requires there the
-engines of the campaign (those the client found), and one the worker lacks fails the task with EngineNotFound
-naming the worker. The task reads the client's engine-run cache where the worker sees its directory (the same machine, or a
+engines of the campaign (those the client found), and one the worker lacks fails the task with EngineNotFound naming
+the worker. The task reads the client's engine-run cache where the worker sees its directory (the same machine, or a
 shared filesystem) and sends back the entries it would have written, which the client stores (engines/cache.py:
 atomically; a failed run is never among them), with its hits and misses and its ``demcheck`` log lines (a damaged
 cache entry: each line once).
