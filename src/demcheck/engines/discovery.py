@@ -23,6 +23,7 @@ import tempfile
 from dataclasses import dataclass
 
 from . import registry
+from .serve import ESCAPES, plain_text
 
 DISCOVERY_TIMEOUT = 5.0  # s: a banner takes well under a second
 # the environment of every engine process (discovery's ``-h``, runs and workers: engines/run.py): one thread each
@@ -101,7 +102,8 @@ def output_of(argv: list[str], seconds: float, what: str = "") -> tuple[str | No
     """(what ``argv`` printed, stdout and stderr, "") or (None, why) if it does not start or end within
     ``seconds``: an engine's question (its banner, its version), asked in a temporary directory with ENGINE_ENV.
     Its answer is judged by the process's exit, not by its output pipe's end (its output goes to a file: a helper
-    it leaves behind may hold a pipe open); whatever it leaves running in its process group is killed."""
+    it leaves behind may hold a pipe open); whatever it leaves running in its process group is killed. The text is
+    ``serve.plain_text``'s: no escape sequence of the engine's reaches a report or a terminal."""
     with tempfile.TemporaryDirectory(prefix="demcheck-discovery-") as cwd:
         out_path = os.path.join(cwd, "output.txt")
         try:
@@ -118,7 +120,7 @@ def output_of(argv: list[str], seconds: float, what: str = "") -> tuple[str | No
             end_group(proc.pid)
             proc.wait()
         with open(out_path, encoding="utf-8", errors="replace") as fh:
-            return fh.read(), ""
+            return plain_text(fh.read()), ""
 
 
 @functools.lru_cache(maxsize=None)
@@ -140,14 +142,14 @@ def find(name: str) -> EngineInfo | None:
     return None
 
 
-# a terminal's escape sequences (CSI: colours, cursor moves; OSC: titles) and other control characters
-_ESCAPES = re.compile(r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x1b[@-Z\\-_]|[\x00-\x1f\x7f-\x9f]")
+_CONTROLS = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
 def plain_version(text: str) -> str:
-    """A version read off a banner as plain text: a build that colours its banner (ANSI escapes) or prints control
-    characters in it gives its version without them — it goes into reports, cache keys and expected differences."""
-    return " ".join(_ESCAPES.sub(" ", text).split())
+    """A version read off a banner as plain text: a build that colours its banner (ANSI escapes: serve.ESCAPES, the
+    one pattern every engine text goes through) or prints control characters in it gives its version without them —
+    it goes into reports, cache keys and expected differences."""
+    return " ".join(_CONTROLS.sub(" ", ESCAPES.sub("", text)).split())
 
 
 def resolve(text: str, key: str = "--engines", required: bool | None = None) -> list[str]:

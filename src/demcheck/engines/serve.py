@@ -32,6 +32,22 @@ import time
 import traceback
 
 
+# what an engine prints for a terminal, not as text (ECMA-48): a control sequence (CSI: colours, cursor moves), a
+# control string ended by BEL or ST (OSC, DCS, APC, PM, SOS: a window's title) or at its line's end, an escape
+ESCAPES = re.compile(r"(?:\x1b\[|\x9b)[0-?]*[ -/]*[@-~]"
+                     r"|(?:\x1b[\]PX^_]|[\x90\x98\x9d-\x9f])[^\n]*?(?:\x07|\x1b\\|\x9c|(?=\n)|\Z)"
+                     r"|\x1b[ -/]*[0-~]")
+_CONTROL = {c: f"\\x{c:02x}" for c in [*range(0, 9), *range(11, 32), 127, *range(128, 160)]}  # a tab, a line stay
+
+
+def plain_text(text: str) -> str:
+    """An engine's text as text: its escape sequences (a build's coloured banner) removed, a line ended by CR or
+    CR LF ended by LF, any other control character shown as \\xNN. Every engine text demcheck reads (banners,
+    versions, a worker's version and errors) goes through it before a report, JSON or a terminal sees it."""
+    text = ESCAPES.sub("", text.replace("\r\n", "\n"))
+    return text.replace("\r", "\n").translate(_CONTROL)
+
+
 class Server:
     """One engine in a worker. ``run`` is called in the run's work directory, with descriptors 1 and 2 on its
     ``screen.txt``; it raises on an engine error (the exception's text is the answer's error)."""
@@ -122,7 +138,7 @@ def _run(server: Server, workdir: str, deck: str, home: str, devnull: int) -> tu
         if loop is not None:
             answer["loop"] = loop
     except Exception as exc:  # noqa: BLE001 - the engine's error, whatever its type: the answer says it
-        answer = {"ok": False, "error": str(exc).strip() or type(exc).__name__}
+        answer = {"ok": False, "error": plain_text(str(exc)).strip() or type(exc).__name__}
     finally:
         try:
             server.flush()
@@ -151,9 +167,9 @@ def serve(server: Server, argv: list[str] | None = None) -> int:
     try:
         version = server.start()
     except BaseException as exc:  # noqa: BLE001 - whatever stops it, the caller gets one line
-        send({"ready": False, "error": f"{type(exc).__name__}: {exc}"})
+        send({"ready": False, "error": plain_text(f"{type(exc).__name__}: {exc}")})
         return 1
-    send({"ready": True, "version": version, "pid": os.getpid()})
+    send({"ready": True, "version": plain_text(version).strip(), "pid": os.getpid()})
     _point_output_at(devnull)  # stderr too: the caller reads only the answers
     for line in sys.stdin:
         if not line.strip():

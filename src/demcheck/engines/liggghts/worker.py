@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import functools
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -40,12 +39,10 @@ def library(executable: str) -> str | None:
     """The LIGGGHTS library ``executable`` runs (Debian's: /usr/lib/x86_64-linux-gnu/libliggghts.so.3.8.0), as
     the dynamic loader resolves it (``ldd``); None for an executable that loads none (a static build, a
     wrapper script): that build runs as a process of its own."""
-    try:
-        out = subprocess.run(["ldd", str(Path(executable).resolve())], capture_output=True, text=True, timeout=30,
-                             stdin=subprocess.DEVNULL).stdout
-    except (OSError, subprocess.SubprocessError):
-        return None
-    match = _LINKED.search(out)
+    from ..discovery import output_of
+
+    out, _ = output_of(["ldd", str(Path(executable).resolve())], 30, "ldd")  # judged by its exit, as a banner
+    match = _LINKED.search(out) if out is not None else None
     return str(Path(match.group(2)).resolve()) if match else None
 
 
