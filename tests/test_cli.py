@@ -332,3 +332,19 @@ def test_models_is_a_compact_table_and_one_model_in_full():
     assert full.returncode == 0 and "formula:" in full.stdout and "LAMMPS 22Jul2025: exact" in full.stdout
     bad = demcheck("models", "ttx")
     assert bad.returncode == 2 and bad.stderr.strip().count("\n") == 0 and "did you mean 'tti'" in bad.stderr
+
+
+def test_a_usage_error_is_one_line_with_exit_2():
+    """click's own errors (an unknown option or command, a value that looks like an option) are one line on
+    stderr naming what is wrong and where help is, exit 2 — as every other bad input, never click's usage block."""
+    import subprocess
+    import sys
+
+    for args, says in ((["models", "--engine", "lammps", "-1"], "No such option '-1'"),
+                       (["frobnicate"], "No such command 'frobnicate'"),
+                       (["verify", "--no-such-flag"], "No such option '--no-such-flag'")):
+        p = subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, timeout=120)
+        assert p.returncode == 2, (args, p.stderr)
+        lines = p.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("demcheck: error: ") and says in lines[0], (args, p.stderr)
+        assert "--help" in lines[0] and p.stdout == ""

@@ -9,7 +9,7 @@
   metrics and statuses, the 1-D verlet ones solved in one compiled call;
 * :func:`sweep` — metrics over a grid of case keys → a pandas DataFrame;
 * :func:`verify` — the verification suite over case files → its results dict (what ``results.json`` holds);
-* :func:`audit` — a user's own LAMMPS or LIGGGHTS deck → the audit as a dict;
+* :func:`audit` — a user's own LAMMPS or LIGGGHTS deck, Kratos DEM project or Yade script → the audit as a dict;
 * :func:`calibrate` — the native input that realises a target metric in an engine at a time step.
 
 Bad input raises :class:`~demcheck.errors.ConfigError` (key, value, rule) before any work; docs/api.md has
@@ -428,7 +428,8 @@ def _case_files(paths, key: str = "paths") -> list[Path]:
 
 
 def audit(path, engine: str | None = None, speed: float | None = None, run_engine: bool = True) -> dict:
-    """The audit of a user's own LAMMPS or LIGGGHTS deck (``demcheck audit``) as a dict: per type pair and
+    """The audit of a user's own LAMMPS or LIGGGHTS deck, Kratos DEM project or Yade script (``demcheck audit``) as
+    a dict: per type pair and
     wall × type the native law, the nearest seed model, the probes (engine, twin, seed model) and the traps
     with their measured sizes; ``status`` is "clean", "traps" or "not audited" (nothing probed: never clean).
     ``run_engine=False``: the twin only."""

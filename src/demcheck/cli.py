@@ -887,14 +887,15 @@ def dt(case_path, target, overrides, as_json):
 @cli.command()
 @click.argument("deck_path", metavar="DECK")
 @click.option("--engine", "engine", default=None,
-              help="the deck's engine (default: read from its vocabulary; lammps or liggghts)")
+              help="the deck's engine (default: from its vocabulary or file: lammps, liggghts, kratos, yade)")
 @click.option("--speed", type=Number(lo=0, lo_open=True, hi=1e4, unit="m/s"), default=None,
               help="characteristic impact speed (default: the deck's largest speed, or characteristicVelocity)")
 @click.option("--json", "as_json", is_flag=True, help="one JSON object on stdout")
 @click.option("--report", "report_dir", type=OutputPath(directory=True, files=("audit.json", "audit.txt")),
               default=None, help="write audit.json and audit.txt into this directory")
 def audit(deck_path, engine, speed, as_json, report_dir):
-    """Audit a user's own LAMMPS or LIGGGHTS input deck: each type pair's and wall's contact law, probed in the
+    """Audit a user's own input: a LAMMPS or LIGGGHTS deck, a Kratos DEM project (ProjectParametersDEM.json) or a
+    Yade script (read as a syntax tree): each type pair's and wall's contact law, probed in the
     engine, its twin and the nearest seed model; the traps it falls into. The deck is read, never run as written.
     Exit 0: every pair and wall probed or listed, nothing found; 1: a trap; 2: a line it cannot read; 3: nothing
     probed (never "clean"). --json prints one JSON object in every case, a refusal included."""
@@ -997,9 +998,16 @@ def main(argv=None) -> None:
         runner.kill_all()
         click.echo(f"demcheck: interrupted: {str(exc).splitlines()[0]}", err=True)
         sys.exit(exc.exit_code)
+    except click.UsageError as exc:  # one line, as every other bad input: what is wrong, and where help is
+        ctx = exc.ctx
+        where = f"{ctx.command_path} --help" if ctx is not None else "demcheck --help"
+        message = exc.format_message().rstrip(".")
+        hint = " (a value that starts with '-' goes after '--')" if "No such option" in message else ""
+        click.echo(f"demcheck: error: {message}{hint}; see {where}", err=True)
+        sys.exit(2)
     except click.exceptions.ClickException as exc:
         exc.show()
-        sys.exit(2 if isinstance(exc, click.UsageError) else exc.exit_code)
+        sys.exit(exc.exit_code)
     except click.exceptions.Exit as exc:
         sys.exit(exc.exit_code)
     except DemcheckError as exc:

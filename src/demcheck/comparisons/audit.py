@@ -1,4 +1,5 @@
-"""``demcheck audit DECK``: does a user's own LAMMPS or LIGGGHTS deck do what it asks for?
+"""``demcheck audit DECK``: does a user's own deck (LAMMPS, LIGGGHTS; a Kratos DEM project, a Yade script) do what it
+asks for?
 
 The deck is read, never run as written: by the engine itself where its package can (a LAMMPS deck's set-up evaluated
 in LAMMPS in a worker process under an allow-list and a budget, engines/lammps/read.py), else by demcheck's reader
