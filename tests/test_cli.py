@@ -348,3 +348,21 @@ def test_a_usage_error_is_one_line_with_exit_2():
         lines = p.stderr.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("demcheck: error: ") and says in lines[0], (args, p.stderr)
         assert "--help" in lines[0] and p.stdout == ""
+
+
+def test_pack_refuses_a_duration_shorter_than_the_first_fall():
+    """`pack --duration 1e-300` reported the starting lattice as a packing, exit 0 (issue 32): a run shorter than the
+    lowest body's free fall to the floor, √(2h/g), ends before any contact with it forms. The column's lowest body
+    starts 1 µm above its floor (g = 9.81 m/s²): 4.52e-4 s."""
+    import math
+    import subprocess
+    import sys
+
+    fall = f"{math.sqrt(2 * 1e-6 / 9.81):.3g}"
+    for args, key in ((["pack", "column-lsd", "--duration", "1e-300"], "--duration = 1e-300"),
+                      (["pack", "column-lsd", "--duration", "4.4e-4"], "--duration = 0.00044"),
+                      (["pack", "column-lsd", "--set", "packing.duration=1e-5"], "packing.duration = 1e-05")):
+        p = subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, timeout=300)
+        assert p.returncode == 2 and p.stdout == "", (args, p.stderr)
+        line, = p.stderr.strip().splitlines()
+        assert line.startswith(f"demcheck: error: {key}: must be at least the fall") and f"= {fall} s" in line, line

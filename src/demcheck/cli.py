@@ -681,6 +681,7 @@ def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, x
         raise ConfigError("--threads", threads, "applies to the reference (--engine reference); an engine runs on MPI "
                           "ranks (--mpi)")
     threads = packing.check_threads(threads)  # no more than numba may start here
+    _check_pack_duration(case, duration)
     box = case.packing.box if case.packing else None
     import pandas as pd
 
@@ -729,6 +730,18 @@ def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, x
                 click.echo(f"  {label:22s} {' '.join(f'{show(c):>16s}' for c in row)}")
         else:
             click.echo(f"  {k:22s} {show(v)}")
+
+
+def _check_pack_duration(case, duration) -> None:
+    """A packing run shorter than the fall of its lowest body to the floor reports the starting lattice, not a
+    packing: refused before any work, naming the key that set the duration."""
+    from .reference import packing
+
+    key, value = ("--duration", duration) if duration else ("packing.duration", case.packing.duration)
+    fall = packing.fall_time(case)
+    if value is not None and value < fall:
+        raise ConfigError(key, value, f"must be at least the fall of the lowest body to the floor, √(2h/g) = "
+                          f"{fall:.3g} s: a shorter run ends before any body touches it (no packing forms)")
 
 
 def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:

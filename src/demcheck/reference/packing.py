@@ -800,6 +800,23 @@ def law_table(laws_n, laws_t, wall_n, wall_t):
             np.concatenate([laws_t.reshape(ns * ns, -1), wall_t]))
 
 
+def fall_time(case) -> float:
+    """The time the lowest body of a packing's starting state needs to touch a floor (a wall that gravity points
+    into) falling freely from rest: √(2h/|g|), h its smallest gap to such a floor. No contact with a floor can form
+    sooner, so a shorter run cannot give a packing; 0 where nothing falls (no gravity, no floor, a body touching)."""
+    g = np.asarray(case.run.gravity, float)
+    gn = float(np.linalg.norm(g))
+    x = np.array([p.position for p in case.particles], float).reshape(-1, 3)
+    r = np.array([p.radius for p in case.particles], float)
+    gaps = [(x - np.asarray(w.point, float)) @ np.asarray(w.normal, float) - r for w in case.walls
+            if gn > 0.0 and float(np.dot(w.normal, g)) < 0.0]
+    if not gaps or len(r) == 0:
+        return 0.0
+    h = max(0.0, float(min(gap.min() for gap in gaps)))
+    # the component of g along the floor's normal sets the fall; the floors are taken as normal to g
+    return math.sqrt(2.0 * h / gn)
+
+
 def check_threads(threads) -> int:
     """``threads`` as a number of threads for the packing loop: a whole number from 1 to numba's threads
     (NUMBA_NUM_THREADS, by default the machine's cores); anything else is a ConfigError."""
