@@ -341,6 +341,7 @@ def _safe_case(case, path, opts, found) -> dict:
 
 
 def _print(console: Console, summary: dict) -> None:
+    from rich.markup import escape
     from rich.table import Table
 
     counts: dict[str, int] = {}
@@ -351,7 +352,8 @@ def _print(console: Console, summary: dict) -> None:
     for c in bad:
         for k in c.get("comparisons", []):
             if k["verdict"] in verdicts.FAILING:
-                console.print(f"[red]{k['verdict']}[/] {c['case']} {k['source']} {k['metric']}: {k['reason']}")
+                said = escape(f"{c['case']} {k['source']} {k['metric']}: {k['reason']}")
+                console.print(f"[red]{k['verdict']}[/] {said}")
     t = Table(title=f"demcheck verify: {len(summary['cases'])} of {summary['planned']} cases"
               + (" (PARTIAL)" if summary["partial"] else ""))
     t.add_column("verdict")
@@ -361,6 +363,6 @@ def _print(console: Console, summary: dict) -> None:
             t.add_row(v, str(counts[v]))
     console.print(t)
     engines = ", ".join(f"{k} {v['version']}" if v["found"] else f"{k} missing" for k, v in summary["engines"].items())
-    console.print(f"engines: {engines or 'none (reference only)'}")
+    console.print(escape(f"engines: {engines or 'none (reference only)'}"))  # a version or reason is text, not markup
     console.print(f"{summary['failed']} case(s) failing; wall time {summary['wall_time']:.1f} s; "
                   f"report: {summary['report']}/report.md (and report.html, results.json, junit.xml)")

@@ -50,6 +50,7 @@ from pathlib import Path
 
 from ..errors import EngineFailed, EngineInterrupted
 from . import discovery, registry
+from .serve import plain_text
 
 DEFAULT_TIMEOUT = 600.0
 # the engines' own warnings, as they print them
@@ -385,7 +386,7 @@ def _read_log(wd: Path, out: str | None) -> str:
             texts[name] = p.read_text(errors="replace")
     log = max((texts.get("log.txt", ""), texts.get(SCREEN, "")), key=len)
     extra = [t for t in (texts.get(OUTPUT, ""), out or "") if t.strip() and t.strip() not in log]
-    return "\n".join([*extra, log] if log else extra)
+    return plain_text("\n".join([*extra, log] if log else extra))  # an engine's colours never reach a report
 
 
 # ----------------------------------------------------------------------------- long-lived workers
@@ -526,7 +527,8 @@ def _start_worker(engine: str, argv: list[str], info) -> _Worker:
         if not why:
             w.proc.stdin.close()
             code = w.proc.wait()  # it ended (no greeting): what it wrote on stderr, not waiting for the pipe's end
-            why = log_tail(_available(w.proc.stderr.fileno()).decode(errors="replace"), 1) or _exit_words(code)
+            said = plain_text(_available(w.proc.stderr.fileno()).decode(errors="replace"))
+            why = log_tail(said, 1) or _exit_words(code)
         w.end(kill=True)
         raise _fault(f"{engine}'s worker did not start: {why}")
     w.version = str(hello.get("version", ""))
