@@ -32,6 +32,8 @@ from ..mapping import mu_of
 
 VISCEL = "ViscElPhys"
 MINDLIN = "MindlinPhys"
+# Ip2_FrictMat_FrictMat_FrictPhys + this Law2: a ViscElPhys Native whose props carry law2 = CUNDALL (deck.py)
+CUNDALL = "Law2_ScGeom_FrictPhys_CundallStrack"
 LAW2 = {VISCEL: "Law2_ScGeom_ViscElPhys_Basic", MINDLIN: "Law2_ScGeom_MindlinPhys_Mindlin"}  # each physics' law
 CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashpot's attraction at the end of "
          "the contact); the case has limit_force = false")
@@ -113,6 +115,22 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     return Mapping("yade", fid, reasons, nat, keywords)
 
 
+def twin_rules(nat: Native, rules: dict) -> dict:
+    """The engine's rules for the twin of ``nat``. CundallStrack and Mindlin keep their shear force as the history,
+    turned by ScGeom::rotate before the increment, and take the slip as ScGeom's ratcheting-corrected velocity
+    α(v1 − v2) + ω1 × R1 n + ω2 × R2 n, α = (R1 + R2)/(R1 + R2 − δ) (a Wall carries the sphere's radius).
+    CundallStrack (sphericalBodies) puts its torque at R − δ/2 on a wall too; Mindlin at the contact point
+    (R − δ on a wall). Measured against Yade runs: this combination, and no other of these arms, meets oblique
+    and spinning impacts, pair and wall, to ≤ 3e-12 (tests/test_yade.py)."""
+    if nat.props.get("law2") == CUNDALL and nat.tangential == "spring":
+        return {**rules, "rotation": "scgeom", "slip_arm": "ratchet", "wall_slip_arm": "ratchet",
+                "wall_torque_arm": "contact"}
+    if nat.normal == MINDLIN and nat.tangential == "mindlin":
+        # its own getIncidentVel with the ratcheting correction, pair and wall alike; torques at the contact point
+        return {**rules, "rotation": "scgeom", "slip_arm": "ratchet", "wall_slip_arm": "ratchet"}
+    return rules
+
+
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     p = nat.props
     mu = p.get("mu", 0.0)
@@ -121,8 +139,10 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         if nat.tangential == "viscous":
             return nl, TangentialLaw.from_slot(ViscousTangential(eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m))
         if nat.tangential == "spring":
+            # CundallStrack: the force itself is the history (ScGeom::rotate turns it, −ks Δu_s adds to it)
             return nl, TangentialLaw.from_slot(SpringTangential(kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu,
-                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m))
+                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m,
+                                                                force_history=p.get("law2") == CUNDALL))
         return nl, twins.no_friction()
     if nat.normal == MINDLIN:
         c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
