@@ -157,3 +157,37 @@ def test_mindlin_shear_runs_as_its_twin(path, overrides):
     Measured ≤ 2.5e-14."""
     diffs = _native_agreement(path, overrides, _mindlin)
     assert max(diffs.values()) <= 1e-9, diffs
+
+
+SUITE = CASES / "suite"
+
+
+def test_tti_maps_to_mindlin_shear_approximately_and_ddt_keeps_its_reason():
+    """TTIt (Kt = 8Ḡ√(R̄δ), ηt = ηn) is Yade's Mindlin shear with kso = kt√R̄, betas from ηn: approximate, its
+    measured difference named; DDt's Kt = (16/3)Ḡ√(R̄δ) needs kso/kno < 1, which no Poisson's ratio gives.
+    (Before: both were refused as 'not mapped yet'.)"""
+    from demcheck.engines.mapping import contact_mapping
+    from demcheck.laws.model import resolve
+
+    case = C.load(SUITE / "oblique-tti.toml")
+    mp = contact_mapping(case, "yade")
+    assert mp.fidelity == "approximate" and mp.native.tangential == "mindlin"
+    model = resolve(case)
+    kt = model.contact.tangential.kt
+    assert mp.native.props["kso"] == pytest.approx(kt * model.pair.r_eff ** 0.5, rel=1e-15)
+    assert any("incremental" in r and "9.4e-2" in r for r in mp.reasons)
+    ddt = contact_mapping(C.load(SUITE / "oblique-ddt.toml"), "yade")
+    assert ddt.fidelity == "none" and "kso/kno" in ddt.reasons[-1]
+
+
+@pytest.mark.engine("yade")
+@pytest.mark.parametrize("overrides", [[], ["impact.spin=1500.0"], ["impact.angle=60.0"]])
+def test_mapped_tti_runs_as_its_twin(overrides):
+    """The suite's oblique-tti through Yade's Mindlin shear: the run equals its twin (measured ≤ 3e-15)."""
+    case = C.load(SUITE / "oblique-tti.toml", overrides)
+    run = CO.collide(case, "yade")
+    assert run.ok, run.message
+    twin = CO.twin_states(case, "yade", run.dt)
+    a, b = run.metrics(), twin.metrics()
+    diffs = {k: abs(a[k] - b[k]) / abs(b[k]) for k in ALL_METRICS if k in a and b[k] != 0.0}
+    assert max(diffs.values()) <= 1e-9, diffs

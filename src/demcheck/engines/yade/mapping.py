@@ -103,16 +103,49 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                            "rotation")
             keywords[reasons[-1]] = "ScGeom (Ig2_Wall_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom)"
         elif nat.normal == MINDLIN and tl.id == "sqrt_spring":
-            # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
-            # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
-            return refused("yade", "not mapped yet: Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t "
-                                   "dt, not Kt(δ)·ξ) and its slip arm on a wall is R − δ; the reference's "
-                                   "adaptive solver has no incremental-force history to hold it against")
+            why = _mindlin_shear(model, tl, nat, eta, comments)
+            if why:
+                return refused("yade", why)
+            fid = worst(fid, APPROXIMATE)
+            reasons.append(MINDLIN_SHEAR)
+            keywords[reasons[-1]] = LAW2[MINDLIN]
         else:
             return refused("yade", f"no Yade law pairs tangential '{model.tangential.id}' with the normal law "
                                    f"mapped here ({nat.normal})")
     nat.comments = comments
     return Mapping("yade", fid, reasons, nat, keywords)
+
+
+# measured (docs/yade.md): the seed law by the adaptive solver against Yade's twin at the suite's dt
+MINDLIN_SHEAR = ("Yade's Mindlin shear force is incremental (dFt = −kso√δ v_s dt on a force history turned by "
+                 "ScGeom::rotate, the spring capped alone at μ|Fn|), not Kt(δ)·ξ, and its slip velocity is ScGeom's "
+                 "ratcheting-corrected one; measured against the seed law: {measured}")
+MINDLIN_SHEAR = MINDLIN_SHEAR.format(measured="with the normal force held ≥ 0 in both, the tangential restitution "
+                                     "9.4e-2 and the rebound spin 1.9e-1 apart on oblique-tti (30° on a wall; "
+                                     "1.2e-1 and 2.2e-1 with truncation = overlap)")
+
+
+def _mindlin_shear(model: ResolvedModel, tl, nat: Native, eta: float, comments: list) -> str:
+    """Yade's Mindlin shear for a seed Kt = kt√(R̄δ) (DDt, TTIt) into ``nat``'s props; the reason it cannot be
+    ('' where it can): kso = kt√R̄ (Yade's ks = kso√δ) needs kso/kno = 3(1 − ν)/(2 − ν) with ν in (−1, 0.5), and
+    its dashpot cs = 2 betas √(m̄ ks) grows as δ^¼, as the normal one: TTIt's ηt = x·ηn is betas, a constant ηt is
+    not Yade's."""
+    p, m, r = nat.props, model.pair.m_eff, model.pair.r_eff
+    kso = tl.kt * math.sqrt(r)
+    rho = kso / p["kno"]
+    if not 1.0 < rho < 2.0:
+        return (f"Yade's Mindlin shear stiffness is kso = {rho:.4g} kno here; its materials give kso/kno = "
+                "3(1 − ν)/(2 − ν) in (1, 2) only (ν in (−1, 0.5))")
+    betas = 0.0
+    if tl.eta > 0.0 and not tl.eta_normal:
+        return (f"Yade's Mindlin shear dashpot grows as δ^¼ (cs = 2 betas √(m̄ ks)); the case's ηt = {tl.eta:g} "
+                "N·s/m is constant")
+    if tl.eta_normal:
+        betas = tl.eta * eta / (2.0 * math.sqrt(m * kso))  # cs = x ηn δ^¼ (0 with an undamped normal law)
+    nat.tangential = "mindlin"
+    p.update(kso=kso, betas=betas)
+    comments.append(f"MindlinPhys kso = kt√R̄ = {kso:.10g} (Poisson's ratio set for kso/kno), betas = {betas:.17g}")
+    return ""
 
 
 def twin_rules(nat: Native, rules: dict) -> dict:
