@@ -251,7 +251,7 @@ def native_law(case: Case, engine, native, seed: dict | None = None) -> NativeLa
 
     model, t_c = native_contact(case, native)
     engine = as_engine(engine)  # an Engine, or its name
-    rules = engine.rules
+    rules = engine.twin_rules(native)
     tl = model.tangential_law
     if tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
         conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),

@@ -179,6 +179,11 @@ class Engine(ABC):
     def twin(self, native: Native, m_eff: float, r_eff: float):
         """(NormalLaw, TangentialLaw) computing exactly what ``native`` computes for a pair (m̄, R̄)."""
 
+    def twin_rules(self, native: Native) -> dict:
+        """The kinematic rules of the twin of ``native`` (:attr:`rules`, unless a law of the engine computes
+        its slip or turns its history in its own way)."""
+        return self.rules
+
     @abstractmethod
     def summary(self, native: Native) -> str:
         """A native configuration in one line of the engine's own words."""

@@ -275,8 +275,9 @@ def twin_states(case: Case, engine, dt: float, native=None) -> Result:
 
     eng = as_engine(engine)
     mp = contact_mapping(case, eng.name, native)
-    model = twin_model(resolve(case), mp.require())
-    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=eng.rules), case)
+    nat = mp.require()
+    model = twin_model(resolve(case), nat)
+    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=eng.twin_rules(nat)), case)
     res.source = f"{eng.name}-twin"
     res.meta["fidelity"] = mp.fidelity
     return res

@@ -18,8 +18,9 @@ from ..laws.tangential import WALTON
 # verlet method the history is rotated into the new tangent plane keeping its length. A wall's slip arm is the
 # slip arm unless a scheme sets "wall_slip_arm" ("surface": R − δ, the point on the wall's plane, is Yade's).
 SEED_RULES = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "rescale"}
-_ARMS = {"contact": k3.ARM_CONTACT, "radius": k3.ARM_RADIUS, "surface": k3.ARM_SURFACE}
-_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE, "rescale_significant": k3.ROT_RESCALE_SIGNIFICANT}
+_ARMS = {"contact": k3.ARM_CONTACT, "radius": k3.ARM_RADIUS, "surface": k3.ARM_SURFACE, "ratchet": k3.ARM_RATCHET}
+_ROT = {"none": k3.ROT_NONE, "project": k3.ROT_PROJECT, "rescale": k3.ROT_RESCALE, "rescale_significant": k3.ROT_RESCALE_SIGNIFICANT,
+        "scgeom": k3.ROT_SCGEOM}
 
 
 def rules_array(rules: dict | None = None) -> np.ndarray:
@@ -27,6 +28,8 @@ def rules_array(rules: dict | None = None) -> np.ndarray:
     for key in ("slip_arm", "torque_arm"):
         if r[key] == "surface":
             raise ValueError(f"the arm R − δ is a wall's rule ({key} = 'surface' is not a pair's)")
+    if "ratchet" in (r["torque_arm"], r["wall_torque_arm"]):
+        raise ValueError("'ratchet' is a slip-velocity rule (Yade's ScGeom), not a torque's")
     return np.array([_ARMS[r["slip_arm"]], _ARMS[r["torque_arm"]], _ARMS[r["wall_torque_arm"]], _ROT[r["rotation"]],
                      _ARMS[r.get("wall_slip_arm") or r["slip_arm"]]], dtype=float)
 

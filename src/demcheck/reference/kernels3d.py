@@ -34,6 +34,9 @@ G_SIZE = 17
 # rules array
 R_SLIP_ARM, R_TORQUE_ARM, R_WALL_TORQUE_ARM, R_ROTATION, R_WALL_SLIP_ARM = 0, 1, 2, 3, 4
 ARM_CONTACT, ARM_RADIUS, ARM_SURFACE = 0, 1, 2  # R − δ/2, R, R − δ (the last for walls: Yade's contact point)
+# a pair's slip velocity as Yade's ScGeom with avoidGranularRatcheting (Ig2_Sphere_Sphere_ScGeom's default):
+# α(v0 − v1) + ω0 × R0 n + ω1 × R1 n with α = (R0 + R1)/(R0 + R1 − δ) (slip arm rule only)
+ARM_RATCHET = 3
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
@@ -45,6 +48,8 @@ def wall_arm(code, r, delta):
         return r - delta
     return r - 0.5 * delta
 ROT_NONE, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT = 0, 1, 2, 3
+# Yade's ScGeom::rotate before the increment: h −= h × (n_old × n), then h −= h × (½dt n_old·(ω0 + ω1)) n_old
+ROT_SCGEOM = 4
 # aux array: dmax, L*(3), t_ref(3), normal mode, tangential mode (0 stick, 1 slip)
 A_DMAX, A_LSTAR, A_TREF, A_NMODE, A_TMODE = 0, 1, 4, 7, 8
 A_SIZE = 9
@@ -69,6 +74,9 @@ def kinematics(y, geo, rules):
         a0t = wall_arm(rules[R_WALL_TORQUE_ARM], r0, delta)
         vr = v0 + _cross(w0, a0s * n)
         a1s, a1t = 0.0, 0.0
+        if rules[R_WALL_SLIP_ARM] == ARM_RATCHET:  # a Wall carries the sphere's radius in Yade's ScGeom
+            vs = (2.0 * r0 / (2.0 * r0 - delta)) * v0 + _cross(w0, r0 * n)
+            return delta, _dot(vr, n), n, ndot, vs - _dot(vs, n) * n, a0s, a1s, a0t, a1t
     else:
         r1 = geo[G_R1]
         x1, v1, w1 = y[9:12], y[12:15], y[15:18]
@@ -80,13 +88,17 @@ def kinematics(y, geo, rules):
         ndot = (dd - _dot(dd, n) * n) / dist
         if rules[R_SLIP_ARM] == ARM_RADIUS:
             a0s, a1s = r0, r1
-        else:
+        else:  # (ARM_RATCHET: the contact point's arms for δ̇)
             a0s, a1s = r0 - 0.5 * delta, r1 - 0.5 * delta
         if rules[R_TORQUE_ARM] == ARM_RADIUS:
             a0t, a1t = r0, r1
         else:
             a0t, a1t = r0 - 0.5 * delta, r1 - 0.5 * delta
         vr = (v0 + _cross(w0, a0s * n)) - (v1 + _cross(w1, -a1s * n))
+        if rules[R_SLIP_ARM] == ARM_RATCHET:  # the slip only: δ̇ stays the contact point's
+            alpha = (r0 + r1) / (r0 + r1 - delta)
+            vs = alpha * (v0 - v1) + _cross(w0, r0 * n) + _cross(w1, r1 * n)
+            return delta, _dot(vr, n), n, ndot, vs - _dot(vs, n) * n, a0s, a1s, a0t, a1t
     rate = _dot(vr, n)
     vt = vr - rate * n
     return delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t

@@ -19,7 +19,7 @@ from ..laws.tangential_force import (_cross, eta_of, kt_of, _norm, return_map, s
 from .kernels import (M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED)
 from .kernels3d import (A_NMODE, A_SIZE, A_TREF, C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, energy,
                         G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION, ROT_PROJECT, ROT_RESCALE,
-                        ROT_RESCALE_SIGNIFICANT)
+                        ROT_RESCALE_SIGNIFICANT, ROT_SCGEOM)
 
 # ----------------------------------------------------------------------------- velocity Verlet (engines)
 
@@ -52,6 +52,14 @@ def turn_history(xi0, xi1, xi2, n, rot, scale, mu, fabs):
                 r = old / new
                 xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
     return xi0, xi1, xi2
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def scgeom_rotate(h, n_old, n, spin):
+    """Yade's first-order turn of a history (ScGeom::rotate, before the increment): h −= h × (n_old × n), then
+    h −= h × (½dt n_old·(ω0 + ω1)) n_old (``spin`` = ½dt (ω0 + ω1)); no projection, no rescale."""
+    h = h - _cross(h, _cross(n_old, n))
+    return h - _cross(h, (spin[0] * n_old[0] + spin[1] * n_old[1] + spin[2] * n_old[2]) * n_old)
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
@@ -108,6 +116,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     aux = np.zeros(A_SIZE)
     aux[A_NMODE] = M_VE
     hist = np.zeros(3)
+    n_old = np.zeros(3)  # the normal of the step before (ROT_SCGEOM)
     lstar = np.zeros(3)
     prev_vt = np.zeros(3)
     a_prev = 0.0
@@ -116,6 +125,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     family = tl[T_FAMILY]
     wall = geo[G_WALL] != 0.0
     touched = False
+    touched_now = False  # in contact at the step before (ROT_SCGEOM: a new contact is not turned)
     status = ST_NO_SEPARATION
 
     fvec0 = np.zeros(3)
@@ -162,6 +172,12 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
             fn = normal_force(nl, delta, rate, dmax)
             fabs = abs(fn)
             force_hist = family == SPRING and tl[T_FORCE] != 0.0
+            if rules[R_ROTATION] == ROT_SCGEOM:
+                if touched_now:
+                    spin = 0.5 * dt * (y[6:9] + (0.0 if wall else 1.0) * y[15:18])
+                    hist = scgeom_rotate(hist, n_old, n, spin)
+                n_old = n.copy()
+                touched_now = True
             if family == SPRING and tl[T_RESCALE] != 0.0:
                 # mindlin_rescale: a shrinking contact radius scales the history by a/a_prev first
                 a_now = math.sqrt(tl[T_R] * delta)
@@ -173,21 +189,32 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                                                          1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)
             if force_hist:
                 # mindlin/force: F_el += −Kt v_t dt; the sum with the dashpot is capped at μ|Fn| and the
-                # history keeps the elastic part of the capped force
+                # history keeps the elastic part of the capped force (truncation spring: Yade's rule below)
                 eta = eta_of(tl, nl, delta)
                 hist = hist - kt_of(tl, delta) * dt * vt
                 if tl[T_RESCALE] != 0.0:
                     a_prev = math.sqrt(tl[T_R] * delta)
-                ft = hist - eta * vt
-                fm = _norm(ft)
                 cap = tl[T_MU_K] * fabs
-                sliding = fm > cap
-                if sliding:
-                    if _norm(hist) != 0.0:
-                        ft = ft * (cap / fm)
-                        hist = ft + eta * vt
+                if tl[T_TRUNC] == TRUNC_SPRING:
+                    # Yade's MindlinPhys, FrictPhys and ViscElPhys: the elastic force alone capped at μ|Fn| (and
+                    # kept there), the dashpot added only while it sticks
+                    hm = _norm(hist)
+                    sliding = hm > cap
+                    if sliding:
+                        hist = hist * (cap / hm)
+                        ft = hist.copy()
                     else:
-                        ft = np.zeros(3)
+                        ft = hist - eta * vt
+                else:
+                    ft = hist - eta * vt
+                    fm = _norm(ft)
+                    sliding = fm > cap
+                    if sliding:
+                        if _norm(hist) != 0.0:
+                            ft = ft * (cap / fm)
+                            hist = ft + eta * vt
+                        else:
+                            ft = np.zeros(3)
             elif family == SPRING or family == LTH or family == ZZY or family == WALTON:
                 if family == WALTON:
                     if walton_reverses(vt, prev_vt):
@@ -217,6 +244,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 ft = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), aux[A_TREF:A_TREF + 3])
         else:
             hist[:] = 0.0
+            touched_now = False
             lstar[:] = 0.0
             a_prev = 0.0
             prev_vt = np.zeros(3)

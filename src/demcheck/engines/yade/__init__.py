@@ -144,5 +144,8 @@ class Yade(PackageEngine):
     def summary(self, native: Native) -> str:
         return f"{native.normal} + {native.tangential}"
 
+    def twin_rules(self, native: Native) -> dict:
+        return self._part("mapping").twin_rules(native, self.rules)
+
 
 registry.register(Yade())

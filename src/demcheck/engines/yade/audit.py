@@ -612,8 +612,8 @@ def _cundall(ma: Call, mb: Call, mu: float, setup: Setup, a: int, b: int | None,
     rb = ra if b is None else setup.bodies[b].radius
     kn = 2.0 * e[0] * ra * e[1] * rb / (e[0] * ra + e[1] * rb)
     ks = kn * nu[0]
-    # its normal law only: the shear twin (ViscElPhys's spring) differs from a Yade CundallStrack run by 3.8e-3
-    # at 30° and 7.4e-3 at 60° on a wall (measured), so friction is not probed
+    # its normal law only (the probe is head-on): the shear has a twin now (mapping.twin with law2, ≤ 3e-12 of
+    # Yade runs, tests/test_yade.py), not yet probed by the audit
     nat = Native("yade", normal=VISCEL, tangential="none", limit=True,
                  props={"kn": kn, "cn": 0.0, "ks": ks, "cs": 0.0, "mu": 0.0, "law2": CUNDALL})
     nat.comments = [f"FrictPhys kn = {kn:.10g} N/m, ks = {ks:.10g} N/m (Law2_ScGeom_FrictPhys_CundallStrack), "

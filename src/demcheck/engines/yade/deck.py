@@ -20,12 +20,11 @@ from ...case import Case
 from ...errors import DemcheckError, UnsupportedByEngine
 from ...inputs import common
 from ..mapping import contact_mapping
-from .mapping import MINDLIN, VISCEL
+from .mapping import CUNDALL, MINDLIN, VISCEL
 
 VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
-# a ViscElPhys Native whose props name this Law2 runs as FrictMat + FrictPhys + CundallStrack: the same linear
-# spring and incremental shear spring capped at μFn, without dashpots (cn = cs = 0), as Yade's FrictPhys computes
-CUNDALL = "Law2_ScGeom_FrictPhys_CundallStrack"
+# a ViscElPhys Native whose props name CUNDALL (mapping.py) runs as FrictMat + FrictPhys + CundallStrack: a linear
+# spring and an incremental shear force capped at μFn, without dashpots (cn = cs = 0), as Yade's FrictPhys computes
 HEAD = "ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS ff ff ff\n-1 1\n-1 1\n-1 1\nITEM: ATOMS " \
        + " ".join(common.DUMP_COLUMNS) + "\n"
 ROW = "%d %d" + " %.17g" * (len(common.DUMP_COLUMNS) - 2) + "\n"

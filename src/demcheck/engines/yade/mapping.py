@@ -32,6 +32,8 @@ from ..mapping import mu_of
 
 VISCEL = "ViscElPhys"
 MINDLIN = "MindlinPhys"
+# Ip2_FrictMat_FrictMat_FrictPhys + this Law2: a ViscElPhys Native whose props carry law2 = CUNDALL (deck.py)
+CUNDALL = "Law2_ScGeom_FrictPhys_CundallStrack"
 LAW2 = {VISCEL: "Law2_ScGeom_ViscElPhys_Basic", MINDLIN: "Law2_ScGeom_MindlinPhys_Mindlin"}  # each physics' law
 CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashpot's attraction at the end of "
          "the contact); the case has limit_force = false")
@@ -101,16 +103,65 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                            "rotation")
             keywords[reasons[-1]] = "ScGeom (Ig2_Wall_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom)"
         elif nat.normal == MINDLIN and tl.id == "sqrt_spring":
-            # Law2_ScGeom_MindlinPhys_Mindlin: dFt = −kso √δ v_t dt (incremental, not Kt(δ)·ξ), the spring
-            # capped alone, cs = 2 betas √(m̄ ks) while sticking; on a wall its slip arm is R − δ
-            return refused("yade", "not mapped yet: Yade's Mindlin shear force is incremental (dFt = −ks(δ) v_t "
-                                   "dt, not Kt(δ)·ξ) and its slip arm on a wall is R − δ; the reference's "
-                                   "adaptive solver has no incremental-force history to hold it against")
+            why = _mindlin_shear(model, tl, nat, eta, comments)
+            if why:
+                return refused("yade", why)
+            fid = worst(fid, APPROXIMATE)
+            reasons.append(MINDLIN_SHEAR)
+            keywords[reasons[-1]] = LAW2[MINDLIN]
         else:
             return refused("yade", f"no Yade law pairs tangential '{model.tangential.id}' with the normal law "
                                    f"mapped here ({nat.normal})")
     nat.comments = comments
     return Mapping("yade", fid, reasons, nat, keywords)
+
+
+# measured (docs/yade.md): the seed law by the adaptive solver against Yade's twin at the suite's dt
+MINDLIN_SHEAR = ("Yade's Mindlin shear force is incremental (dFt = −kso√δ v_s dt on a force history turned by "
+                 "ScGeom::rotate, the spring capped alone at μ|Fn|), not Kt(δ)·ξ, and its slip velocity is ScGeom's "
+                 "ratcheting-corrected one; measured against the seed law: {measured}")
+MINDLIN_SHEAR = MINDLIN_SHEAR.format(measured="with the normal force held ≥ 0 in both, the tangential restitution "
+                                     "9.4e-2 and the rebound spin 1.9e-1 apart on oblique-tti (30° on a wall; "
+                                     "1.2e-1 and 2.2e-1 with truncation = overlap)")
+
+
+def _mindlin_shear(model: ResolvedModel, tl, nat: Native, eta: float, comments: list) -> str:
+    """Yade's Mindlin shear for a seed Kt = kt√(R̄δ) (DDt, TTIt) into ``nat``'s props; the reason it cannot be
+    ('' where it can): kso = kt√R̄ (Yade's ks = kso√δ) needs kso/kno = 3(1 − ν)/(2 − ν) with ν in (−1, 0.5), and
+    its dashpot cs = 2 betas √(m̄ ks) grows as δ^¼, as the normal one: TTIt's ηt = x·ηn is betas, a constant ηt is
+    not Yade's."""
+    p, m, r = nat.props, model.pair.m_eff, model.pair.r_eff
+    kso = tl.kt * math.sqrt(r)
+    rho = kso / p["kno"]
+    if not 1.0 < rho < 2.0:
+        return (f"Yade's Mindlin shear stiffness is kso = {rho:.4g} kno here; its materials give kso/kno = "
+                "3(1 − ν)/(2 − ν) in (1, 2) only (ν in (−1, 0.5))")
+    betas = 0.0
+    if tl.eta > 0.0 and not tl.eta_normal:
+        return (f"Yade's Mindlin shear dashpot grows as δ^¼ (cs = 2 betas √(m̄ ks)); the case's ηt = {tl.eta:g} "
+                "N·s/m is constant")
+    if tl.eta_normal:
+        betas = tl.eta * eta / (2.0 * math.sqrt(m * kso))  # cs = x ηn δ^¼ (0 with an undamped normal law)
+    nat.tangential = "mindlin"
+    p.update(kso=kso, betas=betas)
+    comments.append(f"MindlinPhys kso = kt√R̄ = {kso:.10g} (Poisson's ratio set for kso/kno), betas = {betas:.17g}")
+    return ""
+
+
+def twin_rules(nat: Native, rules: dict) -> dict:
+    """The engine's rules for the twin of ``nat``. CundallStrack and Mindlin keep their shear force as the history,
+    turned by ScGeom::rotate before the increment, and take the slip as ScGeom's ratcheting-corrected velocity
+    α(v1 − v2) + ω1 × R1 n + ω2 × R2 n, α = (R1 + R2)/(R1 + R2 − δ) (a Wall carries the sphere's radius).
+    CundallStrack (sphericalBodies) puts its torque at R − δ/2 on a wall too; Mindlin at the contact point
+    (R − δ on a wall). Measured against Yade runs: this combination, and no other of these arms, meets oblique
+    and spinning impacts, pair and wall, to ≤ 3e-12 (tests/test_yade.py)."""
+    if nat.props.get("law2") == CUNDALL and nat.tangential == "spring":
+        return {**rules, "rotation": "scgeom", "slip_arm": "ratchet", "wall_slip_arm": "ratchet",
+                "wall_torque_arm": "contact"}
+    if nat.normal == MINDLIN and nat.tangential == "mindlin":
+        # its own getIncidentVel with the ratcheting correction, pair and wall alike; torques at the contact point
+        return {**rules, "rotation": "scgeom", "slip_arm": "ratchet", "wall_slip_arm": "ratchet"}
+    return rules
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
@@ -121,8 +172,10 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         if nat.tangential == "viscous":
             return nl, TangentialLaw.from_slot(ViscousTangential(eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m))
         if nat.tangential == "spring":
+            # CundallStrack: the force itself is the history (ScGeom::rotate turns it, −ks Δu_s adds to it)
             return nl, TangentialLaw.from_slot(SpringTangential(kt=p["ks"], eta=p["cs"], mu_s=mu, mu_k=mu,
-                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m))
+                                                                truncation=TRUNC_SPRING, r_eff=r, m_eff=m,
+                                                                force_history=p.get("law2") == CUNDALL))
         return nl, twins.no_friction()
     if nat.normal == MINDLIN:
         c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
