@@ -334,6 +334,11 @@ def deck(case_path, engine, output, dt, overrides):
 
     case = _load(case_path, overrides)
     source = Source.of(engine)
+    if case.run.scenario != "collision":
+        from .errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{engine}: run.scenario = \"{case.run.scenario}\" is solved by the reference "
+                                  "only (no engine deck for the scenarios beyond sliding yet)")
     if case.kind == "packing":
         dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
