@@ -8,6 +8,7 @@ import json
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -166,3 +167,44 @@ def test_models_lists_the_new_laws():
     assert [r["slot"] for r in api.models("marshall")] == ["twisting"]
     p = subprocess.run([sys.executable, "-m", "demcheck", "models"], capture_output=True, text=True)
     assert p.returncode == 0 and "constant_torque" in p.stdout and "sjkr" in p.stdout
+
+
+# ----------------------------------------------------------------------------- the suite
+
+
+def _verify(tmp_path, files):
+    return api.verify([str(f) for f in files], engines=(), report=tmp_path / "r")
+
+
+def test_verify_judges_each_scenario_against_its_closed_form(tmp_path):
+    files = [case_path(f"suite/{name}.toml") for name in SCENARIO_CASES.values()]
+    res = _verify(tmp_path, files)
+    assert res["failed"] == 0 and len(res["cases"]) == 6
+    for entry in res["cases"]:
+        comps = entry["comparisons"]
+        assert entry["status"] == "ok" and entry["scenario"] in SCENARIO_CASES
+        assert sorted(c["metric"] for c in comps) == sorted(SCENARIO_METRICS[entry["scenario"]])
+        assert all(c["source"] == "closed-form" and c["verdict"] == "agree" and c["rel_diff"] <= 1e-9
+                   for c in comps), comps
+        assert "solved by the reference only" in entry["engines"]
+    assert "(rolling)" in (Path(res["report"]) / "report.md").read_text()
+
+
+def test_verify_fails_a_scenario_whose_solve_misses_its_closed_form(tmp_path, monkeypatch):
+    from demcheck.reference import scenarios
+
+    real = scenarios._b.twist_decay
+    monkeypatch.setattr(scenarios._b, "twist_decay",
+                        lambda *a, **k: {"twist_stop_time": real(*a, **k)["twist_stop_time"] * (1 + 1e-6)})
+    res = _verify(tmp_path, [case_path("suite/beyond-twist.toml")])
+    (entry,) = res["cases"]
+    assert res["failed"] == 1 and entry["status"] == "unexpected"
+
+
+def test_verify_never_agrees_on_a_scenario_that_computed_nothing(tmp_path, monkeypatch):
+    from demcheck.reference import scenarios
+
+    monkeypatch.setattr(scenarios._b, "rolling_on_plane", lambda *a, **k: {})  # no stop found
+    res = _verify(tmp_path, [case_path("suite/beyond-rolling.toml")])
+    (entry,) = res["cases"]
+    assert res["failed"] == 1 and entry["status"] == "failed" and entry["sources"]["reference"]["status"] == "failed"
