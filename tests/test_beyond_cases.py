@@ -208,3 +208,15 @@ def test_verify_never_agrees_on_a_scenario_that_computed_nothing(tmp_path, monke
     res = _verify(tmp_path, [case_path("suite/beyond-rolling.toml")])
     (entry,) = res["cases"]
     assert res["failed"] == 1 and entry["status"] == "failed" and entry["sources"]["reference"]["status"] == "failed"
+
+
+def test_sweep_solves_a_scenario_at_each_point_and_dt_refuses_one():
+    p = subprocess.run([sys.executable, "-m", "demcheck", "sweep", "beyond-rolling", "--vary", "contact.mu_r=0.01:0.04:2",
+                        "--json"], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    rows = json.loads(p.stdout)["rows"]
+    for row in rows:
+        t, _ = b.rolling_stop_closed(row["contact.mu_r"], 1.59e-3, 1.59e-3, 0.1, 9.81)
+        assert row["status"] == "ok" and abs(row["rolling_stop_time"] - t) < 1e-9 * t
+    d = subprocess.run([sys.executable, "-m", "demcheck", "dt", "beyond-twist"], capture_output=True, text=True)
+    assert d.returncode == 2 and "run.scenario = 'twist': has no time step to recommend" in d.stderr

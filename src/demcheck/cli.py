@@ -878,6 +878,9 @@ def dt(case_path, target, overrides, as_json):
     from .comparisons.bench import recommend
 
     case = _load(case_path, overrides)
+    if case.run.scenario != "collision":
+        raise ConfigError("run.scenario", case.run.scenario, "has no time step to recommend: the scenarios beyond "
+                                                             "sliding are solved by the adaptive reference only")
     rec = recommend(case, target)
     if as_json:
         emit_json(rec)
