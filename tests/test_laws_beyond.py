@@ -213,7 +213,7 @@ def test_jkr_loop_energy_against_quadrature():
 def test_capture_velocity_matches_thornton_ning_up_to_their_convention():
     """Thornton & Ning (1998) print v_s = 1.84 (F_c⁵/(E*² R̄ m̄³))^{1/6}. The loop energy gives 1.0348 with the
     same symbols; 1.0348 · 32^{1/6} = 1.844: their coefficient is ours with a factor 2 in F_c (or 4 in E*² with
-    2 in m̄ … ): recorded in docs/beyond-sliding.md, checked here to the 3 digits they print."""
+    2 in m̄ … ): recorded in docs/models.md ("Beyond sliding"), checked here to the 3 digits they print."""
     r, e, w, m = 5e-4, 5e7, 0.1, M / 2
     fc = 1.5 * math.pi * w * r
     coef = b.capture_velocity_closed(r, e, w, m) / (fc ** 5 / (e * e * r * m ** 3)) ** (1 / 6)

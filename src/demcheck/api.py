@@ -194,17 +194,41 @@ def models(model_id: str | None = None, key: str = "model_id") -> list[dict]:
             except KeyError:
                 pass
         table = [r for r in table if (r["slot"], r["id"]) in found]
-        if not table:
+        if not table and not _beyond_rows(model_id):
             import difflib
 
-            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names()]
+            from .laws import slots
+
+            known = [*normal.REGISTRY.names(), *tangential.REGISTRY.names(),
+                     *(id_ for _, id_ in slots.KEYS)]
             near = difflib.get_close_matches(model_id.strip().lower(), known, n=1)
             raise ConfigError(key, model_id, "is not a registered model" + (f"; did you mean '{near[0]}'?" if near
                                                                             else f"; known: {', '.join(known)}"))
     engines = mapping.by_model()
     for row in table:
         row["engines"] = engines[(row["slot"], row["id"])]
-    return table
+    return table + _beyond_rows(model_id)
+
+
+def _beyond_rows(model_id: str | None) -> list[dict]:
+    """The laws of the slots beyond sliding (laws/slots.py): solved by the reference in their scenarios; no
+    engine deck writes them yet (docs/models.md, "Beyond sliding", has the engines' measured mappings)."""
+    from .engines import registry
+    from .laws import slots
+    from .laws.base import sub_model
+
+    reason = ("not wired: the scenarios beyond sliding (run.scenario) are solved by the reference only; "
+              "docs/models.md, \"Beyond sliding\", gives this engine's mapping as measured")
+    rows = []
+    for (slot, id_), keys in slots.KEYS.items():
+        if model_id is not None and model_id.strip().lower() != id_:
+            continue
+        formula, source = slots.DOCS[(slot, id_)]
+        rows.append({"slot": slot, "id": id_, "seed_name": "—", "aliases": [], "title": sub_model(slot, id_).title,
+                     "formula": formula, "source": source, "params": {k.name: k.meaning for k in keys},
+                     "engines": {e: {"fidelity": "not wired", "config": "", "reason": reason, "with": "its scenario"}
+                                 for e in registry.names()}})
+    return rows
 
 
 def sources() -> tuple[str, ...]:

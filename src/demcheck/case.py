@@ -38,6 +38,7 @@ class Material:
     friction_kinetic: float | None = None
     dissipative_constant: float | None = None  # BSHP's A, in seconds
     tangential_restitution: float | None = None
+    specific_heat: float | None = None  # J/(kg·K): the conduction scenario's heat capacity m·c_p
 
     @property
     def shear_modulus(self) -> float:
@@ -67,6 +68,11 @@ class Contact:
     tangential: str = "none"
     limit_force: bool = False
     params: dict = field(default_factory=dict)
+    # the slots beyond sliding (laws/slots.py): rolling, twisting, adhesion and heat resistance laws' ids
+    rolling: str = "none"
+    twisting: str = "none"
+    adhesion: str = "none"
+    heat: str = "none"
 
 
 @dataclass(frozen=True)
@@ -80,6 +86,10 @@ class Run:
     # scale); None: the suite's [verlet] rtol. A case run at many steps per contact sets it tight, so that the
     # verlet method checks the adaptive one
     verlet_rtol: float | None = None
+    # what is solved: a collision, or a scenario beyond sliding (reference/scenarios.py) with its own metrics
+    scenario: str = "collision"
+    temperatures: tuple[float, ...] | None = None  # K, one per body (conduction)
+    overlap: float | None = None  # m: the fixed overlap of the conduction scenario
 
 
 @dataclass(frozen=True)
@@ -407,11 +417,13 @@ def check_name(key: str, value, hint: str = "") -> str:
 
 MATERIAL_KEYS = {
     "density", "youngs_modulus", "poisson_ratio", "restitution", "friction", "friction_kinetic",
-    "dissipative_constant", "tangential_restitution",
+    "dissipative_constant", "tangential_restitution", "specific_heat",
 }
 PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity"}
 WALL_KEYS = {"point", "normal", "rigid", "material"}
-RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method", "verlet_rtol"}
+RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method", "verlet_rtol", "scenario", "temperatures",
+            "overlap"}
+SCENARIOS = ("collision", "rolling", "incline", "twist", "pull_off", "adhesive_impact", "conduction")
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
 TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants",
             "packing", "engine"}
@@ -445,6 +457,8 @@ def _material(name: str, d: dict) -> Material:
                                      rule="must be >= 0 (s)", check=lambda v: v >= 0),
         tangential_restitution=_number(d, "tangential_restitution", where, required=False,
                                        rule="must be in [0, 1]", check=lambda v: 0 <= v <= 1),
+        specific_heat=_number(d, "specific_heat", where, required=False, rule="must be > 0 (J/(kg·K))",
+                              check=_positive),
     )
 
 
@@ -582,6 +596,7 @@ def from_dict(raw: dict) -> Case:
         verlet_rtol=_number(run_raw, "verlet_rtol", "run", required=False, default=None,
                             rule="must be in (0, 1] (a difference in units of each metric's scale)",
                             check=lambda v: 0 < v <= 1),
+        **_scenario_keys(run_raw, kind),
     )
 
     natives = _natives(raw.get("engine"), kind)
@@ -593,7 +608,11 @@ def from_dict(raw: dict) -> Case:
         raise ConfigError("contact.limit_force", limit, "must be true or false")
     normal_id = contact_raw.pop("normal")
     tangential_id = contact_raw.pop("tangential", "none")
-    contact = Contact(normal=str(normal_id), tangential=str(tangential_id), limit_force=limit, params=contact_raw)
+    from .laws.slots import BEYOND_SLOTS, check_id
+
+    beyond = {slot: check_id(slot, contact_raw.pop(slot, "none")) for slot in BEYOND_SLOTS}
+    contact = Contact(normal=str(normal_id), tangential=str(tangential_id), limit_force=limit, params=contact_raw,
+                      **beyond)
 
     if kind == "collision":
         if impact is not None:
@@ -624,11 +643,111 @@ def from_dict(raw: dict) -> Case:
 
     with _computable(case):
         _model.check_contact(case)
-        if kind == "collision":
+        _check_scenario(case)
+        if kind == "collision" and run.scenario == "collision":
             case = _collision_scales(case, build, impact)
         elif packing is not None and packing.duration is not None:
             packing_run(case)  # a packing too long to run is refused here too, before any work
     return case
+
+
+# scenario → (the slot it exercises, the laws it has a metric for, one body on a wall?)
+SCENARIO_LAWS = {
+    "rolling": ("rolling", ("constant_torque",), True),
+    "incline": ("rolling", ("constant_torque", "epsd"), True),
+    "twist": ("twisting", ("sds", "marshall"), True),
+    "pull_off": ("adhesion", ("jkr", "dmt"), None),
+    "adhesive_impact": ("adhesion", ("jkr",), None),
+    "conduction": ("heat", ("radius", "area", "lens"), None),
+}
+
+
+def _check_scenario(case: Case) -> None:
+    """What a scenario beyond sliding needs of the case (reference/scenarios.py solves it): its slot's law, the
+    sphere resting on a wall under gravity (rolling, incline, twist), an approach (adhesive_impact), heat
+    capacities, temperatures and an overlap (conduction). A ConfigError names the key, the value and the rule."""
+    scenario = case.run.scenario
+    if scenario == "collision":
+        return
+    slot, laws, on_wall = SCENARIO_LAWS[scenario]
+    law = getattr(case.contact, slot)
+    if law not in laws:
+        raise ConfigError(f"contact.{slot}", law, f"run.scenario = \"{scenario}\" needs {slot} = "
+                          + " or ".join(f"\"{x}\"" for x in laws))
+    if on_wall:
+        _resting_on_wall(case, scenario)
+    if scenario == "rolling":
+        p, n = case.particles[0], np.asarray(case.walls[0].normal)
+        v = np.asarray(p.velocity)
+        if not np.linalg.norm(v - (v @ n) * n) > 0 or abs(v @ n) > 1e-12 * np.linalg.norm(v):
+            raise ConfigError("particles.0.velocity", list(p.velocity),
+                              "the rolling scenario needs a velocity along the wall (rolling without slip)")
+        g = np.asarray(case.run.gravity)
+        if np.linalg.norm(g + (g @ -n) * n) > 1e-12 * np.linalg.norm(g):
+            raise ConfigError("run.gravity", list(case.run.gravity),
+                              "the rolling scenario is on a level wall: gravity along -normal (run.scenario = "
+                              "\"incline\" for a tilt)")
+    if scenario == "twist":
+        w, n = np.asarray(case.particles[0].angular_velocity), np.asarray(case.walls[0].normal)
+        if not abs(w @ n) > 0:
+            raise ConfigError("particles.0.angular_velocity", list(case.particles[0].angular_velocity),
+                              "the twist scenario needs a spin about the wall's normal")
+    if scenario == "adhesive_impact":
+        from .laws import model as _model
+
+        if not _model.resolve(case).pair.impact_speed > 0:
+            raise ConfigError("particles", "(initial state)", "the bodies never meet: no impact to solve")
+    if scenario == "conduction":
+        _conduction_inputs(case)
+
+
+def _resting_on_wall(case: Case, scenario: str) -> None:
+    if len(case.particles) != 1 or len(case.walls) != 1:
+        raise ConfigError("particles", len(case.particles), f"the {scenario} scenario is one sphere on one wall")
+    p, w = case.particles[0], case.walls[0]
+    gap = float((np.asarray(p.position) - np.asarray(w.point)) @ np.asarray(w.normal)) - p.radius
+    if gap > 1e-9 * p.radius:
+        raise ConfigError("particles.0.position", list(p.position),
+                          f"the {scenario} scenario's sphere rests on the wall (its centre one radius from it)")
+    if not float(np.asarray(case.run.gravity) @ np.asarray(w.normal)) < 0:
+        raise ConfigError("run.gravity", list(case.run.gravity),
+                          f"the {scenario} scenario needs gravity pressing the sphere onto the wall")
+
+
+def _conduction_inputs(case: Case) -> None:
+    if case.run.temperatures is None:
+        raise ConfigError("run.temperatures", None, "missing: the conduction scenario needs one temperature a body")
+    if case.run.overlap is None:
+        raise ConfigError("run.overlap", None, "missing: the conduction scenario holds the bodies at this overlap (m)")
+    if len(case.particles) != 2:
+        raise ConfigError("particles", len(case.particles), "the conduction scenario is two particles")
+    for p in case.particles:
+        if case.materials[p.material].specific_heat is None:
+            raise ConfigError(f"materials.{p.material}.specific_heat", None,
+                              "missing: the conduction scenario needs each body's heat capacity")
+
+
+def _scenario_keys(run_raw: dict, kind: str) -> dict:
+    """[run] scenario, temperatures and overlap, checked alone (what each scenario needs of the rest of the case
+    is reference/scenarios.py's check, run with the contact's)."""
+    scenario = run_raw.get("scenario", "collision")
+    if scenario not in SCENARIOS:
+        raise ConfigError("run.scenario", scenario, f"must be one of {', '.join(SCENARIOS)}")
+    if scenario != "collision" and kind != "collision":
+        raise ConfigError("run.scenario", scenario, "a scenario beyond sliding needs kind = \"collision\" (two bodies)")
+    temps = run_raw.get("temperatures")
+    if temps is not None:
+        if (not isinstance(temps, list) or len(temps) != 2
+                or not all(isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t) and t > 0
+                           for t in temps)):
+            raise ConfigError("run.temperatures", temps, "must be two temperatures > 0 (K), one per body")
+        temps = tuple(float(t) for t in temps)
+    overlap = _number(run_raw, "overlap", "run", required=False, default=None, rule="must be > 0 (m)",
+                      check=_positive)
+    for key, value in (("temperatures", temps), ("overlap", overlap)):
+        if value is not None and scenario != "conduction":
+            raise ConfigError(f"run.{key}", run_raw[key], "is read by run.scenario = \"conduction\" only")
+    return {"scenario": scenario, "temperatures": temps, "overlap": overlap}
 
 
 def _collision_scales(case: Case, build, impact) -> Case:

@@ -334,6 +334,11 @@ def deck(case_path, engine, output, dt, overrides):
 
     case = _load(case_path, overrides)
     source = Source.of(engine)
+    if case.run.scenario != "collision":
+        from .errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{engine}: run.scenario = \"{case.run.scenario}\" is solved by the reference "
+                                  "only (no engine deck for the scenarios beyond sliding yet)")
     if case.kind == "packing":
         dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
@@ -886,6 +891,9 @@ def dt(case_path, target, overrides, as_json):
     from .comparisons.bench import recommend
 
     case = _load(case_path, overrides)
+    if case.run.scenario != "collision":
+        raise ConfigError("run.scenario", case.run.scenario, "has no time step to recommend: the scenarios beyond "
+                                                             "sliding are solved by the adaptive reference only")
     rec = recommend(case, target)
     if as_json:
         emit_json(rec)

@@ -121,6 +121,8 @@ class Source:
         engines.collide.collide); a twin: the reference computing the engine's formula with its scheme at the
         engine's dt. ``native``: the engine's setting (default the case's own, at its own step when ``dt`` is
         None; None: the engine's mapping of the seed model)."""
+        if case.run.scenario != "collision":
+            return self._scenario(case)
         if self.kind == REFERENCE:
             from ..reference.collision import collide
 
@@ -141,6 +143,21 @@ class Source:
             options["timeout"] = timeout
         with native_step_named(case, self.engine, given, dt if native is not None else None):
             return run_engine(case, self.engine, dt=dt, native=native, **options)
+
+
+    def _scenario(self, case: Case) -> Result:
+        """A scenario beyond sliding: the reference's solve (reference/scenarios.py); no engine runs one yet."""
+        from ..errors import UnsupportedByEngine
+
+        if self.kind != REFERENCE:
+            raise UnsupportedByEngine(f"{self.label}: run.scenario = \"{case.run.scenario}\" is solved by the "
+                                      "reference only (no engine deck or twin for the scenarios beyond sliding yet)")
+        if self.method == "verlet":
+            raise ConfigError("method", "verlet", f"run.scenario = \"{case.run.scenario}\" is solved by the "
+                                                  "adaptive reference only")
+        from ..reference.scenarios import solve
+
+        return solve(case)
 
 
 ADAPTIVE, VERLET = Source.reference("adaptive"), Source.reference("verlet")

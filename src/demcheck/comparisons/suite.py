@@ -87,6 +87,8 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
         from .packing_suite import run_packing
 
         return run_packing(case, opts, found, file)
+    if case.run.scenario != "collision":
+        return run_scenario(case, entry, opts)
     model = resolve(case)
     entry["model"] = model.describe()
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
@@ -103,6 +105,36 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
             continue
         _engine_source(case, model, planned, (adaptive, ref), entry, comps, opts, seed_cache)
     entry["series"] = [s for s in entry["series"] if s]
+    entry["comparisons"] = [c.as_dict() for c in comps]
+    worst = verdicts.worst(c.verdict for c in comps)
+    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
+    entry["verdict"] = worst
+    return entry
+
+
+def run_scenario(case: Case, entry: dict, opts: Options) -> dict:
+    """A scenario beyond sliding (run.scenario): the reference's solve against its closed forms
+    (reference/expected.scenario_closed_forms). No engine runs these scenarios yet: none is planned, and the entry
+    says so (``engines``)."""
+    from ..reference.expected import scenario_closed_forms
+
+    model = resolve(case)
+    entry["scenario"] = case.run.scenario
+    entry["model"] = model.describe()
+    entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
+    entry["impact"] = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
+    entry["scales"] = {}
+    entry["engines"] = (f"not run: run.scenario = \"{case.run.scenario}\" is solved by the reference only (no "
+                        "engine deck or twin for the scenarios beyond sliding yet)")
+    comps: list[verdicts.Comparison] = []
+    adaptive = sources.ADAPTIVE.run(case)
+    entry["sources"]["reference"] = _source(adaptive)
+    if not adaptive.ok:
+        comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
+    else:
+        got = adaptive.metrics()
+        for metric, exact in scenario_closed_forms(case).items():
+            comps.append(verdicts.judge_closed_form(metric, got[metric], exact, entry["scales"], opts.tolerances))
     entry["comparisons"] = [c.as_dict() for c in comps]
     worst = verdicts.worst(c.verdict for c in comps)
     entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")

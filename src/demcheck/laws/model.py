@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 from typing import TYPE_CHECKING
@@ -12,8 +12,9 @@ if TYPE_CHECKING:  # the case layer sits above the laws: types only
     from ..case import Case
 from ..errors import ConfigError
 from . import normal as _normal
+from . import slots as _slots
 from . import tangential as _tangential
-from .base import Contact
+from .base import Contact, SubModel
 from .contact import PAIR_RULES, Pair, pair_of, pair_params
 
 # keys of [contact] that belong to the pair rather than to a model (allowed where a model of the case reads them:
@@ -31,15 +32,23 @@ class ResolvedModel:
     params: dict
     limit_force: bool
     gravity: tuple[float, float, float] = (0.0, 0.0, 0.0)  # the case's run.gravity (m/s²)
+    beyond: dict = field(default_factory=dict)  # slot → record of the slots beyond sliding (laws/slots.py)
 
     def describe(self) -> dict:
-        return {"normal": self.normal.id, "tangential": self.tangential.id, "limit_force": self.limit_force}
+        out = {"normal": self.normal.id, "tangential": self.tangential.id, "limit_force": self.limit_force}
+        out.update({slot: rec.id for slot, rec in self.beyond.items() if rec.id != "none"})
+        return out
+
+    def slot(self, name: str) -> SubModel | None:
+        """The record of a slot beyond sliding (None when the case names none)."""
+        rec = self.beyond.get(name)
+        return None if rec is None or rec.id == "none" else rec
 
     @cached_property
     def contact(self) -> Contact:
         """The resolved laws as slot records (laws/base.py): what the engines' vocabularies map, by id."""
         normal, damping = self.normal_law.slots()
-        return Contact(normal, damping, self.tangential_law.slot(), limit_force=self.limit_force)
+        return Contact(normal, damping, self.tangential_law.slot(), limit_force=self.limit_force, **self.beyond)
 
 
 def _lookup(registry_lookup, names, slot: str, value: str):
@@ -80,8 +89,20 @@ def _resolve(case: Case, i: int, j: int | None) -> ResolvedModel:
                 "impact_speed": pair.impact_speed, **normal_out, **tangential_out}
     if pair.restitution is not None:
         resolved.setdefault("restitution", pair.restitution)
+    beyond = _slots.records(_beyond_ids(case), params, pair, _radii(case, i, None if pair.wall else j))
+    for slot, rec in beyond.items():
+        if rec.id != "none":
+            resolved.update({f"{slot}.{k}": v for k, v in rec.describe().items() if k not in ("slot", "id")})
     return ResolvedModel(normal, tangential, pair, normal_law, tangential_law, resolved,
-                         case.contact.limit_force, tuple(case.run.gravity))
+                         case.contact.limit_force, tuple(case.run.gravity), beyond)
+
+
+def _beyond_ids(case: Case) -> dict:
+    return {slot: getattr(case.contact, slot, "none") for slot in _slots.BEYOND_SLOTS}
+
+
+def _radii(case: Case, i: int, j: int | None) -> tuple[float, float]:
+    return case.particles[i].radius, (0.0 if j is None else case.particles[j].radius)
 
 
 def check_contact(case: Case) -> None:
@@ -91,18 +112,34 @@ def check_contact(case: Case) -> None:
     choices; a collision's laws resolve (numbers in range, nothing missing)."""
     normal, tangential = models_of(case)
     params = case.contact.params
-    allowed = {p.name for p in normal.params} | {p.name for p in tangential.params}
+    ids = _beyond_ids(case)
+    allowed = {p.name for p in normal.params} | {p.name for p in tangential.params} | set(_slots.keys_of(ids))
+    named = "".join(f", {slot} '{id_}'" for slot, id_ in ids.items() if id_ != "none")
     for key, value in params.items():
         if key not in allowed:
             near = difflib.get_close_matches(key, sorted(allowed), n=1)
             hint = f"; did you mean '{near[0]}'?" if near else ""
             raise ConfigError(f"contact.{key}", value,
-                              f"is not a parameter of normal '{normal.id}' or tangential '{tangential.id}'{hint}")
+                              f"is not a parameter of normal '{normal.id}' or tangential '{tangential.id}'"
+                              f"{named}{hint}")
+    _check_wired(case, ids)
     pair_params(params)
     _normal.check_choices(normal, params)
     _normal.check_choices(tangential, params)
     if case.kind == "collision":
         resolve(case)
+
+
+def _check_wired(case: Case, ids: dict) -> None:
+    """The slots beyond sliding reach the scenario solvers (reference/scenarios.py) only: a collision or a
+    packing that names one would silently ignore it, so it is refused."""
+    if getattr(case.run, "scenario", "collision") != "collision":
+        return
+    for slot, id_ in ids.items():
+        if id_ != "none":
+            raise ConfigError(f"contact.{slot}", id_, "is solved in the scenarios beyond sliding only (run.scenario = "
+                              "rolling, incline, twist, pull_off, adhesive_impact or conduction); the collision "
+                              "and packing solvers do not model it yet")
 
 
 def characteristic_time(model: ResolvedModel) -> float:

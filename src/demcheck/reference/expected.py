@@ -59,3 +59,13 @@ def closed_form_metrics(model: ResolvedModel) -> dict:
             "energy_dissipated": 0.5 * m * v * v * (1 - e * e),
         }
     return {}
+
+
+def scenario_closed_forms(case) -> dict:
+    """Metric name → closed-form value of a case's scenario beyond sliding (reference/scenarios.py: rolling,
+    incline, twist, pull_off, adhesive_impact, conduction); empty for a collision."""
+    if case.run.scenario == "collision":
+        return {}
+    from .scenarios import scenario_metrics
+
+    return scenario_metrics(case, closed=True)

@@ -18,6 +18,9 @@ def _model(c: dict) -> str:
     if not m:
         return "—"
     text = f"{m['normal']} / {m['tangential']}"
+    text += "".join(f" + {slot} {m[slot]}" for slot in ("rolling", "twisting", "adhesion", "heat") if slot in m)
+    if c.get("scenario"):
+        text += f" ({c['scenario']})"
     return text + (" (limit_force)" if m.get("limit_force") else "")
 
 
