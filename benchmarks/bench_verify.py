@@ -1,10 +1,16 @@
-"""The default suite's run time: engine-run cache cold, then warm (issue: ≤ 3 min cold, ≤ 15 s warm, on
-this 2-core machine, both engines). Each run is the README's main command in a fresh process; the
-compiled kernels are already on disk (they are compiled once at install or by the first run).
+"""The default suite's run time with all four engines: engine-run cache cold, then warm (issue 33 item 5: cold ≤ 5 min,
+warm ≤ 20 s on this 2-core machine), for two versions of demcheck side by side in one run — "before" (a source tree
+given with --before, e.g. a ``git worktree add /tmp/speed-old b2b60bb``, run with PYTHONPATH=its src) and "after"
+(this tree). Each run is ``demcheck verify --engines lammps,liggghts,kratos,yade --jobs 2`` in a fresh process,
+the compiled kernels already on disk (each version's ``demcheck warmup`` first, untimed). The order interleaves
+the versions (before cold, after cold, before warm, after warm) and the load average is printed beside each run:
+the machine is shared, so the ratios within one run are the result, not the absolute times.
 
-Run: .venv/bin/python benchmarks/bench_verify.py > benchmarks/results/bench_verify.txt
+Run: .venv/bin/python benchmarks/bench_verify.py --before /tmp/speed-old/src > benchmarks/results/bench_verify.txt
 """
 
+import argparse
+import json
 import os
 import subprocess
 import sys
@@ -14,6 +20,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMCHECK = [sys.executable, "-m", "demcheck"]
+ENGINES = "lammps,liggghts,kratos,yade"
 
 
 def run(args, env):
@@ -22,27 +29,59 @@ def run(args, env):
     return time.perf_counter() - t, p
 
 
-def main():
-    with tempfile.TemporaryDirectory() as tmp:
-        env = dict(os.environ, DEMCHECK_CACHE=str(Path(tmp) / "engine-runs"))
-        report = str(Path(tmp) / "reports")
-        # compile (or load) the kernels once, so that neither timed run pays for it
-        run(["verify", "cases/glass-pair.toml", "cases/oblique-lsd-wall.toml", "--engines", "none", "--report", report],
-            env)
-        rows = []
-        for label in ("cold (empty engine-run cache)", "warm (every deck cached)"):
-            seconds, p = run(["verify", "--jobs", "2", "--report", report, "--json"], env)
-            import json
+def load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
-            out = json.loads(p.stdout)
-            rows.append((label, seconds, out["wall_time"], len(out["cases"]), out["cache"], p.returncode))
-    print("demcheck verify, the default suite (cases/), both engines, --jobs 2")
-    print(f"{'run':32s} {'process s':>10s} {'suite s':>8s} {'cases':>6s} {'cache hits/misses':>18s} exit")
-    for label, seconds, wall, n, cache, rc in rows:
-        print(f"{label:32s} {seconds:10.1f} {wall:8.1f} {n:6d} {cache['hits']:>8d}/{cache['misses']:<9d} {rc}")
-    cold, warm = rows[0][1], rows[1][1]
-    print(f"\ntargets: cold ≤ 180 s ({'met' if cold <= 180 else 'MISSED'}), warm ≤ 15 s "
-          f"({'met' if warm <= 15 else 'MISSED'}); warm/cold = {warm / cold:.2f}")
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--before", help="the src directory of the version to compare against (PYTHONPATH)")
+    ap.add_argument("--jobs", default="2")
+    a = ap.parse_args()
+    versions = [("after", str(ROOT / "src"))] + ([("before", a.before)] if a.before else [])
+    versions.reverse()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        envs = {}
+        for name, src in versions:
+            env = dict(os.environ, DEMCHECK_CACHE=str(Path(tmp) / f"engine-runs-{name}"), PYTHONPATH=src)
+            envs[name] = env
+            run(["warmup"], env)  # compile (or load) the kernels, so that no timed run pays for it
+        for label in ("cold", "warm"):
+            for name, _ in versions:
+                report = str(Path(tmp) / f"reports-{name}")
+                before_load = load()
+                seconds, p = run(["verify", "--engines", ENGINES, "--jobs", a.jobs, "--report", report, "--json"],
+                                 envs[name])
+                try:
+                    out = json.loads(p.stdout)
+                except ValueError:
+                    print(f"{name} {label}: exit {p.returncode}\n{p.stderr[-3000:]}", file=sys.stderr)
+                    raise
+                per_engine = {}
+                for case in out["cases"]:
+                    for src, s in case.get("sources", {}).items():
+                        if src in ENGINES.split(","):
+                            per_engine[src] = per_engine.get(src, 0) + 1
+                rows.append((name, label, seconds, out["wall_time"], len(out["cases"]), out["cache"], p.returncode,
+                             before_load, load(), out["failed"]))
+                print(f"# {name} {label}: {seconds:.1f} s, load {before_load} → {load()}", file=sys.stderr,
+                      flush=True)
+    print(f"demcheck verify, the default suite (cases/), engines {ENGINES}, --jobs {a.jobs}; "
+          f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} CPUs")
+    print(f"{'version':8s} {'run':5s} {'process s':>10s} {'suite s':>8s} {'cases':>6s} {'hits/misses':>14s} "
+          f"{'failed':>6s} exit  load average (1, 5, 15 min) before → after")
+    for name, label, seconds, wall, n, cache, rc, l0, l1, failed in rows:
+        print(f"{name:8s} {label:5s} {seconds:10.1f} {wall:8.1f} {n:6d} {cache['hits']:>6d}/{cache['misses']:<7d} "
+              f"{failed:6d} {rc:4d}  {l0} → {l1}")
+    t = {(r[0], r[1]): r[2] for r in rows}
+    for label in ("cold", "warm"):
+        if ("before", label) in t:
+            print(f"{label}: after ÷ before = {t[('after', label)] / t[('before', label)]:.2f} "
+                  f"({t[('before', label)] / t[('after', label)]:.2f}× faster)")
+    cold, warm = t[("after", "cold")], t[("after", "warm")]
+    print(f"targets (after): cold ≤ 300 s ({'met' if cold <= 300 else 'MISSED'}: {cold:.0f} s), warm ≤ 20 s "
+          f"({'met' if warm <= 20 else 'MISSED'}: {warm:.1f} s); warm/cold = {warm / cold:.2f}")
 
 
 if __name__ == "__main__":

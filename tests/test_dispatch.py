@@ -85,6 +85,44 @@ def test_a_local_cluster_runs_lammps_and_the_client_stores_its_runs(tmp_path):
     assert verdicts(again) == verdicts(one)
 
 
+def _cmdline(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return ""
+
+
+@pytest.mark.engine("lammps")
+def test_a_local_cluster_runs_the_engine_in_one_worker_per_dask_worker_and_ends_them(tmp_path):
+    """verify --jobs 2: each Dask worker runs its LAMMPS decks in a LAMMPS worker of its own (at most one per Dask
+    worker, started there), with the verdicts of one process, and none is left once the campaign has closed."""
+    import threading
+
+    seen, done = {}, threading.Event()
+
+    def watch():  # the LAMMPS workers under this process (under the cluster's worker processes)
+        while not done.is_set():
+            for pid in _descendants(os.getpid()):
+                if "demcheck.engines.lammps.worker" in (line := _cmdline(pid)):
+                    seen.setdefault(pid, line)
+            time.sleep(0.05)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    try:
+        opts = suite.Options(engines=("lammps",), jobs=2, cache=None)
+        two = suite.run_suite(SMALL + [CASES / "oblique-lsd-wall.toml"], tmp_path / "r", opts, quiet=True)
+    finally:
+        done.set()
+        watcher.join()
+    one = suite.run_suite(SMALL + [CASES / "oblique-lsd-wall.toml"], tmp_path / "one",
+                          suite.Options(engines=("lammps",), jobs=1, cache=None), quiet=True)
+    assert verdicts(two) == verdicts(one)
+    assert 1 <= len(seen) <= 2, seen  # three LAMMPS runs, in at most one worker per Dask worker
+    assert all(f"--parent {os.getpid()}" not in line for line in seen.values())  # started on the Dask workers
+    assert not [pid for pid in seen if proc_stat(pid) is not None and proc_stat(pid)[0] != "Z"]
+
+
 _NOISY = """
 from demcheck.comparisons.dispatch import Campaign
 

@@ -335,3 +335,91 @@ def test_the_worker_dies_with_demcheck(engine, tmp_path):
     while _alive(pid) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not _alive(pid), f"{engine}'s worker {pid} outlived demcheck"
+
+
+# ----------------------------------------------------------------------------- the worker, or else a process
+
+
+@pytest.mark.parametrize("engine", _engines())
+def test_a_deck_error_in_the_worker_is_run_again_as_a_process_and_both_are_kept(engine, tmp_path):
+    """run(worker=OR_PROCESS) (the suite's engine runs): a run its worker fails is made once more as a process of
+    its own, whose failure is the run's; the worker attempt's files are kept beside it and its reason named."""
+    text, files, why = _bad(engine)
+    wd = tmp_path / "w"
+    with pytest.raises(EngineFailed) as err:
+        runner.run(engine, text, files=files, workdir=wd, worker=runner.OR_PROCESS)
+    message = str(err.value)
+    assert message.startswith(f"{engine} failed (") and why in message  # the process's error, its log's tail
+    assert f"(the run in {engine}'s worker had failed first: " in message
+    kept = wd / runner.WORKER_ATTEMPT
+    assert str(kept) in message
+    assert any(why in p.read_text(errors="replace") for p in kept.iterdir() if p.is_file())
+    assert (wd / runner.OUTPUT).exists()  # the process's own output, beside what the worker wrote
+
+
+_FAKE_WORKER = """
+import json, os, sys
+how, version = sys.argv[1], sys.argv[2]
+if how == "not-started":
+    sys.exit(3)
+print(json.dumps({"ready": True, "version": version}), flush=True)
+request = json.loads(sys.stdin.readline())
+with open(os.path.join(request["workdir"], "screen.txt"), "w") as f:
+    f.write("the worker's last words\\n")
+os._exit(9)
+"""
+
+
+@pytest.mark.parametrize("how", ["not-started", "died"])
+@pytest.mark.parametrize("engine", _engines())
+def test_a_worker_that_fails_gives_the_run_to_a_process_with_the_same_bytes(engine, how, alone, tmp_path,
+                                                                              monkeypatch):
+    """A worker that does not start, or dies during a run (a stand-in for the engine's worker, told the version
+    discovery read): the run is made as a process and gives the bytes of a process per run, with a warning that
+    names the worker's failure; a worker that died keeps what it wrote in WORKER_ATTEMPT."""
+    eng = registry.get(engine)
+    script = tmp_path / "fake_worker.py"
+    script.write_text(_FAKE_WORKER)
+    version = discovery.find(engine).version
+    monkeypatch.setattr(type(eng), "worker_argv", lambda self, exe: [sys.executable, str(script), how, version])
+    name = CASE_FILES[engine][0]
+    wd = tmp_path / "run"
+    res = collisions.collide(load(CASES / name), engine, workdir=wd, worker=runner.OR_PROCESS)
+    assert res.status == "ok", res.message
+    assert (wd / "dump.txt").read_bytes() == alone(engine, name)[1]
+    _same_metrics(res, alone(engine, name)[0])
+    [note] = [w for w in res.meta["warnings"] if "the run in its worker failed" in w]
+    assert ("did not start" if how == "not-started" else "its worker process ended: exit code 9") in note
+    assert "it was run again as a process" in note
+    if how == "died":
+        assert (wd / runner.WORKER_ATTEMPT / "screen.txt").read_text() == "the worker's last words\n"
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("yade")
+def test_verify_runs_the_engines_in_their_workers_and_ends_them(tmp_path, monkeypatch):
+    """The suite's engine runs go through one worker per engine (started on the first run, serving the rest), with
+    the numbers of a process per run, and no worker is left once the suite has ended."""
+    import demcheck
+
+    started = []
+    real = runner._start_worker
+
+    def counted(engine, argv, info):
+        w = real(engine, argv, info)
+        started.append((engine, w.proc.pid))
+        return w
+
+    monkeypatch.setattr(runner, "_start_worker", counted)
+    names = ["glass-pair.toml", "hertz-wall.toml"]
+    out = demcheck.verify([CASES / n for n in names], engines="lammps,yade", cache=False, report=None)
+    assert sorted(e for e, _ in started) == ["lammps", "yade"]  # one each, for both cases
+    assert runner.workers() == [] and not any(_alive(pid) for _, pid in started)
+    for case, name in zip(out["cases"], names):
+        for engine in ("lammps", "yade"):
+            got = case["sources"][engine]
+            assert got["status"] == "ok", got
+            alone = collisions.collide(load(CASES / name), engine).metrics()
+            assert got["metrics"].keys() == alone.keys()
+            for k, v in alone.items():
+                assert got["metrics"][k] == v or (math.isnan(v) and math.isnan(got["metrics"][k])), (name, engine, k)

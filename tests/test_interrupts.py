@@ -265,3 +265,46 @@ def test_a_system_error_without_an_interrupt_is_not_hidden(tmp_path):
               "P.simulate = simulate\ncli.main(sys.argv[1:])\n")
     code_got, _, err = _script(script, "pack", CASES / "packing" / "column-lsd.toml", cwd=tmp_path)
     assert code_got == 1 and "SystemError: a real fault" in err and "interrupted" not in err
+
+
+@pytest.mark.engine("lammps")
+@pytest.mark.engine("yade")
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_verify_interrupted_while_its_engine_workers_run_leaves_none(jobs, tmp_path):
+    """verify runs the real engines in their long-lived workers: Ctrl-C once a worker is up (starting, running a
+    deck or idle, as it happens) ends demcheck with 130 and leaves no worker behind, in this process (--jobs 1)
+    or on a local cluster's workers (--jobs 2)."""
+    cases = [CASES / n for n in ("glass-pair.toml", "hertz-wall.toml", "oblique-lsd-wall.toml", "kk-wall.toml")]
+    env = dict(os.environ, DEMCHECK_CACHE=str(tmp_path / "cache"))
+    proc = _start(["verify", *cases, "--engines", "lammps,yade", "--jobs", jobs, "--report", tmp_path / "reports"],
+                  tmp_path, env)
+    seen: set[int] = set()
+
+    def look():
+        for pid in _descendants(proc.pid):
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+            except FileNotFoundError:
+                continue
+            if b"worker" in cmd and b"--parent" in cmd:  # an engine worker (engines/serve.py's command line)
+                seen.add(pid)
+
+    deadline = time.monotonic() + 240
+    while not seen and time.monotonic() < deadline:
+        assert proc.poll() is None, f"demcheck ended before a worker started: {proc.communicate()}"
+        look()
+        time.sleep(0.05)
+    assert seen, "no engine worker started"
+    time.sleep(1.0)
+    look()
+    proc.send_signal(signal.SIGINT)
+    try:
+        _, err = proc.communicate(timeout=240)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        pytest.fail("demcheck did not exit within 240 s of the interrupt")
+    assert proc.returncode == 130, err[-3000:]
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and [p for p in seen if (st := proc_stat(p)) and st[0] != "Z"]:
+        time.sleep(0.1)
+    assert not [p for p in seen if (st := proc_stat(p)) and st[0] != "Z"], "an engine worker outlived demcheck"

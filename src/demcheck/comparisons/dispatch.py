@@ -120,6 +120,8 @@ class Campaign:
             if self._flying:  # left with tasks out (an error, or an interrupt outside the wait): stop them
                 self._wind_down(wait=False)
         finally:
+            if self.in_process:
+                runner.shutdown_workers()  # the engines' idle workers the tasks started here (engines/run.py)
             self._close()
 
     def completed(self, fn: Callable, tasks: Iterable[tuple[object, tuple]]) -> Iterator[tuple[object, object]]:
@@ -219,7 +221,13 @@ class Campaign:
         client, cluster, self.client, self.cluster = self.client, self.cluster, None, None
         try:
             if client is not None:
-                client.close()
+                try:  # each worker's idle engine workers, before the worker goes (a pool per Dask worker process;
+                    # one that cannot be reached: its engine workers die with its process, PR_SET_PDEATHSIG)
+                    client.run(runner.shutdown_workers, on_error="ignore")
+                except Exception:  # noqa: BLE001 — a cluster already gone
+                    pass
+                finally:
+                    client.close()
         finally:
             try:
                 if cluster is not None:

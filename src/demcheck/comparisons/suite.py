@@ -30,12 +30,17 @@ from ..io import console as rich_console
 from ..case import Case, expand, naming_file
 from ..engines import registry
 from ..engines.base import case_natives
+from ..engines.run import OR_PROCESS
 from ..errors import DemcheckError, EngineInterrupted
 from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..laws.model import resolve
 from . import curves, dispatch, sources, verdicts
 
+# the suite's engine runs go through each engine's long-lived worker (one per engine per process running cases), a
+# failed worker run made again as a process of its own (engines/run.py, OR_PROCESS): the same dumps, without an
+# engine start per run
+ENGINE_WORKER = OR_PROCESS
 SERIES_POINTS = 400
 
 
@@ -183,7 +188,7 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
     src, mp, native = planned.source, planned.mapping, planned.native
     engine, (adaptive, ref) = src.label, converged
     try:
-        res = src.run(case, None, native=native, cache=opts.cache, timeout=opts.timeout)
+        res = src.run(case, None, native=native, cache=opts.cache, timeout=opts.timeout, worker=ENGINE_WORKER)
     except EngineInterrupted:
         raise  # the case did not finish: it is left out of the (partial) report
     except DemcheckError as exc:

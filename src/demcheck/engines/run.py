@@ -189,11 +189,18 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     argv = registry.get(engine).worker_argv(info.executable) if worker and mpi == 1 else None
     before = {p.name for p in wd.iterdir()} - {"log.txt", SCREEN, OUTPUT}  # the caller's: never removed
 
-    def attempt() -> RunOutput:
-        if argv is not None:
-            return _run_in_worker(engine, info, list(argv), wd, workdir, timeout)
+    def in_process() -> RunOutput:
         return _run_process(engine, info, wd, workdir, timeout, mpi)
 
+    if argv is None:
+        return _retried(engine, in_process, wd, before)
+    if worker == OR_PROCESS:
+        return _worker_or_process(engine, info, list(argv), wd, workdir, timeout, before, in_process)
+    return _retried(engine, lambda: _run_in_worker(engine, info, list(argv), wd, workdir, timeout), wd, before)
+
+
+def _retried(engine: str, attempt, wd: Path, before: set) -> RunOutput:
+    """``attempt()``, made once more when it fails without an error of the engine's (a fault of the process)."""
     try:
         return attempt()
     except EngineFailed as first:
@@ -211,6 +218,43 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
         out.warnings.append(f"{engine}: a first attempt failed without an error of the engine's ({first.what}); "
                             f"it was run again on a fresh process{'; its last lines: ' + tail if tail else ''}")
         return out
+
+
+OR_PROCESS = "or-process"  # run(worker=OR_PROCESS): in the worker, a failed worker run made again as a process
+WORKER_ATTEMPT = "worker-attempt"  # where such a run's work directory keeps what its worker attempt wrote
+
+
+def _worker_or_process(engine: str, info, argv: list[str], wd: Path, workdir, timeout: float, before: set,
+                       in_process) -> RunOutput:
+    """``run(..., worker=OR_PROCESS)``: the run in the engine's worker; if that fails in any way but its timeout or
+    an interrupt (a deck's error, a worker that died or did not start, a version it does not serve), it is made
+    once more as a process of its own, whose outcome is the run's (a process per run is what the worker stands
+    in for). What the worker attempt wrote is kept in the work directory's WORKER_ATTEMPT folder; its reason and
+    last lines go into the process run's warnings, or, if that fails too, into its error."""
+    try:
+        return _run_in_worker(engine, info, argv, wd, workdir, timeout)
+    except EngineFailed as first:
+        if isinstance(first, (EngineInterrupted, EngineTimeout)):
+            raise
+        worker_failure = first
+    kept = wd / WORKER_ATTEMPT
+    kept.mkdir(exist_ok=True)
+    for p in wd.iterdir():
+        if p.name not in before and p.name != WORKER_ATTEMPT:
+            p.rename(kept / p.name)
+    what = getattr(worker_failure, "what", str(worker_failure).splitlines()[0])
+    try:  # the deck (checked) and its files are in place; a fault of the process is retried as run() does
+        out = _retried(engine, in_process, wd, before | {WORKER_ATTEMPT})
+    except EngineInterrupted:
+        raise
+    except EngineFailed as again:
+        again.args = (f"{again}\n(the run in {engine}'s worker had failed first: {what}; what it wrote is kept in "
+                      f"{kept})",)
+        raise
+    tail = getattr(worker_failure, "tail", "")
+    out.warnings.append(f"{engine}: the run in its worker failed ({what}); it was run again as a process"
+                        f"{'; the worker’s last lines: ' + tail if tail else ''}")
+    return out
 
 
 def _run_process(engine: str, info, wd: Path, workdir, timeout: float, mpi: int) -> RunOutput:
