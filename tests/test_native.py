@@ -128,6 +128,10 @@ def test_verify_runs_a_native_case_and_finds_the_tsuji_gap(tmp_path):
     # about 0.70 realised
     assert abs(e["reference"] - 0.6) < 1e-3 and abs(e["value"] - tsuji_restitution(0.6)) < 2e-3
     assert e["verdict"] == "differs unexpectedly" and entry["status"] == "unexpected"
+    # the run verify made is the one `collide` and `deck` make: the native law at its own step (engines.collide
+    # .setting: its twin's contact time over run.steps_per_contact), not the seed model's step
+    native_step = demcheck.collide(demcheck.load(f), source="lammps").dt
+    assert src["dt"] == native_step
 
 
 def test_liggghts_pair_style_and_properties_are_read():

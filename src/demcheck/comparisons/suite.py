@@ -188,7 +188,9 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
     src, mp, native = planned.source, planned.mapping, planned.native
     engine, (adaptive, ref) = src.label, converged
     try:
-        res = src.run(case, None, native=native, cache=opts.cache, timeout=opts.timeout, worker=ENGINE_WORKER)
+        # the case's own [engine.NAME] setting at its own step (Source.run's default, engines.collide.setting), as
+        # `collide` and `deck` run it: the deck verify runs is the deck `demcheck deck` writes
+        res = src.run(case, None, cache=opts.cache, timeout=opts.timeout, worker=ENGINE_WORKER)
     except EngineInterrupted:
         raise  # the case did not finish: it is left out of the (partial) report
     except DemcheckError as exc:
