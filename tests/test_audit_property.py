@@ -55,3 +55,40 @@ def test_audit_any_pair_coeff_string(setting, tmp_path_factory, capsys):
                     f"pair_coeff * * {line}\n", encoding="utf-8")
     code, out, err = _run(["audit", str(deck)], capsys)
     _check(code, err)
+
+
+# 0, subnormals, the float limits, NaN and inf as LAMMPS would read them, and ordinary values (issue 32's property)
+HOSTILE_NUMBERS = ["0", "-0", "5e-324", "2.2250738585072014e-308", "1e-308", "1e-200", "1e-30", "1e-9", "-1", "0.5",
+                   "1e4", "63e9", "1e30", "1e100", "1e155", "1e300", "1e308", "1.7976931348623157e308", "1e400",
+                   "nan", "inf", "-inf"]
+METRICS = ("restitution", "contact_time")
+
+
+def _coefficient(ordinary: str):
+    """Half the draws the coefficient's ordinary value (so that most settings get as far as the probes), half a
+    hostile number."""
+    return st.one_of(st.just(ordinary), st.sampled_from(HOSTILE_NUMBERS))
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(young=_coefficient("63e9"), nu=_coefficient("0.24"), e=_coefficient("0.6"), mu=_coefficient("0.5"))
+def test_models_never_calls_a_contact_that_was_not_computed_exact(young, nu, e, mu, capsys):
+    """Hostile numbers in every coefficient of a LAMMPS Hertz setting: exit 0, 1 or 2 only, never a traceback, and
+    a fidelity of "exact" or "approximate" only where every probe's twin and seed produced finite metrics (a contact
+    that never formed, passed through or overflowed is a failure, never a gap of 0)."""
+    import json
+
+    setting = f"hertz/material {young} {e} {nu} damping tsuji tangential mindlin NULL 1.0 {mu}"
+    code, out, err = _run(["models", "--engine", "lammps", "--json", "--", setting], capsys)
+    assert code in (0, 1, 2), (setting, code, err)
+    assert "Traceback" not in err
+    if code == 2:
+        assert len(err.strip().splitlines()) == 1, err
+        return
+    r = json.loads(out)
+    if r["fidelity"] in ("exact", "approximate"):
+        for p in r["probes"]:
+            for side in ("twin", "seed"):
+                for k in METRICS:
+                    v = p[side][k]
+                    assert v is not None and v == v and abs(v) != float("inf"), (setting, p["angle"], side, k, v)
