@@ -24,7 +24,11 @@ def test_models_lists_the_plugged_in_engine(tmp_path):
     p = _demcheck("models", "--json", tmp_path=tmp_path)
     assert p.returncode == 0, p.stderr
     rows = json.loads(p.stdout)["models"]
-    assert rows and all(r["engines"]["toy"]["fidelity"] == "exact" for r in rows)
+    seed = [r for r in rows if r["slot"] in ("normal", "tangential")]  # the seed models: the toy runs every one
+    assert seed and all(r["engines"]["toy"]["fidelity"] == "exact" for r in seed)
+    # the laws beyond sliding are listed for every engine, the plug-in included, as not wired (reference only)
+    beyond = [r for r in rows if r["slot"] not in ("normal", "tangential")]
+    assert beyond and all(r["engines"]["toy"]["fidelity"] == "not wired" for r in beyond)
 
 
 @pytest.mark.parametrize("case", ["glass-pair.toml", "oblique-lsd-wall.toml"])
