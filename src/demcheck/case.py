@@ -536,83 +536,12 @@ def from_dict(raw: dict) -> Case:
     if not isinstance(parts_raw, list) or not parts_raw:
         raise ConfigError("particles", parts_raw, "at least one [[particles]] entry is required")
 
-    particles = []
-    for i, d in enumerate(parts_raw):
-        where = f"particles.{i}"
-        if not isinstance(d, dict):
-            raise ConfigError(where, d, "must be a table")
-        _known_keys(d, PARTICLE_KEYS, where)
-        mat = d.get("material")
-        if mat not in materials:
-            near = difflib.get_close_matches(str(mat), list(materials), n=1)
-            hint = f"; did you mean '{near[0]}'?" if near else f"; defined: {', '.join(materials)}"
-            raise ConfigError(f"{where}.material", mat, f"is not a defined material{hint}")
-        radius = _number(d, "radius", where, rule="must be > 0 (m)", check=_positive)
-        pos = _vector(d, "position", where, default=None, required=impact is None)
-        particles.append(dict(material=mat, radius=radius, position=pos,
-                              velocity=_vector(d, "velocity", where, default=(0.0, 0.0, 0.0)),
-                              angular_velocity=_vector(d, "angular_velocity", where, default=(0.0, 0.0, 0.0))))
-
+    particles = _particles(parts_raw, materials, impact)
     _check_masses([(p["material"], p["radius"]) for p in particles], materials)  # before anything uses a mass
-
-    walls = []
-    for i, d in enumerate(raw.get("walls", []) or []):
-        where = f"walls.{i}"
-        if not isinstance(d, dict):
-            raise ConfigError(where, d, "must be a table")
-        _known_keys(d, WALL_KEYS, where)
-        point = _vector(d, "point", where, default=(0.0, 0.0, 0.0))
-        normal = _unit(_vector(d, "normal", where, required=True), f"{where}.normal")
-        rigid = d.get("rigid", "material" not in d)
-        if not isinstance(rigid, bool):
-            raise ConfigError(f"{where}.rigid", rigid, "must be true or false")
-        mat = d.get("material")
-        if not rigid and mat not in materials:
-            raise ConfigError(f"{where}.material", mat, "a non-rigid wall needs a defined material")
-        if rigid and mat is not None and mat not in materials:
-            raise ConfigError(f"{where}.material", mat, "is not a defined material")
-        walls.append(Wall(point=point, normal=normal, rigid=rigid, material=mat))
-
-    run_raw = raw.get("run", {}) or {}
-    _known_keys(run_raw, RUN_KEYS, "run")
-    dt_raw = run_raw.get("dt", "auto")
-    if dt_raw == "auto":
-        dt = None
-    else:
-        dt = _number(run_raw, "dt", "run", rule="must be > 0 (s) or \"auto\"", check=_positive)
-    spc = run_raw.get("steps_per_contact", 200)
-    if isinstance(spc, bool) or not isinstance(spc, int) or not 2 <= spc <= 10**15:
-        raise ConfigError("run.steps_per_contact", spc, "must be an integer from 2 to 10^15")
-    method = run_raw.get("method", "adaptive")
-    if method not in ("adaptive", "verlet"):
-        raise ConfigError("run.method", method, "must be adaptive or verlet")
-    run = Run(
-        dt=dt,
-        steps_per_contact=spc,
-        gravity=_vector(run_raw, "gravity", "run", default=(0.0, 0.0, 0.0)),
-        rtol=_number(run_raw, "rtol", "run", required=False, default=1e-13,
-                     rule="must be in [1e-14, 1e-2]", check=lambda v: 1e-14 <= v <= 1e-2),
-        method=method,
-        verlet_rtol=_number(run_raw, "verlet_rtol", "run", required=False, default=None,
-                            rule="must be in (0, 1] (a difference in units of each metric's scale)",
-                            check=lambda v: 0 < v <= 1),
-        **_scenario_keys(run_raw, kind),
-    )
-
+    walls = _walls(raw.get("walls", []) or [], materials)
+    run = _run(raw.get("run", {}) or {}, kind)
     natives = _natives(raw.get("engine"), kind)
-    contact_raw = dict(raw.get("contact", {}) or {})
-    if "normal" not in contact_raw:
-        raise ConfigError("contact.normal", None, "missing: a normal model id is required (see `demcheck models`)")
-    limit = contact_raw.pop("limit_force", False)
-    if not isinstance(limit, bool):
-        raise ConfigError("contact.limit_force", limit, "must be true or false")
-    normal_id = contact_raw.pop("normal")
-    tangential_id = contact_raw.pop("tangential", "none")
-    from .laws.slots import BEYOND_SLOTS, check_id
-
-    beyond = {slot: check_id(slot, contact_raw.pop(slot, "none")) for slot in BEYOND_SLOTS}
-    contact = Contact(normal=str(normal_id), tangential=str(tangential_id), limit_force=limit, params=contact_raw,
-                      **beyond)
+    contact = _contact(raw.get("contact", {}) or {})
 
     if kind == "collision":
         if impact is not None:
@@ -649,6 +578,94 @@ def from_dict(raw: dict) -> Case:
         elif packing is not None and packing.duration is not None:
             packing_run(case)  # a packing too long to run is refused here too, before any work
     return case
+
+
+def _particles(parts_raw: list, materials: dict, impact) -> list[dict]:
+    """The [[particles]] entries checked, as keyword dicts of Particle (positions may wait for an [impact])."""
+    particles = []
+    for i, d in enumerate(parts_raw):
+        where = f"particles.{i}"
+        if not isinstance(d, dict):
+            raise ConfigError(where, d, "must be a table")
+        _known_keys(d, PARTICLE_KEYS, where)
+        mat = d.get("material")
+        if mat not in materials:
+            near = difflib.get_close_matches(str(mat), list(materials), n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else f"; defined: {', '.join(materials)}"
+            raise ConfigError(f"{where}.material", mat, f"is not a defined material{hint}")
+        radius = _number(d, "radius", where, rule="must be > 0 (m)", check=_positive)
+        pos = _vector(d, "position", where, default=None, required=impact is None)
+        particles.append(dict(material=mat, radius=radius, position=pos,
+                              velocity=_vector(d, "velocity", where, default=(0.0, 0.0, 0.0)),
+                              angular_velocity=_vector(d, "angular_velocity", where, default=(0.0, 0.0, 0.0))))
+    return particles
+
+
+def _walls(walls_raw: list, materials: dict) -> list[Wall]:
+    """The [[walls]] entries checked."""
+    walls = []
+    for i, d in enumerate(walls_raw):
+        where = f"walls.{i}"
+        if not isinstance(d, dict):
+            raise ConfigError(where, d, "must be a table")
+        _known_keys(d, WALL_KEYS, where)
+        point = _vector(d, "point", where, default=(0.0, 0.0, 0.0))
+        normal = _unit(_vector(d, "normal", where, required=True), f"{where}.normal")
+        rigid = d.get("rigid", "material" not in d)
+        if not isinstance(rigid, bool):
+            raise ConfigError(f"{where}.rigid", rigid, "must be true or false")
+        mat = d.get("material")
+        if not rigid and mat not in materials:
+            raise ConfigError(f"{where}.material", mat, "a non-rigid wall needs a defined material")
+        if rigid and mat is not None and mat not in materials:
+            raise ConfigError(f"{where}.material", mat, "is not a defined material")
+        walls.append(Wall(point=point, normal=normal, rigid=rigid, material=mat))
+    return walls
+
+
+def _run(run_raw: dict, kind: str) -> Run:
+    """The [run] table checked."""
+    _known_keys(run_raw, RUN_KEYS, "run")
+    dt_raw = run_raw.get("dt", "auto")
+    if dt_raw == "auto":
+        dt = None
+    else:
+        dt = _number(run_raw, "dt", "run", rule="must be > 0 (s) or \"auto\"", check=_positive)
+    spc = run_raw.get("steps_per_contact", 200)
+    if isinstance(spc, bool) or not isinstance(spc, int) or not 2 <= spc <= 10**15:
+        raise ConfigError("run.steps_per_contact", spc, "must be an integer from 2 to 10^15")
+    method = run_raw.get("method", "adaptive")
+    if method not in ("adaptive", "verlet"):
+        raise ConfigError("run.method", method, "must be adaptive or verlet")
+    return Run(
+        dt=dt,
+        steps_per_contact=spc,
+        gravity=_vector(run_raw, "gravity", "run", default=(0.0, 0.0, 0.0)),
+        rtol=_number(run_raw, "rtol", "run", required=False, default=1e-13,
+                     rule="must be in [1e-14, 1e-2]", check=lambda v: 1e-14 <= v <= 1e-2),
+        method=method,
+        verlet_rtol=_number(run_raw, "verlet_rtol", "run", required=False, default=None,
+                            rule="must be in (0, 1] (a difference in units of each metric's scale)",
+                            check=lambda v: 0 < v <= 1),
+        **_scenario_keys(run_raw, kind),
+    )
+
+
+def _contact(contact_raw: dict) -> Contact:
+    """The [contact] table checked: the model ids of its slots and the parameters the laws read."""
+    contact_raw = dict(contact_raw)
+    if "normal" not in contact_raw:
+        raise ConfigError("contact.normal", None, "missing: a normal model id is required (see `demcheck models`)")
+    limit = contact_raw.pop("limit_force", False)
+    if not isinstance(limit, bool):
+        raise ConfigError("contact.limit_force", limit, "must be true or false")
+    normal_id = contact_raw.pop("normal")
+    tangential_id = contact_raw.pop("tangential", "none")
+    from .laws.slots import BEYOND_SLOTS, check_id
+
+    beyond = {slot: check_id(slot, contact_raw.pop(slot, "none")) for slot in BEYOND_SLOTS}
+    return Contact(normal=str(normal_id), tangential=str(tangential_id), limit_force=limit, params=contact_raw,
+                   **beyond)
 
 
 # scenario → (the slot it exercises, the laws it has a metric for, one body on a wall?)
