@@ -341,7 +341,27 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
     bounds = [lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]]
     masked = len(laws.groups) > 1
 
-    head = [MARKER, "# every value below is a number written by demcheck",
+    lines = [*_head(case, lay, ns, fidelities, reasons), "from yade import utils", "",
+            common.comment(f"the run: dt (s), steps, gravity (m/s^2), the steps whose translational kinetic energy "
+                           f"is printed (every {every} and the last)"),
+            f"DT = {_num(lay.dt)}", f"STEPS = {int(lay.steps)}", f"G = {_vec(g)}",
+            f"SAMPLES = [{', '.join(str(int(s)) for s in samples)}]"]
+    if periodic:
+        lines += _periodic_cell(case, lay, lo, hi)
+    lines += _materials(laws, lay, pairs, walls, masked)
+    lines += _bodies(case, lay, laws, g, masked)
+    lines += floor_lines
+    lines += _engines_and_samples(laws, periodic)
+    lines += _outputs(periodic, bounds)
+    # free text (the case's and materials' names, the mapping's words) reaches the script only in comments, each
+    # an ASCII line (Yade reads a script in the locale's encoding when it is run by hand)
+    text = "\n".join(ascii_comment(x) if x.startswith("#") else x for x in lines)
+    return common.Deck("yade", text, {}, dt=lay.dt, check=check_script)
+
+
+def _head(case: Case, lay, ns: int, fidelities: list, reasons: list) -> list[str]:
+    """The script's header: what wrote it, the case, the mapping's fidelity and notes, how to run it."""
+    return [MARKER, "# every value below is a number written by demcheck",
             common.comment(f"demcheck packing script for yade ({VERSION_NOTE})"),
             common.comment(f"case: {case.name} (hash {case.hash})"),
             common.comment(f"model: normal = {case.contact.normal}, tangential = {case.contact.tangential}, "
@@ -353,24 +373,25 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
                            "(every particle pair in contact)"),
             common.comment("run by hand: yade -x -n <this file> (it writes both files in the working directory and "
                            "prints 'step ke atoms' lines)")]
-    lines = list(head)
-    lines += ["from yade import utils", "",
-              common.comment(f"the run: dt (s), steps, gravity (m/s^2), the steps whose translational kinetic energy "
-                             f"is printed (every {every} and the last)"),
-              f"DT = {_num(lay.dt)}", f"STEPS = {int(lay.steps)}", f"G = {_vec(g)}",
-              f"SAMPLES = [{', '.join(str(int(s)) for s in samples)}]"]
-    if periodic:
-        # Yade's cell is periodic in z too: twice the height from the lowest floor box to the top of the box
-        half = _half_thickness(lay)
-        zs = [float(w.point[2]) for w in case.walls]
-        lz = 2.0 * (max([hi[2], *(z + 2.0 * half for z in zs)]) - min([lo[2], *(z - 2.0 * half for z in zs)]))
-        lines += [common.comment("Yade's periodic cell (periodic in x, y and z): x and y the case's box, z twice the "
-                                 "height of the box and the floor, so nothing reaches across it"),
-                  "O.periodic = True", f"O.cell.setBox({_num(hi[0])}, {_num(hi[1])}, {_num(lz)})",
-                  f"LX = {_num(hi[0])}", f"LY = {_num(hi[1])}"]
-    lines.append(common.comment("material k: species k + 1 (it carries twice its like pair's values: Yade combines "
-                                "two materials in series); after them the floor's"
-                                + (" (one per group of species, each group masked to its own floor)" if masked else "")))
+
+
+def _periodic_cell(case: Case, lay, lo: list, hi: list) -> list[str]:
+    """Yade's periodic cell, x and y the case's box."""
+    # Yade's cell is periodic in z too: twice the height from the lowest floor box to the top of the box
+    half = _half_thickness(lay)
+    zs = [float(w.point[2]) for w in case.walls]
+    lz = 2.0 * (max([hi[2], *(z + 2.0 * half for z in zs)]) - min([lo[2], *(z - 2.0 * half for z in zs)]))
+    return [common.comment("Yade's periodic cell (periodic in x, y and z): x and y the case's box, z twice the "
+                           "height of the box and the floor, so nothing reaches across it"),
+            "O.periodic = True", f"O.cell.setBox({_num(hi[0])}, {_num(hi[1])}, {_num(lz)})",
+            f"LX = {_num(hi[0])}", f"LY = {_num(hi[1])}"]
+
+
+def _materials(laws, lay, pairs: dict, walls: list, masked: bool) -> list[str]:
+    """One Yade material per species, then the floors', and the laws of each pair as comments."""
+    lines = [common.comment("material k: species k + 1 (it carries twice its like pair's values: Yade combines "
+                            "two materials in series); after them the floor's"
+                            + (" (one per group of species, each group masked to its own floor)" if masked else ""))]
     for k, s in enumerate(lay.table):
         lines += [common.comment(f"species {s.type}: {s.material}, radius {fmt(s.radius)} m, mass {fmt(s.mass)} kg"),
                   _material(laws, laws.species[k])]
@@ -381,11 +402,16 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
     lines += [c for c in PD.law_comments(
         [*((f"species {a + 1} with {b + 1}", mp) for (a, b), mp in pairs.items()),
          *((f"species {a + 1} with the walls", mp) for a, mp in enumerate(walls))])]
-    lines += [common.comment("every particle: material (its species), radius (m), mass (kg), moment of inertia "
-                             "0.4 m r^2 (kg m^2), position (m),"),
-              common.comment("velocity v0 - dt/2 g (leap-frog's v at -dt/2, so that v0 is the full-step velocity at "
-                             "step 0: no contact at t = 0), angular velocity (rad/s)"),
-              "P = ["]
+    return lines
+
+
+def _bodies(case: Case, lay, laws, g, masked: bool) -> list[str]:
+    """Every particle's row, and the loop that makes Yade bodies of them."""
+    lines = [common.comment("every particle: material (its species), radius (m), mass (kg), moment of inertia "
+                            "0.4 m r^2 (kg m^2), position (m),"),
+             common.comment("velocity v0 - dt/2 g (leap-frog's v at -dt/2, so that v0 is the full-step velocity at "
+                            "step 0: no contact at t = 0), angular velocity (rad/s)"),
+             "P = ["]
     for k, part in enumerate(case.particles):
         sp = int(lay.species[k])
         m = case.mass(k)
@@ -396,6 +422,7 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
         lines.append(f"    ({sp}, {', '.join(row)}),")
     lines.append("]")
     if masked:
+        ns = len(lay.table)
         lines += [common.comment("each species' mask: bit 0 (every particle touches every particle) and its floor "
                                  "group's bit"),
                   f"MASK = [{', '.join(str(1 | (2 << laws.group_of[a])) for a in range(ns))}]"]
@@ -407,65 +434,69 @@ def deck(case: Case, duration: float | None = None, dt: float | None = None) -> 
               "    O.bodies[b].state.vel = Vector3(p[7], p[8], p[9])",
               "    O.bodies[b].state.angVel = Vector3(p[10], p[11], p[12])",
               "N = len(P)"]
-    lines += floor_lines
+    return lines
+
+
+def _engines_and_samples(laws, periodic: bool) -> list[str]:
+    """The engines, and the loop that prints the kinetic energy at each sample step."""
     bo1, ig2 = ("Bo1_Box_Aabb()", "Ig2_Box_Sphere_ScGeom()") if periodic else ("Bo1_Wall_Aabb()",
                                                                                  "Ig2_Wall_Sphere_ScGeom()")
-    lines += [common.comment("the engines: Yade's leap-frog NewtonIntegrator without its numerical damping (0.2 in "
-                             "many examples)"),
-              f"O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), {bo1}]"
-              + (", allowBiggerThanPeriod=True, sortAxis=2)," if periodic else "),"),
-              f"              InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), {ig2}], [{laws.phys}], [{laws.law}]),",
-              "              NewtonIntegrator(damping=0.0, gravity=G)]",
-              "O.dt = DT",
-              common.comment("at each sample step s: the state x_s, v_{s-1/2}, w_{s-1/2}; one step computes F_s; the "
-                             "full-step velocity v_s = v_{s-1/2} + dt/2 (F_s/m + g)"),
-              "done = 0",
-              "for s in SAMPLES:",
-              "    if s > done:",
-              "        O.run(s - done, True)",
-              "    x = [Vector3(O.bodies[i].state.pos) for i in range(N)]",
-              "    v = [Vector3(O.bodies[i].state.vel) for i in range(N)]",
-              "    w = [Vector3(O.bodies[i].state.angVel) for i in range(N)]",
-              "    O.step()",
-              "    e = 0.0",
-              "    for i in range(N):",
-              "        a = v[i] + (O.forces.f(i) / P[i][2] + G) * (0.5 * DT)",
-              "        e = e + 0.5 * P[i][2] * a.dot(a)",
-              f"    print({KE!r} % (s, e, N))",
-              "    done = s + 1",
-              common.comment("the final state at step STEPS: every particle (id = body id + 1, type = species; radius "
-                             "and mass as Yade holds them), F + m g as the LAMMPS-family engines write a particle's "
-                             "force"
-                             + ("; x and y wrapped into the box" if periodic else "")),
-              f"out = open({PD.FINAL_DUMP!r}, 'w')",
-              f"out.write({FINAL_HEAD[periodic]!r} % (STEPS, N, {', '.join(_num(b) for b in bounds)}))",
-              "for i in range(N):",
-              "    f = O.forces.f(i)",
-              "    t = O.forces.t(i)",
-              "    a = v[i] + (f / P[i][2] + G) * (0.5 * DT)",
-              "    q = w[i] + t * (0.5 * DT / P[i][3])",
-              "    f = f + G * P[i][2]",
-              "    b = O.bodies[i]",
-              (f"    out.write({FINAL_ROW!r} % (i + 1, P[i][0] + 1, b.shape.radius, b.state.mass, "
-               + ("x[i][0] - LX * (x[i][0] // LX), x[i][1] - LY * (x[i][1] // LY), " if periodic
-                  else "x[i][0], x[i][1], ")
-               + "x[i][2], a[0], a[1], a[2], q[0], q[1], q[2], f[0], f[1], f[2]))"),
-              "out.close()",
-              common.comment("every particle pair in contact at step STEPS (the floor's contacts left out): the ids, "
-                             "penetrationDepth, the normal force on the second (repulsive along the normal),"),
-              common.comment("the stored shear force (ViscElPhys: its elastic part; MindlinPhys: without the "
-                             "dashpot) and the normal from the first to the second"),
-              "rows = [c for c in O.interactions if c.isReal and c.id1 < N and c.id2 < N]",
-              f"out = open({PD.CONTACT_DUMP!r}, 'w')",
-              f"out.write({CONTACT_HEAD[periodic]!r} % (STEPS, len(rows), {', '.join(_num(b) for b in bounds)}))",
-              "for c in rows:",
-              "    f = c.phys.normalForce",
-              "    t = c.phys.shearForce",
-              "    a = c.geom.normal",
-              f"    out.write({CONTACT_ROW!r} % (c.id1 + 1, c.id2 + 1, c.geom.penetrationDepth, f[0], f[1], f[2], "
-              "t[0], t[1], t[2], a[0], a[1], a[2]))",
-              "out.close()", ""]
-    # free text (the case's and materials' names, the mapping's words) reaches the script only in comments, each
-    # an ASCII line (Yade reads a script in the locale's encoding when it is run by hand)
-    text = "\n".join(ascii_comment(x) if x.startswith("#") else x for x in lines)
-    return common.Deck("yade", text, {}, dt=lay.dt, check=check_script)
+    return [common.comment("the engines: Yade's leap-frog NewtonIntegrator without its numerical damping (0.2 in "
+                           "many examples)"),
+            f"O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), {bo1}]"
+            + (", allowBiggerThanPeriod=True, sortAxis=2)," if periodic else "),"),
+            f"              InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), {ig2}], [{laws.phys}], [{laws.law}]),",
+            "              NewtonIntegrator(damping=0.0, gravity=G)]",
+            "O.dt = DT",
+            common.comment("at each sample step s: the state x_s, v_{s-1/2}, w_{s-1/2}; one step computes F_s; the "
+                           "full-step velocity v_s = v_{s-1/2} + dt/2 (F_s/m + g)"),
+            "done = 0",
+            "for s in SAMPLES:",
+            "    if s > done:",
+            "        O.run(s - done, True)",
+            "    x = [Vector3(O.bodies[i].state.pos) for i in range(N)]",
+            "    v = [Vector3(O.bodies[i].state.vel) for i in range(N)]",
+            "    w = [Vector3(O.bodies[i].state.angVel) for i in range(N)]",
+            "    O.step()",
+            "    e = 0.0",
+            "    for i in range(N):",
+            "        a = v[i] + (O.forces.f(i) / P[i][2] + G) * (0.5 * DT)",
+            "        e = e + 0.5 * P[i][2] * a.dot(a)",
+            f"    print({KE!r} % (s, e, N))",
+            "    done = s + 1"]
+
+
+def _outputs(periodic: bool, bounds: list) -> list[str]:
+    """The final state of every particle and the particle pairs in contact, as dumps."""
+    return [common.comment("the final state at step STEPS: every particle (id = body id + 1, type = species; radius "
+                           "and mass as Yade holds them), F + m g as the LAMMPS-family engines write a particle's "
+                           "force"
+                           + ("; x and y wrapped into the box" if periodic else "")),
+            f"out = open({PD.FINAL_DUMP!r}, 'w')",
+            f"out.write({FINAL_HEAD[periodic]!r} % (STEPS, N, {', '.join(_num(b) for b in bounds)}))",
+            "for i in range(N):",
+            "    f = O.forces.f(i)",
+            "    t = O.forces.t(i)",
+            "    a = v[i] + (f / P[i][2] + G) * (0.5 * DT)",
+            "    q = w[i] + t * (0.5 * DT / P[i][3])",
+            "    f = f + G * P[i][2]",
+            "    b = O.bodies[i]",
+            (f"    out.write({FINAL_ROW!r} % (i + 1, P[i][0] + 1, b.shape.radius, b.state.mass, "
+             + ("x[i][0] - LX * (x[i][0] // LX), x[i][1] - LY * (x[i][1] // LY), " if periodic
+                else "x[i][0], x[i][1], ")
+             + "x[i][2], a[0], a[1], a[2], q[0], q[1], q[2], f[0], f[1], f[2]))"),
+            "out.close()",
+            common.comment("every particle pair in contact at step STEPS (the floor's contacts left out): the ids, "
+                           "penetrationDepth, the normal force on the second (repulsive along the normal),"),
+            common.comment("the stored shear force (ViscElPhys: its elastic part; MindlinPhys: without the "
+                           "dashpot) and the normal from the first to the second"),
+            "rows = [c for c in O.interactions if c.isReal and c.id1 < N and c.id2 < N]",
+            f"out = open({PD.CONTACT_DUMP!r}, 'w')",
+            f"out.write({CONTACT_HEAD[periodic]!r} % (STEPS, len(rows), {', '.join(_num(b) for b in bounds)}))",
+            "for c in rows:",
+            "    f = c.phys.normalForce",
+            "    t = c.phys.shearForce",
+            "    a = c.geom.normal",
+            f"    out.write({CONTACT_ROW!r} % (c.id1 + 1, c.id2 + 1, c.geom.penetrationDepth, f[0], f[1], f[2], "
+            "t[0], t[1], t[2], a[0], a[1], a[2]))",
+            "out.close()", ""]
