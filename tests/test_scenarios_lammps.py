@@ -109,7 +109,7 @@ def test_the_rolling_run_starts_rolling_without_slip():
 def test_engines_without_a_scenario_deck_say_not_expressible(name):
     planned = {p.source.label: p for p in plan(case(name))}
     assert planned["lammps"].runs
-    for other in ("liggghts", "yade", "kratos"):
+    for other in ("yade", "kratos"):
         assert planned[other].status == NOT_EXPRESSIBLE
         assert "deck is written for run.scenario" in planned[other].why
 

@@ -143,6 +143,7 @@ COMMANDS = frozenset({
     "compute", "timestep", "dump", "dump_modify", "undump", "write_dump", "thermo_style", "thermo_modify", "thermo",
     "run", "hard_particles", "soft_particles", "group"})
 STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/sphere", "move", "heat/flow",
+                                "heat/gran/conduction",
                                 "property/atom"})),
           "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local", "property/atom"})),
           "group": (2, frozenset({"id"})),

@@ -1,0 +1,64 @@
+"""The scenario cases beyond sliding in LIGGGHTS-PUBLIC 3.8.0: the conduction case runs for real from the deck
+demcheck writes (engines/liggghts/scenario.py: the held pair, fix heat/gran/conduction) and meets its twin (the
+lens conductance LensHeat stepped by explicit Euler) to the last bit; against the case's Batchelor & O'Brien
+conductance the time constant is 2.507× shorter (√(2π) = 2.5066 at δ/R̄ = 1e-3) — differs as expected; with
+``heat = "lens"`` the mapping is exact and agrees. The other five are not expressible, each with its reason."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from demcheck.case import load
+from demcheck.comparisons.sources import plan
+from demcheck.comparisons.verdicts import AGREE, EXPECTED, NOT_EXPRESSIBLE
+from demcheck.resources import case_path
+
+
+def rows(c):
+    from demcheck.comparisons.scenario_rows import engine_rows
+    from demcheck.comparisons.sources import ADAPTIVE
+    from demcheck.comparisons.suite import Options, discover
+    from demcheck.laws.model import resolve
+
+    opts = Options(engines=("liggghts",))
+    entry = {"model": resolve(c).describe(), "scales": {}, "sources": {}}
+    comps = []
+    engine_rows(c, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(c).metrics())
+    return entry, comps
+
+
+@pytest.mark.engine("liggghts")
+@pytest.mark.parametrize("heat, verdict, fidelity", [("radius", EXPECTED, "approximate"), ("lens", AGREE, "exact")])
+def test_liggghts_conduction_meets_its_twin(heat, verdict, fidelity):
+    c = load(case_path("suite/beyond-conduction.toml"), [f"contact.heat={heat}"])
+    entry, comps = rows(c)
+    (x,) = comps
+    src = entry["sources"]["liggghts"]
+    assert src["status"] == "ok" and src["fidelity"] == fidelity
+    assert x.metric == "heat_time_constant" and x.verdict == verdict, x.reason
+    assert abs(x.value - src["twin_metrics"]["heat_time_constant"]) <= 1e-9 * x.value  # measured: 0
+    if heat == "radius":
+        assert abs(x.reference / x.value - math.sqrt(2 * math.pi)) < 2e-3 * math.sqrt(2 * math.pi)
+    else:
+        assert x.rel_diff < 1e-4  # explicit Euler's dt/(2τ) = 2.5e-5
+
+
+@pytest.mark.parametrize("name, why", [
+    ("rolling", "no LIGGGHTS deck is written for a sphere rolling on a wall yet"),
+    ("incline", "no LIGGGHTS deck is written for a sphere rolling on a wall yet"),
+    ("twist", "has no twisting torque model"),
+    ("pull-off", "has no JKR or DMT normal model"),
+    ("adhesive-impact", "has no JKR normal model"),
+])
+def test_liggghts_says_why_it_cannot_run_the_others(name, why):
+    planned = {p.source.label: p for p in plan(load(case_path(f"suite/beyond-{name}.toml")))}
+    assert planned["liggghts"].status == NOT_EXPRESSIBLE and why in planned["liggghts"].why
+
+
+def test_liggghts_has_no_conductance_per_area():
+    from demcheck.engines import scenario
+
+    c = load(case_path("suite/beyond-conduction.toml"), ["contact.heat=area"])
+    assert "no conductance per contact area" in scenario.mapping(c, "liggghts").reasons[0]
