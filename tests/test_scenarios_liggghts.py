@@ -2,7 +2,10 @@
 demcheck writes (engines/liggghts/scenario.py: the held pair, fix heat/gran/conduction) and meets its twin (the
 lens conductance LensHeat stepped by explicit Euler) to the last bit; against the case's Batchelor & O'Brien
 conductance the time constant is 2.507× shorter (√(2π) = 2.5066 at δ/R̄ = 1e-3) — differs as expected; with
-``heat = "lens"`` the mapping is exact and agrees. The other five are not expressible, each with its reason."""
+``heat = "lens"`` the mapping is exact and agrees. The rolling case with a linear contact (beyond-rolling-linear:
+hooke/stiffness, tangential history, rolling_friction cdt on a primitive wall) meets its twin to 2.5e-15 and the
+reference to 3.3e-4 (stop time) and 5.6e-7 (distance), within the seed model's own stepped run: agree. The other
+five are not expressible, each with its reason."""
 
 from __future__ import annotations
 
@@ -45,9 +48,38 @@ def test_liggghts_conduction_meets_its_twin(heat, verdict, fidelity):
         assert x.rel_diff < 1e-4  # explicit Euler's dt/(2τ) = 2.5e-5
 
 
+@pytest.mark.engine("liggghts")
+def test_liggghts_rolls_the_linear_case_with_cdt_and_meets_its_twin():
+    c = load(case_path("suite/beyond-rolling-linear.toml"))
+    entry, comps = rows(c)
+    src = entry["sources"]["liggghts"]
+    assert src["status"] == "ok" and src["fidelity"] == "approximate"  # cdt's direction rule, the same here
+    assert {x.metric: x.verdict for x in comps} == {"rolling_stop_time": AGREE, "rolling_distance": AGREE}
+    for x in comps:
+        assert abs(x.value - src["twin_metrics"][x.metric]) <= 1e-9 * abs(x.value)  # measured ≤ 2.5e-15
+        assert x.rel_diff < 4e-4
+
+
+@pytest.mark.engine("liggghts")
+def test_the_liggghts_wall_twin_needs_its_contact_point_arm():
+    """LIGGGHTS's slip velocity and tangential torque use the arm R − δ/2 on a wall: the twin with LAMMPS's R
+    misses the engine by 1.3e-6 in the rolling distance (3.4e-7 in the stop time)."""
+    from demcheck.comparisons.sources import Source
+    from demcheck.engines import registry, scenario
+    from demcheck.reference.scenarios import stepped_metrics
+
+    c = load(case_path("suite/beyond-rolling-linear.toml"))
+    eng = registry.get("liggghts")
+    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
+    lay = scenario.layout(c, laws)
+    got = Source.of("liggghts").run(c).metrics()
+    wrong = stepped_metrics(c, scenario.step(c, {**laws, "arm": 0.0}, lay))
+    assert abs(wrong["rolling_distance"] / got["rolling_distance"] - 1) > 1e-7
+
+
 @pytest.mark.parametrize("name, why", [
-    ("rolling", "no LIGGGHTS deck is written for a sphere rolling on a wall yet"),
-    ("incline", "no LIGGGHTS deck is written for a sphere rolling on a wall yet"),
+    ("rolling", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' (not 'hertz')"),
+    ("incline", "a constant Kt needs hooke/stiffness, i.e. normal 'lsd' (not 'hertz')"),
     ("twist", "has no twisting torque model"),
     ("pull-off", "has no JKR or DMT normal model"),
     ("adhesive-impact", "has no JKR normal model"),

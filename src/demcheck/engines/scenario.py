@@ -158,7 +158,8 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
         return _b.verlet_wall(radius, mass, lay.positions[0], lay.velocities[0], lay.omegas[0], case.run.gravity,
                               w.point, w.normal, lay.dt, lay.steps, lay.every, normal=laws["normal"],
                               fcrit=laws.get("fcrit"), tangential=laws.get("tangential"),
-                              rolling=laws.get("rolling"), twisting=laws.get("twisting"))
+                              rolling=laws.get("rolling"), twisting=laws.get("twisting"),
+                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation") if k in laws})
     if s == "pull_off":
         return _pull(case, laws["adhesion"], lay)
     if s == "adhesive_impact":

@@ -322,15 +322,18 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
 
 def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point, wall_normal, dt: float,
                 steps: int, every: int, *, normal, fcrit=None, tangential=None, rolling=None,
-                twisting=None) -> dict:
+                twisting=None, roll_fcrit=None, arm: float = 0.0, truncation: str = "maw") -> dict:
     """One sphere on a flat wall (its plane through ``wall_point``, ``wall_normal`` pointing to the sphere's
     side) under ``gravity``, stepped the way ``fix nve/sphere`` with ``fix wall/gran`` and ``fix gravity`` does
     (half kick, drift, forces at full-step positions and half-step velocities, half kick). ``normal(δ, δ̇)`` is the
     normal force (> 0 repulsive), ``fcrit(δ, δ̇)`` the force the limits scale with (default |normal|);
-    ``tangential`` = (kt, x_t·η, μ): the linear history spring on the slip velocity v_t − R ω × n_w, its
-    history rescaled after Maw when |F_t| passes μ|Fn| (LAMMPS ``linear_history``); the torque arm is R. The
-    rolling and twisting records see the wall as body 1 (at rest, n from the sphere into the wall). Returns, at
-    steps 0, every, 2·every, …: t, x, v, ω (rows × 3)."""
+    ``tangential`` = (kt, x_t·η, μ): the linear history spring on the slip velocity v_t − r ω × n_w, its
+    history rescaled after Maw when |F_t| passes μ|Fn| (``truncation`` "maw": LAMMPS ``linear_history``) or the
+    spring alone capped and the dashpot added only while it sticks ("spring": LIGGGHTS ``tangential history``);
+    the slip and torque arm r is R − ``arm``·δ (0: LAMMPS's R; ½: LIGGGHTS's contact point). The rolling and
+    twisting records see the wall as body 1 (at rest, n from the sphere into the wall); ``roll_fcrit(δ, δ̇)`` the
+    rolling limit's force when it is not ``fcrit``'s (LIGGGHTS cdt: the elastic part). Returns, at steps 0,
+    every, 2·every, …: t, x, v, ω (rows × 3)."""
     inertia = 0.4 * mass * radius * radius
     nw = np.asarray(wall_normal, dtype=float)
     p = np.asarray(wall_point, dtype=float)
@@ -346,16 +349,19 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
             return mass * g, np.zeros(3)
         rate = -float(v @ nw)
         fn, crit = normal(delta, rate), fcrit(delta, rate)
-        vt = v - (v @ nw) * nw - np.cross(radius * w, nw)
+        r_arm = radius - arm * delta
+        vt = v - (v @ nw) * nw - np.cross(r_arm * w, nw)
         fs, hist = np.zeros(3), state["t"]
         if tangential is not None:
-            fs, hist = _maw_spring(hist, vt, dt if update else 0.0, *tangential, crit)
+            spring = _maw_spring if truncation == "maw" else _capped_spring
+            fs, hist = spring(hist, vt, dt if update else 0.0, *tangential, crit)
         h = dt if update else 0.0
-        m_roll, roll = rolling_torque(rolling, w, -nw, crit, h, state["roll"])
+        m_roll, roll = rolling_torque(rolling, w, -nw, roll_fcrit(delta, rate) if roll_fcrit else crit, h,
+                                      state["roll"])
         m_tw, phi = twisting_torque(twisting, w, -nw, crit, math.sqrt(radius * delta), h, state["twist"])
         if update:
             state.update(t=hist, roll=roll, twist=phi)
-        torque = -radius * np.cross(nw, fs) + m_roll + m_tw
+        torque = -r_arm * np.cross(nw, fs) + m_roll + m_tw
         return fn * nw + fs + mass * g, torque
 
     f, tq = forces(False)
@@ -389,6 +395,23 @@ def _maw_spring(hist, vt, h, kt, damp, mu, fncrit):
         else:
             fs = np.zeros(3)
     return fs, hist
+
+
+def _capped_spring(hist, vt, h, kt, damp, mu, fncrit):
+    """LIGGGHTS's ``tangential history`` on a flat wall: ξ += h v_t; past μ Fcrit the spring force kt|ξ| is scaled
+    to it (ξ with it) and the dashpot dropped, else F = −kt ξ − damp v_t."""
+    hist = hist + h * vt
+    fs = -kt * hist
+    cap = mu * fncrit
+    shear = kt * float(np.linalg.norm(hist))
+    if shear > cap:
+        if shear != 0.0:
+            fs = fs * (cap / shear)
+            hist = -fs / kt
+        else:
+            fs = np.zeros(3)
+        return fs, hist
+    return fs - damp * vt, hist
 
 
 # ----------------------------------------------------------------------------- metrics of a stepped run

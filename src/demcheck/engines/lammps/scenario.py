@@ -47,8 +47,6 @@ def mapping(case: Case) -> Mapping:
     if case.run.scenario in ("rolling", "incline") and nat.tangential != "linear_history":
         return refused("lammps", "a sphere rolling on a wall needs the case's tangential spring (a linear one: "
                                  "LAMMPS linear_history) to roll without slip")
-    if nat.damping != "velocity":
-        return refused("lammps", f"the scenario's twin steps a constant normal dashpot, not damping {nat.damping}")
     made = {"rolling": _rolling, "twisting": _twisting, "heat": _heat}[slot](model, rec, nat)
     if isinstance(made, Mapping):
         return made
@@ -141,6 +139,10 @@ def twin_laws(case: Case, nat: Native) -> dict:
     laws = {"normal": normal, **slots}
     if nat.tangential == "linear_history":
         kt, x_t, mu = nat.tangential_args
+        if x_t and b:
+            from ...errors import UnsupportedByEngine
+            raise UnsupportedByEngine(f"the wall twin steps a constant tangential dashpot, not x_t × damping "
+                                      f"{nat.damping} (δ^{b:g})")
         laws["tangential"] = (kt, x_t * c, mu)
     return laws
 

@@ -16,6 +16,7 @@ from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
 from ...laws.heat import LensHeat
+from ...laws.rolling import ConstantTorqueRolling
 from ...laws.model import resolve
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 from .deck import VERSION_NOTE, model_setup, property_matrices
@@ -36,9 +37,15 @@ WHY_NOT = {
 
 def mapping(case: Case) -> Mapping:
     s = case.run.scenario
+    model = resolve(case)
+    if s in ("rolling", "incline"):  # the contact itself first: the case's own reason where LIGGGHTS has none
+        base = map_model(model, case.contact.params)
+        if base.native is None:
+            return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")
+        if s == "rolling":
+            return _rolling(model, base)
     if s in WHY_NOT:
         return refused("liggghts", WHY_NOT[s])
-    model = resolve(case)
     rec = model.slot("heat")
     if rec.id == "area":
         return refused("liggghts", "LIGGGHTS fix heat/gran/conduction has no conductance per contact area")
@@ -61,11 +68,78 @@ def mapping(case: Case) -> Mapping:
     return mp
 
 
+def _rolling(model, base: Mapping) -> Mapping:
+    """Type A on a wall as ``rolling_friction cdt`` (coefficientRollingFriction μr Rr/R), with the wall's
+    hooke/stiffness contact and ``tangential history``."""
+    nat, rec = base.native, model.slot("rolling")
+    if nat.normal != "hooke/stiffness" or nat.tangential != "history":
+        return refused("liggghts", "the rolling scenario is written for hooke/stiffness with tangential history "
+                                   f"(the case maps to {nat.normal} / {nat.tangential})")
+    r = model.pair.r_eff
+    mu = rec.mu_r * rec.r_roll / r
+    reasons = [] if rec.full_direction else [
+        "cdt takes its direction from the whole relative spin (full_direction): the case's type A takes the "
+        "rolling part only — the same torque while the sphere does not spin about the wall's normal"]
+    nat.props = {**nat.props, "rolling_friction": mu, "slots": {"rolling": ConstantTorqueRolling(mu, r, True)}}
+    nat.comments = [*nat.comments, f"rolling_friction cdt, coefficientRollingFriction {mu:g}"]
+    return Mapping("liggghts", APPROXIMATE if reasons else base.fidelity, [*base.reasons, *reasons], nat,
+                   {**base.keywords, **{x: "rolling_friction cdt" for x in reasons}})
+
+
 def twin_laws(case: Case, nat: Native) -> dict:
-    return {"heat": nat.props["slots"]["heat"]}
+    if case.run.scenario == "conduction":
+        return {"heat": nat.props["slots"]["heat"]}
+    m = case.mass(0)
+    kn, eta = nat.props["kn"], nat.props["gamman"] * m
+    damp = nat.props.get("gammat", 0.0) * m if nat.tangential_damping else 0.0
+    return {"normal": lambda d, rate: kn * d + eta * rate, "roll_fcrit": lambda d, rate: kn * d,
+            "tangential": (nat.props["kt"], damp, nat.props["friction"]), "arm": 0.5, "truncation": "spring",
+            "rolling": nat.props["slots"]["rolling"]}
 
 
 def deck(case: Case, nat: Native, lay) -> common.Deck:
+    return _held_deck(case, nat, lay) if case.run.scenario == "conduction" else _wall_deck(case, nat, lay)
+
+
+DUMP_WALL = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz")
+
+
+def _wall_deck(case: Case, nat: Native, lay) -> common.Deck:
+    """A sphere on a primitive wall (type 2) under gravity, rolling_friction cdt in the pair style and the wall."""
+    props = {k: v for k, v in nat.props.items() if k not in ("slots", "rolling_friction")}
+    plain = replace(nat, props=props)
+    matrices = property_matrices(plain, 2, lambda a, b: plain)
+    model_lines, style, flags = model_setup(plain, matrices, [], [])
+    mu = nat.props["rolling_friction"]
+    style += " rolling_friction cdt"
+    w = case.walls[0]
+    axis = int(np.argmax(np.abs(w.normal)))
+    g = np.asarray(case.run.gravity, dtype=float)
+    gn = float(np.linalg.norm(g))
+    lines = [f"# demcheck scenario {case.run.scenario} ({case.name}); {VERSION_NOTE}",
+             *(f"# {c}" for c in nat.comments),
+             "units si", "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+             "communicate single vel yes", "read_data data.lmp", f"set atom 1 mass {fmt(case.mass(0))}",
+             f"neighbor {fmt(case.particles[0].radius)} bin", "neigh_modify delay 0", *model_lines,
+             f"fix m_rf all property/global coefficientRollingFriction peratomtypepair 2 {' '.join([fmt(mu)] * 4)}",
+             f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *",
+             f"fix wall all wall/gran {style} primitive type 2 {'xyz'[axis]}plane {fmt(w.point[axis])} "
+             f"{' '.join(flags)}",
+             f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(x / gn) for x in g)}",
+             "fix integrate all nve/sphere", f"timestep {fmt(lay.dt)}",
+             f"dump state all custom {lay.every} {common.DUMP_FILE} {' '.join(DUMP_WALL)}",
+             'dump_modify state format "%d' + " %.17g" * (len(DUMP_WALL) - 1) + '" sort id', f"run {lay.steps}", ""]
+    pos = np.array(lay.positions[0])
+    reach = 4 * case.particles[0].radius + abs(float(np.max(np.abs(lay.velocities[0])))) * lay.dt * lay.steps * 2
+    box = (pos - reach, pos + reach)
+    p = case.particles[0]
+    moved = replace(case, particles=[replace(p, position=tuple(lay.positions[0]), velocity=tuple(lay.velocities[0]),
+                                             angular_velocity=tuple(lay.omegas[0]))])
+    data = common.data_file(moved, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
+
+
+def _held_deck(case: Case, nat: Native, lay) -> common.Deck:
     """The held pair: a data file at the layout's positions, the contact's properties, no integrator, the heat fix
     started at body 0's temperature and body 1's set after a ``run 0``."""
     n = len(case.particles)
@@ -98,8 +172,15 @@ def deck(case: Case, nat: Native, lay) -> common.Deck:
 
 
 def read(case: Case, lay, workdir) -> dict:
-    """The held pair's temperatures, sampled from step 0 (the dump after ``run 0`` starts at the run's step 0)."""
+    """The held pair's temperatures, sampled from step 0 (the dump after ``run 0`` starts at the run's step 0);
+    the rolling sphere's samples."""
     from ..dumps import read_dump
+
+    if case.run.scenario != "conduction":
+        t = read_dump(Path(workdir) / common.DUMP_FILE, columns=DUMP_WALL).sort_values("step")
+        cols = lambda *n: np.column_stack([t[c].to_numpy() for c in n])  # noqa: E731
+        return {"t": t["step"].to_numpy() * lay.dt, "x": cols("x", "y", "z"), "v": cols("vx", "vy", "vz"),
+                "omega": cols("omegax", "omegay", "omegaz")}
 
     table = read_dump(Path(workdir) / common.DUMP_FILE, columns=("id", "f_Temp")).sort_values(["step", "id"])
     steps = table["step"].to_numpy()[::2]
