@@ -9,6 +9,7 @@ solve with a verdict. Measured (LAMMPS 22Jul2025):
   rolling spring winds up before it holds its limit);
 * rolling-linear (the same with a linear contact): the same numbers to 1e-14 (the sphere sits at its static overlap);
 * incline (epsd as rolling sds): the critical angle from the acceleration down 10°, 6.5e-6 — agree;
+* incline-linear (LSD, type C without its dashpot, exact): 9.2e-6 — agree;
 * twist (twisting sds, exact): 2.0e-4, all of it the unstretched spring's wind-up that the seed run has too — agree;
 * pull_off (jkr, approximate): the pull-off force 1.5e-9 — agree; the separation 0.52 — differs as expected
   (LAMMPS breaks at δ_c, not δ_f);
@@ -34,6 +35,7 @@ EXPECT = {
     "rolling": ({"rolling_stop_time": AGREE, "rolling_distance": EXPECTED}, "approximate"),
     "rolling-linear": ({"rolling_stop_time": AGREE, "rolling_distance": EXPECTED}, "approximate"),
     "incline": ({"incline_critical_angle": AGREE}, "approximate"),
+    "incline-linear": ({"incline_critical_angle": AGREE}, "exact"),
     "twist": ({"twist_stop_time": AGREE}, "exact"),
     "pull-off": ({"pull_off_force": AGREE, "separation_at_pull_off": EXPECTED}, "approximate"),
     "adhesive-impact": ({"restitution": EXPECTED, "capture_velocity": EXPECTED}, "approximate"),

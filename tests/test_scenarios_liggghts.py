@@ -4,8 +4,11 @@ lens conductance LensHeat stepped by explicit Euler) to the last bit; against th
 conductance the time constant is 2.507× shorter (√(2π) = 2.5066 at δ/R̄ = 1e-3) — differs as expected; with
 ``heat = "lens"`` the mapping is exact and agrees. The rolling case with a linear contact (beyond-rolling-linear:
 hooke/stiffness, tangential history, rolling_friction cdt on a primitive wall) meets its twin to 2.5e-15 and the
-reference to 3.3e-4 (stop time) and 5.6e-7 (distance), within the seed model's own stepped run: agree. The other
-five are not expressible, each with its reason."""
+reference to 3.3e-4 (stop time) and 5.6e-7 (distance), within the seed model's own stepped run: agree. The incline
+with a linear contact (beyond-incline-linear: rolling_friction epsd3, kr = rollingStiffness·kn·μr²·R²) meets its
+twin to 9.4e-12 in the critical angle — per sample, ω differs by up to 1.6e-9 of its largest value, from the second
+step on (LAMMPS on the same case: 5e-15): a rule of LIGGGHTS's epsd family on a loaded wall contact not found —
+and the reference to 1.0e-5: agree. The other five are not expressible, each with its reason."""
 
 from __future__ import annotations
 
@@ -58,6 +61,24 @@ def test_liggghts_rolls_the_linear_case_with_cdt_and_meets_its_twin():
     for x in comps:
         assert abs(x.value - src["twin_metrics"][x.metric]) <= 1e-9 * abs(x.value)  # measured ≤ 2.5e-15
         assert x.rel_diff < 4e-4
+
+
+@pytest.mark.engine("liggghts")
+def test_liggghts_rolls_the_linear_incline_with_epsd3():
+    c = load(case_path("suite/beyond-incline-linear.toml"))
+    entry, comps = rows(c)
+    (x,) = comps
+    src = entry["sources"]["liggghts"]
+    assert src["status"] == "ok" and src["fidelity"] == "exact" and x.verdict == AGREE, x.reason
+    assert abs(x.value - src["twin_metrics"]["incline_critical_angle"]) <= 1e-9 * x.value  # measured 9.4e-12
+    assert x.rel_diff < 2e-5
+
+
+def test_liggghts_epsd3_needs_a_rolling_stiffness_of_at_least_one():
+    from demcheck.engines import scenario
+
+    c = load(case_path("suite/beyond-incline-linear.toml"), ["contact.k_r=1e-3"])
+    assert "requires rollingStiffness ≥ 1" in scenario.mapping(c, "liggghts").reasons[0]
 
 
 @pytest.mark.engine("liggghts")

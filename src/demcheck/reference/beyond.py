@@ -322,7 +322,8 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
 
 def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point, wall_normal, dt: float,
                 steps: int, every: int, *, normal, fcrit=None, tangential=None, rolling=None,
-                twisting=None, roll_fcrit=None, arm: float = 0.0, truncation: str = "maw") -> dict:
+                twisting=None, roll_fcrit=None, arm: float = 0.0, truncation: str = "maw",
+                setup_increment: bool = False) -> dict:
     """One sphere on a flat wall (its plane through ``wall_point``, ``wall_normal`` pointing to the sphere's
     side) under ``gravity``, stepped the way ``fix nve/sphere`` with ``fix wall/gran`` and ``fix gravity`` does
     (half kick, drift, forces at full-step positions and half-step velocities, half kick). ``normal(δ, δ̇)`` is the
@@ -332,8 +333,9 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
     spring alone capped and the dashpot added only while it sticks ("spring": LIGGGHTS ``tangential history``);
     the slip and torque arm r is R − ``arm``·δ (0: LAMMPS's R; ½: LIGGGHTS's contact point). The rolling and
     twisting records see the wall as body 1 (at rest, n from the sphere into the wall); ``roll_fcrit(δ, δ̇)`` the
-    rolling limit's force when it is not ``fcrit``'s (LIGGGHTS cdt: the elastic part). Returns, at steps 0,
-    every, 2·every, …: t, x, v, ω (rows × 3)."""
+    rolling limit's force when it is not ``fcrit``'s (LIGGGHTS cdt: the elastic part); ``setup_increment``: the
+    set-up call adds one step's increment to the rolling torque it applies and forgets it (LIGGGHTS's epsd
+    family, as ``verlet_pair``). Returns, at steps 0, every, 2·every, …: t, x, v, ω (rows × 3)."""
     inertia = 0.4 * mass * radius * radius
     nw = np.asarray(wall_normal, dtype=float)
     p = np.asarray(wall_point, dtype=float)
@@ -356,8 +358,8 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
             spring = _maw_spring if truncation == "maw" else _capped_spring
             fs, hist = spring(hist, vt, dt if update else 0.0, *tangential, crit)
         h = dt if update else 0.0
-        m_roll, roll = rolling_torque(rolling, w, -nw, roll_fcrit(delta, rate) if roll_fcrit else crit, h,
-                                      state["roll"])
+        m_roll, roll = rolling_torque(rolling, w, -nw, roll_fcrit(delta, rate) if roll_fcrit else crit,
+                                      dt if update or setup_increment else 0.0, state["roll"])
         m_tw, phi = twisting_torque(twisting, w, -nw, crit, math.sqrt(radius * delta), h, state["twist"])
         if update:
             state.update(t=hist, roll=roll, twist=phi)

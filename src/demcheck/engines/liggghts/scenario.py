@@ -16,7 +16,7 @@ from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
 from ...laws.heat import LensHeat
-from ...laws.rolling import ConstantTorqueRolling
+from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling
 from ...laws.model import resolve
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 from .deck import VERSION_NOTE, model_setup, property_matrices
@@ -30,8 +30,7 @@ WHY_NOT = {
                        "proportional to the contact area to the normal law)",
     "rolling": "no LIGGGHTS deck is written for a sphere rolling on a wall yet (its hertz tangential spring is "
                "kt = 8G*√(R̄δ), not the case's constant kt, and the twins of its rolling models step pairs only)",
-    "incline": "no LIGGGHTS deck is written for a sphere rolling on a wall yet (epsd/epsd2/epsd3 derive kr from "
-               "the normal or tangential stiffness, δ-dependent under hertz; the case's kr is a constant)",
+    "incline": "LIGGGHTS's incline is written for type C (epsd3) only",
 }
 
 
@@ -44,6 +43,8 @@ def mapping(case: Case) -> Mapping:
             return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")
         if s == "rolling":
             return _rolling(model, base)
+        if model.slot("rolling").id == "epsd":
+            return _incline(model, base)
     if s in WHY_NOT:
         return refused("liggghts", WHY_NOT[s])
     rec = model.slot("heat")
@@ -86,15 +87,47 @@ def _rolling(model, base: Mapping) -> Mapping:
                    {**base.keywords, **{x: "rolling_friction cdt" for x in reasons}})
 
 
+def _incline(model, base: Mapping) -> Mapping:
+    """Type C as ``rolling_friction epsd3``: kr = rollingStiffness·kn·μr²·R² (kn the hooke/stiffness constant),
+    the limit on the spring; written without its dashpot (ηr = 0)."""
+    nat, rec = base.native, model.slot("rolling")
+    if nat.normal != "hooke/stiffness" or nat.tangential != "history":
+        return refused("liggghts", "the incline is written for hooke/stiffness with tangential history "
+                                   f"(the case maps to {nat.normal} / {nat.tangential})")
+    if rec.c_r != 0.0:
+        return refused("liggghts", "the incline is written for LIGGGHTS's epsd3 without its dashpot (c_r = 0): "
+                                   "its Cr = ηr·2√(Ir kr) on a wall is not checked")
+    r = model.pair.r_eff
+    mu = rec.mu_r * rec.r_roll / r
+    factor = rec.k_r / (nat.props["kn"] * mu * mu * r * r)
+    if not factor >= 1.0:
+        return refused("liggghts", f"LIGGGHTS requires rollingStiffness ≥ 1 (kr ≥ kn·μr²·R² = "
+                                   f"{nat.props['kn'] * mu * mu * r * r:.4g} N·m/rad); the case's kr = {rec.k_r:g}")
+    k_r = factor * nat.props["kn"] * mu * mu * r * r
+    reasons = [] if rec.cap == CAP_SPRING else [
+        "LIGGGHTS's epsd family caps the spring (Ai et al.); the case caps spring + dashpot (no dashpot here)"]
+    nat.props = {**nat.props, "rolling_friction": mu, "rolling_model": "epsd3", "rolling_stiffness": factor,
+                 "slots": {"rolling": EpsdRolling(mu, r, k_r, 0.0, CAP_SPRING)}}
+    nat.comments = [*nat.comments, f"rolling_friction epsd3, coefficientRollingFriction {mu:g}, rollingStiffness "
+                                   f"{factor:.10g} (kr = rollingStiffness·kn·μr²·R² = {k_r:.10g} N·m/rad)"]
+    return Mapping("liggghts", APPROXIMATE if reasons else base.fidelity, [*base.reasons, *reasons], nat,
+                   {**base.keywords, **{x: "rolling_friction epsd3" for x in reasons}})
+
+
 def twin_laws(case: Case, nat: Native) -> dict:
     if case.run.scenario == "conduction":
         return {"heat": nat.props["slots"]["heat"]}
     m = case.mass(0)
     kn, eta = nat.props["kn"], nat.props["gamman"] * m
     damp = nat.props.get("gammat", 0.0) * m if nat.tangential_damping else 0.0
-    return {"normal": lambda d, rate: kn * d + eta * rate, "roll_fcrit": lambda d, rate: kn * d,
+    laws = {"normal": lambda d, rate: kn * d + eta * rate,
             "tangential": (nat.props["kt"], damp, nat.props["friction"]), "arm": 0.5, "truncation": "spring",
             "rolling": nat.props["slots"]["rolling"]}
+    if nat.props.get("rolling_model", "cdt") == "cdt":
+        laws["roll_fcrit"] = lambda d, rate: kn * d  # cdt's limit: the elastic part
+    else:
+        laws["setup_increment"] = True  # the epsd family's set-up step
+    return laws
 
 
 def deck(case: Case, nat: Native, lay) -> common.Deck:
@@ -106,12 +139,16 @@ DUMP_WALL = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz"
 
 def _wall_deck(case: Case, nat: Native, lay) -> common.Deck:
     """A sphere on a primitive wall (type 2) under gravity, rolling_friction cdt in the pair style and the wall."""
-    props = {k: v for k, v in nat.props.items() if k not in ("slots", "rolling_friction")}
+    props = {k: v for k, v in nat.props.items()
+             if k not in ("slots", "rolling_friction", "rolling_model", "rolling_stiffness")}
     plain = replace(nat, props=props)
     matrices = property_matrices(plain, 2, lambda a, b: plain)
     model_lines, style, flags = model_setup(plain, matrices, [], [])
-    mu = nat.props["rolling_friction"]
-    style += " rolling_friction cdt"
+    mu, model = nat.props["rolling_friction"], nat.props.get("rolling_model", "cdt")
+    style += f" rolling_friction {model}"
+    if model == "epsd3":
+        model_lines += [f"fix m_rs all property/global rollingStiffness scalar {fmt(nat.props['rolling_stiffness'])}",
+                        "fix m_rd all property/global coefficientRollingViscousDamping peratomtypepair 2 0 0 0 0"]
     w = case.walls[0]
     axis = int(np.argmax(np.abs(w.normal)))
     g = np.asarray(case.run.gravity, dtype=float)
