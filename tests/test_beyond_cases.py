@@ -35,14 +35,14 @@ def test_the_contact_carries_the_records_resolved_for_the_pair():
     from demcheck.laws.model import resolve
 
     c = resolve(load("rolling")).contact
-    assert c.rolling == ConstantTorqueRolling(mu_r=0.02, r_roll=1.59e-3, full_direction=False)
-    assert c.ids() == {"normal": "hertz", "damping": "none", "tangential": "none", "rolling": "constant_torque",
+    assert c.rolling == ConstantTorqueRolling(mu_r=0.1, r_roll=1.59e-3, full_direction=False)
+    assert c.ids() == {"normal": "hertz", "damping": "none", "tangential": "spring", "rolling": "constant_torque",
                        "twisting": "none", "adhesion": "none", "heat": "none"}
     inc = resolve(load("incline", "contact.cap=total")).contact.rolling
     assert isinstance(inc, EpsdRolling) and inc.cap == CAP_TOTAL and inc.k_r == 1e-3 and inc.r_roll == 2e-3
     jkr = resolve(load("pull_off")).contact.adhesion
     assert jkr == JkrAdhesion(r_eff=5e-4, e_eff=1.0 / (2 * (1 - 0.45 ** 2) / 5e6), w=0.05)
-    assert resolve(load("twist")).contact.twisting == SdsTwisting(1e-5, 0.0, 1e-4)
+    assert resolve(load("twist")).contact.twisting == SdsTwisting(1e-3, 0.0, 5e-4)
 
 
 @pytest.mark.parametrize("scenario", sorted(SCENARIO_CASES))
@@ -58,11 +58,11 @@ def test_closed_forms_are_the_textbook_numbers():
     """Independent of the records' plumbing: the shipped cases' numbers into the formulas by hand."""
     m = 2500.0 * 4 / 3 * math.pi * 1.59e-3 ** 3
     got = scenario_metrics(load("rolling"))
-    a = 5 / 7 * 0.02 * 9.81
-    assert abs(got["rolling_stop_time"] - 0.1 / a) < 1e-9 * 0.1 / a
-    assert abs(got["rolling_distance"] - 0.01 / (2 * a)) < 1e-9 * 0.01 / (2 * a)
+    a = 5 / 7 * 0.1 * 9.81
+    assert abs(got["rolling_stop_time"] - 0.02 / a) < 1e-9 * 0.02 / a
+    assert abs(got["rolling_distance"] - 0.02 ** 2 / (2 * a)) < 1e-9 * 0.02 ** 2 / (2 * a)
     assert abs(scenario_metrics(load("incline"))["incline_critical_angle"] - math.atan(0.1)) < 1e-12
-    t = 0.4 * m * 1.59e-3 ** 2 * 50.0 / (1e-4 * m * 9.81)
+    t = 0.4 * m * 1.59e-3 ** 2 * 50.0 / (5e-4 * m * 9.81)
     assert abs(scenario_metrics(load("twist"))["twist_stop_time"] - t) < 1e-9 * t
     assert abs(scenario_metrics(load("pull_off"))["pull_off_force"] - 1.5 * math.pi * 0.05 * 5e-4) < 1e-15
     ms = 7800.0 * 4 / 3 * math.pi * 8e-9
@@ -77,7 +77,7 @@ def test_collide_prints_the_scenario_metrics():
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
     assert d["status"] == "ok" and d["model"]["rolling"] == "constant_torque"
-    t, s = b.rolling_stop_closed(0.02, 1.59e-3, 1.59e-3, 0.1, 9.81)
+    t, s = b.rolling_stop_closed(0.1, 1.59e-3, 1.59e-3, 0.02, 9.81)
     assert abs(d["metrics"]["rolling_stop_time"] - t) < 1e-9 * t and abs(d["metrics"]["rolling_distance"] - s) < 1e-9 * s
     assert api.collide(case_path("suite/beyond-conduction.toml")).metrics()["heat_time_constant"] > 0
 
@@ -87,7 +87,7 @@ def test_collide_prints_the_scenario_metrics():
     (["contact.mu_r=-1"], "contact.mu_r", "must be >= 0"),
     (["contact.mu_r=true"], "contact.mu_r", "must be a finite number"),
     (["contact.full_direction=1"], "contact.full_direction", "must be true or false"),
-    (["contact.k_tw=1"], "contact.k_tw", "is not a parameter of normal 'hertz' or tangential 'none', rolling"),
+    (["contact.k_tw=1"], "contact.k_tw", "is not a parameter of normal 'hertz' or tangential 'spring_sliding', rolling"),
     (["run.scenario=collision"], "contact.rolling", "is solved in the scenarios beyond sliding only"),
     (["run.scenario=spin"], "run.scenario", "must be one of collision, rolling"),
     (["run.scenario=twist"], "contact.twisting", "needs twisting = \"sds\" or \"marshall\""),
@@ -141,7 +141,7 @@ def test_marshall_takes_mu_t_from_the_pairs_friction():
     from demcheck.laws.model import resolve
 
     text = case_path("suite/beyond-twist.toml").read_text().replace(
-        'twisting = "sds"\nk_tw = 1e-5\ngamma_tw = 0.0\nmu_tw = 1e-4', 'twisting = "marshall"\nkt = 1e3')
+        'twisting = "sds"\nk_tw = 1e-3\ngamma_tw = 0.0\nmu_tw = 5e-4', 'twisting = "marshall"\nkt = 1e3')
     law = resolve(C.loads(text)).contact.twisting
     assert law.id == "marshall" and law.mu_t == 0.3 and law.kt == 1e3
     got, closed = (scenario_metrics(C.loads(text), closed=x)["twist_stop_time"] for x in (False, True))
@@ -151,8 +151,8 @@ def test_marshall_takes_mu_t_from_the_pairs_friction():
 def test_engines_refuse_a_scenario_they_do_not_run():
     from demcheck.comparisons.sources import Source
 
-    with pytest.raises(UnsupportedByEngine, match="solved by the reference only"):
-        api.collide(case_path("suite/beyond-rolling.toml"), source="lammps")
+    with pytest.raises(UnsupportedByEngine, match="no Kratos DEM deck is written for run.scenario"):
+        api.collide(case_path("suite/beyond-rolling.toml"), source="kratos")
     with pytest.raises(ConfigError, match="adaptive reference only"):
         Source.reference("verlet").run(load("twist"))
 
@@ -186,7 +186,6 @@ def test_verify_judges_each_scenario_against_its_closed_form(tmp_path):
         assert sorted(c["metric"] for c in comps) == sorted(SCENARIO_METRICS[entry["scenario"]])
         assert all(c["source"] == "closed-form" and c["verdict"] == "agree" and c["rel_diff"] <= 1e-9
                    for c in comps), comps
-        assert "solved by the reference only" in entry["engines"]
     assert "(rolling)" in (Path(res["report"]) / "report.md").read_text()
 
 
@@ -216,7 +215,7 @@ def test_sweep_solves_a_scenario_at_each_point_and_dt_refuses_one():
     assert p.returncode == 0, p.stderr
     rows = json.loads(p.stdout)["rows"]
     for row in rows:
-        t, _ = b.rolling_stop_closed(row["contact.mu_r"], 1.59e-3, 1.59e-3, 0.1, 9.81)
+        t, _ = b.rolling_stop_closed(row["contact.mu_r"], 1.59e-3, 1.59e-3, 0.02, 9.81)
         assert row["status"] == "ok" and abs(row["rolling_stop_time"] - t) < 1e-9 * t
     d = subprocess.run([sys.executable, "-m", "demcheck", "dt", "beyond-twist"], capture_output=True, text=True)
     assert d.returncode == 2 and "run.scenario = 'twist': has no time step to recommend" in d.stderr

@@ -122,7 +122,7 @@ class Source:
         engine's dt. ``native``: the engine's setting (default the case's own, at its own step when ``dt`` is
         None; None: the engine's mapping of the seed model)."""
         if case.run.scenario != "collision":
-            return self._scenario(case)
+            return self._scenario(case, timeout)
         if self.kind == REFERENCE:
             from ..reference.collision import collide
 
@@ -145,16 +145,20 @@ class Source:
             return run_engine(case, self.engine, dt=dt, native=native, **options)
 
 
-    def _scenario(self, case: Case) -> Result:
-        """A scenario beyond sliding: the reference's solve (reference/scenarios.py); no engine runs one yet."""
-        from ..errors import UnsupportedByEngine
+    def _scenario(self, case: Case, timeout: float | None = None) -> Result:
+        """A scenario beyond sliding: the reference's solve (reference/scenarios.py), the engine's run of the deck
+        its package writes, or its twin (engines/scenario.py)."""
+        if self.kind == ENGINE:
+            from ..engines import scenario
 
-        if self.kind != REFERENCE:
-            raise UnsupportedByEngine(f"{self.label}: run.scenario = \"{case.run.scenario}\" is solved by the "
-                                      "reference only (no engine deck or twin for the scenarios beyond sliding yet)")
+            return scenario.run(case, self.engine, timeout=timeout)
+        if self.kind == TWIN:
+            from ..engines import scenario
+
+            return scenario.twin(case, self.engine)
         if self.method == "verlet":
             raise ConfigError("method", "verlet", f"run.scenario = \"{case.run.scenario}\" is solved by the "
-                                                  "adaptive reference only")
+                                                  "adaptive reference only (an engine's step: its seed row)")
         from ..reference.scenarios import solve
 
         return solve(case)
@@ -192,13 +196,16 @@ def engines_of(engines) -> list:
 
 def plan(case: Case, engines: Iterable | None = None, found: dict | None = None, mapping=None) -> list[Planned]:
     """Which engines (and builds) among ``engines`` can run ``case``, and why not: per engine its case's own
-    setting, its mapping of the contact, and "not expressible" (the mapping's reasons) or "engine missing" (not
+    setting, its mapping of the contact (of a scenario case: the contact with its scenario's slot,
+    engines/scenario.mapping), and "not expressible" (the mapping's reasons) or "engine missing" (not
     found: ``found``, the suite's discovery record by name, else discovery now). The order of ``engines``.
     ``mapping(case, name, native)``: the mapping that decides (default engines.mapping.contact_mapping; a packing
     asks for its type pair's)."""
     from ..engines.mapping import contact_mapping
+    from ..engines.scenario import mapping as scenario_mapping
 
-    mapping = mapping or contact_mapping
+    mapping = mapping or (contact_mapping if case.run.scenario == "collision" else
+                          lambda c, name, native: scenario_mapping(c, name))
     out = []
     for engine in engines_of(engines):
         native = engine.case_native(case)

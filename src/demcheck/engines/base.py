@@ -242,6 +242,27 @@ class Engine(ABC):
 
         raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
 
+    def scenario_mapping(self, case) -> Mapping:
+        """The case's contact with its scenario's slot (``[run] scenario``, beyond sliding) in the engine's terms;
+        the default: none, no deck is written for it."""
+        return refused(self.name, f"no {self.title} deck is written for run.scenario = \"{case.run.scenario}\" "
+                                  "(the scenarios beyond sliding)")
+
+    def scenario_twin_laws(self, case, native: Native) -> dict:
+        """The laws ``native`` computes in a scenario, as engines/scenario.step takes them."""
+        from ..errors import UnsupportedByEngine
+        raise UnsupportedByEngine(f"{self.name} has no scenario twin")
+
+    def scenario_deck(self, case, native: Native, layout):
+        """The deck (inputs.common.Deck) of a scenario case run as ``layout`` (engines/scenario.Layout)."""
+        from ..errors import UnsupportedByEngine
+        raise UnsupportedByEngine(f"{self.name} decks are not written for the scenarios beyond sliding")
+
+    def read_scenario(self, case, layout, workdir) -> dict:
+        """A scenario run's output (in ``workdir``) as reference/scenarios.stepped_metrics reads it."""
+        from ..errors import UnsupportedByEngine
+        raise UnsupportedByEngine(f"{self.name} writes no scenario output")
+
     def read_contacts(self, values, i, j, radius, x=None, box=None):
         """(overlap, fn, ft) of the engine's per-contact dump: ``values`` its columns as an array (one row per
         listed pair), ``i``, ``j`` the 0-based particle indices of the first two columns, ``radius`` and ``x``
@@ -269,6 +290,24 @@ class PackageEngine(Engine):
 
     def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
         return self._part("deck").deck(case, dt, length, native=native, **options)
+
+    def _scenario_part(self):
+        import importlib.util
+        name = f"{type(self).__module__}.scenario"
+        return None if importlib.util.find_spec(name) is None else self._part("scenario")
+
+    def scenario_mapping(self, case) -> Mapping:
+        part = self._scenario_part()
+        return super().scenario_mapping(case) if part is None else part.mapping(case)
+
+    def scenario_twin_laws(self, case, native: Native) -> dict:
+        return self._scenario_part().twin_laws(case, native)
+
+    def scenario_deck(self, case, native: Native, layout):
+        return self._scenario_part().deck(case, native, layout)
+
+    def read_scenario(self, case, layout, workdir) -> dict:
+        return self._scenario_part().read(case, layout, workdir)
 
     def packing_deck(self, case, duration=None, dt=None):
         import importlib.util

@@ -141,9 +141,12 @@ COMMANDS = frozenset({
     "units", "atom_style", "atom_modify", "boundary", "newton", "comm_modify", "communicate", "processors", "region",
     "create_box", "create_atoms", "set", "read_data", "neighbor", "neigh_modify", "pair_style", "pair_coeff", "fix",
     "compute", "timestep", "dump", "dump_modify", "undump", "write_dump", "thermo_style", "thermo_modify", "thermo",
-    "run", "hard_particles", "soft_particles"})
-STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/sphere"})),
-          "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local"})),
+    "run", "hard_particles", "soft_particles", "group"})
+STYLES = {"fix": (3, frozenset({"property/global", "wall/gran", "gravity", "nve/sphere", "move", "heat/flow",
+                                "heat/gran/conduction",
+                                "property/atom"})),
+          "compute": (3, frozenset({"pair/local", "property/local", "pair/gran/local", "property/atom"})),
+          "group": (2, frozenset({"id"})),
           "dump": (3, frozenset({"custom", "local"})), "pair_style": (1, frozenset({"granular", "gran"})),
           "atom_style": (1, frozenset({"sphere", "granular"})), "region": (2, frozenset({"block"})),
           "thermo_style": (1, frozenset({"custom"})), "write_dump": (2, frozenset({"custom"}))}

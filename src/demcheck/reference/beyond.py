@@ -318,3 +318,154 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         for k, val in (("x", x), ("v", v), ("omega", w), ("f", f), ("torque", tq), ("T", temp), ("Q", q)):
             out[k].append(np.copy(val))
     return {k: np.array(val) for k, val in out.items()}
+
+
+def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point, wall_normal, dt: float,
+                steps: int, every: int, *, normal, fcrit=None, tangential=None, rolling=None,
+                twisting=None, roll_fcrit=None, arm: float = 0.0, truncation: str = "maw",
+                setup_increment: bool = False) -> dict:
+    """One sphere on a flat wall (its plane through ``wall_point``, ``wall_normal`` pointing to the sphere's
+    side) under ``gravity``, stepped the way ``fix nve/sphere`` with ``fix wall/gran`` and ``fix gravity`` does
+    (half kick, drift, forces at full-step positions and half-step velocities, half kick). ``normal(δ, δ̇)`` is the
+    normal force (> 0 repulsive), ``fcrit(δ, δ̇)`` the force the limits scale with (default |normal|);
+    ``tangential`` = (kt, x_t·η, μ): the linear history spring on the slip velocity v_t − r ω × n_w, its
+    history rescaled after Maw when |F_t| passes μ|Fn| (``truncation`` "maw": LAMMPS ``linear_history``) or the
+    spring alone capped and the dashpot added only while it sticks ("spring": LIGGGHTS ``tangential history``);
+    the slip and torque arm r is R − ``arm``·δ (0: LAMMPS's R; ½: LIGGGHTS's contact point). The rolling and
+    twisting records see the wall as body 1 (at rest, n from the sphere into the wall); ``roll_fcrit(δ, δ̇)`` the
+    rolling limit's force when it is not ``fcrit``'s (LIGGGHTS cdt: the elastic part); ``setup_increment``: the
+    set-up call adds one step's increment to the rolling torque it applies and forgets it (LIGGGHTS's epsd
+    family, as ``verlet_pair``). Returns, at steps 0, every, 2·every, …: t, x, v, ω (rows × 3)."""
+    inertia = 0.4 * mass * radius * radius
+    nw = np.asarray(wall_normal, dtype=float)
+    p = np.asarray(wall_point, dtype=float)
+    g = np.asarray(gravity, dtype=float)
+    x, v, w = (np.array(a, dtype=float) for a in (x0, v0, omega0))
+    state = {"t": np.zeros(3), "roll": np.zeros(3), "twist": 0.0}
+    fcrit = fcrit or (lambda d, rate: abs(normal(d, rate)))
+
+    def forces(update):
+        delta = radius - float((x - p) @ nw)
+        if delta <= 0.0:
+            state.update(t=np.zeros(3), roll=np.zeros(3), twist=0.0)
+            return mass * g, np.zeros(3)
+        rate = -float(v @ nw)
+        fn, crit = normal(delta, rate), fcrit(delta, rate)
+        r_arm = radius - arm * delta
+        vt = v - (v @ nw) * nw - np.cross(r_arm * w, nw)
+        fs, hist = np.zeros(3), state["t"]
+        if tangential is not None:
+            spring = _maw_spring if truncation == "maw" else _capped_spring
+            fs, hist = spring(hist, vt, dt if update else 0.0, *tangential, crit)
+        h = dt if update else 0.0
+        m_roll, roll = rolling_torque(rolling, w, -nw, roll_fcrit(delta, rate) if roll_fcrit else crit,
+                                      dt if update or setup_increment else 0.0, state["roll"])
+        m_tw, phi = twisting_torque(twisting, w, -nw, crit, math.sqrt(radius * delta), h, state["twist"])
+        if update:
+            state.update(t=hist, roll=roll, twist=phi)
+        torque = -r_arm * np.cross(nw, fs) + m_roll + m_tw
+        return fn * nw + fs + mass * g, torque
+
+    f, tq = forces(False)
+    rows = {k: [np.copy(a)] for k, a in (("x", x), ("v", v), ("omega", w))}
+    for k in range(1, steps + 1):
+        v += 0.5 * dt * f / mass
+        x += dt * v
+        w += 0.5 * dt * tq / inertia
+        f, tq = forces(True)
+        v += 0.5 * dt * f / mass
+        w += 0.5 * dt * tq / inertia
+        if k % every == 0:
+            for key, a in (("x", x), ("v", v), ("omega", w)):
+                rows[key].append(np.copy(a))
+    out = {k: np.array(a) for k, a in rows.items()}
+    out["t"] = np.arange(len(out["x"])) * every * dt
+    return out
+
+
+def _maw_spring(hist, vt, h, kt, damp, mu, fncrit):
+    """LAMMPS's ``linear_history`` on a flat wall (the normal fixed, so the history is never rotated): ξ += h v_t,
+    F = −kt ξ − damp v_t, and past μ Fcrit the force scaled to it and ξ set so that it is the spring's (Maw)."""
+    hist = hist + h * vt
+    fs = -kt * hist - damp * vt
+    cap = mu * fncrit
+    mag = float(np.linalg.norm(fs))
+    if mag > cap:
+        if float(np.linalg.norm(hist)) != 0.0:
+            hist = -(cap / mag * fs + damp * vt) / kt
+            fs = cap / mag * fs
+        else:
+            fs = np.zeros(3)
+    return fs, hist
+
+
+def _capped_spring(hist, vt, h, kt, damp, mu, fncrit):
+    """LIGGGHTS's ``tangential history`` on a flat wall: ξ += h v_t; past μ Fcrit the spring force kt|ξ| is scaled
+    to it (ξ with it) and the dashpot dropped, else F = −kt ξ − damp v_t."""
+    hist = hist + h * vt
+    fs = -kt * hist
+    cap = mu * fncrit
+    shear = kt * float(np.linalg.norm(hist))
+    if shear > cap:
+        if shear != 0.0:
+            fs = fs * (cap / shear)
+            hist = -fs / kt
+        else:
+            fs = np.zeros(3)
+        return fs, hist
+    return fs - damp * vt, hist
+
+
+# ----------------------------------------------------------------------------- metrics of a stepped run
+
+
+def first_stop(t, speed, position=None) -> tuple[float, float]:
+    """(time, position) where ``speed`` (positive at the start) first reaches 0, linear between the samples;
+    (nan, nan) when it never does."""
+    speed = np.asarray(speed, dtype=float)
+    hit = np.nonzero(speed <= 0.0)[0]
+    if not speed.size or speed[0] <= 0.0 or not hit.size:
+        return math.nan, math.nan
+    k = int(hit[0])
+    f = speed[k - 1] / (speed[k - 1] - speed[k])
+    pos = math.nan if position is None else float(position[k - 1] + f * (position[k] - position[k - 1]))
+    return float(t[k - 1] + f * (t[k] - t[k - 1])), pos
+
+
+def critical_angle_from_acceleration(acc: float, theta: float, g: float) -> float:
+    """The tilt at which the sphere starts to roll, inferred from its acceleration a down a slope θ past it:
+    a = (5/7) g (sin θ − tan θc cos θ) (type A or a mobilised type C) gives
+    tan θc = tan θ − 7a/(5 g cos θ)."""
+    return math.atan(math.tan(theta) - 1.4 * acc / (g * math.cos(theta)))
+
+
+def fitted_acceleration(t, speed) -> float:
+    """The least-squares slope of ``speed`` over the second half of the samples (past the start's transient)."""
+    t, speed = np.asarray(t, dtype=float), np.asarray(speed, dtype=float)
+    k = len(t) // 2
+    if len(t) - k < 3:
+        return math.nan
+    return float(np.polyfit(t[k:] - t[k], speed[k:], 1)[0])
+
+
+def pull_off_of_path(delta, force) -> dict:
+    """A displacement-controlled pull sampled along ``delta`` (decreasing) with the normal ``force`` (> 0
+    repulsive; exactly 0 once the contact is broken): the largest tension and the last overlap in contact."""
+    delta, force = np.asarray(delta, dtype=float), np.asarray(force, dtype=float)
+    touching = np.nonzero(force != 0.0)[0]
+    if not touching.size or touching[-1] + 1 >= len(force) or force.min() >= 0.0:
+        return {"pull_off_force": math.nan, "separation_at_pull_off": math.nan}
+    return {"pull_off_force": float(-force.min()), "separation_at_pull_off": float(delta[touching[-1]])}
+
+
+def efold_time(t, diff) -> float:
+    """The time at which ``diff`` (a temperature difference) has fallen to diff[0]/e, ln(diff) linear between the
+    samples; nan when it never does."""
+    t, diff = np.asarray(t, dtype=float), np.asarray(diff, dtype=float)
+    ratio = diff / diff[0]
+    hit = np.nonzero(ratio <= 1.0 / math.e)[0]
+    if not hit.size or hit[0] == 0 or not (ratio[hit[0]] > 0.0):
+        return math.nan
+    k = int(hit[0])
+    la, lb = math.log(ratio[k - 1]), math.log(ratio[k])
+    return float(t[k - 1] + (-1.0 - la) / (lb - la) * (t[k] - t[k - 1]))

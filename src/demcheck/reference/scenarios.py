@@ -119,6 +119,40 @@ def _conduction(case, model, closed):
         "heat_time_constant"]}
 
 
+def stepped_metrics(case, run: dict) -> dict:
+    """The case's scenario metrics from a stepped run (an engine's output or a twin's: one computation for both).
+    ``run``: the wall scenarios' samples t, x, v, omega (rows × 3) of the sphere; pull_off's ``delta`` and ``fn``
+    along the imposed path; adhesive_impact's ``v_rel`` (the separation speed at the end, along the line of
+    centres) and ``touching`` (the contact still closed at the end); conduction's t and ``dT`` (T1 − T0)."""
+    scenario = case.run.scenario
+    if scenario in ("rolling", "incline", "twist"):
+        _, _, g, theta, n = _on_wall(case)
+        t, x, v, w = (np.asarray(run[k], dtype=float) for k in ("t", "x", "v", "omega"))
+        if scenario == "twist":
+            sign = math.copysign(1.0, float(np.asarray(case.particles[0].angular_velocity) @ n))
+            return {"twist_stop_time": _b.first_stop(t, sign * (w @ n))[0]}
+        if scenario == "rolling":
+            v0 = np.asarray(case.particles[0].velocity, dtype=float)
+            u = v0 - (v0 @ n) * n
+            u /= np.linalg.norm(u)
+            t_stop, s = _b.first_stop(t, v @ u, (x - x[0]) @ u)
+            return {"rolling_stop_time": t_stop, "rolling_distance": s}
+        gv = np.asarray(case.run.gravity, dtype=float)
+        down = gv - (gv @ n) * n
+        down /= np.linalg.norm(down)
+        acc = _b.fitted_acceleration(t, v @ down)
+        return {"incline_critical_angle": _b.critical_angle_from_acceleration(acc, theta, g)}
+    if scenario == "pull_off":
+        return _b.pull_off_of_path(run["delta"], run["fn"])
+    if scenario == "adhesive_impact":
+        v = resolve(case).pair.impact_speed
+        if run["touching"]:
+            return {"restitution": 0.0, "capture_velocity": math.nan}
+        e = float(run["v_rel"]) / v
+        return {"restitution": e, "capture_velocity": v * math.sqrt(max(0.0, 1.0 - e * e))}
+    return {"heat_time_constant": _b.efold_time(run["t"], run["dT"])}
+
+
 SOLVERS = {"rolling": _rolling, "incline": _incline, "twist": _twist, "pull_off": _pull_off,
            "adhesive_impact": _adhesive_impact, "conduction": _conduction}
 

@@ -1,0 +1,50 @@
+"""The engine rows of a scenario case beyond sliding (``[run] scenario``) in the suite: per engine that can run it
+(comparisons/sources.plan, with the scenario's mapping), its run from the deck its package writes, its twin and
+the seed model's verlet run at its step (engines/scenario.py), each metric judged against the reference's solve as
+a collision case's are (verdicts.judge_engine: the twin at ≤ the implementation bar, the seed run's distance from
+the reference the time step's part). An engine that cannot express the case's law is "not expressible" with
+the reason."""
+
+from __future__ import annotations
+
+from ..errors import DemcheckError, EngineInterrupted
+from . import sources, verdicts
+
+
+def engine_rows(case, entry: dict, comps: list, opts, found: dict, ref: dict) -> None:
+    """Every engine of ``opts.engines`` on the scenario case: ``entry["sources"]`` and ``comps`` gain its rows;
+    ``ref``: the reference's metrics."""
+    for planned in sources.plan(case, opts.engines, found):
+        if verdicts.unavailable(entry, comps, planned):
+            continue
+        _engine(case, planned, entry, comps, opts, ref)
+
+
+def _engine(case, planned, entry: dict, comps: list, opts, ref: dict) -> None:
+    from ..engines import scenario
+
+    src, mp = planned.source, planned.mapping
+    label = src.label
+    try:
+        res = src.run(case, timeout=opts.timeout)
+        twin = src.twin().run(case).metrics()
+        seed = scenario.seed(case, src.engine).metrics()
+    except EngineInterrupted:
+        raise
+    except DemcheckError as exc:
+        entry["sources"][label] = {"status": "failed", "message": str(exc)}
+        comps.append(verdicts.status_comparison(label, verdicts.FAILED, str(exc).splitlines()[0]))
+        return
+    entry["sources"][label] = {"status": res.status, "message": res.message, "method": res.method, "dt": res.dt,
+                               "engine_version": res.engine_version, "wall_time": res.wall_time,
+                               "metrics": res.metrics(), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                               "twin_metrics": twin, "seed_verlet_metrics": seed}
+    if not res.ok:
+        comps.append(verdicts.status_comparison(label, verdicts.FAILED, f"{res.status}: {res.message}"))
+        return
+    got = res.metrics()
+    for metric, value in ref.items():
+        comps.append(verdicts.judge_engine(label, res.engine_version, entry["model"], metric, got[metric], value,
+                                           twin[metric], seed[metric], mp.fidelity, list(mp.reasons),
+                                           entry["scales"], opts.tolerances, opts.expected,
+                                           setting=verdicts.mapping_setting(mp)))

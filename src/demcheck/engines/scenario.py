@@ -1,0 +1,281 @@
+"""The scenarios beyond sliding (``[run] scenario``) in an engine, its twin and the seed model at the engine's step.
+
+One :class:`Layout` per case fixes what is run: the step, the number of steps, the sampling, and the bodies'
+start. A sphere on a wall starts at its static overlap under its weight (so that an undamped normal spring does
+not bounce), a rolling one at ω = n × v/R (rolling without slip, as the scenario is defined); a pull moves body 1
+away at a constant speed; an impact starts 2.5 steps before contact (never on a step: a tie at δ = 0 would be
+decided by round-off); the held pair of the conduction scenario sits at the case's overlap. The engine runs it
+from a deck its package writes (``scenario.py``: ``mapping``, ``twin_laws``, ``deck``, ``read``), the twin steps
+the engine's laws with the engine's scheme (reference/beyond.py: ``verlet_pair`` for a pair, ``verlet_wall`` for a
+wall, the law along the imposed path for a pull, explicit Euler for the held pair's temperatures), and the seed
+model's verlet run steps the case's own laws the same way. Each run's metrics come from one function
+(reference/scenarios.stepped_metrics).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..case import Case
+from ..errors import DemcheckError, UnsupportedByEngine
+from ..laws.adhesion import adhesive_force
+from ..laws.heat import heat_flow
+from ..laws.model import resolve
+from ..reference import beyond as _b
+from ..reference.scenarios import SCENARIO_METRICS, _on_wall, _twisting_law, stepped_metrics
+from ..result import Result
+from . import registry
+
+WALL = ("rolling", "incline", "twist")
+STEPS_PER_PERIOD = 60  # steps per period of the stiffest spring of a sphere on a wall
+PULL_STEPS = 25000  # samples along a pull (every step): the break is located to 2.5e-4 of its overlap
+IMPACT_STEPS_PER_CONTACT = 2000
+CONDUCTION_STEPS_PER_TAU = 20000  # explicit Euler's error on τ is dt/(2τ) = 2.5e-5
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What a scenario run is: ``dt``, ``steps``, samples ``every`` steps, the bodies' start (``positions``,
+    ``velocities``, ``omegas``: one row a body) and, for a pull, body 1's ``pull_speed`` along +x."""
+
+    scenario: str
+    dt: float
+    steps: int
+    every: int
+    positions: tuple
+    velocities: tuple
+    omegas: tuple
+    pull_speed: float = 0.0
+
+
+def mapping(case: Case, engine):
+    """The engine's mapping of the case's contact with its scenario's slot (its package's ``scenario.mapping``),
+    or "none" with the reason where the engine has no scenario deck."""
+    return _engine(engine).scenario_mapping(case)
+
+
+def _engine(engine):
+    return registry.get(engine) if isinstance(engine, str) else engine
+
+
+# ----------------------------------------------------------------------------- the layout
+
+
+def layout(case: Case, laws: dict) -> Layout:
+    """The run of ``case`` for the laws ``laws`` (an engine's twin laws: normal, tangential, …)."""
+    s = case.run.scenario
+    if s in WALL:
+        return _wall_layout(case, laws)
+    model = resolve(case)
+    r0, r1 = (p.radius for p in case.particles)
+    if s == "pull_off":
+        law = model.slot("adhesion")
+        scale = _adhesion_scale(law)
+        dt = 1e-6
+        speed = 2.5 * scale / (PULL_STEPS * dt)
+        return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
+                      ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2, speed)
+    if s == "adhesive_impact":
+        law, pair = model.slot("adhesion"), model.pair
+        t_c = 2.87 * _b._contact_time_scale(law, pair.m_eff, pair.impact_speed)
+        dt = t_c / IMPACT_STEPS_PER_CONTACT
+        v = pair.impact_speed
+        return Layout(s, dt, 6 * IMPACT_STEPS_PER_CONTACT, 100,
+                      ((0.0, 0.0, 0.0), (r0 + r1 + 2.5 * v * dt, 0.0, 0.0)), ((0.0, 0.0, 0.0), (-v, 0.0, 0.0)),
+                      ((0.0, 0.0, 0.0),) * 2)
+    from ..laws.heat import conductance
+
+    c0, c1 = _capacities(case)
+    tau = _b.heat_time_constant_closed(conductance(model.slot("heat"), case.run.overlap), c0, c1)
+    dt = tau / CONDUCTION_STEPS_PER_TAU
+    return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), 100,
+                  ((0.0, 0.0, 0.0), (r0 + r1 - case.run.overlap, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2,
+                  ((0.0, 0.0, 0.0),) * 2)
+
+
+def _adhesion_scale(law) -> float:
+    """The overlap scale of a pull: JKR's |δ_f|, DMT's Hertz overlap under its pull-off force."""
+    if law.id == "jkr":
+        return abs(law.separation_at_pull_off("displacement"))
+    return (law.pull_off_force("load") / (4.0 / 3.0 * law.e_eff * math.sqrt(law.r_eff))) ** (2.0 / 3.0)
+
+
+def _capacities(case: Case) -> tuple[float, float]:
+    return tuple(case.mass(i) * case.materials[p.material].specific_heat for i, p in enumerate(case.particles))
+
+
+def _wall_layout(case: Case, laws: dict) -> Layout:
+    mass, radius, g, theta, n = _on_wall(case)
+    normal = laws["normal"]
+    weight = mass * g * math.cos(theta)
+    delta = brentq(lambda d: normal(d, 0.0) - weight, 0.0, 0.5 * radius, xtol=1e-300, rtol=4 * np.finfo(float).eps)
+    k = (normal(1.001 * delta, 0.0) - normal(0.999 * delta, 0.0)) / (0.002 * delta)
+    if laws.get("tangential") is not None:
+        k = max(k, 3.5 * laws["tangential"][0])  # the slip spring on m·(2/7)
+    dt = 2.0 * math.pi * math.sqrt(mass / k) / STEPS_PER_PERIOD
+    t_end = _wall_duration(case, mass, radius, g, theta)
+    steps = int(math.ceil(t_end / dt))
+    p = case.particles[0]
+    x0 = np.asarray(case.walls[0].point, dtype=float) + (radius - delta) * n
+    omega = tuple(p.angular_velocity)
+    if case.run.scenario == "rolling":  # rolling without slip from the start, as the scenario is defined
+        omega = tuple(np.cross(n, np.asarray(p.velocity, dtype=float)) / radius)
+    return Layout(case.run.scenario, dt, steps, max(1, steps // 4000), (tuple(x0),), (tuple(p.velocity),), (omega,))
+
+
+def _wall_duration(case: Case, mass: float, radius: float, g: float, theta: float) -> float:
+    """1.25 × the closed form's stop (rolling, twist); the time to roll R/4 down the incline."""
+    model = resolve(case)
+    if case.run.scenario == "rolling":
+        law, p, n = model.slot("rolling"), case.particles[0], np.asarray(case.walls[0].normal, dtype=float)
+        v = np.asarray(p.velocity, dtype=float)
+        return 1.25 * _b.rolling_stop_closed(law.mu_r, law.r_roll, radius, float(np.linalg.norm(v - (v @ n) * n)),
+                                            g)[0]
+    if case.run.scenario == "twist":
+        law = _twisting_law(case, model.slot("twisting"))
+        omega = abs(float(np.asarray(case.particles[0].angular_velocity) @ np.asarray(case.walls[0].normal)))
+        return 1.25 * _b.twist_stop_closed(mass, radius, omega, law.mu_tw, mass * g * math.cos(theta))
+    law = model.slot("rolling")
+    acc = _b.incline_closed(law.mu_r, law.r_roll, radius, theta, g)[1]
+    return math.sqrt(0.5 * radius / acc) if acc > 0 else 0.5
+
+
+# ----------------------------------------------------------------------------- stepping the laws
+
+
+def step(case: Case, laws: dict, lay: Layout) -> dict:
+    """The scenario stepped with ``laws`` (normal, fcrit, tangential, rolling, twisting, adhesion, heat) at the
+    layout's step: the run reference/scenarios.stepped_metrics reads."""
+    s = case.run.scenario
+    if s in WALL:
+        mass, radius = case.mass(0), case.particles[0].radius
+        w = case.walls[0]
+        return _b.verlet_wall(radius, mass, lay.positions[0], lay.velocities[0], lay.omegas[0], case.run.gravity,
+                              w.point, w.normal, lay.dt, lay.steps, lay.every, normal=laws["normal"],
+                              fcrit=laws.get("fcrit"), tangential=laws.get("tangential"),
+                              rolling=laws.get("rolling"), twisting=laws.get("twisting"),
+                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment") if k in laws})
+    if s == "pull_off":
+        return _pull(case, laws["adhesion"], lay)
+    if s == "adhesive_impact":
+        p = case.particles[0]
+        x1, v1 = lay.positions[1][0], lay.velocities[1][0]
+        out = _b.verlet_pair(p.radius, case.materials[p.material].density, x1, v1, [0.0] * 3, [0.0] * 3, lay.dt,
+                             lay.steps, adhesion=laws["adhesion"])
+        return {"v_rel": float(out["v"][-1, 1, 0] - out["v"][-1, 0, 0]), "touching": bool(out["f"][-1, 1, 0] != 0.0)}
+    return _held(case, laws["heat"], lay)
+
+
+def _pull(case: Case, law, lay: Layout) -> dict:
+    """Body 1 moved at the layout's speed (``fix move``: x = x0 + u·k·dt), body 0 held: the law along the path."""
+    r0, r1 = (p.radius for p in case.particles)
+    x0, u = lay.positions[1][0], lay.pull_speed
+    deltas, forces, touch = [], [], 0.0
+    for k in range(lay.steps + 1):
+        delta = (r0 + r1) - (x0 + u * (k * lay.dt))
+        f, touch = adhesive_force(law, delta, touch)
+        deltas.append(delta)
+        forces.append(f if touch else 0.0)
+    return {"delta": np.array(deltas), "fn": np.array(forces)}
+
+
+def _held(case: Case, law, lay: Layout) -> dict:
+    """The held pair's temperatures by explicit Euler after each step (``fix heat/flow``), sampled every
+    ``lay.every`` steps from step 0."""
+    r0, r1 = (p.radius for p in case.particles)
+    delta = (r0 + r1) - lay.positions[1][0]
+    c0, c1 = _capacities(case)
+    t0, t1 = (float(x) for x in case.run.temperatures)
+    diffs = [t1 - t0]
+    for k in range(1, lay.steps + 1):
+        q = heat_flow(law, delta, t0, t1)
+        t0, t1 = t0 + lay.dt * q / c0, t1 - lay.dt * q / c1
+        if k % lay.every == 0:
+            diffs.append(t1 - t0)
+    return {"t": np.arange(len(diffs)) * lay.every * lay.dt, "dT": np.array(diffs)}
+
+
+def seed_laws(case: Case) -> dict:
+    """The case's own laws, in the form :func:`step` takes: the seed model at the engine's step."""
+    model = resolve(case)
+    nl, tl = model.normal_law, model.contact.tangential
+
+    def normal(d, rate):
+        return nl.k * d ** nl.a + nl.eta * d ** nl.b * rate
+
+    tangential = None
+    if tl.id == "spring":
+        tangential = (tl.kt, tl.eta, model.pair.friction)
+    elif tl.id != "none":
+        raise UnsupportedByEngine(f"the scenario's seed run steps a tangential spring or none, not '{tl.id}'")
+    laws = {"normal": normal, "tangential": tangential}
+    laws.update({s: model.slot(s) for s in ("rolling", "twisting", "adhesion", "heat")})
+    return laws
+
+
+# ----------------------------------------------------------------------------- results
+
+
+def _result(case: Case, source: str, method: str, metrics: dict, lay: Layout, started: float, **extra) -> Result:
+    bad = [k for k, v in metrics.items() if not math.isfinite(v)]
+    status, message = "ok", extra.pop("message", "")
+    if bad and not (case.run.scenario == "adhesive_impact" and bad == ["capture_velocity"]):
+        status, message = "failed", f"the {case.run.scenario} run gave no {', '.join(bad)} (not finite)"
+    meta = {"scenario": case.run.scenario, "scenario_metrics": metrics, **extra.pop("meta", {})}
+    return Result(source=source, method=method, case_name=case.name, case_hash=case.hash,
+                  model=resolve(case).describe(), params=extra.pop("params", {}), contact=None, dt=lay.dt,
+                  wall_time=time.perf_counter() - started, status=status, message=message, meta=meta, **extra)
+
+
+def _metrics(case: Case, run: dict) -> dict:
+    out = stepped_metrics(case, run)
+    return {k: float(out[k]) for k in SCENARIO_METRICS[case.run.scenario]}
+
+
+def twin(case: Case, engine) -> Result:
+    """The engine's twin: the engine's laws stepped by demcheck with the engine's scheme, at the engine's layout."""
+    eng, started = _engine(engine), time.perf_counter()
+    mp = mapping(case, eng)
+    laws = eng.scenario_twin_laws(case, mp.require())
+    lay = layout(case, laws)
+    return _result(case, eng.name + "-twin", "verlet", _metrics(case, step(case, laws, lay)), lay, started)
+
+
+def seed(case: Case, engine) -> Result:
+    """The case's own laws stepped with the engine's scheme at the engine's layout (the time step's part)."""
+    eng, started = _engine(engine), time.perf_counter()
+    lay = layout(case, eng.scenario_twin_laws(case, mapping(case, eng).require()))
+    return _result(case, "reference-verlet", "verlet", _metrics(case, step(case, seed_laws(case), lay)), lay, started)
+
+
+def run(case: Case, engine, timeout: float | None = None) -> Result:
+    """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics."""
+    from . import run as runner
+
+    eng, started = _engine(engine), time.perf_counter()
+    mp = mapping(case, eng)
+    nat = mp.require()
+    lay = layout(case, eng.scenario_twin_laws(case, nat))
+    dk = eng.scenario_deck(case, nat, lay)
+    out = runner.run(eng.name, dk.text, files=dk.files, timeout=timeout or runner.DEFAULT_TIMEOUT)
+    try:
+        data = eng.read_scenario(case, lay, out.workdir)
+    except DemcheckError as exc:
+        raise DemcheckError(f"{eng.name}: {exc}; work directory kept: {out.workdir}") from None
+    res = _result(case, eng.name, "engine", _metrics(case, data), lay, started, engine_version=out.version,
+                  params={"mapping": mp.fidelity, "native": eng.summary(nat)}, message="; ".join(mp.reasons),
+                  meta={"workdir": str(out.workdir), "deck": dk.text, "fidelity": mp.fidelity,
+                        "reasons": list(mp.reasons), "warnings": out.warnings})
+    if res.ok:
+        import shutil
+
+        shutil.rmtree(out.workdir, ignore_errors=True)
+        res.meta["workdir"] = ""
+    else:
+        res.message += f"; work directory kept: {out.workdir}"
+    return res
