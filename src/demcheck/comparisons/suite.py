@@ -93,7 +93,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
 
         return run_packing(case, opts, found, file)
     if case.run.scenario != "collision":
-        return run_scenario(case, entry, opts)
+        return run_scenario(case, entry, opts, found)
     model = resolve(case)
     entry["model"] = model.describe()
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
@@ -117,10 +117,10 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     return entry
 
 
-def run_scenario(case: Case, entry: dict, opts: Options) -> dict:
+def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
     """A scenario beyond sliding (run.scenario): the reference's solve against its closed forms
-    (reference/expected.scenario_closed_forms). No engine runs these scenarios yet: none is planned, and the entry
-    says so (``engines``)."""
+    (reference/expected.scenario_closed_forms), then each engine that expresses the case against its twin and the
+    reference (comparisons/scenario_rows.py)."""
     from ..reference.expected import scenario_closed_forms
 
     model = resolve(case)
@@ -129,8 +129,6 @@ def run_scenario(case: Case, entry: dict, opts: Options) -> dict:
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     entry["impact"] = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
     entry["scales"] = {}
-    entry["engines"] = (f"not run: run.scenario = \"{case.run.scenario}\" is solved by the reference only (no "
-                        "engine deck or twin for the scenarios beyond sliding yet)")
     comps: list[verdicts.Comparison] = []
     adaptive = sources.ADAPTIVE.run(case)
     entry["sources"]["reference"] = _source(adaptive)
@@ -140,6 +138,9 @@ def run_scenario(case: Case, entry: dict, opts: Options) -> dict:
         got = adaptive.metrics()
         for metric, exact in scenario_closed_forms(case).items():
             comps.append(verdicts.judge_closed_form(metric, got[metric], exact, entry["scales"], opts.tolerances))
+        from .scenario_rows import engine_rows
+
+        engine_rows(case, entry, comps, opts, found, got)
     entry["comparisons"] = [c.as_dict() for c in comps]
     worst = verdicts.worst(c.verdict for c in comps)
     entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
