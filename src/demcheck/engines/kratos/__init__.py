@@ -74,12 +74,17 @@ class Kratos(PackageEngine):
 
         check(text, files)
 
+    def own_twin(self, native: Native) -> bool:
+        from .mapping import FRICTION
+
+        return native.tangential == FRICTION
+
     def twin_collide(self, case, model, native: Native, dt: float):
         """A frictional law's twin steps as Kratos does (reference/twins_kratos.py); a frictionless one is the
         shared verlet twin."""
-        from .mapping import FRICTION, twin_law_array
+        from .mapping import twin_law_array
 
-        if native.tangential != FRICTION:
+        if not self.own_twin(native):
             return super().twin_collide(case, model, native, dt)
         from ...reference import twins_kratos
 
