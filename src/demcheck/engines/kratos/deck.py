@@ -4,8 +4,8 @@ A run is one subprocess, ``python in.deck`` in the work directory (the Python th
 KratosDEMApplication installed). The deck is :data:`TEMPLATE` with its one data line ``CASE = {...}`` (numbers
 only, written with repr) and the files beside it: ``ProjectParameters.json`` (Velocity_Verlet, the case's
 gravity, no global damping, no rolling friction, a neighbour search every step), ``MaterialsDEM.json`` (one
-material a particle, the rigid face's material, one relation a pair with the law, no friction,
-FRICTION_DECAY 0) and ``caseDEM.mdpa`` / ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid
+material a particle, the rigid face's material, one relation a pair with the law, the mapping's friction —
+none without a tangential law — and FRICTION_DECAY) and ``caseDEM.mdpa`` / ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid
 triangle in the wall's plane covering the whole scene). The runner sets each pair's DAMPING_GAMMA after
 Kratos has initialised, the bodies' velocities and spins, and writes every step's states as a LAMMPS-style
 ``dump custom`` (%.17g) to ``dump.txt``.
