@@ -50,8 +50,9 @@ TWIN_CASES = [
 @pytest.mark.parametrize("path,overrides,friction", TWIN_CASES)
 def test_kratos_tangential_force_runs_as_its_twin(path, overrides, friction):
     """Measured ≤ 1.2e-10 (the rebound spin of a contact that sticks first; ≤ 1e-12 where it slides
-    throughout), every metric. With the seed's rules instead (a displacement history, the slip arm R − δ/2 on a
-    wall, no finite rotation of the arms, the cap on the sum), it was no twin at all: Kratos refused friction."""
+    throughout), every metric. Each rule changed alone in the twin misses Kratos (docs/kratos.md): the wall arm
+    R − δ/2 by 2.1e-3 in rebound spin, first-order arm turns by 7e-8, the cap on the sum by 1.6e-2, Hertz without
+    √(δ/δ_prev) by 9.1e-3, Linear with it by 2.4e-3. (Before: Kratos refused friction; there was no twin.)"""
     case = C.load(CASES / path, overrides)
     nat = _native(case, **friction)
     run = CO.collide(case, "kratos", native=nat)
