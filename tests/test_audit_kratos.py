@@ -132,14 +132,14 @@ def test_a_kratos_project_is_audited_with_kratos_runs(tmp_path):
     r = A.audit(_project(tmp_path, dt=5e-9), speed=1.0)
     assert r["engine"] == "kratos" and r["coverage"]["pairs"]["probed"] == 1 and r["coverage"]["walls"]["probed"] == 1
     for p in r["pairs"]:
-        assert len(p["probes"]) == 1  # head-on only: no twin of Kratos' tangential law
+        assert len(p["probes"]) == 1  # head-on only: no oblique probe of Kratos' tangential law
         q = p["probes"][0]
         assert q["engine"]["status"] == "ok" and q["engine_vs_twin"] <= 1e-9, q
     wall = next(p for p in r["pairs"] if p["wall"])
     e = wall["probes"][0]["engine"]["restitution"]
     assert e == pytest.approx(0.9, abs=2e-3)
     assert not any(f["code"] == "restitution" for f in wall["findings"])
-    assert any("not audited" not in n and "no twin of Kratos' tangential" in n for n in wall["notes"])
+    assert any("not audited" not in n and "no oblique probe of Kratos' tangential" in n for n in wall["notes"])
 
 
 def _cli(*args):

@@ -253,7 +253,10 @@ def native_law(case: Case, engine, native, seed: dict | None = None) -> NativeLa
     engine = as_engine(engine)  # an Engine, or its name
     rules = engine.twin_rules(native)
     tl = model.tangential_law
-    if tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
+    if engine.own_twin(native):  # a kernel of the engine's own (Kratos' friction, Yade's Luding): its scheme only
+        conv = states.restate(engine.twin_collide(case, model, native, t_c / CONVERGED_STEPS), case)
+        how = f"verlet at t_c/{CONVERGED_STEPS}: the engine's own twin kernel has no adaptive solve"
+    elif tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
         conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),
                               case)
         how = f"verlet at t_c/{CONVERGED_STEPS}: a force history has no adaptive solve"

@@ -184,6 +184,19 @@ class Engine(ABC):
         its slip or turns its history in its own way)."""
         return self.rules
 
+    def own_twin(self, native: Native) -> bool:
+        """Whether :meth:`twin_collide` steps ``native`` with a kernel of the engine's own (its twin laws from
+        :meth:`twin` then only describe it): such a twin exists for the engines' scheme only."""
+        return False
+
+    def twin_collide(self, case, model, native: Native, dt: float):
+        """The verlet twin's run of ``native`` at ``dt`` (``model`` the twin model, engines.mapping.twin_model):
+        the shared two-body kernel with :meth:`twin_rules`, unless a law of the engine steps its history in a
+        way of its own (Kratos' tangential force: reference/twins_kratos.py)."""
+        from ..reference import collision3d
+
+        return collision3d.collide(case, model, "verlet", dt=dt, rules=self.twin_rules(native))
+
     @abstractmethod
     def summary(self, native: Native) -> str:
         """A native configuration in one line of the engine's own words."""

@@ -270,14 +270,13 @@ def twin_states(case: Case, engine, dt: float, native=None) -> Result:
     """The reference's verlet twin of the engine configuration at the engine's dt, its contact table read
     off its states exactly as an engine's is (states.restate: the bodies' forces with their weights, as an
     engine dumps them, read back less the weights)."""
-    from ..reference import collision3d
     from ..laws.model import resolve
 
     eng = as_engine(engine)
     mp = contact_mapping(case, eng.name, native)
     nat = mp.require()
     model = twin_model(resolve(case), nat)
-    res = states.restate(collision3d.collide(case, model, "verlet", dt=dt, rules=eng.twin_rules(nat)), case)
+    res = states.restate(eng.twin_collide(case, model, nat, dt), case)
     res.source = f"{eng.name}-twin"
     res.meta["fidelity"] = mp.fidelity
     return res

@@ -50,8 +50,8 @@ class Kratos(PackageEngine):
     how_to_install = ("pip install 'KratosMultiphysics==10.4.4' 'KratosDEMApplication==10.4.4' (or 'demcheck[kratos]'), "
                       "or `make engines` in a clone of demcheck")
     banner = _Banner()
-    # only frictionless contacts are mapped (no tangential law maps): the arms never act; recorded as Kratos'
-    # SphericParticle computes them, the slip velocity and the torque at the contact point
+    # the frictionless contacts' twin (the arms never act there); a frictional law's twin steps with Kratos' own
+    # rules (reference/twins_kratos.py: the contact point at R − δ/2 for a pair, R − δ on a wall; twin_collide)
     rules = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "contact", "rotation": "project"}
     style = Style(colour="#ff7f0e", marker="s", linestyle=":")
 
@@ -74,8 +74,30 @@ class Kratos(PackageEngine):
 
         check(text, files)
 
+    def own_twin(self, native: Native) -> bool:
+        from .mapping import FRICTION
+
+        return native.tangential == FRICTION
+
+    def twin_collide(self, case, model, native: Native, dt: float):
+        """A frictional law's twin steps as Kratos does (reference/twins_kratos.py); a frictionless one is the
+        shared verlet twin."""
+        from .mapping import twin_law_array
+
+        if not self.own_twin(native):
+            return super().twin_collide(case, model, native, dt)
+        from ...reference import twins_kratos
+
+        kp = twin_law_array(native, model.pair.m_eff, model.pair.r_eff)
+        return twins_kratos.collide(case, model, kp, dt)
+
     def summary(self, native: Native) -> str:
-        return f"{native.normal} E*={native.normal_args[0]:.6g} DAMPING_GAMMA={native.damping_coeff:.6g} no friction"
+        head = f"{native.normal} E*={native.normal_args[0]:.6g} DAMPING_GAMMA={native.damping_coeff:.6g}"
+        p = native.props
+        if native.tangential == "none":
+            return head + " no friction"
+        return (f"{head} POISSON_RATIO={p['poisson']:.6g} STATIC_FRICTION={p['mu_s']:.6g} "
+                f"DYNAMIC_FRICTION={p['mu_d']:.6g} FRICTION_DECAY={p.get('decay', 0.0):.6g}")
 
 
 registry.register(Kratos())

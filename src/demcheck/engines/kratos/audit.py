@@ -7,8 +7,9 @@ Each material relation between particle materials, and between a particle materi
 assigned to the RigidFacePart of a boundary with conditions), becomes a Native that computes what Kratos DEM
 10.4.4 computes for it: the discontinuum law, E* from both materials' E and ν as Kratos combines them, and the
 DAMPING_GAMMA Kratos itself derives from the relation's COEFFICIENT_OF_RESTITUTION (restitution.py: Kratos
-initialises the relation and the value is read back). Only the head-on probe runs: no twin of Kratos'
-tangential law exists yet, and a head-on impact has no tangential force.
+initialises the relation and the value is read back). Only the head-on probe runs: Kratos' tangential law has a
+twin (reference/twins_kratos.py) but no oblique probe is wired here yet, and a head-on impact has no tangential
+force.
 """
 
 from __future__ import annotations
@@ -361,12 +362,13 @@ def _friction_note(v: dict, w: str, setup: Setup) -> str:
     roll = _number(v, "ROLLING_FRICTION", w, 0.0, ("must be >= 0", lambda x: x >= 0))
     text = (f"STATIC_FRICTION {mu_s:g}, DYNAMIC_FRICTION {mu_d:g}, FRICTION_DECAY {decay:g}"
             + ("" if "FRICTION_DECAY" in v else " (Kratos' default)")
-            + (f", ROLLING_FRICTION {roll:g}" if roll else "") + ": not probed — demcheck has no twin of Kratos' "
-            "tangential law yet; the head-on probe has no tangential force, so it measures the normal law whole")
+            + (f", ROLLING_FRICTION {roll:g}" if roll else "") + ": not probed — the audit has no oblique probe of "
+            "Kratos' tangential law yet (its twin: reference/twins_kratos.py); the head-on probe has no tangential "
+            "force, so it measures the normal law whole")
     if mu_s or mu_d or roll:
         setup.not_audited.append((w, f"friction μs {mu_s:g}, μd {mu_d:g}, decay {decay:g}"
                                   + (f", rolling {roll:g}" if roll else ""),
-                                  "no twin of Kratos' tangential and rolling laws yet (head-on probe only)"))
+                                  "no oblique probe of Kratos' tangential law, no twin of its rolling laws yet (head-on probe only)"))
     return text
 
 

@@ -4,8 +4,8 @@ A run is one subprocess, ``python in.deck`` in the work directory (the Python th
 KratosDEMApplication installed). The deck is :data:`TEMPLATE` with its one data line ``CASE = {...}`` (numbers
 only, written with repr) and the files beside it: ``ProjectParameters.json`` (Velocity_Verlet, the case's
 gravity, no global damping, no rolling friction, a neighbour search every step), ``MaterialsDEM.json`` (one
-material a particle, the rigid face's material, one relation a pair with the law, no friction,
-FRICTION_DECAY 0) and ``caseDEM.mdpa`` / ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid
+material a particle, the rigid face's material, one relation a pair with the law, the mapping's friction —
+none without a tangential law — and FRICTION_DECAY) and ``caseDEM.mdpa`` / ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid
 triangle in the wall's plane covering the whole scene). The runner sets each pair's DAMPING_GAMMA after
 Kratos has initialised, the bodies' velocities and spins, and writes every step's states as a LAMMPS-style
 ``dump custom`` (%.17g) to ``dump.txt``.
@@ -144,7 +144,9 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     # the particles' moduli: Kratos' E* of the contact of interest is the mapped one (a wall face is rigid)
     e_star = nat.normal_args[0]
     mats = [case.materials[p.material] for p in case.particles]
-    nus = [m.poisson_ratio for m in mats]
+    # a frictional law's Poisson's ratio is the mapping's (it sets Kt/Kn = 2(1 − ν)/(2 − ν)); else the materials'
+    nu = nat.props.get("poisson")
+    nus = [m.poisson_ratio if nu is None else float(nu) for m in mats]
     if case.walls:
         youngs = [e_star * (1.0 - nus[0] ** 2)]
     else:
@@ -172,7 +174,9 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         "DeltaTimeSafetyFactor": 1.0, "MaxTimeStep": float(sc.dt), "FinalTime": float(sc.dt) * (sc.steps + 10),
         "NeighbourSearchFrequency": 1, "GraphExportFreq": 1e30, "VelTrapGraphExportFreq": 1e30,
         "OutputTimeStep": 1e30, "PostVelocity": False, "problem_name": PROBLEM}
-    relation = {"STATIC_FRICTION": 0.0, "DYNAMIC_FRICTION": 0.0, "FRICTION_DECAY": 0.0, "ROLLING_FRICTION": 0.0,
+    friction = [float(nat.props.get(k, 0.0)) for k in ("mu_s", "mu_d", "decay")]
+    relation = {"STATIC_FRICTION": friction[0], "DYNAMIC_FRICTION": friction[1], "FRICTION_DECAY": friction[2],
+                "ROLLING_FRICTION": 0.0,
                 "ROLLING_FRICTION_WITH_WALLS": 0.0, "COEFFICIENT_OF_RESTITUTION": 1.0,
                 "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME": nat.normal,
                 "DEM_ROLLING_FRICTION_MODEL_NAME": "DEMRollingFrictionModelBounded"}

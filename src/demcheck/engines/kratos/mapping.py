@@ -25,12 +25,14 @@ import math
 from ...reference import twins
 from ...laws.model import ResolvedModel
 from ...laws.normal import NormalLaw
-from ...laws.tangential import TangentialLaw
+from ...laws.tangential import TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
+from ..mapping import mu_of
 
 HERTZ = "DEM_D_Hertz_viscous_Coulomb"
 LINEAR = "DEM_D_Linear_viscous_Coulomb"
 LAWS = (HERTZ, LINEAR)
+FRICTION = "spring-dashpot-coulomb"  # a Native's tangential: the law's own incremental spring, dashpot and cap
 LINEAR_BETA = 1.432  # the particle–particle factor of DEM_D_Linear_viscous_Coulomb's Kn (absent for walls)
 LINEAR_RADIUS = 0.31225  # its modified radius factor √(α(2 − α)), α = 0.05
 
@@ -55,11 +57,11 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         return refused("kratos", "Kratos DEM 10.4.4 has no linear hysteretic (HLS) discontinuum law")
     if normal.id not in ("hooke", "hertz"):
         return refused("kratos", f"no Kratos DEM discontinuum law for the normal record '{normal.id}'")
-    if contact.tangential.id != "none":
-        return refused("kratos", f"Kratos' tangential force is part of its normal law (incremental spring Kt = "
-                                  f"4G*Kn/E*, dashpot 2γ√(m̄Kt), μ decaying with the slip speed, the Coulomb cap "
-                                  f"split between spring and dashpot in its own way); no seed tangential law, "
-                                  f"'{model.tangential.id}' included, has that form")
+    tl = contact.tangential
+    if tl.id != "none":
+        why = _no_friction_law(normal.id, tl)
+        if why:
+            return refused("kratos", why)
     if normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "quarter")):
         law = HERTZ
         young_eff = normal.k / (4.0 / 3.0 * math.sqrt(r))  # F = (4/3)E*√R̄ δ^3/2
@@ -85,9 +87,62 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                  props={"young_eff": young_eff, "gamma": gamma, "wall": pair.wall},
                  comments=[f"{law}: {kn_note}",
                            f"DAMPING_GAMMA γ = {gamma:.17g} (the seed's η = 2γ√(m̄Kn)), set on the contact's "
-                           "properties after Kratos' own e → γ",
-                           "STATIC_FRICTION = DYNAMIC_FRICTION = 0, no rolling friction, no global damping"])
-    return Mapping("kratos", fid, reasons, nat, keywords)
+                           "properties after Kratos' own e → γ"])
+    if tl.id == "none":
+        nat.comments.append("STATIC_FRICTION = DYNAMIC_FRICTION = 0, no rolling friction, no global damping")
+        return Mapping("kratos", fid, reasons, nat, keywords)
+    mu, _ = mu_of(model, reasons)
+    rho = tl.kt / normal.k if law == LINEAR else 2.0 / 3.0 * tl.kt * math.sqrt(r) / normal.k
+    if not 2.0 / 3.0 < rho < 4.0 / 3.0:
+        return refused("kratos", f"Kratos' tangential stiffness is Kt = 4G*/E*·Kn = 2(1 − ν)/(2 − ν)·Kn, in (2/3, 4/3)"
+                                  f"·Kn for ν in (−1, 0.5); the case's Kt = {rho:.4g}·Kn")
+    nu = (2.0 - 2.0 * rho) / (2.0 - rho)
+    nat.tangential = FRICTION
+    nat.props.update(mu_s=mu, mu_d=mu, decay=0.0, poisson=nu)
+    nat.comments.append(f"Kt/Kn = 4G*/E* = 2(1 − ν)/(2 − ν) = {rho:.10g}: POISSON_RATIO ν = {nu:.17g} (E set for "
+                        f"E*); STATIC_FRICTION = DYNAMIC_FRICTION = {mu:.10g}, FRICTION_DECAY = 0, no rolling "
+                        "friction, no global damping")
+    reasons.append(FRICTION_REASON[tl.id == "sqrt_spring"].format(
+        ratio=math.sqrt(rho), measured=MEASURED.get((model.tangential.id, tl.truncation), "not measured for this law")))
+    keywords[reasons[-1]] = law
+    return Mapping("kratos", APPROXIMATE, reasons, nat, keywords)
+
+
+# the seed's tangential laws Kratos' own law stands for, and why not exactly
+FRICTION_REASON = {
+    False: ("Kratos' tangential force is its own law: an incremental spring on the elastic force (turned with the "
+            "normal, its increment from the contact point's displacement with the arm R − δ on a wall), a dashpot "
+            "2γ√(m̄Kt) = {ratio:.4g}·ηn tied to the normal one, and the cap μ|Fn| split between spring and dashpot "
+            "in its own way, not the seed's; measured against the seed law: {measured}"),
+    True: ("Kratos' tangential force is its own law: an incremental spring on the elastic force (turned with the "
+           "normal, shrunk by √(δ/δ_prev) on unloading, its increment from the contact point's displacement with the "
+           "arm R − δ on a wall), a dashpot 2γ√(m̄Kt) = {ratio:.4g}·ηn, and the cap μ|Fn| split between spring and "
+           "dashpot in its own way, not the seed's; measured against the seed law: {measured}"),
+}
+# measured (docs/kratos.md): the seed law by the adaptive solver against Kratos' twin at the suite's dt, on the
+# suite's 45° impacts on a wall (the normal clamp of Kratos included; the seed's glass, ν = 0.22), by (law,
+# truncation): the tangential restitution and the rebound spin apart
+MEASURED = {
+    ("spring_sliding", 1): "7.3e-2 in tangential restitution, 1.3e-1 in rebound spin (oblique-spring-sliding)",
+    ("lsd_sliding", 0): "1.4e-2 in tangential restitution, 2.9e-2 in rebound spin (oblique-lsd-sliding-force)",
+    ("lsd_sliding", 1): "3.3e-2 in tangential restitution, 7.6e-2 in rebound spin (oblique-lsd-sliding-overlap)",
+    ("lsd_sliding", 2): "6.4e-2 in tangential restitution, 1.7e-1 in rebound spin (oblique-lsd-sliding-spring)",
+    ("tti", 0): "3.3e-2 in tangential restitution, 7.4e-2 in rebound spin (oblique-tti)",
+    ("tti", 1): "6.3e-2 in tangential restitution, 1.3e-1 in rebound spin (oblique-tti-overlap)",
+}
+
+
+def _no_friction_law(normal_id: str, tl) -> str:
+    """Why Kratos' own tangential law cannot stand for the seed's ('' where it can): a spring Kt = ρKn beside
+    its normal law (constant with Linear_viscous_Coulomb, √δ with Hertz_viscous_Coulomb), ρ = 4G*/E* =
+    2(1 − ν)/(2 − ν) in (2/3, 4/3) for ν in (−1, 0.5), its dashpot √ρ times the normal one."""
+    family = {"hooke": "spring", "hertz": "sqrt_spring"}[normal_id]
+    if tl.id != family:
+        return (f"Kratos' tangential force is part of its normal law (an incremental spring Kt = 4G*Kn/E*, "
+                f"{'constant' if normal_id == 'hooke' else '∝ √δ'} with this normal law, a dashpot 2γ√(m̄Kt), μ "
+                f"decaying with the slip speed); the seed's tangential record '{tl.id}' is not a spring of that form")
+    return ""
+
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
@@ -100,6 +155,33 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         c, b = 2.0 * gamma * math.sqrt(m * k_el), 0.0
     else:
         raise ValueError(f"no twin for Kratos law {nat.normal!r}")
+    nl = twins.normal_law(k_el, a, c, b, True)
+    if nat.tangential == FRICTION:
+        # the nearest seed record, for the model's description only: the twin's steps are twins_kratos'
+        # (Engine.twin_collide), whose history, rotation, cap and arms are Kratos' own
+        kt = tangential_ratio(nat) * (2.0 * e_star * math.sqrt(r) if nat.normal == HERTZ else k_el)
+        record = SqrtSpringTangential if nat.normal == HERTZ else SpringTangential
+        return nl, TangentialLaw.from_slot(record(kt=kt / math.sqrt(r) if nat.normal == HERTZ else kt,
+                                                  eta=0.0, mu_s=nat.props["mu_s"], mu_k=nat.props["mu_d"],
+                                                  truncation=TRUNC_SPRING, r_eff=r, m_eff=m, force_history=True))
     if nat.tangential != "none":
         raise ValueError(f"no twin for Kratos tangential {nat.tangential!r}")
-    return twins.normal_law(k_el, a, c, b, True), twins.no_friction()
+    return nl, twins.no_friction()
+
+
+def tangential_ratio(nat: Native) -> float:
+    """Kt/Kn = 4G*/E* of the materials the deck writes: 2(1 − ν)/(2 − ν) for two equal particles or a particle
+    on a rigid face (Kratos' equiv_shear and equiv_young)."""
+    nu = nat.props["poisson"]
+    return 2.0 * (1.0 - nu) / (2.0 - nu)
+
+
+def twin_law_array(nat: Native, m: float, r: float):
+    """The numbers of twins_kratos' kernel for a frictional Kratos native on a pair (m̄, R̄)."""
+    from ...reference import twins_kratos
+
+    e_star = nat.normal_args[0]
+    hertz = nat.normal == HERTZ
+    kn = 2.0 * e_star * math.sqrt(r) if hertz else linear_kn(e_star, r, bool(nat.props.get("wall")))
+    return twins_kratos.law_array(hertz, kn, tangential_ratio(nat), nat.damping_coeff, m, nat.props["mu_s"],
+                                  nat.props["mu_d"], nat.props.get("decay", 0.0))

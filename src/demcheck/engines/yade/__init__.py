@@ -147,5 +147,18 @@ class Yade(PackageEngine):
     def twin_rules(self, native: Native) -> dict:
         return self._part("mapping").twin_rules(native, self.rules)
 
+    def own_twin(self, native: Native) -> bool:
+        return native.normal == self._part("mapping").LUDING
+
+    def twin_collide(self, case, model, native: Native, dt: float):
+        """The Luding law's twin steps its own hysteresis (reference/twins_luding.py); the others are the shared
+        verlet twin with :meth:`twin_rules`."""
+        if not self.own_twin(native):
+            return super().twin_collide(case, model, native, dt)
+        mapping = self._part("mapping")
+        from ...reference import twins_luding
+
+        return twins_luding.collide(case, model, mapping.twin_law_array(native, case), dt)
+
 
 registry.register(Yade())

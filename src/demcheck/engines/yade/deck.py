@@ -20,7 +20,7 @@ from ...case import Case
 from ...errors import DemcheckError, UnsupportedByEngine
 from ...inputs import common
 from ..mapping import contact_mapping
-from .mapping import CUNDALL, MINDLIN, VISCEL
+from .mapping import CUNDALL, LUDING, MINDLIN, VISCEL
 
 VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
 # a ViscElPhys Native whose props name CUNDALL (mapping.py) runs as FrictMat + FrictPhys + CundallStrack: a linear
@@ -35,12 +35,14 @@ NAMES = frozenset({
     "Ip2_FrictMat_FrictMat_MindlinPhys", "Law2_ScGeom_MindlinPhys_Mindlin", "Ip2_ViscElMat_ViscElMat_ViscElPhys",
     "Ip2_FrictMat_FrictMat_FrictPhys", "Law2_ScGeom_FrictPhys_CundallStrack",
     "Law2_ScGeom_ViscElPhys_Basic", "NewtonIntegrator", "open", "range", "len",
+    "LudingMat", "Ip2_LudingMat_LudingMat_LudingPhys", "Law2_ScGeom_LudingPhys_Basic",
     # the template's own variables
     "DT", "STEPS", "G", "ids", "mass", "inertia", "radius", "out", "k", "n", "i", "s", "x", "v", "w", "f", "t", "a",
     "b", "b0", "b1"})
 # keyword arguments of the template's calls (Yade's own constructor keywords)
 KEYWORDS = frozenset({"axis", "betan", "betas", "cn", "cs", "damping", "density", "en", "et", "frictionAngle",
-                      "gravity", "kn", "ks", "material", "poisson", "sense", "tc", "young", "dt"})
+                      "gravity", "kn", "ks", "material", "poisson", "sense", "tc", "young", "dt",
+                      "k1", "kp", "kc", "PhiF", "G0"})
 ATTRIBUTES = frozenset({"materials", "bodies", "append", "sphere", "wall", "state", "mass", "inertia", "pos", "vel",
                         "angVel", "engines", "dt", "step", "forces", "f", "t", "write", "close"})
 NODES = (ast.Module, ast.Expr, ast.Assign, ast.Call, ast.Name, ast.Load, ast.Store, ast.Attribute, ast.Constant,
@@ -135,6 +137,11 @@ def materials(nat, case: Case, sc) -> tuple[str, str]:
         body = (f"ViscElMat(kn={_num(2.0 * p['kn'])}, cn={_num(2.0 * p['cn'])}, ks={_num(2.0 * p['ks'])}, "
                 f"cs={_num(2.0 * p['cs'])}, frictionAngle={_num(phi)}, density=1.0)")
         return body, body
+    if nat.normal == LUDING:
+        # Ip2_LudingMat_LudingMat_LudingPhys: 2/(1/a + 1/b), the value itself for equal materials
+        body = (f"LudingMat(k1={_num(p['k1'])}, kp={_num(p['kp'])}, kc=0.0, ks=0.0, PhiF={_num(p['phi_f'])}, "
+                f"G0=0.0, frictionAngle=0.0, density=1.0)")
+        return body, body
     if nat.normal == MINDLIN:
         r_y = (case.particles[0].radius / 2.0) if case.walls else p["r_eff"]  # Yade's R̄ (a wall: R/2)
         nu = 0.0
@@ -165,6 +172,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         phys, law = "Ip2_FrictMat_FrictMat_FrictPhys()", "Law2_ScGeom_FrictPhys_CundallStrack()"
     elif nat.normal == VISCEL:
         phys, law = "Ip2_ViscElMat_ViscElMat_ViscElPhys()", "Law2_ScGeom_ViscElPhys_Basic()"
+    elif nat.normal == LUDING:
+        phys, law = "Ip2_LudingMat_LudingMat_LudingPhys()", "Law2_ScGeom_LudingPhys_Basic()"
     else:
         phys = (f"Ip2_FrictMat_FrictMat_MindlinPhys(betan={_num(p['betan'])}, betas={_num(p['betas'])})"
                 if p["betan"] > 0.0 or p["betas"] > 0.0 else "Ip2_FrictMat_FrictMat_MindlinPhys()")

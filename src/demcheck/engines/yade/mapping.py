@@ -24,7 +24,7 @@ import math
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import NormalLaw
+from ...laws.normal import HYSTERETIC, NormalLaw
 from ...laws.tangential import (TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw,
                                 ViscousTangential)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
@@ -32,9 +32,11 @@ from ..mapping import mu_of
 
 VISCEL = "ViscElPhys"
 MINDLIN = "MindlinPhys"
+LUDING = "LudingPhys"  # LudingMat + Ip2_LudingMat_LudingMat_LudingPhys + Law2_ScGeom_LudingPhys_Basic (kc = G0 = 0)
 # Ip2_FrictMat_FrictMat_FrictPhys + this Law2: a ViscElPhys Native whose props carry law2 = CUNDALL (deck.py)
 CUNDALL = "Law2_ScGeom_FrictPhys_CundallStrack"
-LAW2 = {VISCEL: "Law2_ScGeom_ViscElPhys_Basic", MINDLIN: "Law2_ScGeom_MindlinPhys_Mindlin"}  # each physics' law
+LAW2 = {VISCEL: "Law2_ScGeom_ViscElPhys_Basic", MINDLIN: "Law2_ScGeom_MindlinPhys_Mindlin",
+        LUDING: "Law2_ScGeom_LudingPhys_Basic"}  # each physics' law
 CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashpot's attraction at the end of "
          "the contact); the case has limit_force = false")
 
@@ -51,8 +53,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     comments: list[str] = []
     fid = EXACT
     if normal.id == "hls":
-        return refused("yade", "no linear hysteretic law is mapped for Yade (its nearest, "
-                               "Law2_ScGeom6D_NormalInelasticityPhys_NormalInelasticity, is unverified here)")
+        return _luding(model)
     if normal.id == "hooke" and (eta == 0.0 or damp.id in ("none", "constant")):
         nat = Native("yade", normal=VISCEL, limit=True)
         nat.props.update(kn=normal.k, cn=eta, ks=0.0, cs=0.0, mu=0.0)
@@ -148,6 +149,54 @@ def _mindlin_shear(model: ResolvedModel, tl, nat: Native, eta: float, comments: 
     return ""
 
 
+# measured (docs/yade.md): the seed's HLS by the adaptive solver against Yade's Luding twin at the suite's dt
+LUDING_LAG = ("Yade's Luding law computes its unloading stiffness k2 = k1 + (kp − k1) δ_max/δ_Pmax from the largest "
+              "overlap of the step before, and δ_0 with that k2, then unloads along min(K_L δ, k2 (δ − δ_0)): a line "
+              "through (δ_max, K_L δ_max) only to one step's growth of k2 (measured against the seed's HLS: "
+              "{measured})")
+LUDING_MEASURED = ("2.3e-5 in restitution, 8.1e-5 in energy dissipated on normal-hls-pair (constant K_U, 0.1 to 10 "
+                   "m/s); 7.2e-7 and 6.8e-6 in restitution with variable unloading, S = 2000 and 20000 1/m")
+LUDING_CONSTANT = ("HLS's constant K_U = K_L/ε² as Yade's Luding unloading stiffness K_L(1 + S δ_max), which grows "
+                   "with the largest overlap: S = {s:.6g} 1/m matches it at the case's impact speed (δ_max = "
+                   "v√(m̄/K_L) = {dmax:.6g} m); other speeds, or gravity, differ")
+LUDING_WALL = ("Yade's Luding law is elastic against a Wall: its plastic depth φ_F·2a1a2/(a1 + a2) takes the radius "
+               "of a body that is not a sphere as 0, so δ_0 = 0 and the contact loads and unloads along kp (measured on "
+               "normal-hls-wall at 1 m/s: restitution 1.0005 where HLS gives 0.957, the peak force 12.98 N for "
+               "9.18 N); no other Yade law of this build is a linear hysteretic spring "
+               "(Law2_ScGeom6D_NormalInelasticityPhys_NormalInelasticity is not in it)")
+
+
+def _luding(model: ResolvedModel) -> Mapping:
+    """HLS between two spheres as Yade's Luding law: k1 = K_L and, with δ_lim above the overlap the collision
+    reaches, kp = K_L(1 + S δ_lim) and φ_F = δ_lim (kp − k1)/(2R̄ kp), so that δ_Pmax = δ_lim and the unloading
+    stiffness is K_L(1 + S δ_max), HLS's variable K_U (constant K_U: S matched at the impact speed)."""
+    contact, pair = model.contact, model.pair
+    law = contact.normal
+    if pair.wall:
+        return refused("yade", LUDING_WALL)
+    if contact.tangential.id != "none":
+        return refused("yade", f"Yade's Luding law is mapped for HLS without friction; the case's tangential law "
+                               f"is '{model.tangential.id}'")
+    m, r, v = pair.m_eff, pair.r_eff, pair.impact_speed
+    dmax = v * math.sqrt(m / law.kl)
+    reasons = [LUDING_LAG.format(measured=LUDING_MEASURED)]
+    s = law.s
+    if law.ku > 0.0:
+        s = (law.ku / law.kl - 1.0) / dmax
+        reasons.append(LUDING_CONSTANT.format(s=s, dmax=dmax))
+    if not (s > 0.0 and math.isfinite(s)):
+        return refused("yade", f"Yade's Luding law needs an unloading stiffness above the loading one (S = {s:g})")
+    d_lim = max(1.0 / s, 4.0 * dmax)
+    kp = law.kl * (1.0 + s * d_lim)
+    phi_f = d_lim * (kp - law.kl) / (kp * 2.0 * r)
+    nat = Native("yade", normal=LUDING, tangential="none", limit=True,
+                 props={"k1": law.kl, "kp": kp, "phi_f": phi_f, "s": s, "kl": law.kl, "r_eff": r},
+                 comments=[f"LudingMat k1 = {law.kl:.10g} N/m, kp = {kp:.10g} N/m, PhiF = {phi_f:.10g} (δ_Pmax = "
+                           f"{d_lim:.6g} m above the collision's δ_max {dmax:.6g} m: K_U = K_L(1 + S δ_max), "
+                           f"S = {s:.10g} 1/m), kc = ks = G0 = 0 (each material carries the pair's value)"])
+    return Mapping("yade", APPROXIMATE, reasons, nat, {r_: LAW2[LUDING] for r_ in reasons})
+
+
 def twin_rules(nat: Native, rules: dict) -> dict:
     """The engine's rules for the twin of ``nat``. CundallStrack and Mindlin keep their shear force as the history,
     turned by ScGeom::rotate before the increment, and take the slip as ScGeom's ratcheting-corrected velocity
@@ -186,4 +235,15 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
                 kt=p["kso"] / math.sqrt(r), eta=factor, eta_normal=True, mu_s=mu, mu_k=mu, truncation=TRUNC_SPRING,
                 force_history=True, r_eff=r, m_eff=m))
         return nl, twins.no_friction()
+    if nat.normal == LUDING:
+        # the nearest seed record, for the model's description: the twin's steps are twins_luding's (twin_collide)
+        return NormalLaw(HYSTERETIC, kl=p["kl"], ku=0.0, s=p["s"], limit=True), twins.no_friction()
     raise ValueError(f"no twin for Yade physics {nat.normal!r}")
+
+
+def twin_law_array(nat: Native, case):
+    """twins_luding's numbers for a Luding native on ``case``'s pair of spheres."""
+    from ...reference import twins_luding
+
+    a1, a2 = (q.radius for q in case.particles)
+    return twins_luding.law_array(nat.props["k1"], nat.props["kp"], nat.props["phi_f"], 2.0 * a1 * a2 / (a1 + a2))

@@ -1,0 +1,241 @@
+"""The twin of Kratos DEM's tangential force: its discontinuum laws' incremental spring with its dashpot and its
+Coulomb cap, stepped as Kratos steps a two-body contact (the state, record and Result of collision3d.py).
+
+What Kratos 10.4.4 computes (read in applications/DEMApplication: custom_constitutive/DEM_D_Hertz_viscous_Coulomb,
+DEM_D_Linear_viscous_Coulomb; custom_elements/spheric_particle.cpp), in the reference's convention (n from body 0
+into body 1, v_t the slip velocity, force on body 0 = −Fn n + Ft):
+
+* Kt = ρ Kn with ρ = 4G*/E* from the materials (ρ = 2(1 − ν)/(2 − ν) for equal materials or a rigid face),
+  Kn = 2E*√(R̄δ) (Hertz) or constant (Linear); the tangential dashpot c_t = 2γ√(m̄ Kt) (γ the contact's
+  DAMPING_GAMMA); the cap μ|Fn|, |Fn| the normal force held ≥ 0, μ = μd + (μs − μd) exp(−d |v_t|).
+* The history is the elastic tangential force F_e. Each step it is turned into the new tangent plane
+  (a pair: the stored force rotated about n_old × n by asin|n_old × n|; a wall: projected), (Hertz) scaled by
+  √(δ/δ_prev) when the overlap shrinks, and incremented by −Kt Δu_t, Δu the contact point's relative
+  displacement over the step: the bodies' displacements (x_new − x_old) plus the turn of each lever arm by the
+  body's rotation over the step (DELTA_ROTATION = ω dt), by a finite rotation (R(Δθ)a − a for a pair's arms
+  a = ±(R − δ/2) n; a − R(−Δθ)a on a wall, a = (R − δ) n). δ_prev = δ − Δu·n.
+* The dashpot −c_t v_t (v_t with the same arms). If |F_e + F_d| > μ|Fn| Kratos splits the cap between spring and
+  dashpot: with F_e·F_d ≥ 0, the spring is cut to the cap and the dashpot dropped if |F_e| > cap, else the
+  dashpot is cut to cap − |F_e|; with F_e·F_d < 0, the dashpot is cut to (cap + |F_e|)/|F_d| of itself if
+  |F_d| ≥ |F_e|, else the spring to the cap and the dashpot dropped.
+* Torques at R − δ/2 (pair, equal moduli) and R − δ (wall).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numba import njit
+
+from .. import KERNEL_CACHE
+from ..laws.normal_force import normal_force
+from ..laws.tangential_force import _cross, _dot, _norm
+from .kernels import M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED
+from .kernels3d import (A_NMODE, A_SIZE, C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, G_GX, G_I0, G_I1,
+                        G_M0, G_M1, G_R0, G_R1, G_WALL, NCOL, energy, kinematics)
+
+# the law's numbers (kp array): Kn = KN · δ^½ (Hertz) or KN (Linear); Kt = RHO · Kn; c_t = 2 GAMMA √(M Kt);
+# μ = MU_D + (MU_S − MU_D) exp(−DECAY |v_t|); MINOR: the Hertz law's √(δ/δ_prev) on unloading
+K_HERTZ, K_KN, K_RHO, K_GAMMA, K_M, K_MU_S, K_MU_D, K_DECAY, K_MINOR = range(9)
+K_SIZE = 9
+# Kratos' kinematic rules: slip at the contact point (R − δ/2 for a pair, R − δ on a wall), torques likewise
+RULES = {"slip_arm": "contact", "torque_arm": "contact", "wall_torque_arm": "surface", "wall_slip_arm": "surface",
+         "rotation": "none"}
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def rotate(v, axis, angle):
+    """v turned by ``angle`` about the unit ``axis`` (Rodrigues)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return v * c + _cross(axis, v) * s + axis * (_dot(axis, v) * (1.0 - c))
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def arm_turn(arm, dtheta, forward):
+    """The displacement of a lever arm's tip by the body's rotation ``dtheta`` over the step: R(Δθ)a − a
+    (``forward``, a pair's arms) or a − R(−Δθ)a (a wall's arm)."""
+    angle = _norm(dtheta)
+    if angle == 0.0:
+        return np.zeros(3)
+    axis = dtheta / angle
+    if forward:
+        return rotate(arm, axis, angle) - arm
+    return arm - rotate(arm, axis, -angle)
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def turn_pair_history(h, n_old, n):
+    """Kratos' RotateOldContactForces then its projection on the new tangent plane."""
+    ax = _cross(n_old, n)
+    s = _norm(ax)
+    if s > 0.0:
+        h = rotate(h, ax / s, math.asin(min(s, 1.0)))
+    return h - _dot(h, n) * n
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def coulomb_split(fe, fd, cap):
+    """Kratos' cap of spring + dashpot at ``cap``: (F_e, F_d, sliding)."""
+    tot = fe + fd
+    if _norm(tot) <= cap:
+        return fe, fd, False
+    ne, nd = _norm(fe), _norm(fd)
+    if _dot(fe, fd) >= 0.0:
+        if ne > cap:
+            return fe * (cap / ne), np.zeros(3), True
+        return fe, fd * ((cap - ne) / nd), True
+    if nd >= ne:
+        return fe, fd * ((cap + ne) / nd), True
+    return fe * (cap / ne), np.zeros(3), True
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def tangential(kp, fn, delta, delta_prev, du, vt, hist):
+    """(F_t, new history F_e, sliding) of one step: ``hist`` already turned into the new tangent plane, ``du``
+    and ``vt`` tangential."""
+    kn = kp[K_KN] * (math.sqrt(delta) if kp[K_HERTZ] != 0.0 else 1.0)
+    kt = kp[K_RHO] * kn
+    if kp[K_MINOR] != 0.0 and delta_prev > delta:
+        hist = hist * math.sqrt(delta / delta_prev)
+    fe = hist - kt * du
+    fd = -2.0 * kp[K_GAMMA] * math.sqrt(kp[K_M] * kt) * vt
+    mu = kp[K_MU_D] + (kp[K_MU_S] - kp[K_MU_D]) * math.exp(-kp[K_DECAY] * _norm(vt))
+    fe, fd, sliding = coulomb_split(fe, fd, fn * mu)
+    return fe + fd, fe, sliding
+
+
+@njit(cache=KERNEL_CACHE, nogil=True)
+def kratos_3d(y0, nl, kp, geo, rules, dt, t_max, capacity):
+    """Velocity Verlet as Kratos' Velocity_Verlet with Direct_Integration of the spins (verlet3d's scheme), with
+    Kratos' tangential force (the module's doc). The same returns as verlet3d.verlet_3d."""
+    rec = np.empty((capacity, NCOL))
+    y = y0.copy()
+    aux = np.zeros(A_SIZE)
+    aux[A_NMODE] = M_VE
+    hist = np.zeros(3)
+    n_old = np.zeros(3)
+    dmax = 0.0
+    wall = geo[G_WALL] != 0.0
+    touched = False
+    status = ST_NO_SEPARATION
+    fvec0, tau0, tau1 = np.zeros(3), np.zeros(3), np.zeros(3)
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+    fn = normal_force(nl, delta, rate, delta) if delta > 0.0 else 0.0
+    fvec0 = -fn * n
+    rec[0, C_T] = 0.0
+    rec[0, C_X0:C_X0 + 18] = y[0:18]
+    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, fn
+    rec[0, C_FT:C_FT + 3] = 0.0
+    rec[0, C_VT:C_VT + 3] = vt
+    rec[0, C_N:C_N + 3] = n
+    rec[0, C_E] = energy(y, geo)
+    rec[0, C_SLIP] = 0.0
+    g = geo[G_GX:G_GX + 3]
+    i, step = 1, 0
+    while i < capacity:
+        step += 1
+        t = step * dt
+        if t > t_max:
+            status = ST_NO_SEPARATION if touched else ST_NO_CONTACT
+            break
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        dx0 = dt * y[3:6]
+        y[0:3] += dx0
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        dth0 = dt * y[6:9]
+        dx1, dth1 = np.zeros(3), np.zeros(3)
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            dx1 = dt * y[12:15]
+            y[9:12] += dx1
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+            dth1 = dt * y[15:18]
+        delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
+        ft = np.zeros(3)
+        fn = 0.0
+        sliding = False
+        if delta > 0.0:
+            dmax = max(dmax, delta)
+            fn = abs(normal_force(nl, delta, rate, dmax))
+            if wall:
+                du = dx0 + arm_turn((geo[G_R0] - delta) * n, dth0, False)
+                hist = hist - _dot(hist, n) * n
+            else:
+                du = (dx0 - dx1 + arm_turn((geo[G_R0] - 0.5 * delta) * n, dth0, True)
+                      - arm_turn(-(geo[G_R1] - 0.5 * delta) * n, dth1, True))
+                if touched:
+                    hist = turn_pair_history(hist, n_old, n)
+            delta_prev = delta - _dot(du, n)
+            ft, hist, sliding = tangential(kp, fn, delta, delta_prev, du - _dot(du, n) * n, vt, hist)
+            n_old = n.copy()
+            touched = True
+        else:
+            hist[:] = 0.0
+            dmax = 0.0
+        fvec0 = -fn * n + ft
+        tau0 = _cross(a0t * n, ft)
+        tau1 = _cross(a1t * n, ft)
+        y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
+        y[6:9] += 0.5 * dt * tau0 / geo[G_I0]
+        if not wall:
+            y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
+            y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
+        rec[i, C_T] = t
+        rec[i, C_X0:C_X0 + 18] = y[0:18]
+        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
+        rec[i, C_FT:C_FT + 3] = ft
+        rec[i, C_VT:C_VT + 3] = vt
+        rec[i, C_N:C_N + 3] = n
+        rec[i, C_E] = energy(y, geo)
+        rec[i, C_SLIP] = 1.0 if sliding else 0.0
+        i += 1
+        if not np.all(np.isfinite(y[0:18])):
+            status = ST_UNRESOLVED
+            break
+        if delta <= 0.0 and touched:
+            status = ST_OK
+            break
+    else:
+        status = ST_STEPS
+    return status, i, rec[:i].copy()
+
+
+def law_array(hertz: bool, kn: float, rho: float, gamma: float, m_eff: float, mu_s: float, mu_d: float,
+              decay: float) -> np.ndarray:
+    kp = np.zeros(K_SIZE)
+    kp[K_HERTZ], kp[K_KN], kp[K_RHO], kp[K_GAMMA], kp[K_M] = float(hertz), kn, rho, gamma, m_eff
+    kp[K_MU_S], kp[K_MU_D], kp[K_DECAY], kp[K_MINOR] = mu_s, mu_d, decay, float(hertz)
+    return kp
+
+
+def collide(case, model, kp: np.ndarray, dt: float):
+    """The verlet twin of a Kratos contact with friction: collision3d.collide's verlet branch with this module's
+    kernel (``model`` the twin model: its normal law is Kratos' normal law)."""
+    from ..errors import ConfigError
+    from ..laws.model import characteristic_time
+    from ..result import Result
+    from . import collision3d
+    from .outcome import MESSAGES, ROW_BYTES_3D, STATUS, judge, time_to_contact, verlet_capacity
+
+    if not (dt > 0) or not math.isfinite(dt):
+        raise ConfigError("--dt", dt, "must be > 0 (s) and finite")
+    t_c = characteristic_time(model)
+    geo = collision3d.geometry(case, t_c)
+    rul = collision3d.rules_array(RULES)
+    y0 = collision3d.initial_state(case)
+    t_contact = time_to_contact(case)
+    t_max = t_contact + 200.0 * t_c
+    capacity = verlet_capacity(case, dt, True, t_contact, t_c, t_max, ROW_BYTES_3D)
+    started = time.perf_counter()
+    status, n, rec = kratos_3d(y0, model.normal_law.array(), kp, geo, rul, dt, t_max, capacity)
+    contact, particles = collision3d.tables(rec, wall=len(case.particles) == 1)
+    name = STATUS[status]
+    result = Result(source="reference", method="verlet", case_name=case.name, case_hash=case.hash,
+                    model=model.describe(), params=dict(model.params), contact=contact, particles=particles,
+                    events=None, dt=dt, rtol=None, wall_time=time.perf_counter() - started, status=name,
+                    message=MESSAGES.get(name, ""),
+                    meta={"solver": "3d", "steps": int(n), "rules": dict(RULES), "kratos_tangential": kp.tolist(),
+                          "radius0": case.particles[0].radius})
+    return judge(result, case, model)
