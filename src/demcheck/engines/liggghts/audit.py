@@ -11,6 +11,7 @@ from pathlib import Path
 from ...inputs.script import (NEVER_RUN, Body, Command, note_unread, Finding, PairSetting, ScriptError,
                               Setup, _num, body, finish, read_common, to_number)
 from ..base import Native
+from . import read as ENGINE_READ  # the deck's set-up evaluated in LIGGGHTS itself (a worker process)
 
 MODELS = ("hertz", "hooke", "hooke/stiffness", "hertz/stiffness")  # the probed ones (they have a twin)
 OTHER_MODELS = ("luding", "edinburgh", "thornton_ning", "hooke/hysteresis", "hertz/stiffness/ttt")
