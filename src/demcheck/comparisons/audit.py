@@ -97,7 +97,7 @@ def read(path: str | Path, engine: str | None = None):
             except via.ReadFailed as exc:
                 why = str(exc)
             if why:
-                answer = None
+                answer = _within_budget(answer, via, found[name], root)
     if answer is not None:
         script = via.script_of(answer, root)
     elif script is None:
@@ -110,6 +110,9 @@ def read(path: str | Path, engine: str | None = None):
     setup.box = script.variables.get("__box__", (None, None))[1]
     if answer is not None:
         via.apply(setup, answer, script)
+        if answer.stopped:  # the budget of commands ran out: what the engine read so far, the rest listed
+            where = answer.stopped.split(": ", 1)[0]
+            setup.not_audited.append((where, "", answer.stopped))
     elif via is not None:
         setup.read_by = f"demcheck's reader (inputs/script.py): {why}"
         if refused_by_engine:  # the installed engine stops on a set-up line: the deck as written does not run
@@ -127,6 +130,18 @@ def read(path: str | Path, engine: str | None = None):
                 "not convert")
         convert(setup)
     return setup
+
+
+def _within_budget(answer, via, reader, root: Path):
+    """An engine's read stopped by its budget of commands (a long loop of runs after the set-up): kept when what
+    the engine read up to there defines contacts the reader reads, else None (the present reader takes over)."""
+    if answer is None or not getattr(answer, "budget", False):
+        return None
+    try:
+        setup = reader.read(via.script_of(answer, root), root)
+    except deck_script.ScriptError:
+        return None
+    return answer if setup.pairs else None
 
 
 def _sniff(path: Path, found: dict) -> str:

@@ -474,6 +474,7 @@ def script_of(answer: EngineRead, root: Path):
     from ..inputs.script import Command, Script, _geometry
 
     script = Script()
+    script.engine_types = {a["type"] for a in answer.state.get("atoms", [])}
     for rec in answer.lines:
         words = rec["words"]
         head = (words or rec["text"].split() or [""])[0]

@@ -112,6 +112,7 @@ def _prop(cmd: Command, w: list[str]) -> tuple[str, str, list[float]]:
 def read(script, root: Path) -> Setup:
     setup = Setup("liggghts")
     setup.regions = script.regions
+    setup.populated |= script.engine_types  # the types LIGGGHTS's own read of the set-up gave atoms
     props: dict = {}  # name → (kind, values, where)
     style = None
     walls = []

@@ -232,6 +232,8 @@ class _Walker(F.Walker):
 
     def _refusal(self, words: list) -> str:
         why = super()._refusal(words)
+        if not why and words[0] == "set" and "property/atom" in words:
+            return "set … property/atom: not executed (a per-atom property of a fix the audit does not run)"
         if not why and words[0] == "fix":
             for key in FILE_KEYS:
                 if key in words[4:]:
