@@ -538,7 +538,8 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             reason += (f" — its box, types and bodies come from read_restart ({restarts[0]}), a binary file demcheck "
                        "does not read (audit the deck that wrote it)")
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
-            "read_by": setup.read_by, "units": units_info(setup), "dimension": setup.dimension,
+            "read_by": setup.read_by, "findings": [_finding(f) for f in setup.findings],
+            "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
             "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass,
                            "sizes": sorted({r for r, _ in b.sizes}) and
@@ -766,6 +767,8 @@ def text_report(r: dict) -> str:
              f"  dt = {r['dt']:g} {t_unit}{_si(r['dt'], u, 'time')} ({r['dt_from']}); characteristic speed "
              + (f"{r['speed']:g} {v_unit}{_si(r['speed'], u, 'speed')} ({r['speed_from']})" if r["speed"] is not None
                 else f"— ({r['speed_from']})")]
+    for f in r.get("findings", []):  # the deck's own (not one pair's): the engine refusing a line
+        lines.append(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
     cov = r["coverage"]
     lines.append("  probed: " + ", ".join(f"{c['probed']} of {c['total']} {kind}" for kind, c in cov.items())
                  + (" (2-D deck: density per area, probed as spheres of that mass)" if r["dimension"] == 2 else ""))
