@@ -53,7 +53,8 @@ FIX_STYLES = frozenset({
     "mesh/surface/stress", "mesh/surface/planar", "particletemplate/sphere", "particletemplate/multisphere",
     "particledistribution/discrete", "particledistribution/discrete/massbased",
     "particledistribution/discrete/numberbased", "insert/pack", "insert/stream", "insert/rate/region", "pour",
-    "enforce2d", "freeze", "setforce", "addforce", "viscous", "check/timestep/gran", "heat/gran"})
+    "enforce2d", "freeze", "setforce", "addforce", "viscous", "check/timestep/gran", "heat/gran",
+    "multicontact/halfspace"})
 COMPUTE_STYLES = frozenset({"erotate/sphere", "ke", "temp", "reduce", "com", "contact/atom", "property/atom",
                             "pair/gran/local", "wall/gran/local", "rigid", "ke/atom"})
 FILE_ARGS = {"read_data": 1, "include": 1, "read_restart": 1}
@@ -97,10 +98,13 @@ def _died(scratch: Path, rc: int) -> EngineRead | None:
     progress = scratch / "progress.jsonl"
     lines = [json.loads(x) for x in progress.read_text(encoding="utf-8").splitlines() if x.strip()] \
         if progress.is_file() else []
-    if not error or not lines:
+    if not lines:
         return None
     last = lines[-1]
     where = f"{last['file']}:{last['line']}"
+    if not error:  # Error::one aborts MPI before its message reaches the log: the line, not the engine's words
+        raise ReadFailed(f"the engine's worker died at {where} {last['text'][:60]!r} (exit status {rc}; LIGGGHTS "
+                         "aborted without an ERROR line in its log)")
     return EngineRead(_version(text), lines, {}, f"{where}: {last['text'][:70]!r}: the engine stops here: "
                       f"ERROR: {error[-1].strip()[:300]}", engine_error=True)
 
