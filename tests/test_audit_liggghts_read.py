@@ -171,3 +171,33 @@ run 1000
     assert asked["restitution"] == pytest.approx(0.8)  # in.run's property, not in.init's 0.5
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["in.init", "in.run", "post"]
     assert json.dumps(r)  # the report is JSON as --json prints it
+
+
+@pytest.mark.engine("liggghts")
+def test_a_long_loop_of_runs_after_the_set_up_keeps_the_engines_read(tmp_path):
+    """A loop of 100 000 `run 1` after the set-up (the tutorials' coupling loops): LIGGGHTS follows it up to the
+    budget of commands; what it read by then (bodies, contacts) is kept and audited, and the line where the read
+    stopped is listed as not audited; a hostile file name (../) in a fix is refused, never read."""
+    deck = _deck(tmp_path, HEAD + MATERIALS + """fix zw all wall/gran model hertz tangential history primitive type 2 zplane 0.0
+fix pts1 all particletemplate/sphere 15485863 atom_type 1 density constant 2000 radius constant 0.0015
+fix pdd1 all particledistribution/discrete 32452843 1 pts1 1.0
+region bc block -0.04 0.04 -0.04 0.04 0.01 0.08 units box
+fix ins all insert/pack seed 32452867 distributiontemplate pdd1 vel constant 0. 0. -2 insert_every once overlapcheck yes all_in yes particles_in_region 5 region bc
+label again
+variable i loop 100000
+run 1 post no
+next i
+jump SELF again
+""")
+    r = A.audit(deck)
+    assert r["read_by"].startswith("the engine (LIGGGHTS-PUBLIC 3.8.0)")
+    assert r["bodies"][1]["radius"] == pytest.approx(0.0015, rel=1e-12) and r["speed"] == pytest.approx(2.0)
+    assert r["coverage"]["pairs"]["probed"] == 1 and r["coverage"]["walls"]["probed"] == 1
+    assert any("more than 20000 commands followed" in n["why"] for n in r["not_audited"])
+    (tmp_path / "sub").mkdir()
+    hostile = _deck(tmp_path / "sub", HEAD + "fix cad all mesh/surface file ../../etc/passwd type 2\n" + MATERIALS)
+    from demcheck.engines.liggghts import read as R
+
+    answer = R.engine_read(hostile)
+    assert "'../../etc/passwd': the file lies outside the deck's directory" in answer.stopped
+    assert not [rec for rec in answer.lines if rec["ran"] and "passwd" in rec["text"]]

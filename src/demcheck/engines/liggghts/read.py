@@ -59,7 +59,8 @@ COMPUTE_STYLES = frozenset({"erotate/sphere", "ke", "temp", "reduce", "com", "co
                             "pair/gran/local", "wall/gran/local", "rigid", "ke/atom"})
 FILE_ARGS = {"read_data": 1, "include": 1, "read_restart": 1}
 LISTS = F.Lists(ALLOWED, VARIABLE_STYLES, PAIR_STYLES, FIX_STYLES, COMPUTE_STYLES, FILE_ARGS)
-# the files a fix reads (fix mesh/surface … file F; particletemplate/multisphere … file F): inside the folder
+# the files a fix or region reads (fix mesh/surface … file F, particletemplate/multisphere … file F, region
+# mesh/tet file F): inside the folder
 FILE_KEYS = ("file",)
 _VAR = re.compile(r"\$\{([^}]*)\}|\$\((.*?)\)|\$([A-Za-z0-9_])|v_(\w+)")
 _REF = re.compile(r"\b([cf])_([A-Za-z0-9_]+)")
@@ -238,10 +239,10 @@ class _Walker(F.Walker):
         why = super()._refusal(words)
         if not why and words[0] == "set" and "property/atom" in words:
             return "set … property/atom: not executed (a per-atom property of a fix the audit does not run)"
-        if not why and words[0] == "fix":
+        if not why and words[0] in ("fix", "region"):  # fix mesh/surface … file F, region … mesh/tet file F
             for key in FILE_KEYS:
-                if key in words[4:]:
-                    k = words.index(key, 4) + 1
+                if key in words[3:]:
+                    k = words.index(key, 3) + 1
                     self._inside(words[k] if k < len(words) else "")
         return why
 
