@@ -171,6 +171,8 @@ run 1000
     assert asked["restitution"] == pytest.approx(0.8)  # in.run's property, not in.init's 0.5
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["in.init", "in.run", "post"]
     assert json.dumps(r)  # the report is JSON as --json prints it
+    latest = _deck(tmp_path, deck.read_text().replace("post/restart.5000", "post/restart.*"), "in.latest")
+    assert "the deck that writes post/restart.*" in A.audit(latest)["read_by"]  # read_restart's latest-file form
 
 
 @pytest.mark.engine("liggghts")

@@ -255,8 +255,7 @@ class Walker:
             return self._if(rec, words, name, line)
         if head == "write_restart" and self.restart and (name, line) == self.restart["line"]:
             return self._restart_written(rec)
-        if head == "read_restart" and len(words) > 1 and "*" not in words[1] \
-                and not (self.root / words[1]).resolve().is_file():
+        if head == "read_restart" and len(words) > 1 and not self._exists(words[1]):
             return self._read_restart(rec, words, name, line)
         why = self._refusal(words)
         if why:
@@ -265,12 +264,20 @@ class Walker:
                 self.skipped_ids.add((head, words[1]))
             return None
         self._run(rec, self.run_as if head == "run" else expanded, name, line)
+        if head in ("fix", "compute", "variable") and len(words) > 1:
+            self.skipped_ids.discard((head, words[1]))  # defined again, now executed
         if head == "next":
             self._next(words)
         natoms = self.lmp.natoms()
         if natoms > MAX_ATOMS:
             raise Refused(f"{name}:{line}: {natoms} atoms: more than the {MAX_ATOMS} the audit's read takes")
         return None
+
+    def _exists(self, word: str) -> bool:
+        """A restart file of the deck's folder (``*``: any timestep's, as read_restart searches for the latest)."""
+        if "*" in word:
+            return any(p.is_file() for p in self.root.glob(word))
+        return (self.root / word).resolve().is_file()
 
     def _run(self, rec, text, name, line) -> None:
         try:

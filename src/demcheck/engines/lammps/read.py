@@ -1,5 +1,9 @@
 """The deck read as LAMMPS reads it (``demcheck audit``): the engine itself evaluates the deck's set-up.
 
+The walk, the budget, the answer and the caller's side are the LAMMPS family's, shared with LIGGGHTS
+(engines/family_read.py); this module gives LAMMPS's allow-list, its Python module behind the walk's protocol
+and the state it reads back.
+
 ``engine_read(path)`` runs ``python -m demcheck.engines.lammps.read`` — a worker process of its own, which a
 hostile deck may crash or exhaust without taking demcheck down — and reads back what the engine made of the
 deck. The worker walks the deck's lines (comments stripped and continuations joined by inputs/script.py) and,
