@@ -101,7 +101,8 @@ run 2000
     assert cov["pairs"]["probed"] == cov["pairs"]["total"] == 3  # the smallest, largest and mass-weighted pairs
     assert cov["walls"]["probed"] == cov["walls"]["total"] == 6  # the mesh and the primitive wall × 3 sizes
     engine = A.read(deck)
-    assert engine.bodies[1].size_from.startswith("the engine's 40 atom(s) of type 1")
+    assert "its sizes those of the engine's 40 atom(s) of type 1, weighted by the distribution's mass fractions" \
+        in engine.bodies[1].size_from
     assert any("the engine's atoms" in w for _, w in engine.speeds)
 
 

@@ -514,6 +514,15 @@ def _writes(cmd) -> bool:
     return True
 
 
+def _of_distribution(b, sizes: dict) -> bool:
+    """Whether the reader gave type ``b`` several sizes with weights (a LIGGGHTS distribution of templates, fix
+    pour's range or poly) among which are all the sizes the engine's atoms have: the engine inserted a first
+    sample of that distribution, whose mass fractions are the deck's own statement of the mix."""
+    import math
+
+    return len(b.sizes) > 1 and all(any(math.isclose(r, x, rel_tol=1e-9) for x, _ in b.sizes) for r in sizes)
+
+
 def apply(setup, answer: EngineRead, script, how: str = "") -> None:
     """The engine's state into a Setup the reader built from the engine's lines: units, dt, dimension, box, and
     each type's bodies (their radii with mass weights, density, positions, velocities, spins)."""
@@ -542,13 +551,17 @@ def apply(setup, answer: EngineRead, script, how: str = "") -> None:
         shape = (lambda r: math.pi * r * r) if setup.dimension == 2 else (lambda r: 4.0 / 3.0 * math.pi * r ** 3)
         b.density = sum(m / shape(r) * m for r, m in rows) / sum(m for _, m in rows)  # mass-weighted
         b.mass = None
+        setup.populated.add(t)
+        if _of_distribution(b, sizes):  # an insertion's first sample: the distribution's own mass fractions
+            b.size_from += (f"; its sizes those of the engine's {len(rows)} atom(s) of type {t}, weighted by the "
+                            "distribution's mass fractions")
+            continue
         if len(sizes) == 1:
             b.radius, b.sizes = rows[0][0], []
         else:
             b.sizes = sorted(sizes.items())
             b.radius = sum(r * m for r, m in b.sizes) / total
         b.size_from = f"the engine's {len(rows)} atom(s) of type {t}"
-        setup.populated.add(t)
     setup.atoms = {a["id"]: [a["type"], a["x"], a["v"]] for a in s["atoms"] if a["x"] is not None}
     fastest = max(((math.sqrt(sum(x * x for x in a["v"])), a) for a in s["atoms"] if a["v"]),
                   key=lambda p: p[0], default=(0.0, None))
