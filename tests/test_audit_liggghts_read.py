@@ -13,6 +13,7 @@ import sys
 import pytest
 
 from demcheck.comparisons import audit as A
+from demcheck.inputs.script import ScriptError
 
 from .conftest import ROOT
 
@@ -197,6 +198,12 @@ jump SELF again
     assert r["bodies"][1]["radius"] == pytest.approx(0.0015, rel=1e-12) and r["speed"] == pytest.approx(2.0)
     assert r["coverage"]["pairs"]["probed"] == 1 and r["coverage"]["walls"]["probed"] == 1
     assert any("more than 20000 commands followed" in n["why"] for n in r["not_audited"])
+    endless = _deck(tmp_path, deck.read_text().replace("next i\n", ""), "in.endless")
+    with pytest.raises(ScriptError, match="control flow"):  # no next: the loop may never end — not kept
+        A.read(endless)
+    sets = _deck(tmp_path, deck.read_text().replace("next i\n", "next i\nset type 1 diameter 0.004\n"), "in.sets")
+    with pytest.raises(ScriptError, match="control flow"):  # each pass may change the bodies — not kept
+        A.read(sets)
     (tmp_path / "sub").mkdir()
     hostile = _deck(tmp_path / "sub", HEAD + "fix cad all mesh/surface file ../../etc/passwd type 2\n" + MATERIALS)
     from demcheck.engines.liggghts import read as R

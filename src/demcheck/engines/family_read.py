@@ -201,11 +201,40 @@ class Walker:
             frame[1] += 1
             self.count += 1
             if self.count > MAX_COMMANDS:
-                raise _Budget(f"{name}:{lines[k][0]}: more than {MAX_COMMANDS} commands followed (control flow "
-                              "that does not end within the budget: not audited beyond this line)")
+                why = (f"{name}:{lines[k][0]}: more than {MAX_COMMANDS} commands followed (control flow that does "
+                       "not end within the budget: not audited beyond this line)")
+                raise (_Budget if self._repeats_only_runs() else Refused)(why)
             if self.one(name, *lines[k]) == "quit":
                 return ""
         return ""
+
+    def _repeats_only_runs(self) -> bool:
+        """At the budget: whether what is left is only more passes of a loop that sets nothing the audit reads —
+        every line of the deck's files already followed, the lines followed more than once only runs, output,
+        ``set`` of per-atom values the contacts do not depend on, loop/index variables and the loop's own
+        ``label``/``next``/``jump`` (the reader's rule for a loop read once, inputs/script.py), and a ``next`` among
+        them (the loop ends). Then the set-up read so far is the deck's."""
+        from ..inputs.script import LOOP_SAFE, SET_READ
+
+        seen: dict = {}
+        for rec in self.out:
+            key = (rec["file"], rec["line"])
+            seen[key] = seen.get(key, 0) + 1
+        if any((name, n) not in seen for name, lines in self.files.items() for n, _ in lines):
+            return False
+        heads = set()
+        for rec in self.out:
+            if seen[(rec["file"], rec["line"])] < 2:
+                continue
+            w = rec["words"] or rec["text"].split()
+            heads.add(w[0])
+            if w[0] == "variable" and w[2:3] not in (["loop"], ["index"]):
+                return False
+            if w[0] == "set" and SET_READ & set(w[3::2]):
+                return False
+            if w[0] not in LOOP_SAFE | {"label", "jump", "variable", "set"}:
+                return False
+        return "next" in heads
 
     def one(self, name: str, line: int, text: str):
         rec = {"file": name, "line": line, "text": text, "words": None, "ran": False, "why": ""}
