@@ -136,12 +136,14 @@ run 100
 def test_a_missing_restart_read_from_the_deck_that_writes_it(tmp_path):
     """The tutorials' pair of decks: in.init inserts the bodies and writes post/restart.* ; in.run reads
     post/restart.5000, which the folder lacks, redefines materials, contact law and walls (a restart keeps box,
-    types and atoms, not fixes) and sets the bodies' speed. The bodies come from in.init's set-up in LIGGGHTS,
+    types and atoms, not fixes), sets the bodies' speed and ends in a long coupling loop of `run 1`; both include
+    the same parameter file. The bodies come from in.init's set-up in LIGGGHTS,
     carried over by LIGGGHTS's own write_restart/read_restart in demcheck's scratch folder; in.run's own commands
     after read_restart apply; the report says where the bodies came from; no file appears in the folder."""
     (tmp_path / "post").mkdir()
-    _deck(tmp_path, HEAD + MATERIALS + """fix zw all wall/gran model hertz tangential history primitive type 2 zplane 0.0
-fix pts1 all particletemplate/sphere 15485863 atom_type 1 density constant 2000 radius constant 0.0015
+    _deck(tmp_path, "variable rho equal 2000\nvariable vz equal -0.7\n", "in.params")
+    _deck(tmp_path, "include in.params\n" + HEAD + MATERIALS + """fix zw all wall/gran model hertz tangential history primitive type 2 zplane 0.0
+fix pts1 all particletemplate/sphere 15485863 atom_type 1 density constant ${rho} radius constant 0.0015
 fix pdd1 all particledistribution/discrete 32452843 1 pts1 1.0
 region bc block -0.04 0.04 -0.04 0.04 0.01 0.08 units box
 fix ins all insert/pack seed 32452867 distributiontemplate pdd1 vel constant 0. 0. -3 insert_every once overlapcheck yes all_in yes particles_in_region 12 region bc
@@ -149,7 +151,8 @@ fix integr all nve/sphere
 run 5000
 write_restart post/restart.*
 """, "in.init")
-    deck = _deck(tmp_path, """atom_style granular
+    deck = _deck(tmp_path, """include in.params
+atom_style granular
 atom_modify map array
 communicate single vel yes
 boundary f f f
@@ -159,9 +162,13 @@ read_restart post/restart.5000
 neighbor 0.002 bin
 neigh_modify delay 0
 """ + MATERIALS.replace("0.5 0.5 0.5 0.5", "0.8 0.8 0.8 0.8") + """fix zw all wall/gran model hertz tangential history primitive type 2 zplane 0.0
-velocity all set 0 0 -0.7
+velocity all set 0 0 ${vz}
 fix integr all nve/sphere
-run 1000
+label coupling
+variable step loop 100000
+run 1 post no
+next step
+jump SELF coupling
 """, "in.run")
     r = A.audit(deck)
     assert "bodies from in.init, the deck that writes post/restart.5000" in r["read_by"]
@@ -171,7 +178,8 @@ run 1000
     assert r["coverage"]["pairs"]["probed"] == 1 and r["coverage"]["walls"]["probed"] == 1
     asked = r["pairs"][0]["asked"]
     assert asked["restitution"] == pytest.approx(0.8)  # in.run's property, not in.init's 0.5
-    assert sorted(p.name for p in tmp_path.rglob("*")) == ["in.init", "in.run", "post"]
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["in.init", "in.params", "in.run", "post"]
+    assert any("more than 20000 commands followed" in n["why"] for n in r["not_audited"])  # its coupling loop
     assert json.dumps(r)  # the report is JSON as --json prints it
     latest = _deck(tmp_path, deck.read_text().replace("post/restart.5000", "post/restart.*"), "in.latest")
     assert "the deck that writes post/restart.*" in A.audit(latest)["read_by"]  # read_restart's latest-file form

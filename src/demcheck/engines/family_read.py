@@ -210,10 +210,10 @@ class Walker:
 
     def _repeats_only_runs(self) -> bool:
         """At the budget: whether what is left is only more passes of a loop that sets nothing the audit reads —
-        every line of the deck's files already followed, the lines followed more than once only runs, output,
-        ``set`` of per-atom values the contacts do not depend on, loop/index variables and the loop's own
-        ``label``/``next``/``jump`` (the reader's rule for a loop read once, inputs/script.py), and a ``next`` among
-        them (the loop ends). Then the set-up read so far is the deck's."""
+        every line of the deck's files already followed; the last half of the lines followed all followed before
+        (passes of a loop) and only runs, output, ``set`` of per-atom values the contacts do not depend on,
+        loop/index variables and the loop's own ``label``/``next``/``jump`` (the reader's rule for a loop read once,
+        inputs/script.py); and a ``next`` among them (the loop ends). Then the set-up read so far is the deck's."""
         from ..inputs.script import LOOP_SAFE, SET_READ
 
         seen: dict = {}
@@ -223,9 +223,9 @@ class Walker:
         if any((name, n) not in seen for name, lines in self.files.items() for n, _ in lines):
             return False
         heads = set()
-        for rec in self.out:
+        for rec in self.out[len(self.out) // 2:]:  # the last half: passes of the loop (an include read twice is not)
             if seen[(rec["file"], rec["line"])] < 2:
-                continue
+                return False
             w = rec["words"] or rec["text"].split()
             heads.add(w[0])
             if w[0] == "variable" and w[2:3] not in (["loop"], ["index"]):
