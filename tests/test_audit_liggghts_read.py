@@ -7,6 +7,7 @@ patterns of LIGGGHTS's tutorials, each read by the real LIGGGHTS 3.8; each test 
 LIGGGHTS read: control flow refused, the reader's read_by, a restart's deck with nothing probed)."""
 
 import json
+import math
 import subprocess
 import sys
 
@@ -101,6 +102,9 @@ run 2000
     cov = r["coverage"]
     assert cov["pairs"]["probed"] == cov["pairs"]["total"] == 3  # the smallest, largest and mass-weighted pairs
     assert cov["walls"]["probed"] == cov["walls"]["total"] == 6  # the mesh and the primitive wall × 3 sizes
+    # the insertion velocity plus the fall from the region's top (0.08) to the box's bottom (-0.01): the plane wall
+    # at 0.09 is a lid, not a floor (the mesh floor at 0 is not read: its facets are not)
+    assert r["speed"] == pytest.approx(math.sqrt(1.5 ** 2 + 2 * 9.81 * 0.09), rel=1e-12)
     engine = A.read(deck)
     assert "its sizes those of the engine's 40 atom(s) of type 1, weighted by the distribution's mass fractions" \
         in engine.bodies[1].size_from

@@ -196,7 +196,8 @@ def _insertion_speed(setup) -> tuple[float, str] | None:
             bounds = setup.regions.get(region) if region else None
             if not bounds or not all(map(math.isfinite, bounds[2 * axis:2 * axis + 2])):
                 bounds = setup.box
-            floors = [c for a, c in setup.floors if a == axis]
+            # a plane wall above the insertion region (a lid) is no floor
+            floors = [c for a, c in setup.floors if a == axis and bounds is not None and c <= bounds[2 * axis + 1]]
             lo = min(floors) if floors else (setup.box[2 * axis] if setup.box else None)
             if bounds is None or lo is None or not math.isfinite(lo):
                 continue
