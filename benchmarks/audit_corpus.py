@@ -70,7 +70,8 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
         return row
     pairs = r.get("pairs", [])
     probed = [p for p in pairs if p.get("probed")]  # the report's own count: a probe that measured a contact
-    codes = sorted({f["code"] for p in pairs for f in p.get("findings", []) if f["kind"] == "trap"})
+    codes = sorted({f["code"] for f in [*r.get("findings", []), *(f for p in pairs for f in p.get("findings", []))]
+                    if f["kind"] == "trap"})  # the deck's own (engine-refuses) and each pair's
     row.update(pairs=len(pairs), probed_pairs=len(probed), status=r.get("status"), traps=r.get("traps"),
                coverage=r.get("coverage"), codes=codes, units=(r.get("units") or {}).get("style"),
                speed_from=str(r.get("speed_from", ""))[:60],

@@ -14,6 +14,15 @@ from demcheck.inputs.script import ScriptError
 
 from .test_audit_corpus import LIGGGHTS, _deck
 
+
+@pytest.fixture(autouse=True)
+def _reader_path(monkeypatch):
+    """These are the reader's rules: LIGGGHTS's own read (engines/liggghts/read.py, which follows loops in the
+    engine, tests/test_audit_liggghts_read.py) is set aside, as where libliggghts is not installed."""
+    from demcheck.engines.liggghts import read as LR
+
+    monkeypatch.setattr(LR, "available", lambda: False)
+
 NO_FRICTION = LIGGGHTS.replace("tangential history", "tangential no_history").replace(
     "coefficientFriction peratomtypepair 1 0.5", "coefficientFriction peratomtypepair 1 0.0").replace(
     "fix pts2 all particletemplate/sphere 15485867 atom_type 1 density constant 2500 radius constant 0.008\n", "").replace(

@@ -97,7 +97,7 @@ def read(path: str | Path, engine: str | None = None):
             except via.ReadFailed as exc:
                 why = str(exc)
             if why:
-                answer = None
+                answer = _within_budget(answer, via, found[name], root)
     if answer is not None:
         script = via.script_of(answer, root)
     elif script is None:
@@ -110,6 +110,9 @@ def read(path: str | Path, engine: str | None = None):
     setup.box = script.variables.get("__box__", (None, None))[1]
     if answer is not None:
         via.apply(setup, answer, script)
+        if answer.stopped:  # the budget of commands ran out: what the engine read so far, the rest listed
+            where = answer.stopped.split(": ", 1)[0]
+            setup.not_audited.append((where, "", answer.stopped))
     elif via is not None:
         setup.read_by = f"demcheck's reader (inputs/script.py): {why}"
         if refused_by_engine:  # the installed engine stops on a set-up line: the deck as written does not run
@@ -127,6 +130,18 @@ def read(path: str | Path, engine: str | None = None):
                 "not convert")
         convert(setup)
     return setup
+
+
+def _within_budget(answer, via, reader, root: Path):
+    """An engine's read stopped by its budget of commands (a long loop of runs after the set-up): kept when what
+    the engine read up to there defines contacts the reader reads, else None (the present reader takes over)."""
+    if answer is None or not getattr(answer, "budget", False):
+        return None
+    try:
+        setup = reader.read(via.script_of(answer, root), root)
+    except deck_script.ScriptError:
+        return None
+    return answer if setup.pairs else None
 
 
 def _sniff(path: Path, found: dict) -> str:
@@ -181,7 +196,8 @@ def _insertion_speed(setup) -> tuple[float, str] | None:
             bounds = setup.regions.get(region) if region else None
             if not bounds or not all(map(math.isfinite, bounds[2 * axis:2 * axis + 2])):
                 bounds = setup.box
-            floors = [c for a, c in setup.floors if a == axis]
+            # a plane wall above the insertion region (a lid) is no floor
+            floors = [c for a, c in setup.floors if a == axis and bounds is not None and c <= bounds[2 * axis + 1]]
             lo = min(floors) if floors else (setup.box[2 * axis] if setup.box else None)
             if bounds is None or lo is None or not math.isfinite(lo):
                 continue
@@ -523,7 +539,8 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             reason += (f" — its box, types and bodies come from read_restart ({restarts[0]}), a binary file demcheck "
                        "does not read (audit the deck that wrote it)")
     return {"deck": str(path), "engine": setup.engine, "engine_version": info.version if info else None,
-            "read_by": setup.read_by, "units": units_info(setup), "dimension": setup.dimension,
+            "read_by": setup.read_by, "findings": [_finding(f) for f in setup.findings],
+            "units": units_info(setup), "dimension": setup.dimension,
             "dt": setup.dt, "dt_from": setup.dt_where, "speed": v, "speed_from": v_from,
             "bodies": {t: {"radius": b.radius, "density": b.density, "mass": b.mass,
                            "sizes": sorted({r for r, _ in b.sizes}) and
@@ -751,6 +768,8 @@ def text_report(r: dict) -> str:
              f"  dt = {r['dt']:g} {t_unit}{_si(r['dt'], u, 'time')} ({r['dt_from']}); characteristic speed "
              + (f"{r['speed']:g} {v_unit}{_si(r['speed'], u, 'speed')} ({r['speed_from']})" if r["speed"] is not None
                 else f"— ({r['speed_from']})")]
+    for f in r.get("findings", []):  # the deck's own (not one pair's): the engine refusing a line
+        lines.append(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
     cov = r["coverage"]
     lines.append("  probed: " + ", ".join(f"{c['probed']} of {c['total']} {kind}" for kind, c in cov.items())
                  + (" (2-D deck: density per area, probed as spheres of that mass)" if r["dimension"] == 2 else ""))

@@ -86,6 +86,7 @@ class Script:
     regions: dict = field(default_factory=dict)  # region id → (xlo, xhi, ylo, yhi, zlo, zhi) or None (other shapes)
     atom_formulas: dict = field(default_factory=dict)  # atom-style variable → its formula (for fix adapt's growth)
     radius_computes: dict = field(default_factory=dict)  # compute id → "radius" | "diameter" (property/atom)
+    engine_types: set = field(default_factory=set)  # types with atoms in the engine's own read of the set-up
 
 
 # ----------------------------------------------------------------------------- the safe evaluator

@@ -11,6 +11,7 @@ from pathlib import Path
 from ...inputs.script import (NEVER_RUN, Body, Command, note_unread, Finding, PairSetting, ScriptError,
                               Setup, _num, body, finish, read_common, to_number)
 from ..base import Native
+from . import read as ENGINE_READ  # the deck's set-up evaluated in LIGGGHTS itself (a worker process)
 
 MODELS = ("hertz", "hooke", "hooke/stiffness", "hertz/stiffness")  # the probed ones (they have a twin)
 OTHER_MODELS = ("luding", "edinburgh", "thornton_ning", "hooke/hysteresis", "hertz/stiffness/ttt")
@@ -111,6 +112,7 @@ def _prop(cmd: Command, w: list[str]) -> tuple[str, str, list[float]]:
 def read(script, root: Path) -> Setup:
     setup = Setup("liggghts")
     setup.regions = script.regions
+    setup.populated |= script.engine_types  # the types LIGGGHTS's own read of the set-up gave atoms
     props: dict = {}  # name → (kind, values, where)
     style = None
     walls = []
