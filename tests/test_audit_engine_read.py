@@ -196,3 +196,21 @@ velocity all set 0 0 -1
     answer = R.engine_read(deck)
     assert sorted(a["x"][2] for a in answer.state["atoms"]) == pytest.approx([-0.003, 0.0], abs=1e-15)
     assert [rec["words"][0] for rec in answer.lines if rec["words"]].count("set") == 1
+
+
+@pytest.mark.engine("lammps")
+def test_a_parallel_layout_is_not_a_refusal(tmp_path):
+    """``processors 2 1 *`` lays the deck out on two ranks; the read runs on one, where LAMMPS stops at create_box
+    ("Could not create 3d grid of processors"). The layout changes no contact: it is not executed, and the deck is
+    read by the engine with no engine-refuses trap (main 61ee0df reported one)."""
+    deck = _deck(tmp_path, HEAD.replace("boundary f f f\n", "boundary f f f\nprocessors 2 1 *\n") + """
+create_atoms 1 single 0 0 0 units box
+create_atoms 1 single 0.0021 0 0 units box
+set atom * diameter 0.002 density 2500
+velocity all set 0 0 0
+set atom 2 vx -0.5
+""" + LAW + "run 1000\n")
+    r = A.audit(deck)
+    assert r["read_by"].startswith("the engine (LAMMPS"), r["read_by"]
+    assert not [f for f in A.read(deck).findings if f.code == "engine-refuses"]
+    assert r["coverage"]["pairs"]["probed"] == 1

@@ -38,9 +38,10 @@ MODULE = "demcheck.engines.lammps.read"
 MAX_SECONDS = 60.0
 IF_VARIABLE = "__demcheck_if"
 
-# commands that only set up a simulation in memory
+# commands that only set up a simulation in memory (not `processors`: the read runs on one rank, where a layout
+# for several stops LAMMPS at create_box; a layout changes no contact)
 ALLOWED = frozenset({
-    "units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "processors", "comm_modify",
+    "units", "dimension", "boundary", "atom_style", "atom_modify", "newton", "comm_modify",
     "comm_style", "neighbor", "neigh_modify", "lattice", "region", "create_box", "create_atoms", "delete_atoms",
     "displace_atoms", "set", "mass", "velocity", "group", "variable", "pair_style", "pair_coeff", "pair_modify",
     "timestep", "fix", "unfix", "fix_modify", "compute", "uncompute", "run", "reset_timestep",
