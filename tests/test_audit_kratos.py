@@ -164,3 +164,26 @@ def test_a_law_without_twin_is_listed_not_probed(tmp_path):
     setup = A.read(_project(tmp_path, law_pair="DEM_D_Stress_Dependent_Cohesive"))
     pair = setup.pairs[0]
     assert not pair.probe and any("no twin of Kratos' DEM_D_Stress_Dependent_Cohesive" in n for n in pair.notes)
+
+
+@pytest.mark.engine("kratos")  # Kratos' own γ is read from Kratos
+def test_a_law_the_twin_steps_its_own_way_is_converged_by_its_own_kernel(tmp_path):
+    """Where an engine's twin steps a law with a kernel of its own (Engine.own_twin: Kratos' Coulomb tangential
+    force, Yade's Luding law), the probe's converged answer is that kernel at dt/16, not the adaptive solver of the
+    law's description. The Kratos audit reads no tangential law yet (its natives are frictionless), so the pair's
+    native is given Kratos' friction here: the converged restitution is then the own kernel's, within its O(dt²)
+    error of the twin at dt; the frictionless native keeps the adaptive solver."""
+    import copy
+
+    from demcheck.engines.kratos.mapping import FRICTION
+
+    setup = A.read(_project(tmp_path, dt=5e-9))
+    pair = setup.pairs[0]
+    w = A.probe(setup, pair, 1.0, 0.0, run_engine=False)
+    assert w["converged"]["by"] == "the adaptive solver"
+    pair.native = copy.deepcopy(pair.native)
+    pair.native.tangential = FRICTION
+    pair.native.props.update(poisson=NU_GLASS, mu_s=0.4, mu_d=0.3, decay=500.0)
+    q = A.probe(setup, pair, 1.0, 0.0, run_engine=False)
+    assert q["converged"]["status"] == "ok" and q["converged"]["by"] == "the engine's own law stepped at dt/16"
+    assert q["converged"]["restitution"] == pytest.approx(q["twin"]["restitution"], rel=1e-4)

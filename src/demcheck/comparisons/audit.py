@@ -434,8 +434,8 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: T
     twin = twin_states(case, setup.engine, dt, native=ps.native)
     out["twin"] = {"status": twin.status, "message": twin.message, **_metrics(twin)}
     try:
-        conv = collision3d.collide(case, twin_model(resolve(case), ps.native), "adaptive")
-        out["converged"] = {"status": conv.status, **_metrics(conv)}
+        conv = _converged(case, setup.engine, eng, ps.native, dt)
+        out["converged"] = {"status": conv.status, **_metrics(conv), "by": conv.meta.get("converged_by", "")}
     except ConfigError as exc:
         conv = None
         out["converged"] = {"status": "not run", "message": str(exc)}
@@ -466,6 +466,22 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: T
     sides = {k: out[k] for k in ("engine", "twin", "converged", "seed") if k in out}
     out["failure"] = health_failure(sides, min(p.radius for p in case.particles))
     return out
+
+
+OWN_LAW_REFINE = 16  # an engine's own twin kernel has no adaptive form: its converged answer is dt / 16 (error / 256)
+
+
+def _converged(case, name: str, eng, native, dt: float):
+    """The probe's converged answer: the twin's law by the adaptive solver, or, where the engine's twin steps a law
+    of its own (Engine.own_twin: Kratos' tangential force, Yade's Luding law), that kernel at dt / 16 — the
+    adaptive solver would solve the description of the law, not the law."""
+    if eng.own_twin(native):
+        conv = twin_states(case, name, dt / OWN_LAW_REFINE, native=native)
+        conv.meta["converged_by"] = f"the engine's own law stepped at dt/{OWN_LAW_REFINE}"
+        return conv
+    conv = collision3d.collide(case, twin_model(resolve(case), native), "adaptive")
+    conv.meta["converged_by"] = "the adaptive solver"
+    return conv
 
 
 REQUIRED = ("restitution", "contact_time")  # every formed contact has them: NaN on both sides is a failure
