@@ -109,13 +109,24 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
     comparisons) raises _Unevaluable: the reader never guesses a value."""
     if depth > 20:
         raise _Unevaluable("variables refer to each other too deeply")
-    tokens, pos = [], 0
     expr = expr.strip()
+    parser = _Formula(expr, _tokens(expr), variables, depth)
+    x = parser.add()
+    if parser.k != len(parser.tokens):
+        raise _Unevaluable(f"unexpected {parser.tokens[parser.k][1]!r} in {expr!r}")
+    if not math.isfinite(x):
+        raise _Unevaluable(f"{expr!r} is not finite")
+    return x
+
+
+def _tokens(expr: str) -> list[tuple]:
+    """The formula's tokens: ("num", value), ("var", NAME), ("name", word), ("op", symbol)."""
     nest = 0
     for ch in expr:  # the parser recurses per parenthesis: bound it before parsing (never a RecursionError)
         nest += (ch == "(") - (ch == ")")
         if nest > MAX_NESTING:
             raise _Unevaluable(f"parentheses nested more than {MAX_NESTING} deep")
+    tokens, pos = [], 0
     while pos < len(expr):
         m = _TOKEN.match(expr, pos)
         if not m or m.end() == pos:
@@ -126,42 +137,48 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
         pos = m.end()
         while pos < len(expr) and expr[pos].isspace():
             pos += 1
-    k = 0
+    return tokens
 
-    def peek():
-        return tokens[k] if k < len(tokens) else ("end", None)
 
-    def take(kind=None, value=None):
-        nonlocal k
-        t = peek()
+class _Formula:
+    """A recursive-descent reading of an equal-style formula's tokens, with LAMMPS's precedence."""
+
+    def __init__(self, expr: str, tokens: list, variables: dict, depth: int):
+        self.expr, self.tokens, self.variables, self.depth, self.k = expr, tokens, variables, depth, 0
+
+    def peek(self):
+        return self.tokens[self.k] if self.k < len(self.tokens) else ("end", None)
+
+    def take(self, kind=None, value=None):
+        t = self.peek()
         if (kind and t[0] != kind) or (value and t[1] != value):
-            raise _Unevaluable(f"expected {value or kind} in {expr!r}")
-        k += 1
+            raise _Unevaluable(f"expected {value or kind} in {self.expr!r}")
+        self.k += 1
         return t
 
-    def add():
-        x = mul()
-        while peek() in (("op", "+"), ("op", "-")):
-            op = take()[1]
-            y = mul()
+    def add(self):
+        x = self.mul()
+        while self.peek() in (("op", "+"), ("op", "-")):
+            op = self.take()[1]
+            y = self.mul()
             x = x + y if op == "+" else x - y
         return x
 
-    def mul():
-        x = power()
-        while peek() in (("op", "*"), ("op", "/")):
-            op = take()[1]
-            y = power()
+    def mul(self):
+        x = self.power()
+        while self.peek() in (("op", "*"), ("op", "/")):
+            op = self.take()[1]
+            y = self.power()
             if op == "/" and y == 0:
                 raise _Unevaluable("division by zero")
             x = x * y if op == "*" else x / y
         return x
 
-    def power():  # as LAMMPS evaluates it (checked with its library): left to right, 2^3^2 = 64, -2^2 = 4
-        x = unary()
-        while peek() == ("op", "^"):
-            take()
-            y = unary()
+    def power(self):  # as LAMMPS evaluates it (checked with its library): left to right, 2^3^2 = 64, -2^2 = 4
+        x = self.unary()
+        while self.peek() == ("op", "^"):
+            self.take()
+            y = self.unary()
             try:
                 x = float(x) ** y
             except OverflowError:
@@ -172,55 +189,52 @@ def evaluate(expr: str, variables: dict, depth: int = 0) -> float:
                 raise _Unevaluable("a negative number to a fractional power")
         return x
 
-    def unary():  # a sign binds tighter than ^ in LAMMPS
-        if peek() in (("op", "-"), ("op", "+")):
-            sign = -1.0 if take()[1] == "-" else 1.0
-            return sign * unary()
-        return atom()
+    def unary(self):  # a sign binds tighter than ^ in LAMMPS
+        if self.peek() in (("op", "-"), ("op", "+")):
+            sign = -1.0 if self.take()[1] == "-" else 1.0
+            return sign * self.unary()
+        return self.atom()
 
-    def atom():
-        kind, value = peek()
+    def atom(self):
+        kind, value = self.peek()
         if kind == "num":
-            take()
+            self.take()
             return value
         if kind == "op" and value == "(":
-            take()
-            x = add()
-            take("op", ")")
+            self.take()
+            x = self.add()
+            self.take("op", ")")
             return x
         if kind == "var":
-            take()
-            return lookup(value, variables, depth + 1)
+            self.take()
+            return lookup(value, self.variables, self.depth + 1)
         if kind == "name":
-            take()
-            if value in _CONSTANTS:
-                return _CONSTANTS[value]
-            box = variables.get("__box__", (None, None))[1]
-            if box and value in BOX_KEYS + ("lx", "ly", "lz"):
-                if value.startswith("l"):
-                    axis = "xyz".index(value[1])
-                    return box[2 * axis + 1] - box[2 * axis]
-                return box[BOX_KEYS.index(value)]
-            if value in _FUNCTIONS and peek() == ("op", "("):
-                take()
-                args = [add()]
-                while peek() == ("op", ","):
-                    take()
-                    args.append(add())
-                take("op", ")")
-                try:
-                    return float(_FUNCTIONS[value](*args))
-                except (TypeError, ValueError, OverflowError, ZeroDivisionError) as exc:
-                    raise _Unevaluable(f"{value}{tuple(args)}: {exc}") from None
-            raise _Unevaluable(f"'{value}' is not a number the reader can know before a run")
-        raise _Unevaluable(f"unexpected {value!r} in {expr!r}")
+            self.take()
+            return self.name(value)
+        raise _Unevaluable(f"unexpected {value!r} in {self.expr!r}")
 
-    x = add()
-    if k != len(tokens):
-        raise _Unevaluable(f"unexpected {tokens[k][1]!r} in {expr!r}")
-    if not math.isfinite(x):
-        raise _Unevaluable(f"{expr!r} is not finite")
-    return x
+    def name(self, value: str) -> float:
+        """A constant, a box extent or a function call."""
+        if value in _CONSTANTS:
+            return _CONSTANTS[value]
+        box = self.variables.get("__box__", (None, None))[1]
+        if box and value in BOX_KEYS + ("lx", "ly", "lz"):
+            if value.startswith("l"):
+                axis = "xyz".index(value[1])
+                return box[2 * axis + 1] - box[2 * axis]
+            return box[BOX_KEYS.index(value)]
+        if value in _FUNCTIONS and self.peek() == ("op", "("):
+            self.take()
+            args = [self.add()]
+            while self.peek() == ("op", ","):
+                self.take()
+                args.append(self.add())
+            self.take("op", ")")
+            try:
+                return float(_FUNCTIONS[value](*args))
+            except (TypeError, ValueError, OverflowError, ZeroDivisionError) as exc:
+                raise _Unevaluable(f"{value}{tuple(args)}: {exc}") from None
+        raise _Unevaluable(f"'{value}' is not a number the reader can know before a run")
 
 
 def lookup(name: str, variables: dict, depth: int = 0) -> float:
