@@ -521,63 +521,10 @@ def native_from_case(table: dict, case) -> Native:
         if key != "pair_style" and key not in CASE_PROPERTIES:
             raise ConfigError(f"engine.liggghts.{key}", table[key], "is not a setting read here (pair_style, "
                               + ", ".join(CASE_PROPERTIES) + "; youngsModulus and poissonsRatio come from [materials])")
-    if "pair_style" not in table:
-        raise ConfigError("engine.liggghts.pair_style", None, "missing: \"gran model M tangential T\"")
+    spec = _case_style(table)
     text = table["pair_style"]
-    words = text.split()
-    words = words[1:] if words[:1] == ["gran"] else words
-    cmd = Command(["pair_style", "gran", *words], "engine.liggghts.pair_style", 1, text)
-    try:
-        spec, k = parse_style(cmd, cmd.words, 2)
-        if k != len(cmd.words):
-            raise _bad(cmd, f"{cmd.words[k]!r} is not a keyword of pair_style gran")
-    except ScriptError as exc:
-        raise ConfigError("engine.liggghts.pair_style", text, str(exc).split(": ", 2)[-1]) from None
-    for key in spec["flags"]:
-        if key not in CASE_FLAGS:
-            raise ConfigError("engine.liggghts.pair_style", text, f"flag {key}: demcheck's deck writes "
-                              f"{', '.join(CASE_FLAGS)} only")
-    for key in ("rolling", "cohesion"):
-        if spec[key] != "off":
-            raise ConfigError("engine.liggghts.pair_style", text, f"{key} {spec[key]}: demcheck's twin has none "
-                                                                  "(leave it out)")
-    if spec.get("surface", "off") not in ("off", "default"):
-        raise ConfigError("engine.liggghts.pair_style", text, f"surface {spec['surface']}: not read here")
-    props: dict = {}
-    for name in CASE_PROPERTIES:
-        if name in table:
-            c = Command(["fix", "p", "all", "property/global", name, "scalar", *table[name].split()],
-                        f"engine.liggghts.{name}", 1, table[name])
-            try:
-                if len(c.words) != 7:
-                    raise _bad(c, "one number")
-                props[name] = ("scalar", [_num(c, 6, name)], c.file)
-            except ScriptError as exc:
-                raise ConfigError(f"engine.liggghts.{name}", table[name], str(exc).split(": ", 2)[-1]) from None
-    mats = [case.materials[p.material] for p in case.particles]
-    walls = list(case.walls)
-    for name, attr in (("coefficientRestitution", "restitution"), ("coefficientFriction", "friction")):
-        if name in props:
-            continue
-        own = {getattr(m, attr) for m in mats} | ({getattr(case.materials[w.material], attr) for w in walls
-                                                   if w.material} - {None})
-        if len(own) == 1 and None not in own:
-            props[name] = ("scalar", [next(iter(own))], f"materials' {attr}")
-        elif len(own) > 1:
-            raise ConfigError(f"engine.liggghts.{name}", None, f"the bodies' materials differ in {attr}: give it "
-                                                                 "here")
-    moduli = [m.youngs_modulus for m in mats]
-    ratios = [m.poisson_ratio for m in mats]
-    if walls:
-        w = walls[0]
-        if w.rigid:
-            moduli.append(RIGID_WALL_MODULUS)
-            ratios.append(ratios[0])
-        else:
-            moduli.append(case.materials[w.material].youngs_modulus)
-            ratios.append(case.materials[w.material].poisson_ratio)
-    props["youngsModulus"] = ("peratomtype", moduli, "materials")
-    props["poissonsRatio"] = ("peratomtype", ratios, "materials")
+    props = _case_properties(table)
+    _material_properties(case, props)
     if spec["model"] in ("hooke/stiffness", "hertz/stiffness"):
         missing = [n for n in STIFFNESS if n not in table]
         if missing:
@@ -603,3 +550,83 @@ def native_from_case(table: dict, case) -> Native:
         raise ConfigError("engine.liggghts", sorted(table), f"no twin: {exc}") from None
     ps.native.comments.append("the case's own native setting ([engine.liggghts])")
     return ps.native
+
+
+def _case_style(table: dict) -> dict:
+    """The ``pair_style`` of a case's [engine.liggghts] table, parsed by the deck reader; what the deck writer
+    does not write is refused by key."""
+    from ...errors import ConfigError
+
+    if "pair_style" not in table:
+        raise ConfigError("engine.liggghts.pair_style", None, "missing: \"gran model M tangential T\"")
+    text = table["pair_style"]
+    words = text.split()
+    words = words[1:] if words[:1] == ["gran"] else words
+    cmd = Command(["pair_style", "gran", *words], "engine.liggghts.pair_style", 1, text)
+    try:
+        spec, k = parse_style(cmd, cmd.words, 2)
+        if k != len(cmd.words):
+            raise _bad(cmd, f"{cmd.words[k]!r} is not a keyword of pair_style gran")
+    except ScriptError as exc:
+        raise ConfigError("engine.liggghts.pair_style", text, str(exc).split(": ", 2)[-1]) from None
+    for key in spec["flags"]:
+        if key not in CASE_FLAGS:
+            raise ConfigError("engine.liggghts.pair_style", text, f"flag {key}: demcheck's deck writes "
+                              f"{', '.join(CASE_FLAGS)} only")
+    for key in ("rolling", "cohesion"):
+        if spec[key] != "off":
+            raise ConfigError("engine.liggghts.pair_style", text, f"{key} {spec[key]}: demcheck's twin has none "
+                                                                  "(leave it out)")
+    if spec.get("surface", "off") not in ("off", "default"):
+        raise ConfigError("engine.liggghts.pair_style", text, f"surface {spec['surface']}: not read here")
+    return spec
+
+
+def _case_properties(table: dict) -> dict:
+    """The scalar properties of a case's [engine.liggghts] table, each read as its fix property/global line."""
+    from ...errors import ConfigError
+
+    props: dict = {}
+    for name in CASE_PROPERTIES:
+        if name in table:
+            c = Command(["fix", "p", "all", "property/global", name, "scalar", *table[name].split()],
+                        f"engine.liggghts.{name}", 1, table[name])
+            try:
+                if len(c.words) != 7:
+                    raise _bad(c, "one number")
+                props[name] = ("scalar", [_num(c, 6, name)], c.file)
+            except ScriptError as exc:
+                raise ConfigError(f"engine.liggghts.{name}", table[name], str(exc).split(": ", 2)[-1]) from None
+    return props
+
+
+def _material_properties(case, props: dict) -> None:
+    """Restitution and friction from the case's materials where the table leaves them out (the bodies must share
+    them), and youngsModulus and poissonsRatio per atom type from the materials (a rigid wall: LIGGGHTS's wall
+    modulus)."""
+    from ...errors import ConfigError
+
+    mats = [case.materials[p.material] for p in case.particles]
+    walls = list(case.walls)
+    for name, attr in (("coefficientRestitution", "restitution"), ("coefficientFriction", "friction")):
+        if name in props:
+            continue
+        own = {getattr(m, attr) for m in mats} | ({getattr(case.materials[w.material], attr) for w in walls
+                                                   if w.material} - {None})
+        if len(own) == 1 and None not in own:
+            props[name] = ("scalar", [next(iter(own))], f"materials' {attr}")
+        elif len(own) > 1:
+            raise ConfigError(f"engine.liggghts.{name}", None, f"the bodies' materials differ in {attr}: give it "
+                                                                 "here")
+    moduli = [m.youngs_modulus for m in mats]
+    ratios = [m.poisson_ratio for m in mats]
+    if walls:
+        w = walls[0]
+        if w.rigid:
+            moduli.append(RIGID_WALL_MODULUS)
+            ratios.append(ratios[0])
+        else:
+            moduli.append(case.materials[w.material].youngs_modulus)
+            ratios.append(case.materials[w.material].poisson_ratio)
+    props["youngsModulus"] = ("peratomtype", moduli, "materials")
+    props["poissonsRatio"] = ("peratomtype", ratios, "materials")
