@@ -97,48 +97,15 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
     lines = common.header("liggghts", sc, mp, VERSION_NOTE, "liggghts -in") + common.notes(nat.comments)
-    # every type pair's configuration (the wall type pairs with each particle)
-    natives = {}
-    for i, j in common.type_pairs(case):
-        pm = pair_mapping(case, "liggghts", i, j, native)
-        if pm.native is None:
-            raise UnsupportedByEngine(f"type pair {i + 1} {j + 1 if j is not None else 'wall'}: "
-                                      f"{'; '.join(pm.reasons)}")
-        if pm.native.normal != nat.normal or pm.native.tangential != nat.tangential:
-            raise UnsupportedByEngine("LIGGGHTS has one gran model per pair style: type pairs map differently")
-        natives[(i, n if j is None else j)] = pm.native
+    natives = _type_natives(case, native, nat, n)
+
     def native_of_types(a, b):
         ia = n if (case.walls and a == ntypes - 1) else a % n
         ib = n if (case.walls and b == ntypes - 1) else b % n
         return natives.get((min(ia, ib), max(ia, ib)))
 
     matrices = property_matrices(nat, ntypes, native_of_types)
-    moduli = []
-    if nat.normal == "edinburgh":
-        # K_L = 2E*R̄ of the contact: equal moduli E for the particles give E* = E/(2(1−ν²)); a rigid wall
-        # type of modulus 1e30 gives E* = E/(1−ν²)
-        nu = case.materials[case.particles[0].material].poisson_ratio
-        r_eff = sc.model.pair.r_eff
-        if case.walls:
-            if not case.walls[0].rigid:
-                raise UnsupportedByEngine("edinburgh (HLS) decks are written for rigid walls")
-            e_part = (1.0 - nu * nu) * nat.props["kl"] / (2.0 * r_eff)
-            moduli, ratios = [e_part] * (n * copies) + [RIGID_WALL_MODULUS], [nu] * (n * copies + 1)
-        else:
-            moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * (n * copies), [nu] * (n * copies)
-    if nat.normal in ("hertz", "hooke"):
-        mats = [case.materials[p.material] for p in case.particles] * copies
-        moduli = [m.youngs_modulus for m in mats]
-        ratios = [m.poisson_ratio for m in mats]
-        if case.walls:
-            w = case.walls[0]
-            if w.rigid:
-                moduli.append(RIGID_WALL_MODULUS)
-                ratios.append(ratios[0])
-            else:
-                wm = case.materials[w.material]
-                moduli.append(wm.youngs_modulus)
-                ratios.append(wm.poisson_ratio)
+    moduli, ratios = _moduli(case, nat, sc.model.pair.r_eff, n, copies)
     lines += ["", "units si", "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
               "communicate single vel yes",
               f"read_data {data_name}"]
@@ -147,7 +114,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
         lines.append(f"set atom {k} mass {fmt(case.mass((k - 1) % n))}")
     rmax = max(p.radius for p in case.particles)
     lines += ["", f"neighbor {fmt(rmax)} bin", "neigh_modify delay 0", ""]
-    model_lines, style, flags = model_setup(nat, matrices, moduli, ratios if moduli else [])
+    model_lines, style, flags = model_setup(nat, matrices, moduli, ratios)
     lines += model_lines
     lines += [f"pair_style gran {style} {' '.join(flags)}", "pair_coeff * *"]
     if case.walls:
@@ -168,3 +135,49 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     data = common.data_file(case, ntypes, (lo, hi), f"demcheck: case {case.name} (hash {case.hash})", copies=copies,
                             axis=batch_axis, spacing=spacing)
     return common.Deck("liggghts", "\n".join(lines), {data_name: data}, dt=sc.dt)
+
+
+def _type_natives(case: Case, native, nat, n: int) -> dict:
+    """Every type pair's configuration, keyed (i, j) with the wall as type n (it pairs with each particle); LIGGGHTS
+    has one gran model per pair style, so every pair must map to the model of ``nat``."""
+    natives = {}
+    for i, j in common.type_pairs(case):
+        pm = pair_mapping(case, "liggghts", i, j, native)
+        if pm.native is None:
+            raise UnsupportedByEngine(f"type pair {i + 1} {j + 1 if j is not None else 'wall'}: "
+                                      f"{'; '.join(pm.reasons)}")
+        if pm.native.normal != nat.normal or pm.native.tangential != nat.tangential:
+            raise UnsupportedByEngine("LIGGGHTS has one gran model per pair style: type pairs map differently")
+        natives[(i, n if j is None else j)] = pm.native
+    return natives
+
+
+def _moduli(case: Case, nat, r_eff: float, n: int, copies: int) -> tuple[list, list]:
+    """youngsModulus and poissonsRatio per atom type (the wall's type last): the materials' (hertz, hooke), or
+    those that give edinburgh's K_L = 2E*R̄ of the contact; empty for the stiffness models."""
+    moduli, ratios = [], []
+    if nat.normal == "edinburgh":
+        # K_L = 2E*R̄ of the contact: equal moduli E for the particles give E* = E/(2(1−ν²)); a rigid wall
+        # type of modulus 1e30 gives E* = E/(1−ν²)
+        nu = case.materials[case.particles[0].material].poisson_ratio
+        if case.walls:
+            if not case.walls[0].rigid:
+                raise UnsupportedByEngine("edinburgh (HLS) decks are written for rigid walls")
+            e_part = (1.0 - nu * nu) * nat.props["kl"] / (2.0 * r_eff)
+            moduli, ratios = [e_part] * (n * copies) + [RIGID_WALL_MODULUS], [nu] * (n * copies + 1)
+        else:
+            moduli, ratios = [(1.0 - nu * nu) * nat.props["kl"] / r_eff] * (n * copies), [nu] * (n * copies)
+    if nat.normal in ("hertz", "hooke"):
+        mats = [case.materials[p.material] for p in case.particles] * copies
+        moduli = [m.youngs_modulus for m in mats]
+        ratios = [m.poisson_ratio for m in mats]
+        if case.walls:
+            w = case.walls[0]
+            if w.rigid:
+                moduli.append(RIGID_WALL_MODULUS)
+                ratios.append(ratios[0])
+            else:
+                wm = case.materials[w.material]
+                moduli.append(wm.youngs_modulus)
+                ratios.append(wm.poisson_ratio)
+    return moduli, ratios
