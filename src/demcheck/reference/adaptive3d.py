@@ -214,12 +214,17 @@ def _dp5_3(y, aux, nl, tl, geo, rules, h):
 
 
 N_EVENTS = 8
+MAX_EVENTS = 250  # events located in one run (its event arrays hold 256)
 # of a step: two events located this close are taken as simultaneous (LSDn with a spring law at 5°: the slip
 # ended where the force did, located 1e-16 of a step before it, and the force's end went unrecorded)
 SIMULTANEOUS_THETA = 1e-9
 # of the time scale: a stick→slip graze retaken within this of the last one is at the same instant (LTH at the
-# end of an LSDn contact, Chung & Ooi Test 4 at 30°: a graze retaken every 6.5e-20 s ran out of output points)
-GRAZE_SAME_INSTANT = 1e-12
+# end of an LSDn contact, Chung & Ooi Test 4 at 30°: a graze retaken every 6.5e-20 s ran out of output points).
+# So is one retaken every 5e-11 t_c (the suite's LTH on a wall at 57.4–58.5°, at δ ≈ 7.6e-13 m, 1e-6 of the
+# largest overlap: the stick each graze predicts re-crosses its surface within a few steps, 250 events ran out
+# and the run stopped with too-many-steps). A stick that short moves no metric by more than its 1e-9 of t_c;
+# the contact lies on its slip surface, where stick and slip give LTH and ZZY the same force.
+GRAZE_SAME_INSTANT = 1e-9
 # LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
 # of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
 # the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
@@ -475,7 +480,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     for _ in range(10_000_000):
         if t >= t_max:
             break
-        if n >= capacity - 2 or ne >= 250:
+        if n >= capacity - 2 or ne >= MAX_EVENTS:
             status = ST_STEPS
             break
         hstep = min(hstep, t_max - t)
