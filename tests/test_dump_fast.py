@@ -36,6 +36,9 @@ ITEM: BOX BOUNDS pp pp ff
 ITEM: ATOMS id type x vx fx
 1 1 1e-300 -inf 4.9406564584124654e-324
 """
+# every block the same size (a collision's dumps: the same bodies every step), read a header line at a time
+SAME_SIZE = LAMMPS.replace("ITEM: NUMBER OF ATOMS\n1\n", "ITEM: NUMBER OF ATOMS\n2\n").replace(
+    "4.9406564584124654e-324\n", "4.9406564584124654e-324\n2 1 0.5 0.25 -0\n")
 LIGGGHTS = "\n".join(line + " " if line[:1].isdigit() and line.count(" ") == 4 else line
                      for line in LAMMPS.split("\n"))
 
@@ -44,16 +47,19 @@ def _bits(t):
     return {c: (t[c].dtype, t[c].to_numpy().view(np.int64).tolist()) for c in t.columns}
 
 
-@pytest.mark.parametrize("text", [LAMMPS, LIGGGHTS], ids=["lammps", "liggghts"])
-def test_an_engine_dump_is_read_at_once_with_the_line_readers_values(tmp_path, text, monkeypatch):
+@pytest.mark.parametrize("text,steps", [(LAMMPS, [0, 0, 10]), (LIGGGHTS, [0, 0, 10]), (SAME_SIZE, [0, 0, 10, 10])],
+                         ids=["lammps", "liggghts", "same-size"])
+def test_an_engine_dump_is_read_at_once_with_the_line_readers_values(tmp_path, text, steps, monkeypatch):
     path = tmp_path / "dump.txt"
     path.write_text(text)
     slow = dumps._read_dump_lines(path, None)
+    assert (dumps._same_size_blocks(text.split("\n"), len(text.rstrip("\n").split("\n"))) is not None) == \
+        (text is SAME_SIZE)
     monkeypatch.setattr(dumps, "_read_dump_lines", lambda *a: pytest.fail("read line by line"))
     fast = dumps.read_dump(path)
     assert list(fast.columns) == list(slow.columns) == ["step", "id", "type", "x", "vx", "fx"]
     assert _bits(fast) == _bits(slow)
-    assert fast["step"].tolist() == [0, 0, 10]
+    assert fast["step"].tolist() == steps
 
 
 @pytest.mark.parametrize("name", ["two_blocks.txt", "variable_rows.txt"])
@@ -67,7 +73,8 @@ def test_the_fixtures_read_the_same_either_way(name):
     lambda s: s.replace("-inf", "x"),  # not a number
     lambda s: s.replace("ITEM: BOX BOUNDS pp pp ff\n-4.7", "ITEM: BOX BOUND\n-4.7"),  # a header
 ])
-def test_anything_unusual_goes_to_the_line_reader(tmp_path, change, monkeypatch):
-    path = tmp_path / "dump.txt"
-    path.write_text(change(LAMMPS))
-    assert dumps._well_formed(path.read_text()) is None
+@pytest.mark.parametrize("text", [LAMMPS, SAME_SIZE], ids=["blocks", "same-size"])
+def test_anything_unusual_goes_to_the_line_reader(tmp_path, change, text):
+    changed = change(text)
+    assert changed != text
+    assert dumps._well_formed(changed) is None

@@ -57,28 +57,11 @@ def _well_formed(text: str):
     end = len(lines)
     while end and not lines[end - 1].strip():
         end -= 1
-    i, names, counts, rows = 0, None, [], []
-    while i < end:
-        if not lines[i].startswith("ITEM: TIMESTEP") or i + 9 > end:
-            return None
-        head = lines[i + 2]
-        item = "ENTRIES" if head.startswith("ITEM: NUMBER OF ENTRIES") else "ATOMS"
-        if not head.startswith(f"ITEM: NUMBER OF {item}") or not lines[i + 4].startswith("ITEM: BOX BOUNDS") \
-                or not lines[i + 8].startswith(f"ITEM: {item}"):
-            return None
-        try:
-            step, natoms = int(lines[i + 1].split()[0]), int(lines[i + 3].split()[0])
-        except (ValueError, IndexError):
-            return None
-        cols = tuple(lines[i + 8].split()[2:])
-        names = names or cols
-        if cols != names or natoms < 0 or i + 9 + natoms > end:
-            return None
-        rows += lines[i + 9:i + 9 + natoms]
-        counts.append((step, natoms))
-        i += 9 + natoms
-        while i < end and not lines[i].strip():
-            i += 1
+    blocks = _same_size_blocks(lines, end)
+    if blocks is not None:
+        names, counts, rows = blocks
+    else:
+        names, counts, rows = _walk(lines, end)
     if names is None:
         return None
     spaces = len(names) - 1
@@ -92,6 +75,59 @@ def _well_formed(text: str):
         return None
     steps, sizes = zip(*counts)
     return names, [np.repeat(np.array(steps, dtype=np.int64), sizes)], [data]
+
+
+def _same_size_blocks(lines: list[str], end: int):
+    """(names, [(step, rows)], rows) of a dump whose blocks all have the first block's number of rows and the
+    same header lines (a collision's dumps: the two bodies every step), checked a header line at a time across
+    all blocks; None otherwise (the block-by-block walk then reads it)."""
+    try:
+        natoms = int(lines[3].split()[0])
+    except (ValueError, IndexError):
+        return None
+    size = 9 + natoms
+    if natoms <= 0 or end % size or end < size:
+        return None
+    item = lines[8]
+    if not lines[0].startswith("ITEM: TIMESTEP") or not lines[2].startswith("ITEM: NUMBER OF ATOMS") \
+            or not lines[4].startswith("ITEM: BOX BOUNDS") or not item.startswith("ITEM: ATOMS"):
+        return None
+    for k in (0, 2, 3, 4, 8):
+        if lines[k:end:size].count(lines[k]) != end // size:
+            return None
+    try:
+        steps = [int(x) for x in lines[1:end:size]]
+    except ValueError:
+        return None
+    rows = [r for block in zip(*(lines[k:end:size] for k in range(9, size))) for r in block]
+    return tuple(item.split()[2:]), [(s, natoms) for s in steps], rows
+
+
+def _walk(lines: list[str], end: int):
+    """(names, [(step, rows)], rows) block by block; names None where a block is not as expected."""
+    i, names, counts, rows = 0, None, [], []
+    while i < end:
+        if not lines[i].startswith("ITEM: TIMESTEP") or i + 9 > end:
+            return None, [], []
+        head = lines[i + 2]
+        item = "ENTRIES" if head.startswith("ITEM: NUMBER OF ENTRIES") else "ATOMS"
+        if not head.startswith(f"ITEM: NUMBER OF {item}") or not lines[i + 4].startswith("ITEM: BOX BOUNDS") \
+                or not lines[i + 8].startswith(f"ITEM: {item}"):
+            return None, [], []
+        try:
+            step, natoms = int(lines[i + 1].split()[0]), int(lines[i + 3].split()[0])
+        except (ValueError, IndexError):
+            return None, [], []
+        cols = tuple(lines[i + 8].split()[2:])
+        names = names or cols
+        if cols != names or natoms < 0 or i + 9 + natoms > end:
+            return None, [], []
+        rows += lines[i + 9:i + 9 + natoms]
+        counts.append((step, natoms))
+        i += 9 + natoms
+        while i < end and not lines[i].strip():
+            i += 1
+    return names, counts, rows
 
 
 def _table(path: Path, names, steps, blocks, columns) -> pd.DataFrame:
