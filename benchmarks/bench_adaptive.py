@@ -11,8 +11,17 @@ Run: .venv/bin/python benchmarks/bench_adaptive.py  (writes benchmarks/results/b
    the full 3-D solver, side by side, and the two answers' agreement.
 4. A command-line call with the on-disk compilation cache warm, against one with an empty cache (what every
    call would cost without numba's cache=True).
+5. With --before PATH (a tree's root, e.g. `git worktree add /tmp/before BASE`): the suite's oblique cases, every
+   variant, at their default tolerance (rtol 1e-13), the tree before a change and this one side by side in one run
+   (each in a child process: adaptive3d_suite_child.py), with each variant's accuracy against the converged verlet
+   answer (the verlet method at 20 000 steps per contact) beside the time, and whether the two trees' metrics are
+   identical. The machine's load average is recorded; read the ratios.
+
+Run: .venv/bin/python benchmarks/bench_adaptive.py [--before PATH] [--only-suite]
 """
 
+import argparse
+import json
 import os
 import statistics
 import subprocess
@@ -48,7 +57,76 @@ def median_time(fn, repeat=200):
     return statistics.median(samples)
 
 
-def main():
+def _child(src: Path, repeat: int, name: str) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(src)}  # (numba caches each tree's kernels beside its sources)
+    out = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "adaptive3d_suite_child.py"), str(repeat), name],
+                         env=env, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _both(before: Path, repeat: int) -> tuple[dict, dict]:
+    """Both trees, one suite file at a time, taking turns at going first (the load shifts during the run)."""
+    old, new = {}, {}
+    names = sorted(p.stem for p in (ROOT / "src" / "demcheck" / "cases" / "suite").glob("oblique-*.toml"))
+    for k, name in enumerate(names):
+        first, second = (before / "src", old), (ROOT / "src", new)
+        for src, into in ((first, second) if k % 2 == 0 else (second, first)):
+            into.update(_child(src, repeat, name))
+    return old, new
+
+
+def _verlet_error(label: str, metrics: dict) -> float:
+    """The largest relative difference of the adaptive answer from the verlet method's at 20 000 steps per
+    contact, over restitution, tangential restitution, contact time and rebound spin."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from adaptive3d_suite_child import variants
+
+    raw = dict(variants())[label]
+    from demcheck import case as C
+
+    case = C.from_dict(raw)
+    model = resolve(case)
+    v = collision3d.collide(case, model, "verlet", dt=characteristic_time(model) / 20_000).metrics()
+    keys = ("restitution", "tangential_restitution", "contact_time", "rebound_angular_velocity")
+    return max(abs(metrics[k] / v[k] - 1.0) for k in keys if metrics.get(k) and v.get(k))
+
+
+def suite_section(before: Path) -> list[str]:
+    load0 = os.getloadavg()
+    old, new = _both(before, 5)
+    load1 = os.getloadavg()
+    lines = ["", f"5. the suite's oblique cases at their default tolerance (rtol 1e-13), before ({before}) and after, "
+             "one run, the two trees taking turns case file by case file, median CPU time of 5 (1 for a solve over "
+             "0.3 s)",
+             f"load average (1, 5, 15 min) at the start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}, "
+             f"at the end {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} (2 cores, shared)",
+             f"{'variant':36s} {'points':>6s} {'kernel before':>13s} {'after (ms)':>10s} {'ratio':>6s} "
+             f"{'collide() after':>15s} {'vs verlet':>9s} {'metrics':>9s}"]
+    ratios, kern, same_all = [], [], True
+    for label, b in old.items():
+        a = new[label]
+        same = a["metrics"] == b["metrics"] and a["points"] == b["points"]
+        same_all &= same
+        err = _verlet_error(label, a["metrics"])
+        ratios.append(b["kernel"] / a["kernel"])
+        kern.append(a["kernel"])
+        lines.append(f"{label:36s} {a['points']:6d} {b['kernel'] * 1e3:13.2f} {a['kernel'] * 1e3:10.2f} "
+                     f"{ratios[-1]:6.2f} {a['collide'] * 1e3:15.2f} {err:9.1e} {'same' if same else 'DIFFER':>9s}")
+    lines += [f"{len(ratios)} variants: kernel after, median {statistics.median(kern) * 1e3:.2f} ms, "
+              f"least {min(kern) * 1e3:.2f} ms, most {max(kern) * 1e3:.1f} ms; speed-up before/after median "
+              f"{statistics.median(ratios):.2f}x (least {min(ratios):.2f}x, most {max(ratios):.2f}x); metrics and "
+              f"points of every variant {'identical' if same_all else 'NOT identical'}"]
+    return lines
+
+
+def main(before: Path | None = None, only_suite: bool = False):
+    if only_suite:
+        text = "\n".join(suite_section(before)) + "\n"
+        print(text)
+        out = ROOT / "benchmarks" / "results" / "bench_adaptive.txt"
+        kept = out.read_text().split("\n5. the suite's oblique cases")[0].rstrip("\n") + "\n"
+        out.write_text(kept + text)
+        return
     lines = ["adaptive collision, rtol = 1e-10, warm (median of 200)",
              f"{'model':8s} {'kernel (ms)':>12s} {'collide() (ms)':>15s} {'steps':>6s}"]
     for name, params in MODELS.items():
@@ -103,6 +181,8 @@ def main():
     lines += ["", "command-line call (`demcheck collide glass-pair --json`), median of 3",
               f"compilation cache warm: {warm:.2f} s", f"empty cache (compiles): {cold:.2f} s",
               f"ratio empty/warm: {cold / warm:.1f}x"]
+    if before is not None:
+        lines += suite_section(before)
     text = "\n".join(lines) + "\n"
     print(text)
     out = ROOT / "benchmarks" / "results" / "bench_adaptive.txt"
@@ -110,4 +190,8 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--before", type=Path, help="a tree (its root) to time side by side with this one (section 5)")
+    ap.add_argument("--only-suite", action="store_true", help="run section 5 only (replacing it in the results)")
+    args = ap.parse_args()
+    main(args.before, args.only_suite)

@@ -21,11 +21,12 @@ def _lth(angle: float) -> dict:
     return raw
 
 
-def test_lth_at_58_degrees_completes_with_its_tolerance_relaxed_and_says_so():
+def test_lth_at_58_degrees_completes_at_its_tolerance():
+    """58° ran out of events (a graze retaken every 5e-11 t_c near contact end, tests/test_adaptive_graze.py), not
+    of points: it completes at the asked tolerance, unrelaxed."""
     r = demcheck.collide(_lth(58.0))
     assert r.ok, r.message
-    assert r.rtol == pytest.approx(1e-12) and r.meta["rtol_asked"] == pytest.approx(1e-13)
-    assert r.message.startswith("rtol relaxed from 1e-13 to 1e-12")
+    assert r.rtol == pytest.approx(1e-13) and "rtol_asked" not in r.meta and not r.message
     # the converged answer, by the independent discrete path: the verlet method at 20 000 steps per contact, whose
     # own time-step error the case bounds at 5e-5 (its run.verlet_rtol, measured over the suite's angles)
     v = demcheck.collide(_lth(58.0), method="verlet")

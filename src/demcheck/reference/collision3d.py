@@ -92,15 +92,15 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         f_scale = model.pair.m_eff * v / t_c
         scales = np.concatenate([np.full(3, l_scale), np.full(3, v_scale), np.full(3, v_scale / r0)] * 2
                                 + [np.full(3, f_scale if model.tangential_law.family == WALTON else l_scale)])
-        status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
+        status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, POINTS)
         asked = rtol
         floor = _round_off_floor(rec[:n], l_scale)
-        while STATUS[status] == "too-many-steps" and rtol < floor <= RTOL_RELAX_CEILING:
+        while _out_of_points(status, n, ne) and rtol < floor <= RTOL_RELAX_CEILING:
             # a tolerance float64 cannot hold on these positions is the solver's to relax: to the first decade
             # above the round-off floor (then a decade more while the points still run out). A floor above the
             # ceiling (a tiny impact speed) is the user's to decide: the message says to raise run.rtol
             rtol = min(max(10.0 * rtol, 10.0 ** math.ceil(math.log10(floor))), RTOL_RELAX_CEILING)
-            status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, 200_000)
+            status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, POINTS)
             floor = max(floor, _round_off_floor(rec[:n], l_scale))
         names = {**kernels.EVENT_NAMES, **k3.EVENT_NAMES_3D}
         idx = np.searchsorted(rec[:, k3.C_T], ev_t)
@@ -128,7 +128,11 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         meta={"solver": "3d", "steps": int(n), "rules": {**SEED_RULES, **(rules or {})},
               "radius0": r0},
     )
-    if status_name == "too-many-steps" and method == "adaptive":
+    if status_name == "too-many-steps" and method == "adaptive" and not _out_of_points(status, n, ne):
+        result.message = (f"the adaptive method located more than {adaptive3d.MAX_EVENTS} events (stick/slip "
+                          f"switches, the last at t = {ev_t[-1]:.6g} s): the contact chattered between two states "
+                          "(a defect of the solver: please report the case)")
+    elif status_name == "too-many-steps" and method == "adaptive":
         result.message = _points_message(result, rtol, l_scale)
     elif method == "adaptive" and rtol != asked:
         result.meta["rtol_asked"] = asked
@@ -157,6 +161,16 @@ def _points_message(result: Result, rtol: float, l_scale: float) -> str:
                 f"rtol = {rtol:g} fights their float64 round-off: raise run.rtol (each decade takes about ten "
                 "times fewer points) or the impact speed")
     return MESSAGES["too-many-steps"]
+
+
+POINTS = 200_000  # the adaptive method's output points
+
+
+def _out_of_points(status: int, n: int, ne: int) -> bool:
+    """Whether an adaptive run stopped on its output points (round-off shrinking the steps), not its events."""
+    from .outcome import STATUS
+
+    return STATUS[status] == "too-many-steps" and ne < adaptive3d.MAX_EVENTS and n >= POINTS - 2
 
 
 # the loosest tolerance the adaptive method relaxes to by itself (the metrics' verdicts need ~1e-6 at most)

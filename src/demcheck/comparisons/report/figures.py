@@ -330,7 +330,11 @@ def panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_l
 
 
 def packing_plots(entry: dict) -> str:
-    return _png(packing_figure(entry))
+    """The packing's panels, from the plot cache when the same data was drawn before (its three panels took
+    2–3 s a packing to lay out and draw: most of a warm suite's report)."""
+    key = {"packing": entry["packing"], "case": entry.get("case"), "v": PLOT_VERSION,
+           "sources": {src: v.get("status") for src, v in (entry.get("sources") or {}).items()}}
+    return _cached(key, lambda: _png(packing_figure(entry)), _png_ok)
 
 
 def force_count(forces: dict) -> int | None:
