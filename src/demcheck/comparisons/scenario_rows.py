@@ -27,8 +27,8 @@ def _engine(case, planned, entry: dict, comps: list, opts, ref: dict) -> None:
     label = src.label
     try:
         res = src.run(case, timeout=opts.timeout)
-        twin = src.twin().run(case).metrics()
-        seed = scenario.seed(case, src.engine).metrics()
+        twin = scenario.cached_metrics("twin", case, src.engine, opts.cache)
+        seed = scenario.cached_metrics("seed", case, src.engine, opts.cache)
     except EngineInterrupted:
         raise
     except DemcheckError as exc:

@@ -14,6 +14,7 @@ model's verlet run steps the case's own laws the same way. Each run's metrics co
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -251,6 +252,52 @@ def seed(case: Case, engine) -> Result:
     eng, started = _engine(engine), time.perf_counter()
     lay = layout(case, eng.scenario_twin_laws(case, mapping(case, eng).require()))
     return _result(case, "reference-verlet", "verlet", _metrics(case, step(case, seed_laws(case), lay)), lay, started)
+
+
+def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
+    """The metrics of the engine's ``twin`` or of the ``seed`` run (``kind``), from ``cache`` (engines.cache.Cache)
+    when an entry is there: keyed by the kind, the engine, the case's hash and the fingerprint of demcheck's own
+    source and of numpy's, numba's and scipy's versions (:func:`code_fingerprint`), so a changed law, scheme,
+    mapping or layout never serves an old result. A metric that is not finite is stored as such (its flag
+    column), never as a number."""
+    import json
+
+    import pandas as pd
+
+    from .cache import key
+
+    run_it = twin if kind == "twin" else seed
+    if cache is None:
+        return run_it(case, engine).metrics()
+    name = _engine(engine).name
+    names = SCENARIO_METRICS[case.run.scenario]
+    k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
+    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1)
+    if hit is not None:
+        row = hit[0].iloc[0]
+        return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}
+    metrics = run_it(case, engine).metrics()
+    table = {m: [metrics[m] if math.isfinite(metrics[m]) else 0.0] for m in names}
+    table.update({f"{m}__nan": [0.0 if math.isfinite(metrics[m]) else 1.0] for m in names})
+    cache.put(k, pd.DataFrame(table), {})
+    return metrics
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """A hash of every source file of demcheck (the laws, the reference's schemes, the engines' mappings and
+    layouts all shape a twin's result) and of numpy's, numba's and scipy's versions."""
+    import hashlib
+    from pathlib import Path
+
+    import numba
+    import scipy
+
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256(f"numpy {np.__version__} numba {numba.__version__} scipy {scipy.__version__}".encode())
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
 
 
 def run(case: Case, engine, timeout: float | None = None) -> Result:
