@@ -64,6 +64,74 @@ def _engine(engine):
     return registry.get(engine) if isinstance(engine, str) else engine
 
 
+# ----------------------------------------------------------------------------- each law's mapping
+
+# the scenarios that run each slot, and the suite's cases of each (cases/suite/beyond-*.toml)
+SLOT_CASES = {"rolling": ("rolling", "rolling-linear", "incline", "incline-linear"), "twisting": ("twist",),
+              "adhesion": ("pull-off", "adhesive-impact"), "heat": ("conduction",)}
+# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it)
+EXAMPLE_PARAMS = {("rolling", "constant_torque"): {"mu_r": 0.1}, ("rolling", "viscous"): {"c_r": 1e-7},
+                  ("rolling", "epsd"): {"mu_r": 0.1, "k_r": 1e-3}, ("twisting", "sds"): {"k_tw": 1e-3, "mu_tw": 1e-4},
+                  ("twisting", "marshall"): {"kt": 1e5}, ("adhesion", "jkr"): {"w": 0.1}, ("adhesion", "dmt"): {"w": 0.1},
+                  ("adhesion", "sjkr"): {"k_c": 1e5}, ("heat", "radius"): {"k": 45.0}, ("heat", "area"): {"k": 1e6},
+                  ("heat", "lens"): {"k": 45.0}}
+KEPT_KEYS = ("kt",)  # also the tangential spring's: never taken out with another law's keys
+RANK = {"exact": 0, "approximate": 1}
+
+
+def law_cases(slot: str, law_id: str) -> tuple[list[Case], list[str]]:
+    """The suite's cases of ``slot``'s scenarios with its law set to ``law_id`` (the case's own parameters where it
+    runs that law, else EXAMPLE_PARAMS), and the rules that left the others out (a scenario that does not run the
+    law: its ConfigError's text)."""
+    import tomllib
+
+    from ..case import from_dict
+    from ..errors import ConfigError
+    from ..laws.slots import KEYS
+    from ..resources import case_path
+
+    cases, refusals = [], []
+    for name in SLOT_CASES[slot]:
+        raw = tomllib.loads(case_path(f"suite/beyond-{name}.toml").read_text())
+        contact = raw["contact"]
+        if contact.get(slot, "none") != law_id:
+            for key in KEYS.get((slot, contact.get(slot, "none")), ()):
+                if key.name not in KEPT_KEYS:
+                    contact.pop(key.name, None)
+            contact[slot] = law_id
+            contact.update({k: v for k, v in EXAMPLE_PARAMS[(slot, law_id)].items() if k not in contact})
+        try:
+            cases.append(from_dict(raw))
+        except ConfigError as exc:
+            refusals.append(str(exc))
+    return cases, refusals
+
+
+def law_mappings(slot: str, law_id: str) -> dict:
+    """{engine: {fidelity, config, reason, with}}: each registered engine's scenario mapping of the law, the best
+    over the suite's cases of its slot (:func:`law_cases`; exact before approximate before none), ``with`` naming
+    that case; ``config`` the engine's words for it, ``reason`` the mapping's reasons (the first case's for none)."""
+    cases, refusals = law_cases(slot, law_id)
+    out = {}
+    for name in registry.names():
+        best = None
+        for case in cases:
+            mp = mapping(case, name)
+            if best is None or RANK.get(mp.fidelity, 2) < RANK.get(best[0].fidelity, 2):
+                best = (mp, case)
+        if best is None:
+            out[name] = {"fidelity": "none", "config": "", "with": "no scenario",
+                         "reason": "no scenario runs it: " + "; ".join(dict.fromkeys(refusals))}
+            continue
+        mp, case = best
+        words = ""
+        if mp.native is not None:
+            words = "; ".join([_engine(name).summary(mp.native), *mp.native.comments[-1:]])
+        out[name] = {"fidelity": mp.fidelity, "config": words, "reason": "; ".join(mp.reasons),
+                     "with": f"scenario {case.run.scenario} ({case.name})"}
+    return out
+
+
 # ----------------------------------------------------------------------------- the layout
 
 
