@@ -368,15 +368,26 @@ def code_fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
+def deck(case: Case, engine):
+    """The deck (inputs.common.Deck) the engine runs for the scenario case (``demcheck deck``; :func:`run` runs
+    this one): UnsupportedByEngine with the mapping's reason where the engine cannot express the case."""
+    return _planned_deck(case, _engine(engine))[3]
+
+
+def _planned_deck(case: Case, eng):
+    """(mapping, native, layout, deck) of the engine's run of the scenario case."""
+    mp = mapping(case, eng)
+    nat = mp.require()
+    lay = layout(case, eng.scenario_twin_laws(case, nat))
+    return mp, nat, lay, eng.scenario_deck(case, nat, lay)
+
+
 def run(case: Case, engine, timeout: float | None = None) -> Result:
     """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics."""
     from . import run as runner
 
     eng, started = _engine(engine), time.perf_counter()
-    mp = mapping(case, eng)
-    nat = mp.require()
-    lay = layout(case, eng.scenario_twin_laws(case, nat))
-    dk = eng.scenario_deck(case, nat, lay)
+    mp, nat, lay, dk = _planned_deck(case, eng)
     out = runner.run(eng.name, dk.text, files=dk.files, timeout=timeout or runner.DEFAULT_TIMEOUT)
     try:
         data = eng.read_scenario(case, lay, out.workdir)
