@@ -16,6 +16,7 @@ Run: .venv/bin/python benchmarks/bench_scenarios.py --before /tmp/old-beyond4/sr
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -75,6 +76,7 @@ def main():
     before_warm, after_warm = times[1], times[3]
     print(f"warm: after ÷ before = {after_warm / before_warm:.2f} ({before_warm / after_warm:.1f}× faster)")
     same = numbers(last["before"]) == numbers(last["after"])
+    shutil.rmtree(tmp, ignore_errors=True)
     print(f"numbers equal (every metric, twin, seed run and comparison): {same}")
     return 0 if same else 1
 
