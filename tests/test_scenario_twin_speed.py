@@ -83,3 +83,26 @@ def test_a_metric_that_is_not_finite_is_cached_as_not_finite(tmp_path, monkeypat
     again = scenario.cached_metrics("twin", c, "lammps", cache)
     assert cache.hits == 1 and again["restitution"] == 0.0 and math.isnan(again["capture_velocity"])
     assert math.isnan(first["capture_velocity"])
+
+
+@pytest.mark.engine("lammps")
+def test_a_scenario_engine_run_is_cached_by_its_deck(tmp_path, monkeypatch):
+    """An ok engine run is kept as its metrics: the second run of the same deck reads them (the same numbers, the
+    engine's version, ok) without running the engine; another deck runs."""
+    from demcheck.engines import run as runner
+
+    c = load(case_path("suite/beyond-conduction.toml"))
+    cache = Cache(tmp_path)
+    first = scenario.run(c, "lammps", cache=cache)
+    assert first.ok and cache.misses == 1
+
+    def no_run(*a, **k):
+        raise AssertionError("ran although cached")
+
+    monkeypatch.setattr(runner, "run", no_run)
+    again = scenario.run(c, "lammps", cache=cache)
+    assert again.ok and again.metrics() == first.metrics() and again.engine_version == first.engine_version
+    assert again.meta["cached"] and cache.hits == 1
+    other = load(case_path("suite/beyond-conduction.toml"), ["run.overlap=2e-6"])
+    with pytest.raises(AssertionError, match="ran although cached"):
+        scenario.run(other, "lammps", cache=cache)

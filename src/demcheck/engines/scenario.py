@@ -330,8 +330,6 @@ def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
     column), never as a number."""
     import json
 
-    import pandas as pd
-
     from .cache import key
 
     run_it = twin if kind == "twin" else seed
@@ -340,15 +338,31 @@ def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
     name = _engine(engine).name
     names = SCENARIO_METRICS[case.run.scenario]
     k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
-    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1)
+    hit = _get_metrics(cache, k, names)
     if hit is not None:
-        row = hit[0].iloc[0]
-        return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}
+        return hit[0]
     metrics = run_it(case, engine).metrics()
-    table = {m: [metrics[m] if math.isfinite(metrics[m]) else 0.0] for m in names}
-    table.update({f"{m}__nan": [0.0 if math.isfinite(metrics[m]) else 1.0] for m in names})
-    cache.put(k, pd.DataFrame(table), {})
+    _put_metrics(cache, k, metrics, {})
     return metrics
+
+
+def _get_metrics(cache, k: str, names, meta_keys=()) -> tuple[dict, dict] | None:
+    """(metrics, meta) of a cache entry :func:`_put_metrics` wrote, or None."""
+    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1, meta_keys=meta_keys)
+    if hit is None:
+        return None
+    row = hit[0].iloc[0]
+    return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}, hit[1]
+
+
+def _put_metrics(cache, k: str, metrics: dict, meta: dict) -> None:
+    """One row: each metric, and beside it a flag that it is not finite (stored as 0: a table holds finite
+    values only)."""
+    import pandas as pd
+
+    table = {m: [v if math.isfinite(v) else 0.0] for m, v in metrics.items()}
+    table.update({f"{m}__nan": [0.0 if math.isfinite(v) else 1.0] for m, v in metrics.items()})
+    cache.put(k, pd.DataFrame(table), meta)
 
 
 @functools.lru_cache(maxsize=1)
@@ -382,12 +396,37 @@ def _planned_deck(case: Case, eng):
     return mp, nat, lay, eng.scenario_deck(case, nat, lay)
 
 
-def run(case: Case, engine, timeout: float | None = None) -> Result:
-    """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics."""
-    from . import run as runner
-
+def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
+    """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics;
+    with ``cache`` (engines.cache.Cache) a run that ended ok is kept as its metrics, keyed as an engine run is
+    (the engine, its version and build, the deck and its files) and by :func:`code_fingerprint` (the reading and
+    the metrics are demcheck's code): a warm verify does not run the deck again."""
     eng, started = _engine(engine), time.perf_counter()
     mp, nat, lay, dk = _planned_deck(case, eng)
+    if cache is not None:
+        from . import discovery
+        from .cache import key, text, texts
+
+        version = discovery.require(eng.name).version
+        k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
+        hit = _get_metrics(cache, k, SCENARIO_METRICS[case.run.scenario],
+                           {"engine_version": text, "warnings": texts})
+        if hit is not None:
+            return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],
+                           params={"mapping": mp.fidelity, "native": eng.summary(nat)},
+                           message="; ".join(mp.reasons),
+                           meta={"workdir": "", "deck": dk.text, "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                                 "warnings": hit[1]["warnings"], "cached": True})
+    res = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
+    if cache is not None and res.ok:
+        _put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
+                                               "warnings": list(res.meta["warnings"])})
+    return res
+
+
+def _run_deck(case: Case, eng, mp, nat, lay, dk, timeout, started) -> Result:
+    from . import run as runner
+
     out = runner.run(eng.name, dk.text, files=dk.files, timeout=timeout or runner.DEFAULT_TIMEOUT)
     try:
         data = eng.read_scenario(case, lay, out.workdir)
