@@ -26,9 +26,11 @@ def test_models_lists_the_plugged_in_engine(tmp_path):
     rows = json.loads(p.stdout)["models"]
     seed = [r for r in rows if r["slot"] in ("normal", "tangential")]  # the seed models: the toy runs every one
     assert seed and all(r["engines"]["toy"]["fidelity"] == "exact" for r in seed)
-    # the laws beyond sliding are listed for every engine, the plug-in included, as not wired (reference only)
+    # the laws beyond sliding are listed for every engine, the plug-in included: it writes no scenario deck
     beyond = [r for r in rows if r["slot"] not in ("normal", "tangential")]
-    assert beyond and all(r["engines"]["toy"]["fidelity"] == "not wired" for r in beyond)
+    assert beyond and all(r["engines"]["toy"]["fidelity"] == "none" for r in beyond)
+    assert all("deck is written" in r["engines"]["toy"]["reason"] or "no scenario runs it" in
+               r["engines"]["toy"]["reason"] for r in beyond)
 
 
 @pytest.mark.parametrize("case", ["glass-pair.toml", "oblique-lsd-wall.toml"])

@@ -211,14 +211,13 @@ def models(model_id: str | None = None, key: str = "model_id") -> list[dict]:
 
 
 def _beyond_rows(model_id: str | None) -> list[dict]:
-    """The laws of the slots beyond sliding (laws/slots.py): solved by the reference in their scenarios; no
-    engine deck writes them yet (docs/models.md, "Beyond sliding", has the engines' measured mappings)."""
-    from .engines import registry
+    """The laws of the slots beyond sliding (laws/slots.py), each engine's mapping as its scenario mapping gives
+    it (engines/scenario.law_mappings: exact, approximate or none, with the reasons and the suite case it was
+    taken from)."""
+    from .engines import scenario
     from .laws import slots
     from .laws.base import sub_model
 
-    reason = ("not wired: the scenarios beyond sliding (run.scenario) are solved by the reference only; "
-              "docs/models.md, \"Beyond sliding\", gives this engine's mapping as measured")
     rows = []
     for (slot, id_), keys in slots.KEYS.items():
         if model_id is not None and model_id.strip().lower() != id_:
@@ -226,8 +225,7 @@ def _beyond_rows(model_id: str | None) -> list[dict]:
         formula, source = slots.DOCS[(slot, id_)]
         rows.append({"slot": slot, "id": id_, "seed_name": "—", "aliases": [], "title": sub_model(slot, id_).title,
                      "formula": formula, "source": source, "params": {k.name: k.meaning for k in keys},
-                     "engines": {e: {"fidelity": "not wired", "config": "", "reason": reason, "with": "its scenario"}
-                                 for e in registry.names()}})
+                     "engines": scenario.law_mappings(slot, id_)})
     return rows
 
 

@@ -326,20 +326,23 @@ def _print_side_by_side(summaries: dict, skipped: dict) -> None:
 @click.option("--dt", type=DT, default=None, help="time step (s); default: the case's")
 @_set_option
 def deck(case_path, engine, output, dt, overrides):
-    """Write the engine's input deck of a collision or packing case, runnable by hand: lmp -in / liggghts -in
-    (a packing's deck reads data.lmp, its initial state, written beside it), yade -x -n (a Python script that
-    reads no file), Kratos: python in.deck beside the parameter and model files written with it."""
+    """Write the engine's input deck of a collision, packing or scenario case (run.scenario beyond sliding: the
+    deck verify runs), runnable by hand: lmp -in / liggghts -in (a packing's deck reads data.lmp, its initial
+    state, written beside it), yade -x -n (a Python script that reads no file), Kratos: python in.deck beside the
+    parameter and model files written with it."""
     from .comparisons.sources import Source
     from .engines.collide import finite, setting_deck
 
     case = _load(case_path, overrides)
     source = Source.of(engine)
-    if case.run.scenario != "collision":
-        from .errors import UnsupportedByEngine
+    if case.run.scenario != "collision":  # the deck the suite runs (engines/scenario.py): its layout fixes dt
+        from .engines import scenario
 
-        raise UnsupportedByEngine(f"{engine}: run.scenario = \"{case.run.scenario}\" is solved by the reference "
-                                  "only (no engine deck for the scenarios beyond sliding yet)")
-    if case.kind == "packing":
+        if dt is not None:
+            raise ConfigError("--dt", dt, f"is not taken with run.scenario = \"{case.run.scenario}\": the "
+                                          "scenario's layout fixes its step (the one verify runs)")
+        dk = scenario.deck(case, source.engine)
+    elif case.kind == "packing":
         dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
         dk = setting_deck(case, source.engine, dt)

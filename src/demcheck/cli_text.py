@@ -21,7 +21,7 @@ def models_table(table: list[dict], names) -> list[str]:
     def cut(text, width):
         return text if len(text) < width else text[:width - 2] + "… "
 
-    short = {"approximate": "approx", "not wired": "-"}
+    short = {"approximate": "approx"}
     widths = {n: max(len(n) + 1, 7) for n in names}  # "approx" and a space, or the engine's name
     seed_w = max(8, min(15, 80 - 27 - sum(widths.values())))  # the seed name gives way to engine columns
     lines = [f"{'slot':<11}{'id':<16}{'seed':<{seed_w}}" + "".join(f"{n:<{widths[n]}}" for n in names).rstrip()]
@@ -29,9 +29,9 @@ def models_table(table: list[dict], names) -> list[str]:
         lines.append((f"{row['slot']:<11}{row['id']:<16}{cut(row['seed_name'], seed_w):<{seed_w}}"
                       + "".join(f"{short.get(f := row['engines'][n]['fidelity'], f):<{widths[n]}}"
                                 for n in names)).rstrip())
-    lines.append("\napprox = approximate; - = not wired yet (rolling, twisting, adhesion, heat: the\n"
-                 "reference solves them in their scenarios). `demcheck models ID` shows a model in\n"
-                 "full, with each engine's reasons; --json gives everything.")
+    lines.append("\napprox = approximate. Rolling, twisting, adhesion, heat: each engine's\n"
+                 "mapping in its scenario (the suite's beyond-* cases). `demcheck models ID`\n"
+                 "shows a model in full, with each engine's reasons; --json gives everything.")
     return lines
 
 

@@ -26,9 +26,9 @@ def _engine(case, planned, entry: dict, comps: list, opts, ref: dict) -> None:
     src, mp = planned.source, planned.mapping
     label = src.label
     try:
-        res = src.run(case, timeout=opts.timeout)
-        twin = src.twin().run(case).metrics()
-        seed = scenario.seed(case, src.engine).metrics()
+        res = scenario.run(case, src.engine, timeout=opts.timeout, cache=opts.cache)  # src.run's, cached
+        twin = scenario.cached_metrics("twin", case, src.engine, opts.cache)
+        seed = scenario.cached_metrics("seed", case, src.engine, opts.cache)
     except EngineInterrupted:
         raise
     except DemcheckError as exc:

@@ -14,6 +14,7 @@ model's verlet run steps the case's own laws the same way. Each run's metrics co
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
@@ -61,6 +62,74 @@ def mapping(case: Case, engine):
 
 def _engine(engine):
     return registry.get(engine) if isinstance(engine, str) else engine
+
+
+# ----------------------------------------------------------------------------- each law's mapping
+
+# the scenarios that run each slot, and the suite's cases of each (cases/suite/beyond-*.toml)
+SLOT_CASES = {"rolling": ("rolling", "rolling-linear", "incline", "incline-linear"), "twisting": ("twist",),
+              "adhesion": ("pull-off", "adhesive-impact"), "heat": ("conduction",)}
+# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it)
+EXAMPLE_PARAMS = {("rolling", "constant_torque"): {"mu_r": 0.1}, ("rolling", "viscous"): {"c_r": 1e-7},
+                  ("rolling", "epsd"): {"mu_r": 0.1, "k_r": 1e-3}, ("twisting", "sds"): {"k_tw": 1e-3, "mu_tw": 1e-4},
+                  ("twisting", "marshall"): {"kt": 1e5}, ("adhesion", "jkr"): {"w": 0.1}, ("adhesion", "dmt"): {"w": 0.1},
+                  ("adhesion", "sjkr"): {"k_c": 1e5}, ("heat", "radius"): {"k": 45.0}, ("heat", "area"): {"k": 1e6},
+                  ("heat", "lens"): {"k": 45.0}}
+KEPT_KEYS = ("kt",)  # also the tangential spring's: never taken out with another law's keys
+RANK = {"exact": 0, "approximate": 1}
+
+
+def law_cases(slot: str, law_id: str) -> tuple[list[Case], list[str]]:
+    """The suite's cases of ``slot``'s scenarios with its law set to ``law_id`` (the case's own parameters where it
+    runs that law, else EXAMPLE_PARAMS), and the rules that left the others out (a scenario that does not run the
+    law: its ConfigError's text)."""
+    import tomllib
+
+    from ..case import from_dict
+    from ..errors import ConfigError
+    from ..laws.slots import KEYS
+    from ..resources import case_path
+
+    cases, refusals = [], []
+    for name in SLOT_CASES[slot]:
+        raw = tomllib.loads(case_path(f"suite/beyond-{name}.toml").read_text())
+        contact = raw["contact"]
+        if contact.get(slot, "none") != law_id:
+            for key in KEYS.get((slot, contact.get(slot, "none")), ()):
+                if key.name not in KEPT_KEYS:
+                    contact.pop(key.name, None)
+            contact[slot] = law_id
+            contact.update({k: v for k, v in EXAMPLE_PARAMS[(slot, law_id)].items() if k not in contact})
+        try:
+            cases.append(from_dict(raw))
+        except ConfigError as exc:
+            refusals.append(str(exc))
+    return cases, refusals
+
+
+def law_mappings(slot: str, law_id: str) -> dict:
+    """{engine: {fidelity, config, reason, with}}: each registered engine's scenario mapping of the law, the best
+    over the suite's cases of its slot (:func:`law_cases`; exact before approximate before none), ``with`` naming
+    that case; ``config`` the engine's words for it, ``reason`` the mapping's reasons (the first case's for none)."""
+    cases, refusals = law_cases(slot, law_id)
+    out = {}
+    for name in registry.names():
+        best = None
+        for case in cases:
+            mp = mapping(case, name)
+            if best is None or RANK.get(mp.fidelity, 2) < RANK.get(best[0].fidelity, 2):
+                best = (mp, case)
+        if best is None:
+            out[name] = {"fidelity": "none", "config": "", "with": "no scenario",
+                         "reason": "no scenario runs it: " + "; ".join(dict.fromkeys(refusals))}
+            continue
+        mp, case = best
+        words = ""
+        if mp.native is not None:
+            words = "; ".join([_engine(name).summary(mp.native), *mp.native.comments[-1:]])
+        out[name] = {"fidelity": mp.fidelity, "config": words, "reason": "; ".join(mp.reasons),
+                     "with": f"scenario {case.run.scenario} ({case.name})"}
+    return out
 
 
 # ----------------------------------------------------------------------------- the layout
@@ -253,15 +322,111 @@ def seed(case: Case, engine) -> Result:
     return _result(case, "reference-verlet", "verlet", _metrics(case, step(case, seed_laws(case), lay)), lay, started)
 
 
-def run(case: Case, engine, timeout: float | None = None) -> Result:
-    """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics."""
-    from . import run as runner
+def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
+    """The metrics of the engine's ``twin`` or of the ``seed`` run (``kind``), from ``cache`` (engines.cache.Cache)
+    when an entry is there: keyed by the kind, the engine, the case's hash and the fingerprint of demcheck's own
+    source and of numpy's, numba's and scipy's versions (:func:`code_fingerprint`), so a changed law, scheme,
+    mapping or layout never serves an old result. A metric that is not finite is stored as such (its flag
+    column), never as a number."""
+    import json
 
-    eng, started = _engine(engine), time.perf_counter()
+    from .cache import key
+
+    run_it = twin if kind == "twin" else seed
+    if cache is None:
+        return run_it(case, engine).metrics()
+    name = _engine(engine).name
+    names = SCENARIO_METRICS[case.run.scenario]
+    k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
+    hit = _get_metrics(cache, k, names)
+    if hit is not None:
+        return hit[0]
+    metrics = run_it(case, engine).metrics()
+    _put_metrics(cache, k, metrics, {})
+    return metrics
+
+
+def _get_metrics(cache, k: str, names, meta_keys=()) -> tuple[dict, dict] | None:
+    """(metrics, meta) of a cache entry :func:`_put_metrics` wrote, or None."""
+    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1, meta_keys=meta_keys)
+    if hit is None:
+        return None
+    row = hit[0].iloc[0]
+    return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}, hit[1]
+
+
+def _put_metrics(cache, k: str, metrics: dict, meta: dict) -> None:
+    """One row: each metric, and beside it a flag that it is not finite (stored as 0: a table holds finite
+    values only)."""
+    import pandas as pd
+
+    table = {m: [v if math.isfinite(v) else 0.0] for m, v in metrics.items()}
+    table.update({f"{m}__nan": [0.0 if math.isfinite(v) else 1.0] for m, v in metrics.items()})
+    cache.put(k, pd.DataFrame(table), meta)
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """A hash of every source file of demcheck (the laws, the reference's schemes, the engines' mappings and
+    layouts all shape a twin's result) and of numpy's, numba's and scipy's versions."""
+    import hashlib
+    from pathlib import Path
+
+    import numba
+    import scipy
+
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256(f"numpy {np.__version__} numba {numba.__version__} scipy {scipy.__version__}".encode())
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]
+
+
+def deck(case: Case, engine):
+    """The deck (inputs.common.Deck) the engine runs for the scenario case (``demcheck deck``; :func:`run` runs
+    this one): UnsupportedByEngine with the mapping's reason where the engine cannot express the case."""
+    return _planned_deck(case, _engine(engine))[3]
+
+
+def _planned_deck(case: Case, eng):
+    """(mapping, native, layout, deck) of the engine's run of the scenario case."""
     mp = mapping(case, eng)
     nat = mp.require()
     lay = layout(case, eng.scenario_twin_laws(case, nat))
-    dk = eng.scenario_deck(case, nat, lay)
+    return mp, nat, lay, eng.scenario_deck(case, nat, lay)
+
+
+def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
+    """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics;
+    with ``cache`` (engines.cache.Cache) a run that ended ok is kept as its metrics, keyed as an engine run is
+    (the engine, its version and build, the deck and its files) and by :func:`code_fingerprint` (the reading and
+    the metrics are demcheck's code): a warm verify does not run the deck again."""
+    eng, started = _engine(engine), time.perf_counter()
+    mp, nat, lay, dk = _planned_deck(case, eng)
+    if cache is not None:
+        from . import discovery
+        from .cache import key, text, texts
+
+        version = discovery.require(eng.name).version
+        k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
+        hit = _get_metrics(cache, k, SCENARIO_METRICS[case.run.scenario],
+                           {"engine_version": text, "warnings": texts})
+        if hit is not None:
+            return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],
+                           params={"mapping": mp.fidelity, "native": eng.summary(nat)},
+                           message="; ".join(mp.reasons),
+                           meta={"workdir": "", "deck": dk.text, "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                                 "warnings": hit[1]["warnings"], "cached": True})
+    res = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
+    if cache is not None and res.ok:
+        _put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
+                                               "warnings": list(res.meta["warnings"])})
+    return res
+
+
+def _run_deck(case: Case, eng, mp, nat, lay, dk, timeout, started) -> Result:
+    from . import run as runner
+
     out = runner.run(eng.name, dk.text, files=dk.files, timeout=timeout or runner.DEFAULT_TIMEOUT)
     try:
         data = eng.read_scenario(case, lay, out.workdir)

@@ -28,10 +28,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
+from ..laws import rolling as _rolling
+from ..laws import twisting as _twisting
 from ..laws.adhesion import adhesive_force
 from ..laws.heat import conductance, heat_flow
 from ..laws.rolling import rolling_torque
-from ..laws.twisting import twisting_torque
 
 RTOL = 1e-11
 N_DOWN = np.array([0.0, 0.0, -1.0])  # from the sphere into the plane
@@ -271,6 +272,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
     w = np.array([omega0, omega1], dtype=float)
     temp = np.array(temps, dtype=float)
     state = {"roll": np.zeros(3), "twist": 0.0, "touch": 0.0}
+    rolling_at, twisting_at = _rolling_kernel(rolling), _twisting_kernel(twisting)
 
     def normal(delta, rate):
         if adhesion is not None and adhesion.replaces_normal:
@@ -296,8 +298,8 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
         f[0], f[1] = -fn * n, fn * n
         wrel = w[0] - w[1]
         h = dt if update or setup_increment else 0.0
-        m_roll, hist = rolling_torque(rolling, wrel, n, fcrit, h, state["roll"])
-        m_tw, phi = twisting_torque(twisting, wrel, n, fcrit, math.sqrt(rbar * max(delta, 0.0)), h, state["twist"])
+        m_roll, hist = rolling_at(wrel, n, fcrit, h, state["roll"])
+        m_tw, phi = twisting_at(wrel, n, fcrit, math.sqrt(rbar * max(delta, 0.0)), h, state["twist"])
         if update:
             state.update(roll=hist, twist=phi)
         tq[0] += m_roll + m_tw
@@ -343,6 +345,8 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
     x, v, w = (np.array(a, dtype=float) for a in (x0, v0, omega0))
     state = {"t": np.zeros(3), "roll": np.zeros(3), "twist": 0.0}
     fcrit = fcrit or (lambda d, rate: abs(normal(d, rate)))
+    rolling_at, twisting_at = _rolling_kernel(rolling), _twisting_kernel(twisting)
+    into_wall = -nw
 
     def forces(update):
         delta = radius - float((x - p) @ nw)
@@ -352,18 +356,18 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
         rate = -float(v @ nw)
         fn, crit = normal(delta, rate), fcrit(delta, rate)
         r_arm = radius - arm * delta
-        vt = v - (v @ nw) * nw - np.cross(r_arm * w, nw)
+        vt = v - (v @ nw) * nw - _cross(r_arm * w, nw)
         fs, hist = np.zeros(3), state["t"]
         if tangential is not None:
             spring = _maw_spring if truncation == "maw" else _capped_spring
             fs, hist = spring(hist, vt, dt if update else 0.0, *tangential, crit)
         h = dt if update else 0.0
-        m_roll, roll = rolling_torque(rolling, w, -nw, roll_fcrit(delta, rate) if roll_fcrit else crit,
-                                      dt if update or setup_increment else 0.0, state["roll"])
-        m_tw, phi = twisting_torque(twisting, w, -nw, crit, math.sqrt(radius * delta), h, state["twist"])
+        m_roll, roll = rolling_at(w, into_wall, roll_fcrit(delta, rate) if roll_fcrit else crit,
+                                  dt if update or setup_increment else 0.0, state["roll"])
+        m_tw, phi = twisting_at(w, into_wall, crit, math.sqrt(radius * delta), h, state["twist"])
         if update:
             state.update(t=hist, roll=roll, twist=phi)
-        torque = -r_arm * np.cross(nw, fs) + m_roll + m_tw
+        torque = -r_arm * _cross(nw, fs) + m_roll + m_tw
         return fn * nw + fs + mass * g, torque
 
     f, tq = forces(False)
@@ -383,15 +387,45 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
     return out
 
 
+def _cross(a, b):
+    """a × b of two 3-vectors: numpy.cross's products and differences, in its order (the same bits), without its
+    per-call axis handling (the wall twin's largest cost)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def _norm(a) -> float:
+    """|a|: numpy.linalg.norm's √(a·a), as a float."""
+    return math.sqrt(float(a @ a))
+
+
+def _rolling_kernel(law):
+    """``rolling_torque`` of ``law`` with its coefficients laid out once: (w, n, |Fn|, dt, history) → (torque,
+    history), the compiled force function called as rolling_torque calls it."""
+    if law is None or law.id not in _rolling.FORCES:
+        return lambda w, n, fn_abs, dt, history: (np.zeros(3), np.asarray(history, dtype=np.float64))
+    force, c = _rolling.FORCES[law.id], law.array()
+    return lambda w, n, fn_abs, dt, history: force(c, np.asarray(w, dtype=np.float64), n, float(fn_abs), float(dt),
+                                                   np.asarray(history, dtype=np.float64))
+
+
+def _twisting_kernel(law):
+    """``twisting_torque`` of ``law`` with its coefficients laid out once: (w, n, |Fn|, a, dt, φ) → (torque, φ)."""
+    if law is None or law.id not in _twisting.FORCES:
+        return lambda w, n, fn_abs, a, dt, phi: (np.zeros(3), phi)
+    force, c = _twisting.FORCES[law.id], law.array()
+    return lambda w, n, fn_abs, a, dt, phi: force(c, np.asarray(w, dtype=np.float64), n, float(fn_abs), float(a),
+                                                  float(dt), float(phi))
+
+
 def _maw_spring(hist, vt, h, kt, damp, mu, fncrit):
     """LAMMPS's ``linear_history`` on a flat wall (the normal fixed, so the history is never rotated): ξ += h v_t,
     F = −kt ξ − damp v_t, and past μ Fcrit the force scaled to it and ξ set so that it is the spring's (Maw)."""
     hist = hist + h * vt
     fs = -kt * hist - damp * vt
     cap = mu * fncrit
-    mag = float(np.linalg.norm(fs))
+    mag = _norm(fs)
     if mag > cap:
-        if float(np.linalg.norm(hist)) != 0.0:
+        if _norm(hist) != 0.0:
             hist = -(cap / mag * fs + damp * vt) / kt
             fs = cap / mag * fs
         else:
@@ -405,7 +439,7 @@ def _capped_spring(hist, vt, h, kt, damp, mu, fncrit):
     hist = hist + h * vt
     fs = -kt * hist
     cap = mu * fncrit
-    shear = kt * float(np.linalg.norm(hist))
+    shear = kt * _norm(hist)
     if shear > cap:
         if shear != 0.0:
             fs = fs * (cap / shear)

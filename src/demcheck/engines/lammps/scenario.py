@@ -84,6 +84,9 @@ def _twisting(model, rec, nat: Native):
     if rec.id == "sds":
         return (f"twisting sds {fmt(rec.k_tw)} {fmt(rec.gamma_tw)} {fmt(rec.mu_tw)}",
                 SdsTwisting(rec.k_tw, rec.gamma_tw, rec.mu_tw), EXACT, [])
+    if nat.tangential != "linear_history":  # linear_nohistory takes (x_t, μ) only: no spring to build it from
+        return refused("lammps", "LAMMPS twisting marshall takes kt, the damping and μ of the tangential model: "
+                                 "the case's tangential spring must be the twisting law's (kt, μt, no damping)")
     kt, x_t, mu = nat.tangential_args
     if not (kt == rec.kt and mu == rec.mu_t and x_t == 0.0 and rec.gamma_t == 0.0):
         return refused("lammps", "LAMMPS twisting marshall takes kt, the damping and μ of the tangential model: "

@@ -1,0 +1,96 @@
+"""`demcheck models` lists each law beyond sliding with each engine's mapping as the scenario mapping gives it
+(engines/scenario.law_mappings): exact, approximate with its reasons, or none with its reason — the mapping verify
+runs the suite's beyond cases with, never "not wired"."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+
+from demcheck import api
+from demcheck.case import load
+from demcheck.cli import cli
+from demcheck.engines import registry, scenario
+from demcheck.laws.model import resolve
+from demcheck.laws import slots
+from demcheck.resources import case_path
+
+BEYOND = ("rolling", "twisting", "adhesion", "heat")
+
+
+def _beyond_rows():
+    return [r for r in api.models() if r["slot"] in BEYOND]
+
+
+def test_every_beyond_law_has_each_engines_scenario_mapping():
+    rows = _beyond_rows()
+    assert {(r["slot"], r["id"]) for r in rows} == set(slots.KEYS)
+    for r in rows:
+        assert set(r["engines"]) == set(registry.names())
+        for name, m in r["engines"].items():
+            assert m["fidelity"] in ("exact", "approximate", "none"), (r["id"], name, m)
+            if m["fidelity"] != "exact":
+                assert m["reason"], (r["id"], name)  # approximate and none say why
+            else:
+                assert m["config"]
+
+
+def test_the_listed_mapping_is_the_one_verify_runs_the_suite_case_with():
+    """Where a row names a suite case, that case's own scenario mapping (what verify runs) is the row's."""
+    checked = 0
+    for r in _beyond_rows():
+        for name, m in r["engines"].items():
+            if "suite-beyond-" not in m["with"]:
+                continue
+            file = m["with"].split("(suite-beyond-")[1].rstrip(")")
+            c = load(case_path(f"suite/beyond-{file}.toml"))
+            if resolve(c).slot(r["slot"]).id != r["id"]:
+                continue  # the law set into another law's case: law_cases' own
+            mp = scenario.mapping(c, name)
+            assert (m["fidelity"], m["reason"]) == (mp.fidelity, "; ".join(mp.reasons)), (r["id"], name)
+            checked += 1
+    assert checked >= 10
+
+
+def test_measured_mappings_of_lammps_and_liggghts():
+    """The mappings tests/test_scenarios_lammps.py and test_scenarios_liggghts.py run for real."""
+    got = {(r["slot"], r["id"]): {e: m["fidelity"] for e, m in r["engines"].items()} for r in _beyond_rows()}
+    assert got[("rolling", "constant_torque")]["lammps"] == "approximate"
+    assert got[("rolling", "epsd")]["lammps"] == "exact"
+    assert got[("twisting", "sds")]["lammps"] == "exact"
+    assert got[("adhesion", "jkr")]["lammps"] == "approximate"
+    assert got[("heat", "radius")]["lammps"] == "exact"
+    assert got[("heat", "lens")]["liggghts"] == "exact"
+    assert got[("heat", "radius")]["liggghts"] == "approximate"
+    assert got[("twisting", "sds")]["liggghts"] == "none"
+    # no scenario runs a viscous rolling torque or sjkr cohesion: none, with the case's rule as the reason
+    for law in (("rolling", "viscous"), ("adhesion", "sjkr")):
+        assert set(got[law].values()) == {"none"}
+
+
+def test_marshall_in_a_case_without_a_tangential_spring_is_refused_with_its_reason():
+    """LAMMPS twisting marshall builds on the tangential spring: a twist case without one is none, not a crash."""
+    rows = [r for r in _beyond_rows() if r["id"] == "marshall"]
+    m = rows[0]["engines"]["lammps"]
+    assert m["fidelity"] == "none" and "tangential" in m["reason"]
+
+
+def test_models_command_shows_the_fidelities():
+    out = CliRunner().invoke(cli, ["models"])
+    assert out.exit_code == 0, out.output
+    line = next(x for x in out.output.splitlines() if x.startswith("rolling") and " epsd " in x)
+    assert line.split()[2:4] == ["—", "exact"] and "not wired" not in out.output
+    js = json.loads(CliRunner().invoke(cli, ["models", "dmt", "--json"]).output)["models"]
+    assert js[0]["engines"]["lammps"]["fidelity"] == "exact"
+
+
+def test_lammps_scenario_mapping_of_marshall_without_a_tangential_spring():
+    import tomllib
+
+    from demcheck.case import from_dict
+
+    raw = tomllib.loads(case_path("suite/beyond-twist.toml").read_text())
+    raw["contact"] = {"normal": "hertz", "twisting": "marshall", "kt": 1e5}
+    mp = scenario.mapping(from_dict(raw), "lammps")
+    assert mp.fidelity == "none" and mp.native is None and "tangential spring" in mp.reasons[0]
