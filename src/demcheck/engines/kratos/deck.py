@@ -26,7 +26,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ..mapping import contact_mapping, pair_mapping
-from .mapping import LAWS
+from .mapping import LAWS, particle_young
 
 VERSION_NOTE = "written for Kratos DEM 10.4.4 (KratosMultiphysics + KratosDEMApplication from PyPI)"
 SCHEME = "Velocity_Verlet"  # x += v dt + ½a dt², v += ½a dt; forces; v += ½a dt: LAMMPS's nve/sphere, the twin's
@@ -147,10 +147,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     # a frictional law's Poisson's ratio is the mapping's (it sets Kt/Kn = 2(1 − ν)/(2 − ν)); else the materials'
     nu = nat.props.get("poisson")
     nus = [m.poisson_ratio if nu is None else float(nu) for m in mats]
-    if case.walls:
-        youngs = [e_star * (1.0 - nus[0] ** 2)]
-    else:
-        youngs = [e_star * ((1.0 - nus[0] ** 2) + (1.0 - nus[1] ** 2))] * 2
+    youngs = [particle_young(e_star, nus, bool(case.walls))] * n
     wall_id = n + 1
     gamma = []
     for (i, j), pn in natives.items():
