@@ -27,10 +27,10 @@ LAW_CASES = [
 @pytest.mark.engine("kratos")
 @pytest.mark.parametrize("law,path,overrides,friction", LAW_CASES)
 def test_kratos_variant_laws_run_as_their_twin(law, path, overrides, friction):
-    """Measured ≤ 1.2e-10 every metric (Nestle on the wall, rebound spin; the others ≤ 4e-11). Each law's difference from its parent, dropped in the twin alone, misses
-    Kratos (docs/kratos.md): HighStiffness with Kt = ρ·(5Kn) as its source reads by 0.18 in tangential restitution
-    (wall), Nestle with the source's tangential dashpot 2γ√(m̄Kn)/0.55 by 1.7e-2. (Before: the deck refused these
-    laws and there was no twin.)"""
+    """Measured ≤ 1.2e-10 every metric (Nestle on the wall, rebound spin; the others ≤ 4e-11). Each law's
+    difference from its parent, dropped in the twin alone, misses Kratos (docs/kratos.md): HighStiffness with
+    Kt = ρ·(5Kn) as its source reads by 0.18 in tangential restitution (wall), Nestle with the source's tangential
+    dashpot 2γ√(m̄Kn)/0.55 by 1.7e-2. (Before: the deck refused these laws and there was no twin.)"""
     case = C.load(CASES / path, overrides)
     nat = _native(case, **friction)
     nat.normal = law
