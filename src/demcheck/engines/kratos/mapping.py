@@ -34,13 +34,14 @@ LINEAR = "DEM_D_Linear_viscous_Coulomb"
 HIGH = "DEM_D_Linear_HighStiffness"
 NESTLE = "DEM_D_Hertz_viscous_Coulomb_Nestle"
 SIMPLE = "DEM_D_Linear_Simple_Coulomb"
-LAWS = (HERTZ, LINEAR, HIGH, NESTLE, SIMPLE)  # twinned (the three last: a native configuration's, not mapped)
+CUSTOM = "DEM_D_Linear_Custom_Constants"
+LAWS = (HERTZ, LINEAR, HIGH, NESTLE, SIMPLE, CUSTOM)  # twinned (the three last: a native configuration's, not mapped)
 # how each twinned law differs from its parent, as measured against Kratos 10.4.4 runs (docs/kratos.md):
 # Linear_HighStiffness: Kn five times Linear_viscous_Coulomb's, Kt (and its dashpot) that of the unaugmented Kn;
 # Hertz_viscous_Coulomb_Nestle: Hertz_viscous_Coulomb's forces exactly (the source's tangential dashpot
 # 2γ√(m̄Kn)/0.55 does not act in the installed build); Linear_Simple_Coulomb: Kn = E₁·2R₁R₂/(R₁ + R₂) (E₁·R on a
 # wall), Kt = ν₁Kn, no dashpot, no √(δ/δ_prev), the cap tan(STATIC_FRICTION)·Fn
-PARENT = {HERTZ: HERTZ, LINEAR: LINEAR, HIGH: LINEAR, NESTLE: HERTZ, SIMPLE: SIMPLE}
+PARENT = {HERTZ: HERTZ, LINEAR: LINEAR, HIGH: LINEAR, NESTLE: HERTZ, SIMPLE: SIMPLE, CUSTOM: LINEAR}
 KN_FACTOR = {HIGH: 5.0}
 FRICTION = "spring-dashpot-coulomb"  # a Native's tangential: the law's own incremental spring, dashpot and cap
 LINEAR_BETA = 1.432  # the particle–particle factor of DEM_D_Linear_viscous_Coulomb's Kn (absent for walls)
@@ -174,10 +175,12 @@ def law_numbers(nat: Native, m: float, r: float) -> dict:
         out.update(kn=2.0 * e_star * math.sqrt(r), k_el=4.0 / 3.0 * e_star * math.sqrt(r), a=1.5, b=0.25,
                    c=2.0 * gamma * math.sqrt(2.0 * m * e_star * math.sqrt(r)))
     elif parent == LINEAR:
-        k = linear_kn(e_star, r, wall, KN_FACTOR.get(law, 1.0))
+        k = nat.props["k_normal"] if law == CUSTOM else linear_kn(e_star, r, wall, KN_FACTOR.get(law, 1.0))
         out.update(kn=k, k_el=k, a=1.0, b=0.0, c=2.0 * gamma * math.sqrt(m * k))
         if law in KN_FACTOR:
             out["rho"] = tangential_ratio(nat) / KN_FACTOR[law]
+        elif law == CUSTOM:
+            out["rho"] = nat.props["k_tangential"] / k
     else:  # Simple_Coulomb: element 1's E and ν, no dashpot, the cap tan(STATIC_FRICTION)·Fn
         nu = nat.props.get("poisson")
         if nu is None:
