@@ -71,3 +71,24 @@ def test_simple_coulomb_numbers():
     kp = twin_law_array(nat, 1e-5, 1e-3)
     assert kp[K_KN] == pytest.approx(5 * linear_kn(1e9, 1e-3, False), rel=1e-15)
     assert kp[K_RHO] == pytest.approx(2 * 0.75 / 1.75 / 5, rel=1e-15) and kp[K_GAMMA] == 0.2
+
+
+@pytest.mark.engine("kratos")  # Kratos' own γ is read from Kratos, the probes run Kratos
+def test_the_audit_probes_a_project_with_the_variant_laws(tmp_path):
+    """A user's project with Linear_HighStiffness between the spheres and Hertz_viscous_Coulomb_Nestle on the
+    wall: both relations are probed with real Kratos runs from demcheck's deck, the engine equal to its twin
+    (Nestle's γ by Thornton's fit, as Kratos derives it for a 'Hertz' law). Simple_Coulomb and Custom_Constants
+    are listed, not probed (their stiffness is not read). (Before: each was 'no twin', not probed.)"""
+    from demcheck.comparisons import audit as A
+
+    from .test_audit_kratos import _project
+
+    r = A.audit(_project(tmp_path, dt=5e-9, law_pair=HIGH, law_wall=NESTLE), speed=1.0)
+    assert r["coverage"]["pairs"]["probed"] == 1 and r["coverage"]["walls"]["probed"] == 1
+    for p in r["pairs"]:
+        q = p["probes"][0]
+        assert q["engine"]["status"] == "ok" and q["engine_vs_twin"] <= 1e-9, q
+    assert any("Thornton's fit" in n for n in next(p for p in r["pairs"] if p["wall"])["notes"])
+    setup = A.read(_project(tmp_path, law_pair=SIMPLE, law_wall=CUSTOM))
+    for ps in setup.pairs:
+        assert not ps.probe and any("twinned but its stiffness is not read" in n for n in ps.notes)

@@ -19,6 +19,10 @@ into body 1, v_t the slip velocity, force on body 0 = −Fn n + Ft):
   dashpot is cut to cap − |F_e|; with F_e·F_d < 0, the dashpot is cut to (cap + |F_e|)/|F_d| of itself if
   |F_d| ≥ |F_e|, else the spring to the cap and the dashpot dropped.
 * Torques at R − δ/2 (pair, equal moduli) and R − δ (wall).
+
+The other twinned laws (engines/kratos/mapping.law_numbers) are these numbers changed: Kn and ρ
+(Linear_HighStiffness, Linear_Custom_Constants), or no dashpot, no √(δ/δ_prev) and μ = tan φ
+(Linear_Simple_Coulomb).
 """
 
 from __future__ import annotations

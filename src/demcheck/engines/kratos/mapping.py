@@ -12,6 +12,9 @@ What the laws compute (read in applications/DEMApplication/custom_constitutive/ 
 * Both tangential parts: an incremental spring Kt = 4G*Kn/E* with a dashpot 2γ√(m̄Kt), a Coulomb cap
   μ(v) = μd + (μs − μd) exp(−FRICTION_DECAY |v_t|) split between spring and dashpot in Kratos' own way, and
   (Hertz) the spring force scaled by √(δ/δ_prev) on unloading. No seed tangential law has that form.
+* Four more 3-D laws are twinned for a native configuration and the audit (:func:`law_numbers`, measured against
+  runs: docs/kratos.md): ``DEM_D_Linear_HighStiffness``, ``DEM_D_Hertz_viscous_Coulomb_Nestle``,
+  ``DEM_D_Linear_Simple_Coulomb``, ``DEM_D_Linear_Custom_Constants``; the seed models map onto the two above only.
 
 γ (DAMPING_GAMMA) is what Kratos derives from COEFFICIENT_OF_RESTITUTION (a bisection to 1e-4 for Linear
 laws, Thornton's fit for Hertz laws); demcheck's runner sets the γ of the seed's η directly on the contact's
@@ -41,6 +44,9 @@ LAWS = (HERTZ, LINEAR, HIGH, NESTLE, SIMPLE, CUSTOM)  # twinned (the three last:
 # Hertz_viscous_Coulomb_Nestle: Hertz_viscous_Coulomb's forces exactly (the source's tangential dashpot
 # 2γ√(m̄Kn)/0.55 does not act in the installed build); Linear_Simple_Coulomb: Kn = E₁·2R₁R₂/(R₁ + R₂) (E₁·R on a
 # wall), Kt = ν₁Kn, no dashpot, no √(δ/δ_prev), the cap tan(STATIC_FRICTION)·Fn
+# the laws `demcheck audit` probes in a user's project: E* and γ are all it needs of them (Simple_Coulomb needs the
+# first material's E and ν, Custom_Constants the relation's K_NORMAL and K_TANGENTIAL: not read yet)
+AUDITED = (HERTZ, LINEAR, HIGH, NESTLE)
 PARENT = {HERTZ: HERTZ, LINEAR: LINEAR, HIGH: LINEAR, NESTLE: HERTZ, SIMPLE: SIMPLE, CUSTOM: LINEAR}
 KN_FACTOR = {HIGH: 5.0}
 FRICTION = "spring-dashpot-coulomb"  # a Native's tangential: the law's own incremental spring, dashpot and cap
@@ -177,7 +183,7 @@ def law_numbers(nat: Native, m: float, r: float) -> dict:
     elif parent == LINEAR:
         k = nat.props["k_normal"] if law == CUSTOM else linear_kn(e_star, r, wall, KN_FACTOR.get(law, 1.0))
         out.update(kn=k, k_el=k, a=1.0, b=0.0, c=2.0 * gamma * math.sqrt(m * k))
-        if law in KN_FACTOR:
+        if law in KN_FACTOR and nat.tangential == FRICTION:
             out["rho"] = tangential_ratio(nat) / KN_FACTOR[law]
         elif law == CUSTOM:
             out["rho"] = nat.props["k_tangential"] / k
