@@ -19,6 +19,10 @@ into body 1, v_t the slip velocity, force on body 0 = −Fn n + Ft):
   dashpot is cut to cap − |F_e|; with F_e·F_d < 0, the dashpot is cut to (cap + |F_e|)/|F_d| of itself if
   |F_d| ≥ |F_e|, else the spring to the cap and the dashpot dropped.
 * Torques at R − δ/2 (pair, equal moduli) and R − δ (wall).
+
+The other twinned laws (engines/kratos/mapping.law_numbers) are these numbers changed: Kn and ρ
+(Linear_HighStiffness, Linear_Custom_Constants), or no dashpot, no √(δ/δ_prev) and μ = tan φ
+(Linear_Simple_Coulomb).
 """
 
 from __future__ import annotations
@@ -203,10 +207,12 @@ def kratos_3d(y0, nl, kp, geo, rules, dt, t_max, capacity):
 
 
 def law_array(hertz: bool, kn: float, rho: float, gamma: float, m_eff: float, mu_s: float, mu_d: float,
-              decay: float) -> np.ndarray:
+              decay: float, minor: bool | None = None) -> np.ndarray:
+    """The kernel's numbers (``minor``: the √(δ/δ_prev) shrink on unloading, the Hertz law's by default)."""
     kp = np.zeros(K_SIZE)
     kp[K_HERTZ], kp[K_KN], kp[K_RHO], kp[K_GAMMA], kp[K_M] = float(hertz), kn, rho, gamma, m_eff
-    kp[K_MU_S], kp[K_MU_D], kp[K_DECAY], kp[K_MINOR] = mu_s, mu_d, decay, float(hertz)
+    kp[K_MU_S], kp[K_MU_D], kp[K_DECAY] = mu_s, mu_d, decay
+    kp[K_MINOR] = float(hertz if minor is None else minor)
     return kp
 
 

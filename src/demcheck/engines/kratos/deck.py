@@ -26,7 +26,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ..mapping import contact_mapping, pair_mapping
-from .mapping import LAWS
+from .mapping import CUSTOM, LAWS, particle_young
 
 VERSION_NOTE = "written for Kratos DEM 10.4.4 (KratosMultiphysics + KratosDEMApplication from PyPI)"
 SCHEME = "Velocity_Verlet"  # x += v dt + ½a dt², v += ½a dt; forces; v += ½a dt: LAMMPS's nve/sphere, the twin's
@@ -147,10 +147,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     # a frictional law's Poisson's ratio is the mapping's (it sets Kt/Kn = 2(1 − ν)/(2 − ν)); else the materials'
     nu = nat.props.get("poisson")
     nus = [m.poisson_ratio if nu is None else float(nu) for m in mats]
-    if case.walls:
-        youngs = [e_star * (1.0 - nus[0] ** 2)]
-    else:
-        youngs = [e_star * ((1.0 - nus[0] ** 2) + (1.0 - nus[1] ** 2))] * 2
+    youngs = [particle_young(e_star, nus, bool(case.walls))] * n
     wall_id = n + 1
     gamma = []
     for (i, j), pn in natives.items():
@@ -180,6 +177,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
                 "ROLLING_FRICTION_WITH_WALLS": 0.0, "COEFFICIENT_OF_RESTITUTION": 1.0,
                 "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME": nat.normal,
                 "DEM_ROLLING_FRICTION_MODEL_NAME": "DEMRollingFrictionModelBounded"}
+    if nat.normal == CUSTOM:  # its Kn, Kt are the contact's (the relation's) K_NORMAL, K_TANGENTIAL
+        relation.update(K_NORMAL=float(nat.props["k_normal"]), K_TANGENTIAL=float(nat.props["k_tangential"]))
     materials = [{"material_name": f"particle{k + 1}", "material_id": k + 1,
                   "Variables": {"PARTICLE_DENSITY": float(mats[k].density), "YOUNG_MODULUS": float(youngs[k]),
                                 "POISSON_RATIO": float(nus[k])}} for k in range(n)]
@@ -341,7 +340,8 @@ PARAMETER_KEYS = frozenset({
     "materials", "material_relations", "material_assignation_table", "material_name", "material_id", "Variables",
     "material_names_list", "material_ids_list", "PARTICLE_DENSITY", "YOUNG_MODULUS", "POISSON_RATIO",
     "STATIC_FRICTION", "DYNAMIC_FRICTION", "FRICTION_DECAY", "ROLLING_FRICTION", "ROLLING_FRICTION_WITH_WALLS",
-    "COEFFICIENT_OF_RESTITUTION", "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME", "DEM_ROLLING_FRICTION_MODEL_NAME"})
+    "COEFFICIENT_OF_RESTITUTION", "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME", "DEM_ROLLING_FRICTION_MODEL_NAME",
+    "K_NORMAL", "K_TANGENTIAL"})
 KNOWN_STRINGS = frozenset({"sphere_strategy", "MaterialsDEM.json", "Ascii", "single_file", "SphericPartDEMElement3D",
                            SCHEME, "Direct_Integration", PROBLEM, "DEMRollingFrictionModelBounded", "wall",
                            *LAWS})

@@ -12,6 +12,9 @@ What the laws compute (read in applications/DEMApplication/custom_constitutive/ 
 * Both tangential parts: an incremental spring Kt = 4G*Kn/E* with a dashpot 2γ√(m̄Kt), a Coulomb cap
   μ(v) = μd + (μs − μd) exp(−FRICTION_DECAY |v_t|) split between spring and dashpot in Kratos' own way, and
   (Hertz) the spring force scaled by √(δ/δ_prev) on unloading. No seed tangential law has that form.
+* Four more 3-D laws are twinned for a native configuration and the audit (:func:`law_numbers`, measured against
+  runs: docs/kratos.md): ``DEM_D_Linear_HighStiffness``, ``DEM_D_Hertz_viscous_Coulomb_Nestle``,
+  ``DEM_D_Linear_Simple_Coulomb``, ``DEM_D_Linear_Custom_Constants``; the seed models map onto the two above only.
 
 γ (DAMPING_GAMMA) is what Kratos derives from COEFFICIENT_OF_RESTITUTION (a bisection to 1e-4 for Linear
 laws, Thornton's fit for Hertz laws); demcheck's runner sets the γ of the seed's η directly on the contact's
@@ -31,16 +34,37 @@ from ..mapping import mu_of
 
 HERTZ = "DEM_D_Hertz_viscous_Coulomb"
 LINEAR = "DEM_D_Linear_viscous_Coulomb"
-LAWS = (HERTZ, LINEAR)
+HIGH = "DEM_D_Linear_HighStiffness"
+NESTLE = "DEM_D_Hertz_viscous_Coulomb_Nestle"
+SIMPLE = "DEM_D_Linear_Simple_Coulomb"
+CUSTOM = "DEM_D_Linear_Custom_Constants"
+LAWS = (HERTZ, LINEAR, HIGH, NESTLE, SIMPLE, CUSTOM)  # twinned (the three last: a native configuration's, not mapped)
+# how each twinned law differs from its parent, as measured against Kratos 10.4.4 runs (docs/kratos.md):
+# Linear_HighStiffness: Kn five times Linear_viscous_Coulomb's, Kt (and its dashpot) that of the unaugmented Kn;
+# Hertz_viscous_Coulomb_Nestle: Hertz_viscous_Coulomb's forces exactly (the source's tangential dashpot
+# 2γ√(m̄Kn)/0.55 does not act in the installed build); Linear_Simple_Coulomb: Kn = E₁·2R₁R₂/(R₁ + R₂) (E₁·R on a
+# wall), Kt = ν₁Kn, no dashpot, no √(δ/δ_prev), the cap tan(STATIC_FRICTION)·Fn
+# the laws `demcheck audit` probes in a user's project: E* and γ are all it needs of them (Simple_Coulomb needs the
+# first material's E and ν, Custom_Constants the relation's K_NORMAL and K_TANGENTIAL: not read yet)
+AUDITED = (HERTZ, LINEAR, HIGH, NESTLE)
+PARENT = {HERTZ: HERTZ, LINEAR: LINEAR, HIGH: LINEAR, NESTLE: HERTZ, SIMPLE: SIMPLE, CUSTOM: LINEAR}
+KN_FACTOR = {HIGH: 5.0}
 FRICTION = "spring-dashpot-coulomb"  # a Native's tangential: the law's own incremental spring, dashpot and cap
 LINEAR_BETA = 1.432  # the particle–particle factor of DEM_D_Linear_viscous_Coulomb's Kn (absent for walls)
 LINEAR_RADIUS = 0.31225  # its modified radius factor √(α(2 − α)), α = 0.05
 
 
-def linear_kn(young_eff: float, r_eff: float, wall: bool) -> float:
-    """DEM_D_Linear_viscous_Coulomb's Kn, in Kratos' order of operations."""
-    beta = 1.0 if wall else LINEAR_BETA
+def linear_kn(young_eff: float, r_eff: float, wall: bool, factor: float = 1.0) -> float:
+    """DEM_D_Linear_viscous_Coulomb's Kn, in Kratos' order of operations (``factor``: Linear_HighStiffness' 5)."""
+    beta = factor if wall else factor * LINEAR_BETA
     return beta * young_eff * math.pi * (r_eff * LINEAR_RADIUS)
+
+
+def particle_young(e_star: float, nus: list, wall: bool) -> float:
+    """The YOUNG_MODULUS the deck gives the particles for a contact's E* (a wall's face is rigid)."""
+    if wall:
+        return e_star * (1.0 - nus[0] ** 2)
+    return e_star * ((1.0 - nus[0] ** 2) + (1.0 - nus[1] ** 2))
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
@@ -145,28 +169,56 @@ def _no_friction_law(normal_id: str, tl) -> str:
 
 
 
+def law_numbers(nat: Native, m: float, r: float) -> dict:
+    """What a twinned law computes on a pair (m̄, R̄): its normal spring k_el δ^a with the dashpot c δ^b, Kn's
+    coefficient (× √δ for Hertz) and the tangential kernel's options."""
+    law, e_star, gamma, wall = nat.normal, nat.normal_args[0], nat.damping_coeff, bool(nat.props.get("wall"))
+    parent = PARENT.get(law)
+    if parent is None:
+        raise ValueError(f"no twin for Kratos law {law!r}")
+    out = {"hertz": parent == HERTZ, "rho": None, "gamma": gamma, "minor": None}
+    if parent == HERTZ:
+        out.update(kn=2.0 * e_star * math.sqrt(r), k_el=4.0 / 3.0 * e_star * math.sqrt(r), a=1.5, b=0.25,
+                   c=2.0 * gamma * math.sqrt(2.0 * m * e_star * math.sqrt(r)))
+    elif parent == LINEAR:
+        k = nat.props["k_normal"] if law == CUSTOM else linear_kn(e_star, r, wall, KN_FACTOR.get(law, 1.0))
+        out.update(kn=k, k_el=k, a=1.0, b=0.0, c=2.0 * gamma * math.sqrt(m * k))
+        if law in KN_FACTOR and nat.tangential == FRICTION:
+            out["rho"] = tangential_ratio(nat) / KN_FACTOR[law]
+        elif law == CUSTOM:
+            out["rho"] = nat.props["k_tangential"] / k
+    else:  # Simple_Coulomb: element 1's E and ν, no dashpot, the cap tan(STATIC_FRICTION)·Fn
+        nu = nat.props.get("poisson")
+        if nu is None:
+            raise ValueError(f"{law}'s twin needs the deck's POISSON_RATIO (its Kt = ν·Kn)")
+        k = particle_young(e_star, [nu, nu], wall) * (r if wall else 2.0 * r)
+        out.update(kn=k, k_el=k, a=1.0, b=0.0, c=0.0, rho=nu, gamma=0.0, minor=False)
+    return out
+
+
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
-    e_star, gamma = nat.normal_args[0], nat.damping_coeff
-    if nat.normal == HERTZ:
-        k_el, a = 4.0 / 3.0 * e_star * math.sqrt(r), 1.5
-        c, b = 2.0 * gamma * math.sqrt(2.0 * m * e_star * math.sqrt(r)), 0.25
-    elif nat.normal == LINEAR:
-        k_el, a = linear_kn(e_star, r, bool(nat.props.get("wall"))), 1.0
-        c, b = 2.0 * gamma * math.sqrt(m * k_el), 0.0
-    else:
-        raise ValueError(f"no twin for Kratos law {nat.normal!r}")
-    nl = twins.normal_law(k_el, a, c, b, True)
+    ln = law_numbers(nat, m, r)
+    nl = twins.normal_law(ln["k_el"], ln["a"], ln["c"], ln["b"], True)
     if nat.tangential == FRICTION:
         # the nearest seed record, for the model's description only: the twin's steps are twins_kratos'
         # (Engine.twin_collide), whose history, rotation, cap and arms are Kratos' own
-        kt = tangential_ratio(nat) * (2.0 * e_star * math.sqrt(r) if nat.normal == HERTZ else k_el)
-        record = SqrtSpringTangential if nat.normal == HERTZ else SpringTangential
-        return nl, TangentialLaw.from_slot(record(kt=kt / math.sqrt(r) if nat.normal == HERTZ else kt,
-                                                  eta=0.0, mu_s=nat.props["mu_s"], mu_k=nat.props["mu_d"],
+        kt = (ln["rho"] or tangential_ratio(nat)) * ln["kn"]
+        record = SqrtSpringTangential if ln["hertz"] else SpringTangential
+        mu_s, mu_d = friction_of(nat)
+        return nl, TangentialLaw.from_slot(record(kt=kt / math.sqrt(r) if ln["hertz"] else kt,
+                                                  eta=0.0, mu_s=mu_s, mu_k=mu_d,
                                                   truncation=TRUNC_SPRING, r_eff=r, m_eff=m, force_history=True))
     if nat.tangential != "none":
         raise ValueError(f"no twin for Kratos tangential {nat.tangential!r}")
     return nl, twins.no_friction()
+
+
+def friction_of(nat: Native) -> tuple[float, float]:
+    """(μs, μd) of the cap: Simple_Coulomb's is tan(STATIC_FRICTION) (an angle), the others' the two numbers."""
+    if nat.normal == SIMPLE:
+        mu = math.tan(nat.props["mu_s"])
+        return mu, mu
+    return nat.props["mu_s"], nat.props["mu_d"]
 
 
 def tangential_ratio(nat: Native) -> float:
@@ -180,8 +232,8 @@ def twin_law_array(nat: Native, m: float, r: float):
     """The numbers of twins_kratos' kernel for a frictional Kratos native on a pair (m̄, R̄)."""
     from ...reference import twins_kratos
 
-    e_star = nat.normal_args[0]
-    hertz = nat.normal == HERTZ
-    kn = 2.0 * e_star * math.sqrt(r) if hertz else linear_kn(e_star, r, bool(nat.props.get("wall")))
-    return twins_kratos.law_array(hertz, kn, tangential_ratio(nat), nat.damping_coeff, m, nat.props["mu_s"],
-                                  nat.props["mu_d"], nat.props.get("decay", 0.0))
+    ln = law_numbers(nat, m, r)
+    mu_s, mu_d = friction_of(nat)
+    decay = 0.0 if nat.normal == SIMPLE else nat.props.get("decay", 0.0)
+    return twins_kratos.law_array(ln["hertz"], ln["kn"], ln["rho"] or tangential_ratio(nat), ln["gamma"], m, mu_s,
+                                  mu_d, decay, ln["minor"])
