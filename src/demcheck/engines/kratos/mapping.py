@@ -115,7 +115,10 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     if tl.id == "none":
         nat.comments.append("STATIC_FRICTION = DYNAMIC_FRICTION = 0, no rolling friction, no global damping")
         return Mapping("kratos", fid, reasons, nat, keywords)
+    n_reasons = len(reasons)
     mu, _ = mu_of(model, reasons)
+    for reason in reasons[n_reasons:]:  # one friction coefficient for the seed's two: the deck's setting
+        keywords[reason] = "STATIC_FRICTION = DYNAMIC_FRICTION"
     rho = tl.kt / normal.k if law == LINEAR else 2.0 / 3.0 * tl.kt * math.sqrt(r) / normal.k
     if not 2.0 / 3.0 < rho < 4.0 / 3.0:
         return refused("kratos", f"Kratos' tangential stiffness is Kt = 4G*/E*·Kn = 2(1 − ν)/(2 − ν)·Kn, in (2/3, 4/3)"
