@@ -19,10 +19,9 @@ from .integrator import (crossed, ended_with_it, error, grow, H_MIN, H_START, il
                          THETA_TOL)
 from .kernels import (EV_END, EV_FORCE_END, EV_MAX_OVERLAP, EV_PEAK, EV_REENTER, EV_RELOAD, EV_START, M_FREE, M_LOAD,
                       M_PRE, M_UNLOAD, M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_TOLERANCE)
-from .kernels3d import (A_DMAX, A_LSTAR, A_NMODE, A_SIZE, A_TMODE, A_TREF, ARM_RADIUS, ARM_SURFACE, C_D, C_E, C_FN,
-                        C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, energy, EV_KINK, EV_REVERSAL, EV_SLIP_STICK,
-                        EV_STICK_SLIP, G_GX, G_I0, G_I1, G_M0, G_M1, G_TS, G_WALL, kinematics, NCOL, R_SLIP_ARM,
-                        R_WALL_SLIP_ARM, SLIP, STICK)
+from .kernels3d import (A_DMAX, A_LSTAR, A_NMODE, A_SIZE, A_TMODE, A_TREF, ARM_RADIUS, ARM_SURFACE, C_FN, C_FT,
+                        EV_KINK, EV_REVERSAL, EV_SLIP_STICK, EV_STICK_SLIP, G_GX, G_I0, G_I1, G_M0, G_M1, G_TS,
+                        G_WALL, kinematics, NCOL, R_SLIP_ARM, R_WALL_SLIP_ARM, record_row, SLIP, STICK)
 
 # ----------------------------------------------------------------------------- the continuous system
 
@@ -491,16 +490,7 @@ def _record(rec, i, t, y, aux, nl, tl, geo, rules):
 def _record_with(rec, i, t, y, aux, geo, rules, fn, ft):
     """A record row of y, whose rhs gave the normal force fn and tangential force ft."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    rec[i, C_T] = t
-    rec[i, C_X0:C_X0 + 18] = y[0:18]
-    rec[i, C_D] = delta
-    rec[i, C_R] = rate
-    rec[i, C_FN] = fn
-    rec[i, C_FT:C_FT + 3] = ft
-    rec[i, C_VT:C_VT + 3] = vt
-    rec[i, C_N:C_N + 3] = n
-    rec[i, C_E] = energy(y, geo)
-    rec[i, C_SLIP] = aux[A_TMODE]
+    record_row(rec, i, t, y, geo, delta, rate, fn, ft, vt, n, aux[A_TMODE])
 
 
 @njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads

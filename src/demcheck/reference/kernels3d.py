@@ -104,6 +104,22 @@ def kinematics(y, geo, rules):
     return delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t
 
 
+@njit(cache=KERNEL_CACHE, inline="always")
+def record_row(rec, i, t, y, geo, delta, rate, fn, ft, vt, n, slip):
+    """Row i of a record (the C_* columns): the time, the state, the overlap, its rate, the forces, the slip
+    velocity, the normal, the energy and the slip mode — one layout for every 3-D kernel."""
+    rec[i, C_T] = t
+    rec[i, C_X0:C_X0 + 18] = y[0:18]
+    rec[i, C_D] = delta
+    rec[i, C_R] = rate
+    rec[i, C_FN] = fn
+    rec[i, C_FT:C_FT + 3] = ft
+    rec[i, C_VT:C_VT + 3] = vt
+    rec[i, C_N:C_N + 3] = n
+    rec[i, C_E] = energy(y, geo)
+    rec[i, C_SLIP] = slip
+
+
 @njit(cache=KERNEL_CACHE)
 def energy(y, geo):
     """Kinetic (translation + rotation) plus gravitational potential energy of the bodies."""

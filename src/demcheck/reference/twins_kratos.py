@@ -37,8 +37,8 @@ from .. import KERNEL_CACHE
 from ..laws.normal_force import normal_force
 from ..laws.tangential_force import _cross, _dot, _norm
 from .kernels import M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED
-from .kernels3d import (A_NMODE, A_SIZE, C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, G_GX, G_I0, G_I1,
-                        G_M0, G_M1, G_R0, G_R1, G_WALL, NCOL, energy, kinematics)
+from .kernels3d import (A_NMODE, A_SIZE, G_GX, G_I0, G_I1, G_M0, G_M1, G_R0, G_R1, G_WALL, kinematics, NCOL,
+                        record_row)
 
 # the law's numbers (kp array): Kn = KN · δ^½ (Hertz) or KN (Linear); Kt = RHO · Kn; c_t = 2 GAMMA √(M Kt);
 # μ = MU_D + (MU_S − MU_D) exp(−DECAY |v_t|); MINOR: the Hertz law's √(δ/δ_prev) on unloading
@@ -128,14 +128,7 @@ def kratos_3d(y0, nl, kp, geo, rules, dt, t_max, capacity):
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fn = normal_force(nl, delta, rate, delta) if delta > 0.0 else 0.0
     fvec0 = -fn * n
-    rec[0, C_T] = 0.0
-    rec[0, C_X0:C_X0 + 18] = y[0:18]
-    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, fn
-    rec[0, C_FT:C_FT + 3] = 0.0
-    rec[0, C_VT:C_VT + 3] = vt
-    rec[0, C_N:C_N + 3] = n
-    rec[0, C_E] = energy(y, geo)
-    rec[0, C_SLIP] = 0.0
+    record_row(rec, 0, 0.0, y, geo, delta, rate, fn, np.zeros(3), vt, n, 0.0)
     g = geo[G_GX:G_GX + 3]
     i, step = 1, 0
     while i < capacity:
@@ -186,14 +179,7 @@ def kratos_3d(y0, nl, kp, geo, rules, dt, t_max, capacity):
         if not wall:
             y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
             y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
-        rec[i, C_T] = t
-        rec[i, C_X0:C_X0 + 18] = y[0:18]
-        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
-        rec[i, C_FT:C_FT + 3] = ft
-        rec[i, C_VT:C_VT + 3] = vt
-        rec[i, C_N:C_N + 3] = n
-        rec[i, C_E] = energy(y, geo)
-        rec[i, C_SLIP] = 1.0 if sliding else 0.0
+        record_row(rec, i, t, y, geo, delta, rate, fn, ft, vt, n, (1.0 if sliding else 0.0))
         i += 1
         if not np.all(np.isfinite(y[0:18])):
             status = ST_UNRESOLVED

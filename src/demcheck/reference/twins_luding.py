@@ -26,8 +26,7 @@ from numba import njit
 
 from .. import KERNEL_CACHE
 from .kernels import ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED
-from .kernels3d import (C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, G_GX, G_I0, G_I1, G_M0, G_M1,
-                        G_WALL, NCOL, energy, kinematics)
+from .kernels3d import (G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, record_row)
 
 # the law's numbers: k1, kp, δ_Pmax, δ_P0
 L_K1, L_KP, L_DPMAX, L_DP0 = range(4)
@@ -74,14 +73,8 @@ def luding_3d(y0, law, geo, rules, dt, t_max, capacity):
     status = ST_NO_SEPARATION
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     fvec0 = np.zeros(3)
-    rec[0, C_T] = 0.0
-    rec[0, C_X0:C_X0 + 18] = y[0:18]
-    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, 0.0
-    rec[0, C_FT:C_FT + 3] = 0.0
-    rec[0, C_VT:C_VT + 3] = vt
-    rec[0, C_N:C_N + 3] = n
-    rec[0, C_E] = energy(y, geo)
-    rec[0, C_SLIP] = 0.0
+    no_force = np.zeros(3)  # Luding's law here has no tangential force
+    record_row(rec, 0, 0.0, y, geo, delta, rate, 0.0, no_force, vt, n, 0.0)
     g = geo[G_GX:G_GX + 3]
     i, step = 1, 0
     while i < capacity:
@@ -107,14 +100,7 @@ def luding_3d(y0, law, geo, rules, dt, t_max, capacity):
         y[3:6] += 0.5 * dt * (fvec0 / geo[G_M0] + g)
         if not wall:
             y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
-        rec[i, C_T] = t
-        rec[i, C_X0:C_X0 + 18] = y[0:18]
-        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
-        rec[i, C_FT:C_FT + 3] = 0.0
-        rec[i, C_VT:C_VT + 3] = vt
-        rec[i, C_N:C_N + 3] = n
-        rec[i, C_E] = energy(y, geo)
-        rec[i, C_SLIP] = 0.0
+        record_row(rec, i, t, y, geo, delta, rate, fn, no_force, vt, n, 0.0)
         i += 1
         if not np.all(np.isfinite(y[0:18])):
             status = ST_UNRESOLVED

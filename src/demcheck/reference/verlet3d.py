@@ -17,9 +17,8 @@ from ..laws.tangential import (LTH, NONE, SPRING, T_FAMILY, T_FORCE, T_MU_K, T_M
 from ..laws.tangential_force import (_cross, eta_of, kt_of, _norm, return_map, slip_surface, tangential_force,
                                      walton_reverses, walton_stiffness)
 from .kernels import (M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED)
-from .kernels3d import (A_NMODE, A_SIZE, A_TREF, C_D, C_E, C_FN, C_FT, C_N, C_R, C_SLIP, C_T, C_VT, C_X0, energy,
-                        G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION, ROT_PROJECT, ROT_RESCALE,
-                        ROT_RESCALE_SIGNIFICANT, ROT_SCGEOM)
+from .kernels3d import (A_NMODE, A_SIZE, A_TREF, G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION,
+                        record_row, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT, ROT_SCGEOM)
 
 # ----------------------------------------------------------------------------- velocity Verlet (engines)
 
@@ -137,14 +136,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     if delta > 0.0:
         fn = normal_force(nl, delta, rate, delta)
         fvec0 = -fn * n
-    rec[0, C_T] = 0.0
-    rec[0, C_X0:C_X0 + 18] = y[0:18]
-    rec[0, C_D], rec[0, C_R], rec[0, C_FN] = delta, rate, fn
-    rec[0, C_FT:C_FT + 3] = 0.0
-    rec[0, C_VT:C_VT + 3] = vt
-    rec[0, C_N:C_N + 3] = n
-    rec[0, C_E] = energy(y, geo)
-    rec[0, C_SLIP] = 0.0
+    record_row(rec, 0, 0.0, y, geo, delta, rate, fn, np.zeros(3), vt, n, 0.0)
     g = geo[G_GX:G_GX + 3]
     i = 1
     step = 0
@@ -259,14 +251,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
         if not wall:
             y[12:15] += 0.5 * dt * (-fvec0 / geo[G_M1] + g)
             y[15:18] += 0.5 * dt * tau1 / geo[G_I1]
-        rec[i, C_T] = t
-        rec[i, C_X0:C_X0 + 18] = y[0:18]
-        rec[i, C_D], rec[i, C_R], rec[i, C_FN] = delta, rate, fn
-        rec[i, C_FT:C_FT + 3] = ft
-        rec[i, C_VT:C_VT + 3] = vt
-        rec[i, C_N:C_N + 3] = n
-        rec[i, C_E] = energy(y, geo)
-        rec[i, C_SLIP] = 1.0 if sliding else 0.0
+        record_row(rec, i, t, y, geo, delta, rate, fn, ft, vt, n, (1.0 if sliding else 0.0))
         i += 1
         if not np.all(np.isfinite(y[0:18])):
             status = ST_UNRESOLVED
