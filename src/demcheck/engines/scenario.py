@@ -14,7 +14,6 @@ model's verlet run steps the case's own laws the same way. Each run's metrics co
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from dataclasses import dataclass
@@ -31,6 +30,7 @@ from ..reference import beyond as _b
 from ..reference.scenarios import SCENARIO_METRICS, _on_wall, _twisting_law, stepped_metrics
 from ..result import Result
 from . import registry
+from .cache import code_fingerprint, get_metrics, put_metrics
 
 WALL = ("rolling", "incline", "twist")
 STEPS_PER_PERIOD = 60  # steps per period of the stiffest spring of a sphere on a wall
@@ -338,48 +338,12 @@ def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
     name = _engine(engine).name
     names = SCENARIO_METRICS[case.run.scenario]
     k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
-    hit = _get_metrics(cache, k, names)
+    hit = get_metrics(cache, k, names)
     if hit is not None:
         return hit[0]
     metrics = run_it(case, engine).metrics()
-    _put_metrics(cache, k, metrics, {})
+    put_metrics(cache, k, metrics, {})
     return metrics
-
-
-def _get_metrics(cache, k: str, names, meta_keys=()) -> tuple[dict, dict] | None:
-    """(metrics, meta) of a cache entry :func:`_put_metrics` wrote, or None."""
-    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1, meta_keys=meta_keys)
-    if hit is None:
-        return None
-    row = hit[0].iloc[0]
-    return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}, hit[1]
-
-
-def _put_metrics(cache, k: str, metrics: dict, meta: dict) -> None:
-    """One row: each metric, and beside it a flag that it is not finite (stored as 0: a table holds finite
-    values only)."""
-    import pandas as pd
-
-    table = {m: [v if math.isfinite(v) else 0.0] for m, v in metrics.items()}
-    table.update({f"{m}__nan": [0.0 if math.isfinite(v) else 1.0] for m, v in metrics.items()})
-    cache.put(k, pd.DataFrame(table), meta)
-
-
-@functools.lru_cache(maxsize=1)
-def code_fingerprint() -> str:
-    """A hash of every source file of demcheck (the laws, the reference's schemes, the engines' mappings and
-    layouts all shape a twin's result) and of numpy's, numba's and scipy's versions."""
-    import hashlib
-    from pathlib import Path
-
-    import numba
-    import scipy
-
-    root = Path(__file__).resolve().parent.parent
-    h = hashlib.sha256(f"numpy {np.__version__} numba {numba.__version__} scipy {scipy.__version__}".encode())
-    for f in sorted(root.rglob("*.py")):
-        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()[:16]
 
 
 def deck(case: Case, engine):
@@ -409,7 +373,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
 
         version = discovery.require(eng.name).version
         k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
-        hit = _get_metrics(cache, k, SCENARIO_METRICS[case.run.scenario],
+        hit = get_metrics(cache, k, SCENARIO_METRICS[case.run.scenario],
                            {"engine_version": text, "warnings": texts})
         if hit is not None:
             return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],
@@ -419,7 +383,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
                                  "warnings": hit[1]["warnings"], "cached": True})
     res = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
     if cache is not None and res.ok:
-        _put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
+        put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
                                                "warnings": list(res.meta["warnings"])})
     return res
 
