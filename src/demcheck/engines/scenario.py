@@ -228,7 +228,8 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
                               w.point, w.normal, lay.dt, lay.steps, lay.every, normal=laws["normal"],
                               fcrit=laws.get("fcrit"), tangential=laws.get("tangential"),
                               rolling=laws.get("rolling"), twisting=laws.get("twisting"),
-                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment") if k in laws})
+                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment", "roll_surface_w")
+                                 if k in laws})
     if s == "pull_off":
         return _pull(case, laws["adhesion"], lay)
     if s == "adhesive_impact":
