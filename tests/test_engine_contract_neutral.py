@@ -36,3 +36,10 @@ def test_only_lammps_and_liggghts_are_of_the_lammps_family():
         eng = registry.get(name)
         assert isinstance(eng, PackageEngine) and eng.argv("exe", "deck.py")[:1] == ["exe"]
         assert "-in" not in eng.argv("exe", "deck.py")
+
+
+def test_an_engine_without_packings_says_so_when_asked_for_its_packing_output(tmp_path):
+    from demcheck.errors import UnsupportedByEngine
+
+    with pytest.raises(UnsupportedByEngine, match="kratos writes no packing output"):
+        registry.get("kratos").read_packing(tmp_path, "")

@@ -259,6 +259,13 @@ class Engine(ABC):
 
         raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
 
+    def read_packing(self, workdir, log: str):
+        """A packing deck's output: (the final per-particle table of inputs.packing_decks.FINAL_COLUMNS, sorted by
+        id, one row per particle; the kinetic energy series [(step, ke)] read from ``log``)."""
+        from ..errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{self.name} writes no packing output")
+
     def scenario_mapping(self, case) -> Mapping:
         """The case's contact with its scenario's slot (``[run] scenario``, beyond sliding) in the engine's terms;
         the default: none, no deck is written for it."""

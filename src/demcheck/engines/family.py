@@ -5,6 +5,7 @@ engine of another family implements these three methods itself (engines/base.py)
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from .base import PackageEngine
@@ -25,6 +26,11 @@ class LammpsFamily(PackageEngine):
         """The collision deck's ``dump custom`` (inputs/common.py DUMP_FILE, DUMP_COLUMNS)."""
         return read_state_dump(workdir)
 
+    def read_packing(self, workdir: Path, log: str):
+        """The packing deck's final ``dump custom`` and its thermo lines' kinetic energy
+        (:func:`read_packing_output`)."""
+        return read_packing_output(workdir, log)
+
 
 def read_state_dump(workdir: Path):
     """A collision run's bodies, step by step, from the LAMMPS-style dump the family's decks write (and Yade's and
@@ -33,3 +39,20 @@ def read_state_dump(workdir: Path):
     from .dumps import read_dump
 
     return read_dump(Path(workdir) / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
+
+
+# a packing deck's thermo line: step, kinetic energy, atoms (inputs/packing_decks.py writes ``thermo_style custom step
+# ke atoms``; Yade's packing script prints the same columns)
+_THERMO = re.compile(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", re.M)
+
+
+def read_packing_output(workdir: Path, log: str):
+    """(final table, kinetic energy series) of a packing run: the last block of the final dump
+    (inputs/packing_decks.py FINAL_DUMP, FINAL_COLUMNS; row k is particle id k + 1) and [(step, ke)] from the
+    thermo lines of ``log``."""
+    from ..inputs.packing_decks import FINAL_COLUMNS, FINAL_DUMP
+    from .dumps import read_dump
+
+    table = read_dump(Path(workdir) / FINAL_DUMP, columns=FINAL_COLUMNS)
+    table = table[table["step"] == table["step"].max()].sort_values("id").reset_index(drop=True)
+    return table, [(int(m.group(1)), float(m.group(2))) for m in _THERMO.finditer(log)]
