@@ -139,3 +139,17 @@ def test_the_fingerprint_names_the_cpu(monkeypatch):
     finally:
         monkeypatch.undo()
         cache_mod.code_fingerprint.cache_clear()
+
+
+@pytest.mark.parametrize("name", ["suite/beyond-conduction.toml", "suite/beyond-pull-off.toml"])
+def test_a_scenario_solve_with_values_that_are_not_finite_in_its_fields_reads_back_the_same(tmp_path, name):
+    """A scenario's reference solve keeps NaN or inf among its fields (its meta): stored, and read back equal."""
+    case = load(case_path(name))
+    res = sources.ADAPTIVE.run(case)
+    cache = Cache(tmp_path)
+    k = result_cache.result_key("reference-adaptive", case)
+    assert result_cache.store(cache, k, res)
+    back = result_cache.load(cache, k)
+    for f in result_cache.FIELDS:
+        assert json.dumps(getattr(back, f), sort_keys=True) == json.dumps(getattr(res, f), sort_keys=True), f
+    assert json.dumps(back.metrics()) == json.dumps(res.metrics())

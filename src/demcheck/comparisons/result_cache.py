@@ -68,7 +68,7 @@ def cached_metrics(cache, kind: str, case, compute) -> dict:
 def store(cache, k: str, res: Result) -> bool:
     """``res`` under ``k``, one entry: its tables side by side (each column named ``table.column``, the shorter
     tables padded with zeros, each table's rows, dtypes and labels in the metadata) and its fields. False when
-    anything is not storable (a field JSON cannot hold as it is, a value that is not finite)."""
+    anything is not storable (a field JSON cannot hold, a table value that is not finite)."""
     parts, layouts = {}, {}
     for name in TABLES:
         cols = res.table(name)
@@ -81,10 +81,10 @@ def store(cache, k: str, res: Result) -> bool:
         parts.update({f"{name}.{c}": v for c, v in encoded.items()})
     rows = max([1, *(lay["rows"] for lay in layouts.values())])
     frame = pd.DataFrame({c: np.pad(v, (0, rows - len(v))) for c, v in parts.items()} or {"empty": np.zeros(1)})
-    try:
+    try:  # NaN and ±inf kept as JSON's NaN and Infinity tokens (Python's json reads them back)
         meta = json.loads(json.dumps({"fields": {f: getattr(res, f) for f in FIELDS}, "tables": layouts,
-                                      "wall_time": res.wall_time}, allow_nan=False))
-    except (TypeError, ValueError):  # a field JSON cannot hold as it is (a numpy value, a NaN): not cached
+                                      "wall_time": res.wall_time}))
+    except (TypeError, ValueError):  # a field JSON cannot hold as it is (a numpy array): not cached
         return False
     return cache.put(k, frame, meta)
 
