@@ -202,6 +202,24 @@ def test_verify_fails_a_scenario_whose_solve_misses_its_closed_form(tmp_path, mo
     assert res["failed"] == 1 and entry["status"] == "unexpected"
 
 
+@pytest.mark.parametrize("name, solver, metric", [("pull-off-sjkr", "cohesive_pull_off", "pull_off_force"),
+                                                   ("rolling-viscous", "efold_time", None)])
+def test_verify_fails_sjkr_and_viscous_solves_that_miss_their_closed_forms(tmp_path, monkeypatch, name, solver,
+                                                                           metric):
+    """A planted error of 1e-6 in the sjkr pull's tension or in type B's time constant fails verify."""
+    from demcheck.reference import scenarios
+
+    real = getattr(scenarios._b, solver)
+    if metric:
+        monkeypatch.setattr(scenarios._b, solver, lambda *a, **k: {**real(*a, **k),
+                                                                     metric: real(*a, **k)[metric] * (1 + 1e-6)})
+    else:
+        monkeypatch.setattr(scenarios._b, solver, lambda *a, **k: real(*a, **k) * (1 + 1e-6))
+    res = _verify(tmp_path, [case_path(f"suite/beyond-{name}.toml")])
+    (entry,) = res["cases"]
+    assert res["failed"] == 1 and entry["status"] == "unexpected"
+
+
 def test_verify_never_agrees_on_a_scenario_that_computed_nothing(tmp_path, monkeypatch):
     from demcheck.reference import scenarios
 

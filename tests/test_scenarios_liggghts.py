@@ -148,3 +148,27 @@ def test_liggghts_has_no_viscous_rolling_torque():
     c = load(case_path("suite/beyond-rolling-viscous.toml"))
     mp = scenario.mapping(c, "liggghts")
     assert mp.fidelity == "none" and "viscous rolling torque (type B)" in mp.reasons[0]
+
+
+@pytest.mark.engine("liggghts")
+def test_a_wrong_cohesion_area_in_the_deck_is_caught_by_the_twin(monkeypatch):
+    """A planted wrong mapping: the lens case written as ``cohesion sjkr2`` (the band, twice the force between like
+    spheres) while the twin keeps the lens — the engine leaves its twin and the verdict is not agree."""
+    from dataclasses import replace as dc_replace
+
+    from demcheck.engines.liggghts import scenario as lig
+
+    real = lig._cohesion
+
+    def planted(model, base):
+        mp = real(model, base)
+        mp.native.props = {**mp.native.props, "cohesion": "sjkr2"}
+        return dc_replace(mp)
+
+    monkeypatch.setattr(lig, "_cohesion", planted)
+    c = load(case_path("suite/beyond-pull-off-sjkr.toml"))
+    entry, comps = rows(c)
+    src = entry["sources"]["liggghts"]
+    force = {x.metric: x for x in comps}["pull_off_force"]
+    assert force.verdict != AGREE, force.reason
+    assert abs(src["metrics"]["pull_off_force"] / src["twin_metrics"]["pull_off_force"] - 1) > 0.5
