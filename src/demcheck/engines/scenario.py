@@ -145,7 +145,7 @@ def layout(case: Case, laws: dict) -> Layout:
     r0, r1 = (p.radius for p in case.particles)
     if s == "pull_off":
         law = model.slot("adhesion")
-        scale = _adhesion_scale(law, (model.normal_law.k, scenario_closed_forms(case).get("pull_off_force", 0.0)))
+        scale = _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
         return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
@@ -168,12 +168,16 @@ def layout(case: Case, laws: dict) -> Layout:
                   ((0.0, 0.0, 0.0),) * 2)
 
 
-def _adhesion_scale(law, hertz_k_tension=(1.0, 0.0)) -> float:
+def _cohesion_scale(case: Case, model) -> float:
+    """The overlap scale of an sjkr pull: 4 × the Hertz overlap under the closed form's largest tension (≈ 2.5 × the
+    overlap where it acts), so that the pull starts past it."""
+    return 4.0 * (scenario_closed_forms(case)["pull_off_force"] / model.normal_law.k) ** (2.0 / 3.0)
+
+
+def _adhesion_scale(law) -> float:
     """The overlap scale of a pull: JKR's |δ_f|, DMT's Hertz overlap under its pull-off force."""
     if law.id == "jkr":
         return abs(law.separation_at_pull_off("displacement"))
-    if law.id == "sjkr":  # 4 × the Hertz overlap under the closed-form tension: 2.5 × the overlap it is at
-        return 4.0 * (hertz_k_tension[1] / hertz_k_tension[0]) ** (2.0 / 3.0)
     return (law.pull_off_force("load") / (4.0 / 3.0 * law.e_eff * math.sqrt(law.r_eff))) ** (2.0 / 3.0)
 
 
