@@ -129,12 +129,14 @@ def test_a_missing_required_parameter_is_named():
     assert e.value.key == "contact.w" and "required by adhesion model 'jkr'" in e.value.rule
 
 
-def test_pull_off_of_a_cohesion_without_tension_is_refused():
-    text = case_path("suite/beyond-pull-off.toml").read_text().replace('adhesion = "jkr"\nw = 0.05',
-                                                                      'adhesion = "sjkr"\nk_c = 1e3')
+def test_an_adhesive_impact_of_a_cohesion_is_refused():
+    """sjkr has its pull-off (added to an elastic Hertz law, tests/test_laws_beyond.py), not an impact's closed
+    form."""
+    text = case_path("suite/beyond-adhesive-impact.toml").read_text().replace('adhesion = "jkr"\nw = 0.05',
+                                                                             'adhesion = "sjkr"\nk_c = 1e3')
     with pytest.raises(ConfigError) as e:
         C.loads(text)
-    assert e.value.key == "contact.adhesion" and 'needs adhesion = "jkr" or "dmt"' in e.value.rule
+    assert e.value.key == "contact.adhesion" and 'needs adhesion = "jkr"' in e.value.rule
 
 
 def test_marshall_takes_mu_t_from_the_pairs_friction():
@@ -196,6 +198,24 @@ def test_verify_fails_a_scenario_whose_solve_misses_its_closed_form(tmp_path, mo
     monkeypatch.setattr(scenarios._b, "twist_decay",
                         lambda *a, **k: {"twist_stop_time": real(*a, **k)["twist_stop_time"] * (1 + 1e-6)})
     res = _verify(tmp_path, [case_path("suite/beyond-twist.toml")])
+    (entry,) = res["cases"]
+    assert res["failed"] == 1 and entry["status"] == "unexpected"
+
+
+@pytest.mark.parametrize("name, solver, metric", [("pull-off-sjkr", "cohesive_pull_off", "pull_off_force"),
+                                                   ("rolling-viscous", "efold_time", None)])
+def test_verify_fails_sjkr_and_viscous_solves_that_miss_their_closed_forms(tmp_path, monkeypatch, name, solver,
+                                                                           metric):
+    """A planted error of 1e-6 in the sjkr pull's tension or in type B's time constant fails verify."""
+    from demcheck.reference import scenarios
+
+    real = getattr(scenarios._b, solver)
+    if metric:
+        monkeypatch.setattr(scenarios._b, solver, lambda *a, **k: {**real(*a, **k),
+                                                                     metric: real(*a, **k)[metric] * (1 + 1e-6)})
+    else:
+        monkeypatch.setattr(scenarios._b, solver, lambda *a, **k: real(*a, **k) * (1 + 1e-6))
+    res = _verify(tmp_path, [case_path(f"suite/beyond-{name}.toml")])
     (entry,) = res["cases"]
     assert res["failed"] == 1 and entry["status"] == "unexpected"
 

@@ -298,3 +298,85 @@ def test_the_two_lens_areas_agree():
     from demcheck.laws import adhesion, heat
     for args in ((1e-3, 1e-3, 1e-6, False), (1e-3, 2e-3, 3e-5, False), (1e-3, 0.0, 1e-6, True)):
         assert adhesion.lens_area(*args) == heat.lens_area(*args)
+
+
+# ----------------------------------------------------------------------------- sjkr and type B in their scenarios
+
+
+@pytest.mark.parametrize("area", [0, 1])
+def test_sjkr_pull_off_closed_form_against_the_tension_found_on_a_fine_grid(area):
+    """The closed form's largest tension (reference/beyond.py sjkr_pull_off_closed) against the sum of the Hertz
+    force and the compiled sjkr force, minimised on a grid of 2e5 overlaps and refined by brentq on the slope:
+    independent of the closed form's algebra."""
+    e_eff, radius = 3.13e6, 1e-3
+    r_eff = radius / 2
+    k_h = 4.0 / 3.0 * e_eff * math.sqrt(r_eff)
+    law = SjkrAdhesion(1e5, area, False, radius, radius)
+
+    def f(d):
+        return k_h * d ** 1.5 + adhesive_force(law, d, 1.0)[0]
+
+    grid = np.linspace(1e-12, 0.2 * radius, 200001)
+    k = int(np.argmin([f(d) for d in grid]))
+    h = 1e-9 * radius
+
+    def slope(d):
+        return (f(d + h) - f(d - h)) / (2 * h)
+
+    d_star = brentq(slope, grid[k - 1], grid[k + 1], xtol=1e-20)
+    closed = b.sjkr_pull_off_closed(k_h, 1e5, area, radius, r_eff)
+    assert abs(-f(d_star) / closed - 1) < 1e-9
+    assert abs(b.cohesive_pull_off(law, lambda d: k_h * d ** 1.5, 0.5 * radius)["pull_off_force"] / closed - 1) < 1e-9
+
+
+def test_sjkr_and_viscous_scenarios_solve_against_their_closed_forms():
+    """The suite's beyond-pull-off-sjkr (lens and band) and beyond-rolling-viscous: the reference's solve against
+    its closed form (measured 1.2e-13 and 0 for the pull, 1.0e-12 and 2e-16 for the roll)."""
+    from demcheck.case import load
+    from demcheck.reference.scenarios import scenario_metrics
+    from demcheck.resources import case_path
+
+    for name, over in (("pull-off-sjkr", []), ("pull-off-sjkr", ["contact.area=band"]), ("rolling-viscous", [])):
+        c = load(case_path(f"suite/beyond-{name}.toml"), over)
+        got, closed = scenario_metrics(c), scenario_metrics(c, closed=True)
+        assert got.keys() == closed.keys()
+        for k, v in closed.items():
+            assert abs(got[k] - v) <= 1e-9 * abs(v), (name, over, k, got[k], v)
+    c = load(case_path("suite/beyond-rolling-viscous.toml"))
+    law, m, radius = c.contact.params["c_r"], c.mass(0), c.particles[0].radius
+    tau = scenario_metrics(c, closed=True)["rolling_time_constant"]
+    assert abs(tau - 1.4 * m * radius ** 2 / law) <= 1e-15 * tau
+    assert set(scenario_metrics(c)) == {"rolling_time_constant", "rolling_distance"}
+
+
+def test_the_stepped_viscous_roll_reads_the_time_constant_and_the_distance_to_rest():
+    """stepped_metrics on an exact exponential sampled coarsely: T from the e-fold time (log-linear between samples)
+    and the distance to rest from the distance run plus v·T still to go."""
+    from demcheck.case import load
+    from demcheck.reference.scenarios import stepped_metrics
+    from demcheck.resources import case_path
+
+    c = load(case_path("suite/beyond-rolling-viscous.toml"))
+    tau, v0 = 0.01, 0.02
+    t = np.linspace(0.0, 3 * tau, 37)
+    v = v0 * np.exp(-t / tau)
+    x = v0 * tau * (1 - np.exp(-t / tau))
+    zeros = np.zeros_like(t)
+    run = {"t": t, "x": np.column_stack([x, zeros, zeros + 1e-3]), "v": np.column_stack([v, zeros, zeros]),
+           "omega": np.column_stack([zeros, v / 1.59e-3, zeros])}
+    got = stepped_metrics(c, run)
+    assert abs(got["rolling_time_constant"] / tau - 1) < 1e-12
+    assert abs(got["rolling_distance"] / (v0 * tau) - 1) < 1e-12
+
+
+@pytest.mark.parametrize("change, key", [(["particles.1.radius=2e-3", "particles.1.position=[3e-3, 0.0, 0.0]"],
+                                          "particles"),
+                                         (["contact.normal=lsd", "contact.kn=1e5"], "contact.normal")])
+def test_sjkr_pull_off_refuses_what_its_closed_form_does_not_cover(change, key):
+    from demcheck.case import load
+    from demcheck.errors import ConfigError
+    from demcheck.resources import case_path
+
+    with pytest.raises(ConfigError) as exc:
+        load(case_path("suite/beyond-pull-off-sjkr.toml"), change)
+    assert exc.value.key == key and "sjkr" in exc.value.rule

@@ -115,3 +115,60 @@ def test_liggghts_has_no_conductance_per_area():
 
     c = load(case_path("suite/beyond-conduction.toml"), ["contact.heat=area"])
     assert "no conductance per contact area" in scenario.mapping(c, "liggghts").reasons[0]
+
+
+@pytest.mark.engine("liggghts")
+@pytest.mark.parametrize("area, cohesion", [("lens", "sjkr"), ("band", "sjkr2")])
+def test_liggghts_pulls_the_sjkr_cohesion_off_and_meets_its_twin(area, cohesion):
+    """beyond-pull-off-sjkr: the elastic hertz/stiffness law with ``cohesion sjkr`` (lens) or ``sjkr2`` (band), body
+    1 moved by fix move: the pull's largest tension and last overlap in contact equal the twin's (measured: 0 and
+    1.2e-15) and the closed form's to the path's sampling (measured 7.9e-9 and 1.2e-8; the contact ends at δ = 0,
+    the last sample in contact 1.3e-9 m and 5.1e-9 m above it)."""
+    from demcheck.reference.expected import scenario_closed_forms
+
+    c = load(case_path("suite/beyond-pull-off-sjkr.toml"), [f"contact.area={area}"])
+    entry, comps = rows(c)
+    src = entry["sources"]["liggghts"]
+    assert src["status"] == "ok" and src["fidelity"] == "exact", src
+    from demcheck.engines import scenario
+
+    assert f"cohesion {cohesion}," in scenario.mapping(c, "liggghts").native.comments[-1]
+    assert {x.metric: x.verdict for x in comps} == {"pull_off_force": AGREE, "separation_at_pull_off": AGREE}
+    got, twin = src["metrics"], src["twin_metrics"]
+    for k in ("pull_off_force", "separation_at_pull_off"):
+        assert abs(got[k] - twin[k]) <= 1e-9 * abs(got[k])
+    closed = scenario_closed_forms(c)
+    assert abs(got["pull_off_force"] / closed["pull_off_force"] - 1) < 1e-7
+    assert closed["separation_at_pull_off"] == 0.0 and 0.0 < got["separation_at_pull_off"] < 1e-5 * 1e-3
+
+
+def test_liggghts_has_no_viscous_rolling_torque():
+    from demcheck.engines import scenario
+
+    c = load(case_path("suite/beyond-rolling-viscous.toml"))
+    mp = scenario.mapping(c, "liggghts")
+    assert mp.fidelity == "none" and "viscous rolling torque (type B)" in mp.reasons[0]
+
+
+@pytest.mark.engine("liggghts")
+def test_a_wrong_cohesion_area_in_the_deck_is_caught_by_the_twin(monkeypatch):
+    """A planted wrong mapping: the lens case written as ``cohesion sjkr2`` (the band, twice the force between like
+    spheres) while the twin keeps the lens — the engine leaves its twin and the verdict is not agree."""
+    from dataclasses import replace as dc_replace
+
+    from demcheck.engines.liggghts import scenario as lig
+
+    real = lig._cohesion
+
+    def planted(model, base):
+        mp = real(model, base)
+        mp.native.props = {**mp.native.props, "cohesion": "sjkr2"}
+        return dc_replace(mp)
+
+    monkeypatch.setattr(lig, "_cohesion", planted)
+    c = load(case_path("suite/beyond-pull-off-sjkr.toml"))
+    entry, comps = rows(c)
+    src = entry["sources"]["liggghts"]
+    force = {x.metric: x for x in comps}["pull_off_force"]
+    assert force.verdict != AGREE, force.reason
+    assert abs(src["metrics"]["pull_off_force"] / src["twin_metrics"]["pull_off_force"] - 1) > 0.5

@@ -670,10 +670,10 @@ def _contact(contact_raw: dict) -> Contact:
 
 # scenario → (the slot it exercises, the laws it has a metric for, one body on a wall?)
 SCENARIO_LAWS = {
-    "rolling": ("rolling", ("constant_torque",), True),
+    "rolling": ("rolling", ("constant_torque", "viscous"), True),
     "incline": ("rolling", ("constant_torque", "epsd"), True),
     "twist": ("twisting", ("sds", "marshall"), True),
-    "pull_off": ("adhesion", ("jkr", "dmt"), None),
+    "pull_off": ("adhesion", ("jkr", "dmt", "sjkr"), None),
     "adhesive_impact": ("adhesion", ("jkr",), None),
     "conduction": ("heat", ("radius", "area", "lens"), None),
 }
@@ -709,6 +709,8 @@ def _check_scenario(case: Case) -> None:
         if not abs(w @ n) > 0:
             raise ConfigError("particles.0.angular_velocity", list(case.particles[0].angular_velocity),
                               "the twist scenario needs a spin about the wall's normal")
+    if scenario == "pull_off" and law == "sjkr":
+        _sjkr_pull_inputs(case)
     if scenario == "adhesive_impact":
         from .laws import model as _model
 
@@ -716,6 +718,21 @@ def _check_scenario(case: Case) -> None:
             raise ConfigError("particles", "(initial state)", "the bodies never meet: no impact to solve")
     if scenario == "conduction":
         _conduction_inputs(case)
+
+
+def _sjkr_pull_inputs(case: Case) -> None:
+    """sjkr's pull-off has its closed form for like spheres under an elastic Hertz law (reference/beyond.py
+    ``sjkr_pull_off_closed``)."""
+    from .laws import model as _model
+
+    radii = [p.radius for p in case.particles]
+    if len(radii) != 2 or radii[0] != radii[1]:
+        raise ConfigError("particles", radii, "the pull_off scenario with adhesion = \"sjkr\" pulls two like spheres "
+                          "(equal radii)")
+    nl = _model.resolve(case).normal_law
+    if nl.a != 1.5 or nl.eta != 0.0 or case.contact.normal != "hertz":
+        raise ConfigError("contact.normal", case.contact.normal, "the pull_off scenario with adhesion = \"sjkr\" adds "
+                          "the cohesion to the elastic Hertz law: normal = \"hertz\"")
 
 
 def _resting_on_wall(case: Case, scenario: str) -> None:

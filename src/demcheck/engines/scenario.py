@@ -27,7 +27,8 @@ from ..laws.adhesion import adhesive_force
 from ..laws.heat import heat_flow
 from ..laws.model import resolve
 from ..reference import beyond as _b
-from ..reference.scenarios import SCENARIO_METRICS, _on_wall, _twisting_law, stepped_metrics
+from ..reference.expected import scenario_closed_forms
+from ..reference.scenarios import _on_wall, _twisting_law, metric_names, stepped_metrics
 from ..result import Result
 from . import registry
 from .cache import code_fingerprint, get_metrics, put_metrics
@@ -144,7 +145,7 @@ def layout(case: Case, laws: dict) -> Layout:
     r0, r1 = (p.radius for p in case.particles)
     if s == "pull_off":
         law = model.slot("adhesion")
-        scale = _adhesion_scale(law)
+        scale = _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
         return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
@@ -165,6 +166,12 @@ def layout(case: Case, laws: dict) -> Layout:
     return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), 100,
                   ((0.0, 0.0, 0.0), (r0 + r1 - case.run.overlap, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2,
                   ((0.0, 0.0, 0.0),) * 2)
+
+
+def _cohesion_scale(case: Case, model) -> float:
+    """The overlap scale of an sjkr pull: 4 × the Hertz overlap under the closed form's largest tension (≈ 2.5 × the
+    overlap where it acts), so that the pull starts past it."""
+    return 4.0 * (scenario_closed_forms(case)["pull_off_force"] / model.normal_law.k) ** (2.0 / 3.0)
 
 
 def _adhesion_scale(law) -> float:
@@ -231,7 +238,7 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
                               **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment", "roll_surface_w")
                                  if k in laws})
     if s == "pull_off":
-        return _pull(case, laws["adhesion"], lay)
+        return _pull(case, laws["adhesion"], lay, laws.get("normal"))
     if s == "adhesive_impact":
         p = case.particles[0]
         x1, v1 = lay.positions[1][0], lay.velocities[1][0]
@@ -241,14 +248,17 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
     return _held(case, laws["heat"], lay)
 
 
-def _pull(case: Case, law, lay: Layout) -> dict:
-    """Body 1 moved at the layout's speed (``fix move``: x = x0 + u·k·dt), body 0 held: the law along the path."""
+def _pull(case: Case, law, lay: Layout, normal=None) -> dict:
+    """Body 1 moved at the layout's speed (``fix move``: x = x0 + u·k·dt), body 0 held: the law along the path (a
+    cohesion that does not replace the normal law added to ``normal(δ, δ̇)`` while the bodies overlap)."""
     r0, r1 = (p.radius for p in case.particles)
     x0, u = lay.positions[1][0], lay.pull_speed
     deltas, forces, touch = [], [], 0.0
     for k in range(lay.steps + 1):
         delta = (r0 + r1) - (x0 + u * (k * lay.dt))
         f, touch = adhesive_force(law, delta, touch)
+        if not law.replaces_normal and delta > 0.0:
+            f += normal(delta, -u)
         deltas.append(delta)
         forces.append(f if touch else 0.0)
     return {"delta": np.array(deltas), "fn": np.array(forces)}
@@ -304,7 +314,7 @@ def _result(case: Case, source: str, method: str, metrics: dict, lay: Layout, st
 
 def _metrics(case: Case, run: dict) -> dict:
     out = stepped_metrics(case, run)
-    return {k: float(out[k]) for k in SCENARIO_METRICS[case.run.scenario]}
+    return {k: float(out[k]) for k in metric_names(case)}
 
 
 def twin(case: Case, engine) -> Result:
@@ -337,7 +347,7 @@ def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
     if cache is None:
         return run_it(case, engine).metrics()
     name = _engine(engine).name
-    names = SCENARIO_METRICS[case.run.scenario]
+    names = metric_names(case)
     k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
     hit = get_metrics(cache, k, names)
     if hit is not None:
@@ -374,7 +384,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
 
         version = discovery.require(eng.name).version
         k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
-        hit = get_metrics(cache, k, SCENARIO_METRICS[case.run.scenario],
+        hit = get_metrics(cache, k, metric_names(case),
                            {"engine_version": text, "warnings": texts})
         if hit is not None:
             return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],

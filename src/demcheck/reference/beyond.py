@@ -30,7 +30,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from ..laws import rolling as _rolling
 from ..laws import twisting as _twisting
-from ..laws.adhesion import adhesive_force
+from ..laws.adhesion import AREA_BAND, adhesive_force
 from ..laws.heat import conductance, heat_flow
 from ..laws.rolling import rolling_torque
 
@@ -85,6 +85,21 @@ def capture_velocity_closed(r: float, e: float, w: float, m_eff: float, break_at
 
 def adhesive_restitution_closed(v: float, v_capture: float) -> float:
     return math.sqrt(1.0 - (v_capture / v) ** 2) if v > v_capture else 0.0
+
+
+def sjkr_pull_off_closed(k_hertz: float, k_c: float, area: int, radius: float, r_eff: float) -> float:
+    """The largest tension of an elastic Hertz contact F = k_H δ^{3/2} (k_H = (4/3)E*√R̄) with the simplified JKR
+    cohesion −kc·A added while δ > 0, between like spheres of radius R (R̄ = R/2), at the overlap where dF/dδ = 0:
+    ``band`` A = 2π·2R̄δ gives √δ* = 8πkcR̄/(3k_H) and a tension (4/3)πkcR̄δ*; ``lens`` A = π(Rδ − δ²/4) (the circle
+    where the undeformed spheres intersect) gives (kcπ/2)s² + (3/2)k_H s − kcπR = 0 for s = √δ*. The contact ends
+    at δ = 0 (separation_at_pull_off 0)."""
+    if area == AREA_BAND:
+        d = (8.0 * math.pi * k_c * r_eff / (3.0 * k_hertz)) ** 2
+        return -(k_hertz * d ** 1.5 - 4.0 * math.pi * k_c * r_eff * d)
+    a, b, c = 0.5 * math.pi * k_c, 1.5 * k_hertz, -math.pi * k_c * radius
+    s = 2.0 * -c / (b + math.sqrt(b * b - 4.0 * a * c))  # the positive root, without cancellation
+    d = s * s
+    return -(k_hertz * d ** 1.5 - math.pi * k_c * (radius * d - 0.25 * d * d))
 
 
 def heat_time_constant_closed(h: float, c0: float, c1: float) -> float:
@@ -200,6 +215,17 @@ def pull_off(law, delta0: float | None = None) -> dict:
         tension = -f(0.0)
         brk = 0.0
     return {"pull_off_force": tension, "separation_at_pull_off": brk}
+
+
+def cohesive_pull_off(law, normal, delta0: float) -> dict:
+    """Two bodies pulled apart quasi-statically from overlap δ0 where a cohesion record (sjkr) adds its force to
+    the elastic normal law ``normal(δ)``: the largest tension (bounded minimisation of the sum over 0 < δ ≤ δ0) and
+    the overlap at which the contact ends (the cohesion acts while δ > 0: 0)."""
+    def f(d):
+        return normal(d) + adhesive_force(law, d, 1.0)[0]
+
+    r = minimize_scalar(f, bounds=(0.0, delta0), method="bounded", options={"xatol": 1e-15 * delta0})
+    return {"pull_off_force": -r.fun, "separation_at_pull_off": 0.0}
 
 
 def adhesive_impact(law, m_eff: float, v: float, t_end: float | None = None) -> dict:

@@ -3,12 +3,14 @@ and the same inputs into their closed forms.
 
 Each scenario's metrics (DESIGN names):
 
-* ``rolling`` (a sphere rolling on a level wall, constant_torque): rolling_stop_time, rolling_distance;
+* ``rolling`` (a sphere rolling on a level wall, constant_torque): rolling_stop_time, rolling_distance; viscous
+  (type B, which never stops): rolling_time_constant T (v = v0 e^{−t/T}), rolling_distance (to rest, v0·T);
 * ``incline`` (constant_torque, epsd): incline_critical_angle (rad), the tilt at which the sphere starts to roll;
 * ``twist`` (sds, marshall; marshall at the Hertz contact radius under the sphere's weight): twist_stop_time, from
   the twisting spring at its limit (the closed form's assumption);
-* ``pull_off`` (jkr, dmt): pull_off_force (N, the largest tension), separation_at_pull_off (m, the overlap at
-  which the contact breaks: negative, a neck);
+* ``pull_off`` (jkr, dmt; sjkr added to an elastic Hertz law between like spheres): pull_off_force (N, the
+  largest tension), separation_at_pull_off (m, the overlap at which the contact breaks: negative, a neck; 0 for
+  dmt and sjkr);
 * ``adhesive_impact`` (jkr): restitution at the case's approach speed v and capture_velocity √(v² − v_out²) (the
   energy of the loop; nan when the bodies are captured: the solve then bounds it from below only);
 * ``conduction`` (radius, area, lens): heat_time_constant (s) at the case's fixed overlap.
@@ -37,6 +39,17 @@ SCENARIO_METRICS = {
     "adhesive_impact": ("restitution", "capture_velocity"),
     "conduction": ("heat_time_constant",),
 }
+# a law whose scenario measures something else: type B never stops (v = v0 e^{−t/T}): its time constant and the
+# distance to rest v0·T
+LAW_METRICS = {("rolling", "viscous"): ("rolling_time_constant", "rolling_distance")}
+
+
+def metric_names(case) -> tuple:
+    """The metrics of a case's scenario: SCENARIO_METRICS, or LAW_METRICS for the law the scenario runs."""
+    scenario = case.run.scenario
+    if scenario == "rolling" and case.contact.rolling == "viscous":
+        return LAW_METRICS[("rolling", "viscous")]
+    return SCENARIO_METRICS[scenario]
 
 
 def _on_wall(case):
@@ -62,11 +75,23 @@ def _rolling(case, model, closed):
     mass, radius, g, theta, n = _on_wall(case)
     v = np.asarray(case.particles[0].velocity, dtype=float)
     v0 = float(np.linalg.norm(v - (v @ n) * n))
+    if law.id == "viscous":
+        return _rolling_viscous(law, mass, radius, v0, g, closed)
     t_stop, s_stop = _b.rolling_stop_closed(law.mu_r, law.r_roll, radius, v0, g)
     if closed:
         return {"rolling_stop_time": t_stop, "rolling_distance": s_stop}
     out = _b.rolling_on_plane(law, mass, radius, v0, g, t_end=4.0 * t_stop)  # the horizon only
     return {k: out.get(k, math.nan) for k in SCENARIO_METRICS["rolling"]}
+
+
+def _rolling_viscous(law, mass, radius, v0, g, closed):
+    """Type B: the time constant T = 1.4 m R²/Cr and the distance to rest v0·T (closed), or from the integration:
+    the e-fold time of the speed and the distance at 40 T (e^{−40} of it left)."""
+    tau, dist = _b.rolling_viscous_closed(law.c_r, mass, radius, v0)
+    if closed:
+        return {"rolling_time_constant": tau, "rolling_distance": dist}
+    out = _b.rolling_on_plane(law, mass, radius, v0, g, t_end=40.0 * tau)  # the horizon only
+    return {"rolling_time_constant": _b.efold_time(out["t"], out["v"]), "rolling_distance": float(out["x"][-1])}
 
 
 def _incline(case, model, closed):
@@ -90,6 +115,12 @@ def _twist(case, model, closed):
 
 def _pull_off(case, model, closed):
     law = model.slot("adhesion")
+    if law.id == "sjkr":  # a cohesion added to the elastic Hertz law (case.py: like spheres, elastic hertz)
+        nl, radius = model.normal_law, case.particles[0].radius
+        if closed:
+            return {"pull_off_force": _b.sjkr_pull_off_closed(nl.k, law.k_c, law.area, radius, model.pair.r_eff),
+                    "separation_at_pull_off": 0.0}
+        return _b.cohesive_pull_off(law, lambda d: nl.k * d ** nl.a, 0.5 * radius)
     if closed:
         return {"pull_off_force": law.pull_off_force("load"), "separation_at_pull_off": law.separation_at_pull_off()}
     return _b.pull_off(law)
@@ -135,6 +166,10 @@ def stepped_metrics(case, run: dict) -> dict:
             v0 = np.asarray(case.particles[0].velocity, dtype=float)
             u = v0 - (v0 @ n) * n
             u /= np.linalg.norm(u)
+            if case.contact.rolling == "viscous":  # the e-fold time; the distance at the end plus v·T still to go
+                tau = _b.efold_time(t, v @ u)
+                return {"rolling_time_constant": tau,
+                        "rolling_distance": float((x[-1] - x[0]) @ u + (v[-1] @ u) * tau)}
             t_stop, s = _b.first_stop(t, v @ u, (x - x[0]) @ u)
             return {"rolling_stop_time": t_stop, "rolling_distance": s}
         gv = np.asarray(case.run.gravity, dtype=float)
@@ -160,7 +195,7 @@ SOLVERS = {"rolling": _rolling, "incline": _incline, "twist": _twist, "pull_off"
 def scenario_metrics(case, closed: bool = False) -> dict:
     """The case's scenario metrics from the reference's integration (or, ``closed``, its closed forms)."""
     out = SOLVERS[case.run.scenario](case, resolve(case), closed)
-    return {k: float(out[k]) for k in SCENARIO_METRICS[case.run.scenario]}
+    return {k: float(out[k]) for k in metric_names(case)}
 
 
 def solve(case) -> Result:

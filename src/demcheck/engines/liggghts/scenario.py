@@ -1,8 +1,10 @@
 """The scenarios beyond sliding in LIGGGHTS-PUBLIC 3.8.0: the conduction scenario through ``fix heat/gran/conduction``
 (its lens conductance, LensHeat: exact for ``heat = "lens"``, the named variant of Batchelor & O'Brien's
-``radius``), the held pair written without an integrator (the bodies stay where the data file puts them). The
-others are not expressible, each with its reason: LIGGGHTS has no twisting model and no JKR or DMT normal model,
-and no deck is written yet for its rolling models on a wall (their twins step pairs only: verlet_pair).
+``radius``), the held pair written without an integrator (the bodies stay where the data file puts them); the
+rolling sphere on a primitive wall (cdt; epsd3 on the incline); the pull-off of the simplified JKR cohesion
+(``cohesion sjkr`` for the lens area, ``sjkr2`` for the band) on the elastic ``hertz/stiffness`` law, body 1 moved
+by ``fix move linear`` and body 0 held by one at rest, as LAMMPS's pull. The others are not expressible, each with
+its reason: LIGGGHTS has no twisting model, no JKR or DMT normal model and no viscous rolling torque (type B).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
+from ...laws.adhesion import AREA_LENS
 from ...laws.heat import LensHeat
 from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling
 from ...laws.model import resolve
@@ -38,6 +41,9 @@ def mapping(case: Case) -> Mapping:
     s = case.run.scenario
     model = resolve(case)
     if s in ("rolling", "incline"):  # the contact itself first: the case's own reason where LIGGGHTS has none
+        if model.slot("rolling").id == "viscous":
+            return refused("liggghts", "LIGGGHTS-PUBLIC 3.8.0 has no viscous rolling torque (type B): its rolling "
+                                       "models are cdt, epsd, epsd2 and epsd3")
         base = map_model(model, case.contact.params)
         if base.native is None:
             return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")
@@ -45,6 +51,8 @@ def mapping(case: Case) -> Mapping:
             return _rolling(model, base)
         if model.slot("rolling").id == "epsd":
             return _incline(model, base)
+    if s == "pull_off" and model.slot("adhesion").id == "sjkr":
+        return _cohesion(model, map_model(model, case.contact.params))
     if s in WHY_NOT:
         return refused("liggghts", WHY_NOT[s])
     rec = model.slot("heat")
@@ -67,6 +75,22 @@ def mapping(case: Case) -> Mapping:
                  {**base.keywords, **{r: "fix heat/gran/conduction" for r in reasons}})
     mp.native.props["slots"] = {"heat": twin_rec}
     return mp
+
+
+def _cohesion(model, base: Mapping) -> Mapping:
+    """sjkr's lens area as ``cohesion sjkr``, its band as ``cohesion sjkr2`` (cohesionEnergyDensity kc), on the
+    elastic ``hertz/stiffness`` law: the laws as LIGGGHTS computes them (tests/test_laws_beyond_liggghts.py)."""
+    if base.native is None:
+        return base
+    nat, rec = base.native, model.slot("adhesion")
+    if nat.normal != "hertz/stiffness" or nat.props.get("gamman", 0.0) != 0.0:
+        return refused("liggghts", "the sjkr pull-off is written for the elastic hertz/stiffness law "
+                                   f"(the case maps to {nat.normal}, gamman {nat.props.get('gamman', 0.0):g})")
+    name = "sjkr" if rec.area == AREA_LENS else "sjkr2"
+    nat.props = {**nat.props, "cohesion": name, "k_c": rec.k_c, "slots": {"adhesion": rec}}
+    nat.comments = [*nat.comments, f"cohesion {name}, cohesionEnergyDensity {rec.k_c:g} J/m³: −kc·A added to the "
+                                   "normal force while the spheres overlap"]
+    return Mapping("liggghts", base.fidelity, list(base.reasons), nat, dict(base.keywords))
 
 
 def _rolling(model, base: Mapping) -> Mapping:
@@ -117,6 +141,9 @@ def _incline(model, base: Mapping) -> Mapping:
 def twin_laws(case: Case, nat: Native) -> dict:
     if case.run.scenario == "conduction":
         return {"heat": nat.props["slots"]["heat"]}
+    if case.run.scenario == "pull_off":  # hertz/stiffness: kn √R̄ δ^{3/2} (elastic), the cohesion added
+        k = nat.props["kn"] * resolve(case).pair.r_eff ** 0.5
+        return {"normal": lambda d, rate: k * d ** 1.5, "adhesion": nat.props["slots"]["adhesion"]}
     m = case.mass(0)
     kn, eta = nat.props["kn"], nat.props["gamman"] * m
     damp = nat.props.get("gammat", 0.0) * m if nat.tangential_damping else 0.0
@@ -131,7 +158,42 @@ def twin_laws(case: Case, nat: Native) -> dict:
 
 
 def deck(case: Case, nat: Native, lay) -> common.Deck:
+    if case.run.scenario == "pull_off":
+        return _pull_deck(case, nat, lay)
     return _held_deck(case, nat, lay) if case.run.scenario == "conduction" else _wall_deck(case, nat, lay)
+
+
+DUMP_PULL = ("id", "x", "fx")
+
+
+def _pull_deck(case: Case, nat: Native, lay) -> common.Deck:
+    """The pair at the layout's start, body 0 held by ``fix move`` at rest and body 1 moved along +x at the pull's
+    speed (no integrator): x and the force on each body every step."""
+    props = {k: v for k, v in nat.props.items() if k not in ("slots", "cohesion", "k_c")}
+    plain = replace(nat, props=props)
+    matrices = property_matrices(plain, 2, lambda a, b: plain)
+    mats = [case.materials[p.material] for p in case.particles]
+    model_lines, style, flags = model_setup(plain, matrices, [m.youngs_modulus for m in mats],
+                                            [m.poisson_ratio for m in mats])
+    kc = fmt(nat.props["k_c"])
+    lines = [f"# demcheck scenario {case.run.scenario} ({case.name}); {VERSION_NOTE}",
+             *(f"# {c}" for c in nat.comments),
+             "units si", "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+             "communicate single vel yes", "read_data data.lmp",
+             *(f"set atom {i + 1} mass {fmt(case.mass(i))}" for i in range(2)),
+             f"neighbor {fmt(max(p.radius for p in case.particles))} bin", "neigh_modify delay 0", *model_lines,
+             f"fix m_coh all property/global cohesionEnergyDensity peratomtypepair 2 {kc} {kc} {kc} {kc}",
+             f"pair_style gran {style} cohesion {nat.props['cohesion']} {' '.join(flags)}", "pair_coeff * *",
+             f"timestep {fmt(lay.dt)}", "group held id 1", "group pulled id 2",
+             "fix hold held move linear 0 0 0", f"fix pull pulled move linear {fmt(lay.pull_speed)} 0 0",
+             f"dump state all custom 1 {common.DUMP_FILE} {' '.join(DUMP_PULL)}",
+             'dump_modify state format "%d %.17g %.17g" sort id', f"run {lay.steps}", ""]
+    size = 4 * max(p.radius for p in case.particles) + lay.pull_speed * lay.dt * lay.steps
+    box = (np.array(lay.positions).min(axis=0) - size, np.array(lay.positions).max(axis=0) + size)
+    held = replace(case, particles=[replace(p, position=tuple(lay.positions[i]), velocity=(0.0, 0.0, 0.0),
+                                            angular_velocity=(0.0, 0.0, 0.0)) for i, p in enumerate(case.particles)])
+    data = common.data_file(held, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
 
 
 DUMP_WALL = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz")
@@ -213,6 +275,10 @@ def read(case: Case, lay, workdir) -> dict:
     the rolling sphere's samples."""
     from ..dumps import read_dump
 
+    if case.run.scenario == "pull_off":
+        t = read_dump(Path(workdir) / common.DUMP_FILE, columns=DUMP_PULL).sort_values(["step", "id"])
+        x, f = t["x"].to_numpy(), t["fx"].to_numpy()
+        return {"delta": sum(p.radius for p in case.particles) - (x[1::2] - x[0::2]), "fn": f[1::2]}
     if case.run.scenario != "conduction":
         t = read_dump(Path(workdir) / common.DUMP_FILE, columns=DUMP_WALL).sort_values("step")
         cols = lambda *n: np.column_stack([t[c].to_numpy() for c in n])  # noqa: E731
