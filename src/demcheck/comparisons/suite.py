@@ -130,6 +130,10 @@ def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     entry["impact"] = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
     entry["scales"] = {}
+    if case.run.scenario == "pull_off":  # a separation of 0 (DMT, sjkr) is judged in units of the pull's overlap
+        from ..engines.scenario import overlap_scale
+
+        entry["scales"]["overlap"] = overlap_scale(case)
     comps: list[verdicts.Comparison] = []
     adaptive = cached_result(opts.cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
     entry["sources"]["reference"] = _source(adaptive)

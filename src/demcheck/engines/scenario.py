@@ -144,8 +144,7 @@ def layout(case: Case, laws: dict) -> Layout:
     model = resolve(case)
     r0, r1 = (p.radius for p in case.particles)
     if s == "pull_off":
-        law = model.slot("adhesion")
-        scale = _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
+        scale = overlap_scale(case)
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
         return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
@@ -166,6 +165,14 @@ def layout(case: Case, laws: dict) -> Layout:
     return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), 100,
                   ((0.0, 0.0, 0.0), (r0 + r1 - case.run.overlap, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2,
                   ((0.0, 0.0, 0.0),) * 2)
+
+
+def overlap_scale(case: Case) -> float:
+    """The overlap scale of a pull_off case (where its pull starts): JKR's |δ_f|, DMT's Hertz overlap under its
+    pull-off force, sjkr's 4 × the Hertz overlap under its largest tension."""
+    model = resolve(case)
+    law = model.slot("adhesion")
+    return _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
 
 
 def _cohesion_scale(case: Case, model) -> float:
