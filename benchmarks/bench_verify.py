@@ -37,6 +37,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--before", help="the src directory of the version to compare against (PYTHONPATH)")
     ap.add_argument("--jobs", default="2")
+    ap.add_argument("--engines", default=ENGINES, help="the engines verify runs (default all four; none: the "
+                                                      "reference alone)")
     a = ap.parse_args()
     versions = [("after", str(ROOT / "src"))] + ([("before", a.before)] if a.before else [])
     versions.reverse()
@@ -51,7 +53,7 @@ def main():
             for name, _ in versions:
                 report = str(Path(tmp) / f"reports-{name}")
                 before_load = load()
-                seconds, p = run(["verify", "--engines", ENGINES, "--jobs", a.jobs, "--report", report, "--json"],
+                seconds, p = run(["verify", "--engines", a.engines, "--jobs", a.jobs, "--report", report, "--json"],
                                  envs[name])
                 try:
                     out = json.loads(p.stdout)
@@ -61,13 +63,13 @@ def main():
                 per_engine = {}
                 for case in out["cases"]:
                     for src, s in case.get("sources", {}).items():
-                        if src in ENGINES.split(","):
+                        if src in a.engines.split(","):
                             per_engine[src] = per_engine.get(src, 0) + 1
                 rows.append((name, label, seconds, out["wall_time"], len(out["cases"]), out["cache"], p.returncode,
                              before_load, load(), out["failed"]))
                 print(f"# {name} {label}: {seconds:.1f} s, load {before_load} → {load()}", file=sys.stderr,
                       flush=True)
-    print(f"demcheck verify, the default suite (cases/), engines {ENGINES}, --jobs {a.jobs}; "
+    print(f"demcheck verify, the default suite (cases/), engines {a.engines}, --jobs {a.jobs}; "
           f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} CPUs")
     print(f"{'version':8s} {'run':5s} {'process s':>10s} {'suite s':>8s} {'cases':>6s} {'hits/misses':>14s} "
           f"{'failed':>6s} exit  load average (1, 5, 15 min) before → after")

@@ -52,8 +52,17 @@ class Toy(Engine):
             path.chmod(path.stat().st_mode | stat.S_IXUSR)
         return [str(path)]
 
+    def argv(self, executable: str, deck: str) -> list[str]:
+        return [executable, "-in", deck, "-log", "log.txt", "-screen", "screen.txt"]
+
     def check_deck(self, text: str, files: dict | None = None) -> None:
         check_toy_deck(text, files)
+
+    def read_collision(self, workdir):
+        """runner.py's dump: the LAMMPS family's columns (engines/family.py reads them)."""
+        from demcheck.engines.family import read_state_dump
+
+        return read_state_dump(workdir)
 
     def map(self, model, contact_params: dict) -> Mapping:
         native = Native("toy", normal=model.normal.id, tangential=model.tangential.id, limit=model.limit_force,

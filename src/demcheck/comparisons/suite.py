@@ -36,6 +36,7 @@ from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..laws.model import resolve
 from . import curves, dispatch, sources, verdicts
+from .result_cache import cached_metrics, cached_result
 
 # the suite's engine runs go through each engine's long-lived worker (one per engine per process running cases), a
 # failed worker run made again as a process of its own (engines/run.py, OR_PROCESS): the same dumps, without an
@@ -103,7 +104,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     # a grazing impact carries: the normal part alone vanishes at 90°)
     entry["scales"] = impact_scales(case, model)
     comps: list[verdicts.Comparison] = []
-    adaptive, ref = _reference_sources(case, model, entry, comps, opts.tolerances)
+    adaptive, ref = _reference_sources(case, model, entry, comps, opts.tolerances, opts.cache)
     seed_cache: dict = {}
     for planned in sources.plan(case, opts.engines, found):
         if verdicts.unavailable(entry, comps, planned):
@@ -129,8 +130,12 @@ def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
     entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     entry["impact"] = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
     entry["scales"] = {}
+    if case.run.scenario == "pull_off":  # a separation of 0 (DMT, sjkr) is judged in units of the pull's overlap
+        from ..engines.scenario import overlap_scale
+
+        entry["scales"]["overlap"] = overlap_scale(case)
     comps: list[verdicts.Comparison] = []
-    adaptive = sources.ADAPTIVE.run(case)
+    adaptive = cached_result(opts.cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
     entry["sources"]["reference"] = _source(adaptive)
     if not adaptive.ok:
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
@@ -148,11 +153,11 @@ def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
     return entry
 
 
-def _reference_sources(case: Case, model, entry: dict, comps: list, tol) -> tuple:
+def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=None) -> tuple:
     """The reference's two methods in ``entry`` and their comparisons in ``comps``: the adaptive one (the seed
     model's converged answer: returned with its metrics) against the closed forms, the verlet one at the case's
-    step against it."""
-    adaptive = sources.ADAPTIVE.run(case)
+    step against it. With ``cache``, each solve is read from it where it was made before (result_cache.py)."""
+    adaptive = cached_result(cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
     scales = entry["scales"]
     ref = adaptive.metrics()
     entry["sources"]["reference"] = _source(adaptive)
@@ -161,7 +166,7 @@ def _reference_sources(case: Case, model, entry: dict, comps: list, tol) -> tupl
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
         comps.append(verdicts.judge_closed_form(metric, ref[metric], exact, scales, tol))
-    verlet = sources.VERLET.run(case)
+    verlet = cached_result(cache, sources.VERLET.label, case, lambda: sources.VERLET.run(case))
     mv = verlet.metrics()
     label = sources.VERLET.label
     entry["sources"][label] = _source(verlet)
@@ -204,9 +209,12 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
         comps.append(verdicts.status_comparison(engine, verdicts.FAILED, f"{res.status}: {res.message}"))
         return
     me = res.metrics()
-    twin = src.twin().run(case, res.dt, native=native).metrics()
+    twin = cached_metrics(opts.cache, f"{src.twin().label} {res.dt!r} {native!r}", case,
+                          lambda: src.twin().run(case, res.dt, native=native).metrics())
     if res.dt not in seed_cache:
-        seed_cache[res.dt] = states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics()
+        seed_cache[res.dt] = cached_metrics(
+            opts.cache, f"seed verlet {res.dt!r}", case,
+            lambda: states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics())
     seed_v = seed_cache[res.dt]
     entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
                                 "twin_metrics": twin, "seed_verlet_metrics": seed_v}

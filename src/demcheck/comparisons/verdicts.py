@@ -127,6 +127,8 @@ def scale(metric: str, ref: float, case_scales: dict) -> float:
         return 90.0
     if metric == "rebound_angular_velocity":
         return case_scales["spin"]
+    if not ref and metric == "separation_at_pull_off" and "overlap" in case_scales:
+        return case_scales["overlap"]  # a contact that ends at δ = 0 (DMT, sjkr): the pull's overlap scale
     return abs(ref) if ref else 1.0
 
 

@@ -145,9 +145,10 @@ class Engine(ABC):
         the engine needs a wrapper around it (Yade: one that names its version for ``-h``)."""
         return path
 
+    @abstractmethod
     def argv(self, executable: str, deck: str) -> list[str]:
-        """The command that runs ``deck`` (a file name in the work directory) with its log files there."""
-        return [executable, "-in", deck, "-log", "log.txt", "-screen", "screen.txt"]
+        """The command that runs ``deck`` (a file name in the work directory), its log and screen written there
+        (``log.txt``, ``screen.txt``: engines/run.py reads them) or its output printed."""
 
     def worker_argv(self, executable: str) -> list[str] | None:
         """The command of a long-lived worker that runs this engine's decks case after case in one process
@@ -157,12 +158,15 @@ class Engine(ABC):
         between runs (serve.Server.reset)."""
         return None
 
+    @abstractmethod
     def check_deck(self, text: str, files: dict | None = None) -> None:
         """The final guard before the engine runs a deck: every line is one demcheck writes (raises
-        otherwise). The default is the LAMMPS input language's guard (inputs.common.check_deck)."""
-        from ..inputs.common import check_deck
+        otherwise)."""
 
-        check_deck(text, files)
+    @abstractmethod
+    def read_collision(self, workdir):
+        """A collision deck's output in ``workdir``: the bodies' states, one row per body per step (a DataFrame
+        of inputs.common.DUMP_COLUMNS, every value as the engine wrote it)."""
 
     def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
         from ..errors import EngineNotFound
@@ -254,6 +258,13 @@ class Engine(ABC):
         from ..errors import UnsupportedByEngine
 
         raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
+
+    def read_packing(self, workdir, log: str):
+        """A packing deck's output: (the final per-particle table of inputs.packing_decks.FINAL_COLUMNS, sorted by
+        id, one row per particle; the kinetic energy series [(step, ke)] read from ``log``)."""
+        from ..errors import UnsupportedByEngine
+
+        raise UnsupportedByEngine(f"{self.name} writes no packing output")
 
     def scenario_mapping(self, case) -> Mapping:
         """The case's contact with its scenario's slot (``[run] scenario``, beyond sliding) in the engine's terms;

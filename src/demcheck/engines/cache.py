@@ -15,6 +15,7 @@ no permission, a full disk) logs once and returns False: the caller keeps its re
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import logging
@@ -171,3 +172,48 @@ def _load(path: Path, columns, meta_keys, min_rows: int = 0) -> tuple[pd.DataFra
         if c in table:
             table[c] = table[c].astype(np.int64)
     return table, meta
+
+
+def put_metrics(cache: Cache, k: str, metrics: dict, meta: dict) -> bool:
+    """One row under ``k``: each metric, and beside it a flag that it is not finite (stored as 0: a table holds
+    finite values only); ``meta`` with the metrics' names."""
+    table = {m: [v if math.isfinite(v) else 0.0] for m, v in metrics.items()}
+    table.update({f"{m}__nan": [0.0 if math.isfinite(v) else 1.0] for m, v in metrics.items()})
+    return cache.put(k, pd.DataFrame(table), {**meta, "metric_names": list(metrics)})
+
+
+def get_metrics(cache: Cache, k: str, names=None, meta_keys=()) -> tuple[dict, dict] | None:
+    """(metrics, meta) of an entry :func:`put_metrics` wrote, or None; ``names`` the metrics the caller needs
+    (default: the ones stored)."""
+    hit = cache.get(k, columns=tuple(c for m in names or () for c in (m, f"{m}__nan")), min_rows=1,
+                    meta_keys=meta_keys, check=None if names else _names_stored)
+    if hit is None:
+        return None
+    row = hit[0].iloc[0]
+    names = names or hit[1]["metric_names"]
+    return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}, hit[1]
+
+
+def _names_stored(table: pd.DataFrame, meta: dict) -> str | None:
+    names = meta.get("metric_names")
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        return "no list of metric names"
+    missing = [c for m in names for c in (m, f"{m}__nan") if c not in table]
+    return f"missing column(s) {', '.join(missing)}" if missing else None
+
+
+@functools.lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """A hash of every source file of demcheck (the laws, the reference's schemes, the engines' mappings and
+    layouts, the metrics all shape what demcheck computes), of numpy's, numba's and scipy's versions and of the
+    CPU the kernels are compiled for: the key part of every result demcheck computes itself and caches."""
+    import numba
+    import scipy
+    from llvmlite import binding
+
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256(f"numpy {np.__version__} numba {numba.__version__} scipy {scipy.__version__} "
+                       f"cpu {binding.get_host_cpu_name()}".encode())
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
+    return h.hexdigest()[:16]

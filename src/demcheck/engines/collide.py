@@ -148,7 +148,7 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
                                    meta["warnings"])
         else:
             out = runner.run(engine, dk.text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
-            table = dumps.read_dump(out.workdir / common.DUMP_FILE, columns=common.DUMP_COLUMNS)
+            table = eng.read_collision(out.workdir)
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
                 fresh.append((k, table, {"version": out.version, "workdir": str(out.workdir),

@@ -49,8 +49,6 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
     """Run the packing in an engine (``mpi`` ranks). ``cache`` (engines.cache.Cache) skips decks already
     run (keyed with the ranks too). ``workdir``: run there and keep it (the deck, its data file, the dumps — for
     :func:`universe`); by default a temporary directory, removed once read (kept when the run fails)."""
-    import re
-
     from . import discovery, run as runner
     from .cache import key as cache_key
 
@@ -67,10 +65,7 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
             contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
             return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
     out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi, workdir=workdir)
-    table = dumps.read_dump(out.workdir / FINAL_DUMP, columns=FINAL_COLUMNS)
-    table = table[table["step"] == table["step"].max()]
-    ke = [(int(m.group(1)), float(m.group(2))) for m in re.finditer(r"^\s*(\d+)\s+(\S+)\s+\d+\s*$", out.log, re.M)]
-    table = table.sort_values("id").reset_index(drop=True)
+    table, ke = registry.get(engine).read_packing(out.workdir, out.log)
     # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
     contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
                              table[["x", "y", "z"]].to_numpy(), case.packing.box if case.packing else None)

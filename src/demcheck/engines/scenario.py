@@ -14,7 +14,6 @@ model's verlet run steps the case's own laws the same way. Each run's metrics co
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from dataclasses import dataclass
@@ -32,6 +31,7 @@ from ..reference.expected import scenario_closed_forms
 from ..reference.scenarios import _on_wall, _twisting_law, metric_names, stepped_metrics
 from ..result import Result
 from . import registry
+from .cache import code_fingerprint, get_metrics, put_metrics
 
 WALL = ("rolling", "incline", "twist")
 STEPS_PER_PERIOD = 60  # steps per period of the stiffest spring of a sphere on a wall
@@ -144,8 +144,7 @@ def layout(case: Case, laws: dict) -> Layout:
     model = resolve(case)
     r0, r1 = (p.radius for p in case.particles)
     if s == "pull_off":
-        law = model.slot("adhesion")
-        scale = _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
+        scale = overlap_scale(case)
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
         return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
@@ -166,6 +165,14 @@ def layout(case: Case, laws: dict) -> Layout:
     return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), 100,
                   ((0.0, 0.0, 0.0), (r0 + r1 - case.run.overlap, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2,
                   ((0.0, 0.0, 0.0),) * 2)
+
+
+def overlap_scale(case: Case) -> float:
+    """The overlap scale of a pull_off case (where its pull starts): JKR's |δ_f|, DMT's Hertz overlap under its
+    pull-off force, sjkr's 4 × the Hertz overlap under its largest tension."""
+    model = resolve(case)
+    law = model.slot("adhesion")
+    return _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
 
 
 def _cohesion_scale(case: Case, model) -> float:
@@ -235,7 +242,8 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
                               w.point, w.normal, lay.dt, lay.steps, lay.every, normal=laws["normal"],
                               fcrit=laws.get("fcrit"), tangential=laws.get("tangential"),
                               rolling=laws.get("rolling"), twisting=laws.get("twisting"),
-                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment") if k in laws})
+                              **{k: laws[k] for k in ("roll_fcrit", "arm", "truncation", "setup_increment", "roll_surface_w")
+                                 if k in laws})
     if s == "pull_off":
         return _pull(case, laws["adhesion"], lay, laws.get("normal"))
     if s == "adhesive_impact":
@@ -348,48 +356,12 @@ def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
     name = _engine(engine).name
     names = metric_names(case)
     k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
-    hit = _get_metrics(cache, k, names)
+    hit = get_metrics(cache, k, names)
     if hit is not None:
         return hit[0]
     metrics = run_it(case, engine).metrics()
-    _put_metrics(cache, k, metrics, {})
+    put_metrics(cache, k, metrics, {})
     return metrics
-
-
-def _get_metrics(cache, k: str, names, meta_keys=()) -> tuple[dict, dict] | None:
-    """(metrics, meta) of a cache entry :func:`_put_metrics` wrote, or None."""
-    hit = cache.get(k, columns=(*names, *(f"{m}__nan" for m in names)), min_rows=1, meta_keys=meta_keys)
-    if hit is None:
-        return None
-    row = hit[0].iloc[0]
-    return {m: math.nan if row[f"{m}__nan"] else float(row[m]) for m in names}, hit[1]
-
-
-def _put_metrics(cache, k: str, metrics: dict, meta: dict) -> None:
-    """One row: each metric, and beside it a flag that it is not finite (stored as 0: a table holds finite
-    values only)."""
-    import pandas as pd
-
-    table = {m: [v if math.isfinite(v) else 0.0] for m, v in metrics.items()}
-    table.update({f"{m}__nan": [0.0 if math.isfinite(v) else 1.0] for m, v in metrics.items()})
-    cache.put(k, pd.DataFrame(table), meta)
-
-
-@functools.lru_cache(maxsize=1)
-def code_fingerprint() -> str:
-    """A hash of every source file of demcheck (the laws, the reference's schemes, the engines' mappings and
-    layouts all shape a twin's result) and of numpy's, numba's and scipy's versions."""
-    import hashlib
-    from pathlib import Path
-
-    import numba
-    import scipy
-
-    root = Path(__file__).resolve().parent.parent
-    h = hashlib.sha256(f"numpy {np.__version__} numba {numba.__version__} scipy {scipy.__version__}".encode())
-    for f in sorted(root.rglob("*.py")):
-        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes() + b"\0")
-    return h.hexdigest()[:16]
 
 
 def deck(case: Case, engine):
@@ -419,7 +391,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
 
         version = discovery.require(eng.name).version
         k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
-        hit = _get_metrics(cache, k, metric_names(case),
+        hit = get_metrics(cache, k, metric_names(case),
                            {"engine_version": text, "warnings": texts})
         if hit is not None:
             return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],
@@ -429,7 +401,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
                                  "warnings": hit[1]["warnings"], "cached": True})
     res = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
     if cache is not None and res.ok:
-        _put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
+        put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
                                                "warnings": list(res.meta["warnings"])})
     return res
 

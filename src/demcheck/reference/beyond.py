@@ -351,7 +351,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
 def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point, wall_normal, dt: float,
                 steps: int, every: int, *, normal, fcrit=None, tangential=None, rolling=None,
                 twisting=None, roll_fcrit=None, arm: float = 0.0, truncation: str = "maw",
-                setup_increment: bool = False) -> dict:
+                setup_increment: bool = False, roll_surface_w: bool = False) -> dict:
     """One sphere on a flat wall (its plane through ``wall_point``, ``wall_normal`` pointing to the sphere's
     side) under ``gravity``, stepped the way ``fix nve/sphere`` with ``fix wall/gran`` and ``fix gravity`` does
     (half kick, drift, forces at full-step positions and half-step velocities, half kick). ``normal(δ, δ̇)`` is the
@@ -363,7 +363,10 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
     twisting records see the wall as body 1 (at rest, n from the sphere into the wall); ``roll_fcrit(δ, δ̇)`` the
     rolling limit's force when it is not ``fcrit``'s (LIGGGHTS cdt: the elastic part); ``setup_increment``: the
     set-up call adds one step's increment to the rolling torque it applies and forgets it (LIGGGHTS's epsd
-    family, as ``verlet_pair``). Returns, at steps 0, every, 2·every, …: t, x, v, ω (rows × 3)."""
+    family, as ``verlet_pair``); ``roll_surface_w``: the rolling record reads ω (R − ``arm``·δ)/(R − δ), the
+    relative rotation LIGGGHTS's surface model hands its rolling models on a wall (wr = cr·ω/r, cr the contact
+    point's arm, r = R − δ the centre's distance from the wall), not ω. Returns, at steps 0, every, 2·every, …:
+    t, x, v, ω (rows × 3)."""
     inertia = 0.4 * mass * radius * radius
     nw = np.asarray(wall_normal, dtype=float)
     p = np.asarray(wall_point, dtype=float)
@@ -388,7 +391,8 @@ def verlet_wall(radius: float, mass: float, x0, v0, omega0, gravity, wall_point,
             spring = _maw_spring if truncation == "maw" else _capped_spring
             fs, hist = spring(hist, vt, dt if update else 0.0, *tangential, crit)
         h = dt if update else 0.0
-        m_roll, roll = rolling_at(w, into_wall, roll_fcrit(delta, rate) if roll_fcrit else crit,
+        w_roll = w * (r_arm / (radius - delta)) if roll_surface_w else w
+        m_roll, roll = rolling_at(w_roll, into_wall, roll_fcrit(delta, rate) if roll_fcrit else crit,
                                   dt if update or setup_increment else 0.0, state["roll"])
         m_tw, phi = twisting_at(w, into_wall, crit, math.sqrt(radius * delta), h, state["twist"])
         if update:

@@ -74,6 +74,13 @@ class Kratos(PackageEngine):
 
         check(text, files)
 
+    def read_collision(self, workdir):
+        """The collision project's dump (deck.py's script writes the LAMMPS family's columns,
+        engines/family.py)."""
+        from ..family import read_state_dump
+
+        return read_state_dump(workdir)
+
     def own_twin(self, native: Native) -> bool:
         from .mapping import FRICTION
 

@@ -8,10 +8,11 @@ import sys
 from pathlib import Path
 
 from .. import registry
-from ..base import Native, PackageEngine, Style
+from ..base import Native, Style
+from ..family import LammpsFamily
 
 
-class Lammps(PackageEngine):
+class Lammps(LammpsFamily):
     name = "lammps"
     title = "LAMMPS"
     release = "LAMMPS 22Jul2025"

@@ -12,13 +12,14 @@ from pathlib import Path
 import numpy as np
 
 from .. import registry
-from ..base import Native, PackageEngine, Style
+from ..base import Native, Style
+from ..family import LammpsFamily
 
 
 MIN_RESTITUTION = 0.05  # LIGGGHTS refuses a coefficientRestitution e <= 0.05
 
 
-class Liggghts(PackageEngine):
+class Liggghts(LammpsFamily):
     name = "liggghts"
     title = "LIGGGHTS"
     release = "LIGGGHTS 3.8.0"

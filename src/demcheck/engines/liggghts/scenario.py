@@ -149,7 +149,7 @@ def twin_laws(case: Case, nat: Native) -> dict:
     damp = nat.props.get("gammat", 0.0) * m if nat.tangential_damping else 0.0
     laws = {"normal": lambda d, rate: kn * d + eta * rate,
             "tangential": (nat.props["kt"], damp, nat.props["friction"]), "arm": 0.5, "truncation": "spring",
-            "rolling": nat.props["slots"]["rolling"]}
+            "rolling": nat.props["slots"]["rolling"], "roll_surface_w": True}
     if nat.props.get("rolling_model", "cdt") == "cdt":
         laws["roll_fcrit"] = lambda d, rate: kn * d  # cdt's limit: the elastic part
     else:

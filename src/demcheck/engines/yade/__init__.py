@@ -131,6 +131,18 @@ class Yade(PackageEngine):
 
         (packing.check_script if packing.is_packing_script(text) else deck.check_script)(text, files)
 
+    def read_collision(self, workdir):
+        """The collision script's dump (deck.py writes the LAMMPS family's columns, engines/family.py)."""
+        from ..family import read_state_dump
+
+        return read_state_dump(workdir)
+
+    def read_packing(self, workdir, log: str):
+        """The packing script's final dump and thermo lines (packing.py writes the LAMMPS family's)."""
+        from ..family import read_packing_output
+
+        return read_packing_output(workdir, log)
+
     def read_contacts(self, v, i, j, radius, x=None, box=None):
         """A packing script's contact dump (packing.CONTACT_COLUMNS): id1 id2, penetrationDepth, the normal
         force on the second body (3), the stored shear force (3), the contact normal from the first to the
