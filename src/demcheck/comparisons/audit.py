@@ -32,6 +32,7 @@ from ..laws.tangential import NONE, SPRING, VISCOUS_SLIDING
 from ..engines import registry
 from ..engines.collide import collide, twin_states
 from ..engines.mapping import native_summary, twin_model
+from . import audit_beyond
 from .verdicts import Tolerances, scaled
 
 ANGLES = (0.0, 30.0, 60.0)
@@ -533,7 +534,7 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             except (ValueError, ArithmeticError) as exc:
                 ps.probe = False
                 ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
-    probed = [ps for ps in setup.pairs if ps.probe]
+    probed = [ps for ps in setup.pairs if ps.probe or ps.beyond]  # the beyond probes spin, roll and hit at v too
     v, v_from = characteristic_speed(setup, speed) if probed else (None, "no pair or wall is probed")
     # the deck names its engine (--engine or its vocabulary): a named engine is required, never skipped
     info = discovery.require(setup.engine, "the deck") if run_engine and probed else None
@@ -593,7 +594,9 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dic
         measure = getattr(readers()[setup.engine], "measure", None)  # an engine reader's own measured traps
         if measure is not None and run_engine and entry["probes"] and "engine" in entry["probes"][0]:
             found += measure(setup, ps, entry, lambda native: _rerun(setup, ps, native, entry["probes"][0]))
-    entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
+    found += audit_beyond.probe_pair(setup, ps, entry, run_engine, v)
+    entry["probed"] = (any("error" not in p and not p.get("failure") for p in entry["probes"])
+                       or any(r.get("status") == "ok" for r in entry.get("beyond", [])))
     entry["findings"] = [_finding(f) for f in found]
     return entry, found
 
@@ -622,6 +625,9 @@ def _coverage(pairs: list) -> dict:
     for kind, rows in (("pairs", [p for p in pairs if not p["wall"]]), ("walls", [p for p in pairs if p["wall"]])):
         n, k = len(rows), sum(p["probed"] for p in rows)
         out[kind] = {"probed": k, "total": n, "fraction": k / n if n else math.nan}
+    beyond = audit_beyond.coverage(pairs)
+    if beyond["total"]:
+        out["beyond-sliding probes"] = beyond
     return out
 
 
@@ -813,6 +819,7 @@ def text_report(r: dict) -> str:
                          f"stability margin {t['stability_margin']:.3g}×")
         for n in p["notes"]:
             lines.append(f"  note: {n}")
+        lines += audit_beyond.text_lines(p)
         for f in p["findings"]:
             lines.append(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
     if r["not_audited"]:

@@ -158,6 +158,8 @@ def read(script, root: Path) -> Setup:
             _distribution(cmd, w, distributions)
         elif style_name.startswith("insert"):
             _insert(cmd, w, setup, templates, distributions)
+        elif style_name in ("heat/gran", "heat/gran/conduction"):
+            setup.heat.update(fix=style_name, where=cmd.where(), text=cmd.text)
         else:
             note_unread(setup, cmd, QUIET_FIXES)
     if style is None:
@@ -176,6 +178,7 @@ def read(script, root: Path) -> Setup:
         for b in types:
             if b >= a:
                 setup.pairs.append(_pair(setup, spec, where, props, a, b, f"{a}-{b}"))
+    _heat(setup, props)
     for wspec, t_wall, fix_id, wwhere, what in walls:
         for t in types:
             ps = _pair(setup, wspec, wwhere, props, t, t_wall, f"wall {fix_id} × {t}")
@@ -397,10 +400,11 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
     if model not in MODELS or tang == "tan_luding":
         ps.probe = False
         notes.append(f"model {model} / tangential {tang}: listed, not probed (no twin of it in demcheck)")
-    if spec["rolling"] != "off":
-        notes.append(f"rolling_friction {spec['rolling']}: not part of the probes (the twin has none)")
-    if spec["cohesion"] != "off":
-        notes.append(f"cohesion {spec['cohesion']}: not part of the probes (the twin has none)")
+    ps.beyond = _beyond(spec, props, a, b)
+    for key, word in (("rolling", "rolling_friction"), ("cohesion", "cohesion")):
+        if spec[key] != "off":
+            notes.append(f"{word} {spec[key]}: the collision probes run without it; its own probe is audit's "
+                         "beyond-sliding probe (comparisons/audit_beyond.py)")
     if not flags.get("tangential_damping", True) and tang != "off":
         notes.append("tangential_damping off: no tangential dashpot (the seed's TTIt has one); the probes run "
                      "without it")
@@ -408,6 +412,40 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         findings.append(Finding("trap", "limit", "limitForce on: the normal force is held ≥ 0, which raises the "
                                 "restitution above coefficientRestitution", where))
     return ps
+
+
+ROLLING_PROPS = ("coefficientRollingFriction", "rollingStiffness", "coefficientRollingViscousDamping")
+
+
+def _beyond(spec: dict, props: dict, a: int, b: int) -> dict:
+    """The sub-models beyond sliding of a pair (or wall) style: rolling_friction with its property/global values
+    (coefficientRollingFriction, rollingStiffness, coefficientRollingViscousDamping: None where the deck has none),
+    cohesion sjkr/sjkr2 with cohesionEnergyDensity (comparisons/audit_beyond.py probes them)."""
+    out = {}
+    if spec["rolling"] != "off":
+        args = tuple(_pair_value(props, n, a, b) for n in ROLLING_PROPS)
+        out["rolling"] = {"law": spec["rolling"], "args": args,
+                          "words": f"rolling_friction {spec['rolling']} (" + ", ".join(
+                              f"{n} {v:g}" for n, v in zip(ROLLING_PROPS, args) if v is not None) + ")"}
+    if spec["cohesion"] != "off":
+        kc = _pair_value(props, "cohesionEnergyDensity", a, b)
+        out["adhesion"] = {"law": spec["cohesion"], "args": (kc,),
+                           "words": f"cohesion {spec['cohesion']} (cohesionEnergyDensity "
+                                    + ("not set" if kc is None else f"{kc:g}") + ")"}
+    return out
+
+
+def _heat(setup: Setup, props: dict) -> None:
+    """fix heat/gran[/conduction]: the conductivities and capacities per type it reads (property/global
+    thermalConductivity, thermalCapacity), kept for the heat probe of each pair."""
+    if not setup.heat:
+        return
+    for name, key in (("thermalConductivity", "k"), ("thermalCapacity", "cp")):
+        if name in props:
+            kind, values, _ = props[name]
+            setup.heat[key] = {t: v for t, v in enumerate(values, 1)} if kind == "peratomtype" else {}
+            if kind == "scalar":
+                setup.heat[f"{key}_all"] = values[0]
 
 
 # ----------------------------------------------------------------------------- reverse lookup
