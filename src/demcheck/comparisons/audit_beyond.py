@@ -40,11 +40,11 @@ def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None) ->
     the findings they measure."""
     if not ps.beyond:
         return []
-    rows = entry.setdefault("beyond", [])
     if ps.size not in ("", "mass-weighted"):
-        rows.append({"slot": ", ".join(ps.beyond), "status": "not probed",
-                     "why": "probed at the mass-weighted size only (the scenarios are of one sphere size)"})
+        entry["notes"].append(f"{', '.join(ps.beyond)}: probed beyond sliding at the mass-weighted size only (each "
+                              "scenario is of one sphere size)")
         return []
+    rows = entry.setdefault("beyond", [])
     found = []
     for slot, sub in ps.beyond.items():
         for label, raw, why, notes in plans(setup, ps, slot, sub, entry, speed):
@@ -79,7 +79,8 @@ def plans(setup, ps, slot: str, sub: dict, entry: dict, speed) -> list:
     try:
         return maker(setup, ps, sub, base, entry, speed)
     except (ValueError, ArithmeticError) as exc:
-        return [(slot, None, f"the probe cannot be set up: {type(exc).__name__}: {exc}", [])]
+        why = str(exc) if "demcheck has no twin" in str(exc) else f"{type(exc).__name__}: {exc}"
+        return [(slot, None, f"the probe cannot be set up: {why}", [])]
 
 
 def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
@@ -98,6 +99,9 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
         native = dataclasses.replace(native, normal="hertz/material", normal_args=(e_mod, nu))
         notes.append(f"the Hertz part of {ps.beyond['adhesion']['law']} (E {e_mod:g}, ν {nu:g}); its adhesion is "
                      "the pull-off probe's")
+    if not ps.probe and native is ps.native:
+        raise ValueError(f"the sphere rests on the contact's normal law ({_a.native_summary(native)}), of which "
+                         "demcheck has no twin")
     nl, tl = registry.get(setup.engine).twin(native, *_a._effective(setup, ps))
     m = rho * 4.0 / 3.0 * math.pi * r ** 3
     g = setup.gravity[0]

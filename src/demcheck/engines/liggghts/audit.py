@@ -446,6 +446,9 @@ def _heat(setup: Setup, props: dict) -> None:
             setup.heat[key] = {t: v for t, v in enumerate(values, 1)} if kind == "peratomtype" else {}
             if kind == "scalar":
                 setup.heat[f"{key}_all"] = values[0]
+    for ps in setup.pairs:  # the particle pairs (a wall conducts only with its own temperature set)
+        ps.beyond["heat"] = {"law": "lens", "args": (), "words": f"fix {setup.heat['fix']} "
+                             f"({setup.heat['where']}; thermalConductivity and thermalCapacity per type)"}
 
 
 # ----------------------------------------------------------------------------- reverse lookup
