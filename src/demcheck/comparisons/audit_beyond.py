@@ -52,6 +52,7 @@ def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None) ->
             if raw is None:
                 row.update(status="not probed", why=why)
             else:
+                row["case"] = raw  # the scenario case the probe ran (SI keys, in the deck's units)
                 row.update(run_probe(setup, raw, run_engine))
             rows.append(row)
             found += judge(ps, row)

@@ -401,7 +401,11 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         ps.probe = False
         notes.append(f"model {model} / tangential {tang}: listed, not probed (no twin of it in demcheck)")
     ps.beyond = _beyond(spec, props, a, b)
-    for key, word in (("rolling", "rolling_friction"), ("cohesion", "cohesion")):
+    for key, word, prop in (("rolling", "rolling_friction", "coefficientRollingFriction"),
+                            ("cohesion", "cohesion", "cohesionEnergyDensity")):
+        if spec[key] == "off" and prop in props:
+            notes.append(f"{prop} is set ({props[prop][2]}) but the style has no {word} model: LIGGGHTS applies "
+                         "none, and none is probed")
         if spec[key] != "off":
             notes.append(f"{word} {spec[key]}: the collision probes run without it; its own probe is audit's "
                          "beyond-sliding probe (comparisons/audit_beyond.py)")
