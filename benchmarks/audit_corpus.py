@@ -82,6 +82,8 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
     row["beyond"] = {"total": len(beyond), "ran": sum(b.get("status") == "ok" for b in beyond),
                      "failed": sum(b.get("status") == "failed" for b in beyond),
                      "listed": sum(b.get("status") == "not probed" for b in beyond),
+                     "engine_vs_twin": max((b["engine_vs_twin"] for b in beyond if b.get("status") == "ok"),
+                                           default=float("nan")),
                      "traps": sorted({f["code"] for p in pairs for f in p.get("findings", [])
                                       if f["kind"] == "trap" and f["code"].startswith("beyond-")}),
                      "sizes": sorted({f"{b['probe']}: " + ", ".join(f"{k} {q:.3f}×" for k, q in
@@ -133,6 +135,7 @@ def _beyond_text(r: dict) -> str:
         return ""
     text = (f"\n    beyond sliding: {b['total']} sub-model probe(s), {b['ran']} ran (engine, twin, closed form), "
             f"{b['failed']} failed, {b['listed']} listed with a reason"
+            + (f"; largest engine − twin {b['engine_vs_twin']:.2g}" if b["ran"] else "")
             + (f"; traps: {', '.join(b['traps'])}" if b["traps"] else ""))
     return text + "".join(f"\n      {s}" for s in b["sizes"])
 
@@ -142,9 +145,10 @@ def _beyond_totals(rows: list) -> str:
     tot = {k: sum(r["beyond"][k] for r in with_b) for k in ("total", "ran", "failed", "listed")}
     codes = sorted({c for r in with_b for c in r["beyond"]["traps"]})
     ran = sum(r["beyond"]["ran"] > 0 for r in with_b)
+    gap = max((r["beyond"]["engine_vs_twin"] for r in with_b if r["beyond"]["ran"]), default=float("nan"))
     return (f"  beyond sliding: {len(with_b)} decks set rolling, twisting, adhesion or heat; {ran} of them got a probe "
             f"that ran; probes {tot['total']}: ran {tot['ran']}, failed {tot['failed']}, listed with a reason "
-            f"{tot['listed']}; traps: {', '.join(codes) or 'none'}")
+            f"{tot['listed']}; largest engine − twin {gap:.2g}; traps: {', '.join(codes) or 'none'}")
 
 
 def report_totals(rows: list, seconds: float, engine_runs: bool) -> str:

@@ -569,7 +569,8 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             "coverage": coverage, "traps": len(traps), "status": status, "status_reason": reason}
 
 
-def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None, beyond_engine: bool = True) -> tuple[dict, list]:
+def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None,
+                beyond_engine: bool = True) -> tuple[dict, list]:
     from ..errors import EngineInterrupted
 
     entry = {"pair": ps.label, "wall": ps.j is None, "where": ps.where, "native": native_summary(ps.native),
@@ -596,7 +597,9 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None, beyond_engin
         measure = getattr(readers()[setup.engine], "measure", None)  # an engine reader's own measured traps
         if measure is not None and run_engine and entry["probes"] and "engine" in entry["probes"][0]:
             found += measure(setup, ps, entry, lambda native: _rerun(setup, ps, native, entry["probes"][0]))
-    found += audit_beyond.probe_pair(setup, ps, entry, beyond_engine, v)
+    found += audit_beyond.probe_pair(setup, ps, entry, beyond_engine, v,
+                                     getattr(readers()[setup.engine], "BEYOND_PROBES", {}),
+                                     lambda: (_sides(setup, ps), _effective(setup, ps)))
     entry["probed"] = (any("error" not in p and not p.get("failure") for p in entry["probes"])
                        or any(r.get("status") == "ok" for r in entry.get("beyond", [])))
     entry["findings"] = [_finding(f) for f in found]

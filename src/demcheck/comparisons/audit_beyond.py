@@ -35,9 +35,10 @@ TEMPERATURES = (300.0, 400.0)  # the held pair's start (τ does not depend on th
 ROLL_SLIP = 1.05  # the incline needs μs above μr by this factor to roll without slip past the critical angle
 
 
-def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None) -> list:
+def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None, kinds: dict, bodies) -> list:
     """The beyond-sliding probes of one pair or wall: entry["beyond"] (one row a probe or a listed sub-model) and
-    the findings they measure."""
+    the findings they measure. ``kinds``: the engine reader's BEYOND_PROBES (slot → the probe that takes it, one of
+    MAKERS); ``bodies()``: ((radius, density) of each side, (m̄, R̄)) of the pair, or ScriptError."""
     if not ps.beyond:
         return []
     if ps.size not in ("", "mass-weighted"):
@@ -47,7 +48,7 @@ def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None) ->
     rows = entry.setdefault("beyond", [])
     found = []
     for slot, sub in ps.beyond.items():
-        for label, raw, why, notes in plans(setup, ps, slot, sub, entry, speed):
+        for label, raw, why, notes in plans(setup, ps, slot, sub, entry, speed, kinds, bodies):
             row = {"slot": slot, "law": sub["words"], "probe": label, "notes": list(notes)}
             if raw is None:
                 row.update(status="not probed", why=why)
@@ -62,21 +63,16 @@ def probe_pair(setup, ps, entry: dict, run_engine: bool, speed: float | None) ->
 # ----------------------------------------------------------------------------- the cases
 
 
-def plans(setup, ps, slot: str, sub: dict, entry: dict, speed) -> list:
+def plans(setup, ps, slot: str, sub: dict, entry: dict, speed, kinds: dict, bodies) -> list:
     """[(probe label, the scenario case as a dict or None, why not, notes)] of one sub-model."""
-    from . import audit as _a
-
     try:
-        (radius, rho), _ = _a._sides(setup, ps)
+        sides, effective = bodies()
     except deck_script.ScriptError as exc:
         return [(slot, None, f"no body to probe: {exc}", [])]
-    base = {"radius": radius, "density": rho}
-    maker = {("lammps", "rolling"): _lammps_rolling, ("lammps", "twisting"): _lammps_twisting,
-             ("lammps", "adhesion"): _lammps_adhesion, ("lammps", "heat"): _heat,
-             ("liggghts", "rolling"): _liggghts_rolling, ("liggghts", "adhesion"): _liggghts_cohesion,
-             ("liggghts", "heat"): _heat}.get((setup.engine, slot))
+    base = {"radius": sides[0][0], "density": sides[0][1], "second": sides[1], "effective": effective}
+    maker = MAKERS.get(kinds.get(slot, ""))
     if maker is None:
-        return [(slot, None, f"{setup.engine}: no probe of its {slot} sub-model", [])]
+        return [(slot, None, f"{setup.engine}: no probe of its {slot} sub-model in demcheck", [])]
     try:
         return maker(setup, ps, sub, base, entry, speed)
     except (ValueError, ArithmeticError) as exc:
@@ -89,8 +85,8 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
     (Hertz with the twin's E*, or LSD with its kn) and a linear tangential spring (a √δ spring taken at the static
     overlap under the sphere's weight), μ the deck's. The normal dashpot is left out (the sphere rests)."""
     from ..engines import registry
+    from ..engines.mapping import native_summary
     from ..laws.tangential import SPRING
-    from . import audit as _a
 
     r, rho = base["radius"], base["density"]
     native, notes = ps.native, ["the contact's elastic normal law on a rigid plane (its dashpot left out: the "
@@ -101,14 +97,14 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
         notes.append(f"the Hertz part of {ps.beyond['adhesion']['law']} (E {e_mod:g}, ν {nu:g}); its adhesion is "
                      "the pull-off probe's")
     if not ps.probe and native is ps.native:
-        raise ValueError(f"the sphere rests on the contact's normal law ({_a.native_summary(native)}), of which "
+        raise ValueError(f"the sphere rests on the contact's normal law ({native_summary(native)}), of which "
                          "demcheck has no twin")
-    nl, tl = registry.get(setup.engine).twin(native, *_a._effective(setup, ps))
+    nl, tl = registry.get(setup.engine).twin(native, *base["effective"])
     m = rho * 4.0 / 3.0 * math.pi * r ** 3
     g = setup.gravity[0]
     mat = {"density": rho, "restitution": 0.9, "friction": tl.mu_s, "poisson_ratio": 0.3}
     if nl.a == 1.5:
-        e_star = nl.k / (4.0 / 3.0 * math.sqrt(_a._effective(setup, ps)[1]))
+        e_star = nl.k / (4.0 / 3.0 * math.sqrt(base["effective"][1]))
         mat["youngs_modulus"] = e_star * (1.0 - 0.09)
         contact = {"normal": "hertz"}
         delta = (m * g / (4.0 / 3.0 * e_star * math.sqrt(r))) ** (2.0 / 3.0)
@@ -160,7 +156,7 @@ def _incline(setup, ps, base, mu_r: float, rolling: dict, label: str) -> tuple:
     return label, raw, "", notes
 
 
-def _lammps_rolling(setup, ps, sub, base, entry, speed) -> list:
+def _sds_incline(setup, ps, sub, base, entry, speed) -> list:
     k, gamma, mu = sub["args"]
     r = base["radius"]
     rolling = {"rolling": "epsd", "mu_r": mu, "k_r": k * r * r, "c_r": gamma * r * r, "cap": "total",
@@ -168,7 +164,7 @@ def _lammps_rolling(setup, ps, sub, base, entry, speed) -> list:
     return [_incline(setup, ps, base, mu, rolling, f"incline ({ps.label})")]
 
 
-def _lammps_twisting(setup, ps, sub, base, entry, speed) -> list:
+def _twisting(setup, ps, sub, base, entry, speed) -> list:
     label = f"twist ({ps.label})"
     g = _gravity_or_none(setup)
     if g is None:
@@ -202,7 +198,7 @@ def _pair_bodies(name: str, mat: dict, radius: float, contact: dict, run: dict, 
     return raw
 
 
-def _lammps_adhesion(setup, ps, sub, base, entry, speed) -> list:
+def _jkr_dmt(setup, ps, sub, base, entry, speed) -> list:
     """``jkr E η ν γ`` / ``dmt E η ν γ``: two like spheres of E, ν, w = 2γ (LAMMPS's surface energy γ), pulled
     apart; jkr also at the characteristic speed."""
     e_mod, eta, nu, gamma = sub["args"]
@@ -249,9 +245,9 @@ def _heat(setup, ps, sub, base, entry, speed) -> list:
     rho = base["density"]
     mats = {"a": {"density": rho, "youngs_modulus": 1e9, "poisson_ratio": 0.3, "restitution": 0.9,
                   "specific_heat": cps[0]},
-            "b": {"density": _side_density(setup, ps), "youngs_modulus": 1e9, "poisson_ratio": 0.3,
+            "b": {"density": base["second"][1], "youngs_modulus": 1e9, "poisson_ratio": 0.3,
                   "restitution": 0.9, "specific_heat": cps[1]}}
-    r2 = _side_radius(setup, ps)
+    r2 = base["second"][0]
     raw = {"name": f"audit-conduction-{ps.label}", "kind": "collision", "materials": mats,
            "particles": [{"material": "a", "radius": base["radius"], "position": [0.0, 0.0, 0.0]},
                          {"material": "b", "radius": r2, "position": [base["radius"] + r2, 0.0, 0.0]}],
@@ -259,18 +255,6 @@ def _heat(setup, ps, sub, base, entry, speed) -> list:
            "run": {"scenario": "conduction", "temperatures": list(TEMPERATURES), "overlap": overlap}}
     return [(label, raw, "", [f"held at overlap {overlap:.4g} ({where}); c_p {cps[0]:g}, {cps[1]:g}",
                               f"conductance law {law}, k = {k:g}"])]
-
-
-def _side_radius(setup, ps) -> float:
-    from . import audit as _a
-
-    return _a._sides(setup, ps)[1][0]
-
-
-def _side_density(setup, ps) -> float:
-    from . import audit as _a
-
-    return _a._sides(setup, ps)[1][1]
 
 
 def _held_overlap(entry: dict, radius: float) -> tuple[float, str]:
@@ -282,7 +266,7 @@ def _held_overlap(entry: dict, radius: float) -> tuple[float, str]:
     return 0.01 * radius, "1% of the radius: no collision probe gave an overlap"
 
 
-def _liggghts_rolling(setup, ps, sub, base, entry, speed) -> list:
+def _cdt_epsd3(setup, ps, sub, base, entry, speed) -> list:
     mu, stiffness, damping = sub["args"]
     law = sub["law"]
     label = f"{'rolling' if law == 'cdt' else 'incline'} ({ps.label})"
@@ -309,23 +293,27 @@ def _liggghts_rolling(setup, ps, sub, base, entry, speed) -> list:
 
 def _epsd3_kr(setup, ps, base, mu, stiffness) -> float:
     from ..engines import registry
-    from . import audit as _a
 
     if stiffness is None:
         raise ValueError("rolling_friction epsd3 needs rollingStiffness")
-    nl, _ = registry.get(setup.engine).twin(ps.native, *_a._effective(setup, ps))
+    nl, _ = registry.get(setup.engine).twin(ps.native, *base["effective"])
     return stiffness * nl.k * mu * mu * base["radius"] ** 2
 
 
-def _liggghts_cohesion(setup, ps, sub, base, entry, speed) -> list:
+def _sjkr_listed(setup, ps, sub, base, entry, speed) -> list:
     (kc,) = sub["args"]
     label = f"pull-off ({ps.label})"
     if kc is None:
         return [(label, None, "cohesion needs cohesionEnergyDensity (LIGGGHTS stops without it)", [])]
-    return [(label, None, f"cohesion {sub['law']} (cohesionEnergyDensity {kc:g} J/m³) is listed, not probed: its force "
-                          "−kc·A is added to the normal law, which has no closed-form pull-off among demcheck's "
-                          "scenarios (pull_off runs jkr and dmt), and LIGGGHTS-PUBLIC 3.8.0 has no JKR or DMT "
-                          "model to run one", [])]
+    return [(label, None, f"cohesion {sub['law']} (cohesionEnergyDensity {kc:g} J/m³) is listed, not probed: its "
+                          "force −kc·A is added to the normal law, which has no closed-form pull-off among "
+                          "demcheck's scenarios (pull_off runs jkr and dmt), and LIGGGHTS-PUBLIC 3.8.0 has no JKR or "
+                          "DMT model to run one", [])]
+
+
+# the probe of each kind an engine's reader names in its BEYOND_PROBES (slot → kind)
+MAKERS = {"incline_sds": _sds_incline, "twist": _twisting, "pull_off": _jkr_dmt, "held_pair": _heat,
+          "rolling_cdt_epsd3": _cdt_epsd3, "sjkr_listed": _sjkr_listed}
 
 
 # ----------------------------------------------------------------------------- the runs

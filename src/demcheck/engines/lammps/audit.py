@@ -23,6 +23,8 @@ TWISTING_ARGS = {"none": 0, "marshall": 0, "sds": 3}
 HEAT_ARGS = {"none": 0, "radius": 1, "area": 1}
 CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
 PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS)
+BEYOND_PROBES = {"rolling": "incline_sds", "twisting": "twist", "adhesion": "pull_off", "heat": "held_pair"}
 DEFAULT = True  # a LAMMPS-family deck that no other reader claims is read as LAMMPS's
 
 QUIET_FIXES = frozenset({"nve/sphere", "gravity", "print", "ave/time", "ave/atom", "enforce2d", "balance",
@@ -264,9 +266,7 @@ def read(script, root: Path) -> Setup:
     setup = Setup("lammps")
     setup.regions = script.regions
     explicit: dict = {}  # (i, j) i ≤ j → (spec, where)
-    style_cmd = None
-    classic_spec = None
-    classic_name = None
+    style_cmd = classic_spec = classic_name = None
     walls = []  # (spec, where, notes)
     for cmd in script.commands:
         w, name = cmd.words, cmd.name
@@ -330,10 +330,7 @@ def read(script, root: Path) -> Setup:
                 notes.append(f"fix group '{w[2]}': probed with every type")
             walls.append((spec, cmd.where(), notes, cmd, w[1]))
             continue
-        if name == "fix" and len(w) > 4 and w[3] == "heat/flow":
-            heat_flow(cmd, setup)
-            continue
-        note_unread(setup, cmd, QUIET_FIXES)
+        _other(cmd, setup)
     if style_cmd is None:
         raise ScriptError("the deck has no pair_style: nothing defines its contacts")
     finish(setup, "LAMMPS's default")
@@ -407,6 +404,14 @@ def heat_flow(cmd: Command, setup: Setup) -> None:
     else:
         raise _bad(cmd, "fix heat/flow takes constant cp or type cp1 … cpN")
     setup.heat["where"] = cmd.where()
+
+
+def _other(cmd: Command, setup: Setup) -> None:
+    """A command the contact reading does not take: fix heat/flow (the heat probe's capacities), else listed."""
+    if cmd.name == "fix" and len(cmd.words) > 4 and cmd.words[3] == "heat/flow":
+        heat_flow(cmd, setup)
+    else:
+        note_unread(setup, cmd, QUIET_FIXES)
 
 
 def _pairs(setup: Setup, types: list[int], explicit: dict) -> None:

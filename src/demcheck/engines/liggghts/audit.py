@@ -158,10 +158,8 @@ def read(script, root: Path) -> Setup:
             _distribution(cmd, w, distributions)
         elif style_name.startswith("insert"):
             _insert(cmd, w, setup, templates, distributions)
-        elif style_name in ("heat/gran", "heat/gran/conduction"):
-            setup.heat.update(fix=style_name, where=cmd.where(), text=cmd.text)
         else:
-            note_unread(setup, cmd, QUIET_FIXES)
+            _other(cmd, setup, style_name)
     if style is None:
         raise ScriptError("the deck has no pair_style gran: nothing defines its contacts")
     finish(setup, "the default")
@@ -178,7 +176,7 @@ def read(script, root: Path) -> Setup:
         for b in types:
             if b >= a:
                 setup.pairs.append(_pair(setup, spec, where, props, a, b, f"{a}-{b}"))
-    _heat(setup, props)
+    _heat(setup, props)  # on the particle pairs
     for wspec, t_wall, fix_id, wwhere, what in walls:
         for t in types:
             ps = _pair(setup, wspec, wwhere, props, t, t_wall, f"wall {fix_id} × {t}")
@@ -190,6 +188,14 @@ def read(script, root: Path) -> Setup:
                                 "curvature and edges are not probed")
             setup.pairs.append(ps)
     return setup
+
+
+def _other(cmd, setup, style_name: str) -> None:
+    """A command the contact reading does not take: fix heat/gran[/conduction] (the heat probe's), else listed."""
+    if style_name in ("heat/gran", "heat/gran/conduction"):
+        setup.heat.update(fix=style_name, where=cmd.where())
+    else:
+        note_unread(setup, cmd, QUIET_FIXES)
 
 
 def _wall(cmd, w, setup, walls, meshes) -> None:
@@ -418,6 +424,8 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
     return ps
 
 
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS)
+BEYOND_PROBES = {"rolling": "rolling_cdt_epsd3", "adhesion": "sjkr_listed", "heat": "held_pair"}
 ROLLING_PROPS = ("coefficientRollingFriction", "rollingStiffness", "coefficientRollingViscousDamping")
 
 
