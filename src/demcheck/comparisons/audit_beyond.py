@@ -91,6 +91,8 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
     r, rho = base["radius"], base["density"]
     native, notes = ps.native, ["the contact's elastic normal law on a rigid plane (its dashpot left out: the "
                                 "sphere rests)"]
+    if ps.j is not None and ps.j != ps.i:
+        notes.append(f"the sphere is type {ps.i}'s (radius {r:g}, density {rho:g}) under the pair's law")
     if "adhesion" in ps.beyond and ps.beyond["adhesion"]["law"] in ("jkr", "dmt"):  # its Hertz part, E and ν
         e_mod, _, nu, _ = ps.beyond["adhesion"]["args"]
         native = dataclasses.replace(native, normal="hertz/material", normal_args=(e_mod, nu))
