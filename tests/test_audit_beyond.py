@@ -222,6 +222,11 @@ def test_sjkr_cohesion_is_listed_with_its_reason(tmp_path):
     _, rows = _rows(r, "1-1")
     assert rows["pull-off"]["status"] == "not probed"
     assert "cohesionEnergyDensity 300000" in rows["pull-off"]["why"]
+    # the set-up check: kc × the lens π(Rδ − δ²/4) of two like spheres at the head-on probe's largest overlap
+    entry, _ = _rows(r, "1-1")
+    delta, radius = entry["probes"][0]["twin"]["max_overlap"], 0.00159
+    pull = 3e5 * math.pi * (radius * delta - delta * delta / 4)
+    assert f"the cohesion pulls {pull:.4g}" in rows["pull-off"]["notes"][0]
 
 
 def test_a_failed_beyond_probe_is_a_trap_never_clean(tmp_path, monkeypatch):

@@ -307,10 +307,31 @@ def _sjkr_listed(setup, ps, sub, base, entry, speed) -> list:
     label = f"pull-off ({ps.label})"
     if kc is None:
         return [(label, None, "cohesion needs cohesionEnergyDensity (LIGGGHTS stops without it)", [])]
+    notes = [_sjkr_check(ps, sub["law"], kc, base, entry)]
     return [(label, None, f"cohesion {sub['law']} (cohesionEnergyDensity {kc:g} J/m³) is listed, not probed: its "
                           "force −kc·A is added to the normal law, which has no closed-form pull-off among "
                           "demcheck's scenarios (pull_off runs jkr and dmt), and LIGGGHTS-PUBLIC 3.8.0 has no JKR or "
-                          "DMT model to run one", [])]
+                          "DMT model to run one", notes)]
+
+
+def _sjkr_check(ps, law_id: str, kc: float, base: dict, entry: dict) -> str:
+    """The set-up check of a simplified JKR cohesion: its pull −kc·A (A the lens of sjkr, the band 2πR_xδ of
+    sjkr2) at the head-on collision probe's largest overlap, against that probe's peak normal force."""
+    from ..laws.adhesion import AREA_BAND, AREA_LENS, SjkrAdhesion, adhesive_force
+
+    r0 = base["radius"]
+    r1 = base["second"][0] if base["second"] else r0
+    delta, where = _held_overlap(entry, min(r0, r1))
+    law = SjkrAdhesion(kc, AREA_BAND if law_id == "sjkr2" else AREA_LENS, ps.j is None, r0, r1)
+    pull = -adhesive_force(law, delta, 1.0)[0]
+    peaks = [p.get("engine", p.get("twin", {})).get("peak_force", math.nan) for p in entry.get("probes", [])
+             if "error" not in p]
+    peak = peaks[0] if peaks else math.nan
+    text = f"set-up check: at overlap {delta:.4g} ({where}) the cohesion pulls {pull:.4g}"
+    if math.isfinite(peak) and peak > 0:
+        text += (f", {pull / peak:.3g} of the head-on probe's peak normal force {peak:.4g} (its collision runs "
+                 "without it)")
+    return text
 
 
 # the probe of each kind an engine's reader names in its BEYOND_PROBES (slot → kind)
@@ -436,6 +457,7 @@ def text_lines(p: dict) -> list[str]:
         head = f"  beyond: {r.get('probe', r['slot'])} — {r.get('law', '')}"
         if r.get("status") != "ok":
             lines.append(f"{head}: {r.get('status', '').upper()}: {r.get('why', '')}")
+            lines += [f"    note: {n}" for n in r.get("notes", [])]
             continue
         ms = ", ".join(f"{k} {_g(v.get('engine', v['twin']))} (twin {_g(v['twin'])}, closed form "
                        f"{_g(v['reference'])}, {_g(r['engine_vs_reference'][k])}×)" for k, v in r["metrics"].items())
