@@ -261,3 +261,34 @@ def test_a_soft_adhesive_rebound_stays_in_the_lammps_box():
     res = sc.run(case, "lammps")
     assert res.ok, res.message
     assert res.metrics()["restitution"] == pytest.approx(sc.twin(case, "lammps").metrics()["restitution"], rel=1e-9)
+
+
+def test_a_metal_deck_lists_its_sub_models_unconverted(tmp_path):
+    """units metal: the collision probes' coefficients are converted to SI; a rolling sds's are not — listed with
+    that reason, never probed with the style's numbers taken as SI."""
+    deck = ("units metal\natom_style sphere\nboundary f f f\nregion box block -50 50 -50 50 -50 50 units box\n"
+            "create_box 1 box\ncreate_atoms 1 single 0 0 10 units box\nset type 1 diameter 4 density 2.5\n"
+            "velocity all set 0 0 -1\nfix gravity all gravity 1e-3 vector 0 0 -1\ntimestep 0.001\n"
+            "pair_style granular\npair_coeff * * hertz/material 100 0.5 0.3 tangential linear_history 10 0 0.5 "
+            "rolling sds 10 0 0.1\n")
+    r = A.audit(_deck(tmp_path, deck), run_engine=False)
+    _, rows = _rows(r, "1-1")
+    (row,) = rows.values()
+    assert row["status"] == "not probed" and "units metal" in row["why"]
+
+
+@pytest.mark.engine("lammps")
+def test_lammps_dmt_pull_off_meets_the_closed_form_and_names_its_sample_tie(tmp_path):
+    """dmt E 0 ν γ: pull-off 2πwR̄ at δ = 0 (Derjaguin, Muller & Toporov 1975). The pull's samples land on δ = 0
+    exactly, where round-off decides the last touching one: engine and twin one sample apart, noted, never a
+    trap of 1e290 (a relative gap against 0) nor an engine − twin of 0 over nothing."""
+    deck = LAMMPS_DECK.replace("2 2 jkr 5e6 0 0.45 0.025", "2 2 dmt 5e6 0 0.45 0.025")
+    r = A.audit(_deck(tmp_path, deck))
+    entry, rows = _rows(r, "2-2")
+    row = rows["pull-off"]
+    assert row["status"] == "ok" and row["fidelity"] == "exact"
+    assert row["metrics"]["pull_off_force"]["engine"] == pytest.approx(2 * math.pi * 0.05 * 0.0005, rel=2e-6)
+    assert "beyond-engine-vs-twin" not in _codes(entry) and "beyond-pull-off" not in _codes(entry)
+    assert not math.isinf(row["engine_vs_twin"])
+    if math.isnan(row["engine_vs_twin"]):
+        assert "one sample of the pull apart" in row["notes_run"][0]

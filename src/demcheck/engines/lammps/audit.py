@@ -629,6 +629,9 @@ def to_si(setup) -> None:
         b.mass = None if b.mass is None else b.mass * mass
         b.sizes = [(r * length, w) for r, w in b.sizes]
     for ps in setup.pairs:
+        for sub in ps.beyond.values():  # its coefficients stay in the style's units: listed, never probed in SI
+            sub["refused"] = (f"units {style}: the sub-model's coefficients are not converted to SI for a probe "
+                              "(the collision probes' are)")
         ps.native = _native_si(ps.native, length, mass, time, force)
         if ps.intended is not None:
             ps.intended = _native_si(ps.intended, length, mass, time, force)
