@@ -12,9 +12,11 @@ atom_style or pair_style) is audited, one after the other, and sorted into:
 - crash:           any other exception (a traceback: a defect).
 
 A deck is a DEM deck when it defines a granular contact (pair_style granular | gran* | hybrid with gran*, or
-fix wall/gran); the goal counts DEM decks. By default the probes run the twin only (the engine's formulas in the
-reference: reading is what this measures, and it keeps the run short); --engine-runs runs each probe in the
-engine too. The decks are public example decks gathered outside the repository (docs/audit.md says where).
+fix wall/gran); the goal counts DEM decks. By default the collision probes run the twin only (the engine's formulas
+in the reference: reading is what this measures, and it keeps the run short); --engine-runs runs each probe in the
+engine too. The probes beyond sliding (rolling, twisting, adhesion, heat: comparisons/audit_beyond.py) always run
+in the engine, its twin and the closed form (a few seconds each); each row counts the sub-models its deck sets, the
+probes that ran to a result, failed, or are listed with a reason, and their trap codes. The decks are public example decks gathered outside the repository (docs/audit.md says where).
 """
 
 from __future__ import annotations
@@ -59,7 +61,7 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
     dem = bool(GRANULAR.search(path.read_text(encoding="utf-8")))
     row = {"deck": str(path), "dem": dem}
     try:
-        r = audit(path, run_engine=engine_runs)
+        r = audit(path, run_engine=engine_runs, beyond_engine=True)
     except DemcheckError as exc:
         row.update(outcome="refused" if getattr(exc, "exit_code", 1) == 2 else "failed",
                    why=str(exc).splitlines()[0][:200])
@@ -76,6 +78,19 @@ def audit_one(path: Path, engine_runs: bool) -> dict:
                coverage=r.get("coverage"), codes=codes, units=(r.get("units") or {}).get("style"),
                speed_from=str(r.get("speed_from", ""))[:60],
                read_by="engine" if str(r.get("read_by", "")).startswith("the engine") else "reader")
+    beyond = [b for p in pairs for b in p.get("beyond", [])]
+    row["beyond"] = {"total": len(beyond), "ran": sum(b.get("status") == "ok" for b in beyond),
+                     "failed": sum(b.get("status") == "failed" for b in beyond),
+                     "listed": sum(b.get("status") == "not probed" for b in beyond),
+                     "engine_vs_twin": max((b["engine_vs_twin"] for b in beyond if b.get("status") == "ok"),
+                                           default=float("nan")),
+                     "traps": sorted({f["code"] for p in pairs for f in p.get("findings", [])
+                                      if f["kind"] == "trap" and f["code"].startswith("beyond-")}),
+                     "sizes": sorted({f"{b['probe']}: " + ", ".join(f"{k} {q:.3f}×" for k, q in
+                                                                      b["engine_vs_reference"].items()
+                                                                      if abs(q - 1) > 0.01)
+                                      for b in beyond if b.get("status") == "ok"
+                                      and any(abs(q - 1) > 0.01 for q in b["engine_vs_reference"].values())})}
     row["outcome"] = "probed" if probed else "nothing probed"
     if not probed:
         row["why"] = r.get("status_reason") or "no probe ran"
@@ -109,9 +124,31 @@ def main(argv=None) -> int:
                    f"units {r.get('units')}, "
                    f"{r.get('status')}{': ' + ', '.join(r['codes']) if r.get('codes') else ''}]"
                    if r["outcome"] in ("probed", "nothing probed") else "")
-                + (f"  — {r['why']}" if r.get("why") else "") for r in rows]
+                + (f"  — {r['why']}" if r.get("why") else "") + _beyond_text(r) for r in rows]
         a.out.write_text("\n".join(body) + "\n\n" + lines[0] + "\n", encoding="utf-8")
     return 0
+
+
+def _beyond_text(r: dict) -> str:
+    b = r.get("beyond") or {}
+    if not b.get("total"):
+        return ""
+    text = (f"\n    beyond sliding: {b['total']} sub-model probe(s), {b['ran']} ran (engine, twin, closed form), "
+            f"{b['failed']} failed, {b['listed']} listed with a reason"
+            + (f"; largest engine − twin {b['engine_vs_twin']:.2g}" if b["ran"] else "")
+            + (f"; traps: {', '.join(b['traps'])}" if b["traps"] else ""))
+    return text + "".join(f"\n      {s}" for s in b["sizes"])
+
+
+def _beyond_totals(rows: list) -> str:
+    with_b = [r for r in rows if (r.get("beyond") or {}).get("total")]
+    tot = {k: sum(r["beyond"][k] for r in with_b) for k in ("total", "ran", "failed", "listed")}
+    codes = sorted({c for r in with_b for c in r["beyond"]["traps"]})
+    ran = sum(r["beyond"]["ran"] > 0 for r in with_b)
+    gap = max((r["beyond"]["engine_vs_twin"] for r in with_b if r["beyond"]["ran"]), default=float("nan"))
+    return (f"  beyond sliding: {len(with_b)} decks set rolling, twisting, adhesion or heat; {ran} of them got a probe "
+            f"that ran; probes {tot['total']}: ran {tot['ran']}, failed {tot['failed']}, listed with a reason "
+            f"{tot['listed']}; largest engine − twin {gap:.2g}; traps: {', '.join(codes) or 'none'}")
 
 
 def report_totals(rows: list, seconds: float, engine_runs: bool) -> str:
@@ -131,6 +168,7 @@ def report_totals(rows: list, seconds: float, engine_runs: bool) -> str:
     by_engine = [r for r in dem if r.get("read_by") == "engine"]
     out.append(f"  DEM decks read by the engine itself: {len(by_engine)} (the others by demcheck's reader: the engine "
                "has no read path there, or its read stopped — each report's read_by says why)")
+    out.append(_beyond_totals(rows))
     out.append(f"  wall time {seconds:.0f} s")
     return "\n".join(out)
 

@@ -32,6 +32,7 @@ from ..laws.tangential import NONE, SPRING, VISCOUS_SLIDING
 from ..engines import registry
 from ..engines.collide import collide, twin_states
 from ..engines.mapping import native_summary, twin_model
+from . import audit_beyond
 from .verdicts import Tolerances, scaled
 
 ANGLES = (0.0, 30.0, 60.0)
@@ -512,9 +513,10 @@ def _fidelity(gap: float, reasons: list) -> str:
 
 
 def audit(path: str | Path, engine: str | None = None, speed: float | None = None, run_engine: bool = True,
-          tol: Tolerances | None = None) -> dict:
+          tol: Tolerances | None = None, beyond_engine: bool | None = None) -> dict:
     """The audit of a deck as a plain dict (the CLI prints it, --json dumps it). ``status``: "clean" (every pair
-    and wall probed or listed with its reason, no trap), "traps", or "not audited" (no probe ran: never clean)."""
+    and wall probed or listed with its reason, no trap), "traps", or "not audited" (no probe ran: never clean).
+    ``beyond_engine``: run the beyond-sliding probes in the engine (default: as ``run_engine``)."""
     from ..engines import discovery
 
     tol = tol or Tolerances.load()
@@ -533,13 +535,14 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             except (ValueError, ArithmeticError) as exc:
                 ps.probe = False
                 ps.notes.append(f"listed, not probed: demcheck has no twin of this setting ({exc})")
-    probed = [ps for ps in setup.pairs if ps.probe]
+    probed = [ps for ps in setup.pairs if ps.probe or ps.beyond]  # the beyond probes spin, roll and hit at v too
     v, v_from = characteristic_speed(setup, speed) if probed else (None, "no pair or wall is probed")
     # the deck names its engine (--engine or its vocabulary): a named engine is required, never skipped
-    info = discovery.require(setup.engine, "the deck") if run_engine and probed else None
+    beyond_engine = run_engine if beyond_engine is None else beyond_engine
+    info = discovery.require(setup.engine, "the deck") if (run_engine or beyond_engine) and probed else None
     pairs, findings = [], list(setup.findings)
     for ps in setup.pairs:
-        entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)))
+        entry, found = _audit_pair(setup, ps, v, run_engine, tol, failed.get(id(ps)), beyond_engine)
         findings += found
         pairs.append(entry)
     _in_si(pairs, deck_script.SI_OF.get(setup.units), v)
@@ -566,7 +569,8 @@ def audit(path: str | Path, engine: str | None = None, speed: float | None = Non
             "coverage": coverage, "traps": len(traps), "status": status, "status_reason": reason}
 
 
-def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dict, list]:
+def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None,
+                beyond_engine: bool = True) -> tuple[dict, list]:
     from ..errors import EngineInterrupted
 
     entry = {"pair": ps.label, "wall": ps.j is None, "where": ps.where, "native": native_summary(ps.native),
@@ -593,7 +597,11 @@ def _audit_pair(setup, ps, v, run_engine, tol, failure: str | None) -> tuple[dic
         measure = getattr(readers()[setup.engine], "measure", None)  # an engine reader's own measured traps
         if measure is not None and run_engine and entry["probes"] and "engine" in entry["probes"][0]:
             found += measure(setup, ps, entry, lambda native: _rerun(setup, ps, native, entry["probes"][0]))
-    entry["probed"] = any("error" not in p and not p.get("failure") for p in entry["probes"])
+    found += audit_beyond.probe_pair(setup, ps, entry, beyond_engine, v,
+                                     getattr(readers()[setup.engine], "BEYOND_PROBES", {}),
+                                     lambda: (_sides(setup, ps), _effective(setup, ps)))
+    entry["probed"] = (any("error" not in p and not p.get("failure") for p in entry["probes"])
+                       or any(r.get("status") == "ok" for r in entry.get("beyond", [])))
     entry["findings"] = [_finding(f) for f in found]
     return entry, found
 
@@ -622,6 +630,9 @@ def _coverage(pairs: list) -> dict:
     for kind, rows in (("pairs", [p for p in pairs if not p["wall"]]), ("walls", [p for p in pairs if p["wall"]])):
         n, k = len(rows), sum(p["probed"] for p in rows)
         out[kind] = {"probed": k, "total": n, "fraction": k / n if n else math.nan}
+    beyond = audit_beyond.coverage(pairs)
+    if beyond["total"]:
+        out["beyond-sliding probes"] = beyond
     return out
 
 
@@ -813,6 +824,7 @@ def text_report(r: dict) -> str:
                          f"stability margin {t['stability_margin']:.3g}×")
         for n in p["notes"]:
             lines.append(f"  note: {n}")
+        lines += audit_beyond.text_lines(p)
         for f in p["findings"]:
             lines.append(f"  {f['kind'].upper()} [{f['code']}]: {f['text']}")
     if r["not_audited"]:

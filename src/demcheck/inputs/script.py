@@ -662,6 +662,9 @@ class PairSetting:
     probe: bool = True  # False: listed, not run (no twin for its law)
     radii: tuple | None = None  # the radii probed (i, j) where a type comes in several sizes; None: the type's own
     size: str = ""  # which of the sizes: smallest, largest, mass-weighted
+    # the sub-models beyond sliding the deck sets on it: slot (rolling, twisting, adhesion, heat) → {"law": the
+    # engine's word, "args": its coefficients, "words": as written}; probed by comparisons/audit_beyond.py
+    beyond: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -691,6 +694,7 @@ class Setup:
     script: object = None  # the Script read (its atom-style formulas and computes, for growth_speed)
     growth: list = field(default_factory=list)  # (every N steps, atom variable, where) of fix adapt … atom diameter
     read_by: str = "demcheck's reader (inputs/script.py)"
+    heat: dict = field(default_factory=dict)  # the deck's heat set-up: capacities per type, conductivities, where
     units_text: str = ""  # the units line as written  # which path read the deck: the engine or the reader
 
 

@@ -23,6 +23,8 @@ TWISTING_ARGS = {"none": 0, "marshall": 0, "sds": 3}
 HEAT_ARGS = {"none": 0, "radius": 1, "area": 1}
 CLASSIC = ("gran/hooke", "gran/hooke/history", "gran/hertz/history")
 PROBED_NORMALS = ("hooke", "hertz", "hertz/material")
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS)
+BEYOND_PROBES = {"rolling": "incline_sds", "twisting": "twist", "adhesion": "pull_off", "heat": "held_pair"}
 DEFAULT = True  # a LAMMPS-family deck that no other reader claims is read as LAMMPS's
 
 QUIET_FIXES = frozenset({"nve/sphere", "gravity", "print", "ave/time", "ave/atom", "enforce2d", "balance",
@@ -264,9 +266,7 @@ def read(script, root: Path) -> Setup:
     setup = Setup("lammps")
     setup.regions = script.regions
     explicit: dict = {}  # (i, j) i ≤ j → (spec, where)
-    style_cmd = None
-    classic_spec = None
-    classic_name = None
+    style_cmd = classic_spec = classic_name = None
     walls = []  # (spec, where, notes)
     for cmd in script.commands:
         w, name = cmd.words, cmd.name
@@ -330,7 +330,7 @@ def read(script, root: Path) -> Setup:
                 notes.append(f"fix group '{w[2]}': probed with every type")
             walls.append((spec, cmd.where(), notes, cmd, w[1]))
             continue
-        note_unread(setup, cmd, QUIET_FIXES)
+        _other(cmd, setup)
     if style_cmd is None:
         raise ScriptError("the deck has no pair_style: nothing defines its contacts")
     finish(setup, "LAMMPS's default")
@@ -355,9 +355,10 @@ def _static(ps: PairSetting, spec: dict, where: str) -> None:
     if spec["normal"] not in PROBED_NORMALS:
         ps.probe = False
         ps.notes.append(f"normal {spec['normal']}: listed, not probed (no twin of this law in demcheck)")
+    ps.beyond = beyond_of(spec)
     if spec.get("rolling", "none") != "none" or spec.get("twisting", "none") != "none":
-        ps.notes.append("rolling/twisting resistance: not part of the probes (the twin has none); the probes run "
-                        "without it")
+        ps.notes.append("rolling/twisting resistance: the collision probes run without it; its own probes below "
+                        "(comparisons/audit_beyond.py)")
     for extra in spec.get("extras", []):
         ps.notes.append(f"{extra}: not part of the probes")
     if spec["damping"] == "tsuji":
@@ -369,6 +370,48 @@ def _static(ps: PairSetting, spec: dict, where: str) -> None:
     if spec["damping"] == "viscoelastic" and spec["normal"] in PROBED_NORMALS:
         ps.notes.append("damping viscoelastic (the default when no damping is given): the 2nd coefficient is η0 "
                         "in 1/(s·m), not a restitution; e then depends on the speed")
+
+
+def beyond_of(spec: dict, other: dict | None = None) -> dict:
+    """The sub-models beyond sliding of a parsed granular spec: slot → {law, args, words} (rolling sds, twisting
+    sds/marshall, heat radius/area; adhesion the jkr/dmt normal model: args E, η, ν, γ). ``other``: the second
+    type's spec of an auto-mixed pair (LAMMPS mixes every sub-model coefficient by its geometric mean)."""
+    out = {}
+    for slot in ("rolling", "twisting", "heat"):
+        law = spec.get(slot, "none")
+        if law != "none":
+            args = tuple(spec.get(f"{slot}_coeffs") or ())
+            if other is not None and other.get(slot) == law:
+                args = tuple(math.sqrt(x * y) for x, y in zip(args, other.get(f"{slot}_coeffs") or ()))
+            out[slot] = {"law": law, "args": args, "words": " ".join([slot, law, *(f"{x:g}" for x in args)])}
+    if spec["normal"] in ("jkr", "dmt"):
+        args = tuple(spec["normal_coeffs"])
+        out["adhesion"] = {"law": spec["normal"], "args": args,
+                           "words": " ".join([spec["normal"], *(f"{x:g}" for x in args)])}
+    return out
+
+
+def heat_flow(cmd: Command, setup: Setup) -> None:
+    """``fix ID group heat/flow constant cp`` or ``type cp1 … cpN``: the specific heat per type (the heat probe's
+    capacities)."""
+    w = cmd.words
+    if w[4:5] == ["constant"] and len(w) > 5:
+        cp = _num(cmd, 5, "heat/flow cp")
+        setup.heat["cp"] = {t: cp for t in range(1, max(setup.ntypes, 1) + 1)}
+        setup.heat["cp_all"] = cp
+    elif w[4:5] == ["type"]:
+        setup.heat["cp"] = {t: _num(cmd, 4 + t, f"heat/flow cp of type {t}") for t in range(1, len(w) - 4)}
+    else:
+        raise _bad(cmd, "fix heat/flow takes constant cp or type cp1 … cpN")
+    setup.heat["where"] = cmd.where()
+
+
+def _other(cmd: Command, setup: Setup) -> None:
+    """A command the contact reading does not take: fix heat/flow (the heat probe's capacities), else listed."""
+    if cmd.name == "fix" and len(cmd.words) > 4 and cmd.words[3] == "heat/flow":
+        heat_flow(cmd, setup)
+    else:
+        note_unread(setup, cmd, QUIET_FIXES)
 
 
 def _pairs(setup: Setup, types: list[int], explicit: dict) -> None:
@@ -401,6 +444,7 @@ def _pairs(setup: Setup, types: list[int], explicit: dict) -> None:
                 asked["friction"] = nat.tangential_args[-1]
             ps = PairSetting(f"{a}-{b}", a, b, nat, where, asked, intended=intended, notes=notes)
             _static(ps, sa, where)
+            ps.beyond = beyond_of(sa, sb)
             if sa["normal_coeffs"] != sb["normal_coeffs"] or sa["tangential_coeffs"] != sb["tangential_coeffs"]:
                 ps.notes.append("auto-mixed coefficients: E* as Hertz mixes it, every other one by its geometric "
                                 "mean (write pair_coeff for the pair to choose them)"
@@ -585,6 +629,9 @@ def to_si(setup) -> None:
         b.mass = None if b.mass is None else b.mass * mass
         b.sizes = [(r * length, w) for r, w in b.sizes]
     for ps in setup.pairs:
+        for sub in ps.beyond.values():  # its coefficients stay in the style's units: listed, never probed in SI
+            sub["refused"] = (f"units {style}: the sub-model's coefficients are not converted to SI for a probe "
+                              "(the collision probes' are)")
         ps.native = _native_si(ps.native, length, mass, time, force)
         if ps.intended is not None:
             ps.intended = _native_si(ps.intended, length, mass, time, force)

@@ -220,8 +220,8 @@ def _box(case: Case, lay):
     pos = np.array(lay.positions, dtype=float)
     size = 4.0 * max(p.radius for p in case.particles)
     lo, hi = pos.min(axis=0) - size, pos.max(axis=0) + size
-    if case.run.scenario in ("rolling", "incline"):
-        v = np.abs(np.array(lay.velocities[0]))
+    if case.run.scenario in ("rolling", "incline", "adhesive_impact"):  # a rebound's travel too (a soft, slow contact)
+        v = np.abs(np.array(lay.velocities[-1]))
         reach = float(v.max()) * lay.dt * lay.steps + 20.0 * size
         lo, hi = lo - reach, hi + reach
     return lo, hi

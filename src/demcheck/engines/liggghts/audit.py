@@ -159,7 +159,7 @@ def read(script, root: Path) -> Setup:
         elif style_name.startswith("insert"):
             _insert(cmd, w, setup, templates, distributions)
         else:
-            note_unread(setup, cmd, QUIET_FIXES)
+            _other(cmd, setup, style_name)
     if style is None:
         raise ScriptError("the deck has no pair_style gran: nothing defines its contacts")
     finish(setup, "the default")
@@ -176,6 +176,7 @@ def read(script, root: Path) -> Setup:
         for b in types:
             if b >= a:
                 setup.pairs.append(_pair(setup, spec, where, props, a, b, f"{a}-{b}"))
+    _heat(setup, props)  # on the particle pairs
     for wspec, t_wall, fix_id, wwhere, what in walls:
         for t in types:
             ps = _pair(setup, wspec, wwhere, props, t, t_wall, f"wall {fix_id} × {t}")
@@ -187,6 +188,14 @@ def read(script, root: Path) -> Setup:
                                 "curvature and edges are not probed")
             setup.pairs.append(ps)
     return setup
+
+
+def _other(cmd, setup, style_name: str) -> None:
+    """A command the contact reading does not take: fix heat/gran[/conduction] (the heat probe's), else listed."""
+    if style_name in ("heat/gran", "heat/gran/conduction"):
+        setup.heat.update(fix=style_name, where=cmd.where())
+    else:
+        note_unread(setup, cmd, QUIET_FIXES)
 
 
 def _wall(cmd, w, setup, walls, meshes) -> None:
@@ -397,10 +406,15 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
     if model not in MODELS or tang == "tan_luding":
         ps.probe = False
         notes.append(f"model {model} / tangential {tang}: listed, not probed (no twin of it in demcheck)")
-    if spec["rolling"] != "off":
-        notes.append(f"rolling_friction {spec['rolling']}: not part of the probes (the twin has none)")
-    if spec["cohesion"] != "off":
-        notes.append(f"cohesion {spec['cohesion']}: not part of the probes (the twin has none)")
+    ps.beyond = _beyond(spec, props, a, b)
+    for key, word, prop in (("rolling", "rolling_friction", "coefficientRollingFriction"),
+                            ("cohesion", "cohesion", "cohesionEnergyDensity")):
+        if spec[key] == "off" and prop in props:
+            notes.append(f"{prop} is set ({props[prop][2]}) but the style has no {word} model: LIGGGHTS applies "
+                         "none, and none is probed")
+        if spec[key] != "off":
+            notes.append(f"{word} {spec[key]}: the collision probes run without it; its own probe is audit's "
+                         "beyond-sliding probe (comparisons/audit_beyond.py)")
     if not flags.get("tangential_damping", True) and tang != "off":
         notes.append("tangential_damping off: no tangential dashpot (the seed's TTIt has one); the probes run "
                      "without it")
@@ -408,6 +422,45 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
         findings.append(Finding("trap", "limit", "limitForce on: the normal force is held ≥ 0, which raises the "
                                 "restitution above coefficientRestitution", where))
     return ps
+
+
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS)
+BEYOND_PROBES = {"rolling": "rolling_cdt_epsd3", "adhesion": "sjkr_listed", "heat": "held_pair"}
+ROLLING_PROPS = ("coefficientRollingFriction", "rollingStiffness", "coefficientRollingViscousDamping")
+
+
+def _beyond(spec: dict, props: dict, a: int, b: int) -> dict:
+    """The sub-models beyond sliding of a pair (or wall) style: rolling_friction with its property/global values
+    (coefficientRollingFriction, rollingStiffness, coefficientRollingViscousDamping: None where the deck has none),
+    cohesion sjkr/sjkr2 with cohesionEnergyDensity (comparisons/audit_beyond.py probes them)."""
+    out = {}
+    if spec["rolling"] != "off":
+        args = tuple(_pair_value(props, n, a, b) for n in ROLLING_PROPS)
+        out["rolling"] = {"law": spec["rolling"], "args": args,
+                          "words": f"rolling_friction {spec['rolling']} (" + ", ".join(
+                              f"{n} {v:g}" for n, v in zip(ROLLING_PROPS, args) if v is not None) + ")"}
+    if spec["cohesion"] != "off":
+        kc = _pair_value(props, "cohesionEnergyDensity", a, b)
+        out["adhesion"] = {"law": spec["cohesion"], "args": (kc,),
+                           "words": f"cohesion {spec['cohesion']} (cohesionEnergyDensity "
+                                    + ("not set" if kc is None else f"{kc:g}") + ")"}
+    return out
+
+
+def _heat(setup: Setup, props: dict) -> None:
+    """fix heat/gran[/conduction]: the conductivities and capacities per type it reads (property/global
+    thermalConductivity, thermalCapacity), kept for the heat probe of each pair."""
+    if not setup.heat:
+        return
+    for name, key in (("thermalConductivity", "k"), ("thermalCapacity", "cp")):
+        if name in props:
+            kind, values, _ = props[name]
+            setup.heat[key] = {t: v for t, v in enumerate(values, 1)} if kind == "peratomtype" else {}
+            if kind == "scalar":
+                setup.heat[f"{key}_all"] = values[0]
+    for ps in setup.pairs:  # the particle pairs (a wall conducts only with its own temperature set)
+        ps.beyond["heat"] = {"law": "lens", "args": (), "words": f"fix {setup.heat['fix']} "
+                             f"({setup.heat['where']}; thermalConductivity and thermalCapacity per type)"}
 
 
 # ----------------------------------------------------------------------------- reverse lookup
