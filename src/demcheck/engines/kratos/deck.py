@@ -12,7 +12,10 @@ Kratos has initialised, the bodies' velocities and spins, and writes every step'
 
 :func:`check` is the last guard before Kratos runs: the script must be the template line for line (comment
 lines before it allowed), its CASE a literal of known keys and numbers; the JSON files only known keys with
-numbers, booleans or known strings; the .mdpa files only the lines demcheck writes.
+numbers, booleans or known strings; the .mdpa files only the lines demcheck writes. The scenarios' decks
+(engines/kratos/scenario.py) are this deck with their layout's bodies and length, a cohesive law with the
+relation's PARTICLE_COHESION, and for a pull :data:`PULL_TEMPLATE` (the template with body velocities Kratos holds
+fixed, from the CASE line's ``fixed``).
 """
 
 from __future__ import annotations
@@ -134,15 +137,20 @@ def _case_literal(steps: int, bodies: list, gamma: list, fixed: list | None = No
     return f"CASE = {{'steps': {int(steps)}, 'bodies': [{b}], 'gamma': [{g}], 'fixed': [{h}]}}"
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
-    """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
-    model). One copy of the collision only (no batched copies)."""
+def _check_options(options: dict) -> None:
+    """``copies`` (1 only); a scenario's ``steps`` and ``fixed`` (engines/kratos/scenario.py)."""
     if options.get("copies", 1) != 1:
-        from ...errors import UnsupportedByEngine
-
         raise UnsupportedByEngine("Kratos decks are written for one copy of a collision")
     if set(options) - {"copies", "steps", "fixed"}:
         raise TypeError(f"unknown deck options {sorted(set(options) - {'copies', 'steps', 'fixed'})}")
+
+
+def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
+    """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
+    model). One copy of the collision only (no batched copies). A scenario's (engines/kratos/scenario.py):
+    ``steps`` its layout's length (the bodies where its case puts them), ``fixed`` the pull's held velocities
+    (PULL_TEMPLATE)."""
+    _check_options(options)
     fixed = options.get("fixed")
     sc = common.scene(case, dt, length) if options.get("steps") is None else _scenario_scene(case, dt, options["steps"])
     mp = contact_mapping(case, "kratos", native)
@@ -224,17 +232,21 @@ _f = common.float_literal
 
 def _scenario_scene(case: Case, dt: float, steps: int):
     """A scenario's scene (engines/kratos/scenario.py): its layout's step and length, the bodies where the layout
-    put them (they need not meet: a pull), no wall."""
+    put them (they need not meet: a pull, a sphere resting on its wall), a box 40 radii around them."""
     import numpy as np
 
     from ...laws.model import resolve
 
-    if case.walls:
-        raise UnsupportedByEngine("Kratos scenario decks are written for two bodies without a wall")
     pos = np.array([p.position for p in case.particles], dtype=float)
-    reach = 4.0 * max(p.radius for p in case.particles)
-    return common.Scene(case, resolve(case), float(dt), int(steps), (pos.min(axis=0) - reach, pos.max(axis=0) + reach),
-                        None, None, None)
+    reach = 40.0 * max(p.radius for p in case.particles)
+    lo, hi = pos.min(axis=0) - reach, pos.max(axis=0) + reach
+    axis = side = wpos = None
+    if case.walls:
+        if len(case.walls) > 1:
+            raise UnsupportedByEngine("Kratos scenario decks are written for one wall")
+        axis, side = common.wall_axis(case.walls[0], 0)
+        wpos = float(case.walls[0].point[axis])
+    return common.Scene(case, resolve(case), float(dt), int(steps), (lo, hi), axis, side, wpos)
 
 
 def _spheres_mdpa(case: Case) -> str:
