@@ -132,6 +132,12 @@ def test_the_pull_deck_is_checked_before_it_runs():
     d = scenario.deck(case("pull-off"), "kratos")
     check(d.text, d.files)
     assert "'fixed': [[1, [0.0, 0.0, 0.0]], [2, [" in d.text
-    assert '"PARTICLE_COHESION": 0.05' in d.files["MaterialsDEM.json"]
+    import json
+
+    mats = json.loads(d.files["MaterialsDEM.json"])  # w on the relation: Kratos reads it there (not the materials)
+    assert [r["Variables"]["PARTICLE_COHESION"] for r in mats["material_relations"]] == [0.05] * 3
+    assert not any("PARTICLE_COHESION" in m["Variables"] for m in mats["materials"])
+    assert {r["Variables"]["DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME"] for r in mats["material_relations"]} == {
+        "DEM_D_Hertz_viscous_Coulomb_JKR"}
     with pytest.raises(UnsupportedByEngine, match="held velocities"):
         check(d.text.replace("'fixed': [[1,", "'fixed': [[7,"), d.files)
