@@ -144,7 +144,7 @@ def layout(case: Case, laws: dict) -> Layout:
     model = resolve(case)
     r0, r1 = (p.radius for p in case.particles)
     if s == "pull_off":
-        scale = overlap_scale(case)
+        scale = laws.get("pull_scale") or overlap_scale(case)  # an engine's law may pull from further in
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
         # from δ = scale + half a step: no sample lands on δ = 0, where DMT and sjkr let go and round-off would
@@ -237,6 +237,8 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
     """The scenario stepped with ``laws`` (normal, fcrit, tangential, rolling, twisting, adhesion, heat) at the
     layout's step: the run reference/scenarios.stepped_metrics reads."""
     s = case.run.scenario
+    if "step" in laws:  # an engine's own stepping of its laws (Kratos: reference/beyond_kratos.py)
+        return laws["step"](case, lay)
     if s in WALL:
         mass, radius = case.mass(0), case.particles[0].radius
         w = case.walls[0]

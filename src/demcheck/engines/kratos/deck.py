@@ -12,7 +12,10 @@ Kratos has initialised, the bodies' velocities and spins, and writes every step'
 
 :func:`check` is the last guard before Kratos runs: the script must be the template line for line (comment
 lines before it allowed), its CASE a literal of known keys and numbers; the JSON files only known keys with
-numbers, booleans or known strings; the .mdpa files only the lines demcheck writes.
+numbers, booleans or known strings; the .mdpa files only the lines demcheck writes. The scenarios' decks
+(engines/kratos/scenario.py) are this deck with their layout's bodies and length, a cohesive law with the
+relation's PARTICLE_COHESION, and for a pull :data:`PULL_TEMPLATE` (the template with body velocities Kratos holds
+fixed, from the CASE line's ``fixed``).
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ PROBLEM = "case"
 FILES = ("ProjectParameters.json", "MaterialsDEM.json", f"{PROBLEM}DEM.mdpa", f"{PROBLEM}DEM_FEM_boundary.mdpa")
 CASE_LINE = "CASE = None"
 CASE_KEYS = {"steps": int, "bodies": list, "gamma": list}
+PULL_KEYS = {**CASE_KEYS, "fixed": list}
 
 TEMPLATE = r'''
 import json
@@ -104,8 +108,20 @@ DemcheckRun(K.Model(), parameters).Run()
 '''
 
 
-def _case_literal(steps: int, bodies: list, gamma: list) -> str:
-    """The runner's data line: numbers only, each written with repr (float → shortest exact text)."""
+# the pull's runner (scenario pull_off): the template with each ``fixed`` body's velocity held by Kratos (its
+# velocity degrees of freedom fixed at the given values after the bodies are set)
+PULL_LINES = """        for body in CASE["fixed"]:
+            node = self.spheres_model_part.GetNode(body[0])
+            for var, value in zip((K.VELOCITY_X, K.VELOCITY_Y, K.VELOCITY_Z), body[1]):
+                node.Fix(var)
+                node.SetSolutionStepValue(var, value)
+"""
+PULL_TEMPLATE = TEMPLATE.replace("        self.demcheck_step = 0\n", PULL_LINES + "        self.demcheck_step = 0\n", 1)
+COHESIVE = ("DEM_D_Hertz_viscous_Coulomb_JKR", "DEM_D_Hertz_viscous_Coulomb_DMT")  # the scenarios' adhesive laws
+
+def _case_literal(steps: int, bodies: list, gamma: list, fixed: list | None = None) -> str:
+    """The runner's data line: numbers only, each written with repr (float → shortest exact text); ``fixed``
+    (the pull's template only): [node id, [vx, vy, vz]] of each body whose velocity Kratos holds."""
     def num(x):
         x = float(x)
         if not math.isfinite(x):
@@ -115,19 +131,28 @@ def _case_literal(steps: int, bodies: list, gamma: list) -> str:
     b = ", ".join(f"[{num(r)}, [{', '.join(num(c) for c in v)}], [{', '.join(num(c) for c in w)}]]"
                   for r, v, w in bodies)
     g = ", ".join(f"[{int(i)}, {int(j)}, {num(x)}]" for i, j, x in gamma)
-    return f"CASE = {{'steps': {int(steps)}, 'bodies': [{b}], 'gamma': [{g}]}}"
+    if fixed is None:
+        return f"CASE = {{'steps': {int(steps)}, 'bodies': [{b}], 'gamma': [{g}]}}"
+    h = ", ".join(f"[{int(i)}, [{', '.join(num(c) for c in v)}]]" for i, v in fixed)
+    return f"CASE = {{'steps': {int(steps)}, 'bodies': [{b}], 'gamma': [{g}], 'fixed': [{h}]}}"
+
+
+def _check_options(options: dict) -> None:
+    """``copies`` (1 only); a scenario's ``steps`` and ``fixed`` (engines/kratos/scenario.py)."""
+    if options.get("copies", 1) != 1:
+        raise UnsupportedByEngine("Kratos decks are written for one copy of a collision")
+    if set(options) - {"copies", "steps", "fixed"}:
+        raise TypeError(f"unknown deck options {sorted(set(options) - {'copies', 'steps', 'fixed'})}")
 
 
 def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
     """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
-    model). One copy of the collision only (no batched copies)."""
-    if options.get("copies", 1) != 1:
-        from ...errors import UnsupportedByEngine
-
-        raise UnsupportedByEngine("Kratos decks are written for one copy of a collision")
-    if set(options) - {"copies"}:
-        raise TypeError(f"unknown deck options {sorted(set(options) - {'copies'})}")
-    sc = common.scene(case, dt, length)
+    model). One copy of the collision only (no batched copies). A scenario's (engines/kratos/scenario.py):
+    ``steps`` its layout's length (the bodies where its case puts them), ``fixed`` the pull's held velocities
+    (PULL_TEMPLATE)."""
+    _check_options(options)
+    fixed = options.get("fixed")
+    sc = common.scene(case, dt, length) if options.get("steps") is None else _scenario_scene(case, dt, options["steps"])
     mp = contact_mapping(case, "kratos", native)
     nat = mp.require()
     n = len(case.particles)
@@ -156,7 +181,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
     bodies = [(p.radius, p.velocity, p.angular_velocity) for p in case.particles]
     lines = common.header("kratos", sc, mp, VERSION_NOTE, "python") + common.notes(nat.comments)
     lines.append(common.comment(f"time scheme {SCHEME}; files read: {', '.join(FILES)}"))
-    text = "\n".join(lines) + "\n" + TEMPLATE.replace(CASE_LINE, _case_literal(sc.steps, bodies, gamma), 1)
+    data = _case_literal(sc.steps, bodies, gamma, fixed)
+    text = "\n".join(lines) + "\n" + (TEMPLATE if fixed is None else PULL_TEMPLATE).replace(CASE_LINE, data, 1)
     g = list(case.run.gravity)
     params = {
         "Dimension": 3, "PeriodicDomainOption": False, "BoundingBoxOption": False, "dem_inlet_option": False,
@@ -179,6 +205,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
                 "DEM_ROLLING_FRICTION_MODEL_NAME": "DEMRollingFrictionModelBounded"}
     if nat.normal == CUSTOM:  # its Kn, Kt are the contact's (the relation's) K_NORMAL, K_TANGENTIAL
         relation.update(K_NORMAL=float(nat.props["k_normal"]), K_TANGENTIAL=float(nat.props["k_tangential"]))
+    if nat.normal in COHESIVE:  # the cohesive laws read the relation's PARTICLE_COHESION (w, J/m²)
+        relation["PARTICLE_COHESION"] = float(nat.props["cohesion"])
     materials = [{"material_name": f"particle{k + 1}", "material_id": k + 1,
                   "Variables": {"PARTICLE_DENSITY": float(mats[k].density), "YOUNG_MODULUS": float(youngs[k]),
                                 "POISSON_RATIO": float(nus[k])}} for k in range(n)]
@@ -200,6 +228,25 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
 
 
 _f = common.float_literal
+
+
+def _scenario_scene(case: Case, dt: float, steps: int):
+    """A scenario's scene (engines/kratos/scenario.py): its layout's step and length, the bodies where the layout
+    put them (they need not meet: a pull, a sphere resting on its wall), a box 40 radii around them."""
+    import numpy as np
+
+    from ...laws.model import resolve
+
+    pos = np.array([p.position for p in case.particles], dtype=float)
+    reach = 40.0 * max(p.radius for p in case.particles)
+    lo, hi = pos.min(axis=0) - reach, pos.max(axis=0) + reach
+    axis = side = wpos = None
+    if case.walls:
+        if len(case.walls) > 1:
+            raise UnsupportedByEngine("Kratos scenario decks are written for one wall")
+        axis, side = common.wall_axis(case.walls[0], 0)
+        wpos = float(case.walls[0].point[axis])
+    return common.Scene(case, resolve(case), float(dt), int(steps), (lo, hi), axis, side, wpos)
 
 
 def _spheres_mdpa(case: Case) -> str:
@@ -255,7 +302,7 @@ def _refuse(what: str, why: str):
     raise UnsupportedByEngine(f"refusing to run a Kratos deck: {what} {why}")
 
 
-def _check_case(line: str) -> None:
+def _check_case(line: str, keys: dict = CASE_KEYS) -> None:
     if not line.startswith("CASE = "):
         _refuse("its data line", "is not 'CASE = {...}'")
     try:
@@ -273,10 +320,10 @@ def _check_case(line: str) -> None:
                                                   and type(node.operand.value) in (int, float)):
             _refuse("its data line", "negates something other than a number")
     value = ast.literal_eval(tree)
-    if not isinstance(value, dict) or set(value) != set(CASE_KEYS):
-        _refuse("its data line", f"must have exactly the keys {sorted(CASE_KEYS)}")
+    if not isinstance(value, dict) or set(value) != set(keys):
+        _refuse("its data line", f"must have exactly the keys {sorted(keys)}")
     strings = [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
-    if sorted(strings) != sorted(CASE_KEYS):
+    if sorted(strings) != sorted(keys):
         _refuse("its data line", "holds a string that is not one of its keys")
     if not isinstance(value["steps"], int) or value["steps"] < 0:
         _refuse("its data line", "has a step count that is not a whole number ≥ 0")
@@ -293,6 +340,9 @@ def _check_case(line: str) -> None:
     if not all(isinstance(g, list) and len(g) == 3 and type(g[0]) is int and type(g[1]) is int and num(g[2])
                for g in value["gamma"]):
         _refuse("its data line", "has damping entries that are not [property id, property id, number]")
+    if not all(isinstance(f, list) and len(f) == 2 and type(f[0]) is int and 1 <= f[0] <= len(value["bodies"])
+               and vec(f[1]) for f in value.get("fixed", [])):
+        _refuse("its data line", "has held velocities that are not [body id, [3 numbers]]")
 
 
 def check(text: str, files: dict | None = None) -> None:
@@ -312,12 +362,14 @@ def check(text: str, files: dict | None = None) -> None:
             _refuse(f"line {k + 1}", "is a comment with characters that are not printable")
         k += 1
     body = lines[k:]
-    template = TEMPLATE.split("\n")
+    # the collision's template, or the pull's (its line count differs: PULL_LINES)
+    pull = len(body) == len(PULL_TEMPLATE.split("\n"))
+    template = (PULL_TEMPLATE if pull else TEMPLATE).split("\n")
     if len(body) != len(template):
         _refuse("its script", "is not demcheck's runner template (line count)")
     for no, (got, want) in enumerate(zip(body, template), start=k + 1):
         if want == CASE_LINE:
-            _check_case(got)
+            _check_case(got, PULL_KEYS if pull else CASE_KEYS)
         elif got != want:
             _refuse(f"line {no}", f"differs from demcheck's runner template: {got[:60]!r}")
     files = files or {}
@@ -341,10 +393,10 @@ PARAMETER_KEYS = frozenset({
     "material_names_list", "material_ids_list", "PARTICLE_DENSITY", "YOUNG_MODULUS", "POISSON_RATIO",
     "STATIC_FRICTION", "DYNAMIC_FRICTION", "FRICTION_DECAY", "ROLLING_FRICTION", "ROLLING_FRICTION_WITH_WALLS",
     "COEFFICIENT_OF_RESTITUTION", "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME", "DEM_ROLLING_FRICTION_MODEL_NAME",
-    "K_NORMAL", "K_TANGENTIAL"})
+    "K_NORMAL", "K_TANGENTIAL", "PARTICLE_COHESION"})
 KNOWN_STRINGS = frozenset({"sphere_strategy", "MaterialsDEM.json", "Ascii", "single_file", "SphericPartDEMElement3D",
                            SCHEME, "Direct_Integration", PROBLEM, "DEMRollingFrictionModelBounded", "wall",
-                           *LAWS})
+                           *LAWS, *COHESIVE})
 NAME = re.compile(r"particle[0-9]{1,3}|SpheresPart\.Body[0-9]{1,3}|RigidFacePart\.Wall")
 
 

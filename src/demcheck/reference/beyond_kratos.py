@@ -1,0 +1,77 @@
+"""Kratos DEM 10.4.4's adhesive laws in the scenarios beyond sliding, stepped as Kratos steps them (the twin of
+engines/kratos/scenario.py).
+
+What Kratos computes (read in applications/DEMApplication/custom_constitutive/DEM_D_JKR_cohesive_law.cpp,
+DEM_D_DMT_cohesive_law.cpp, DEM_compound_constitutive_law.h, DEM_D_Hertz_viscous_Coulomb_CL.cpp, and checked
+against runs: tests/test_scenarios_kratos.py): ``DEM_D_Hertz_viscous_Coulomb_JKR`` and ``…_DMT`` are the Hertz law
+(F_e = (4/3)E*√R̄ δ^{3/2}, its dashpot, the sum held ≥ 0) with a cohesive force subtracted, both only while the
+overlap δ is positive (the contact exists for δ > 0 only: no neck, no hysteresis):
+
+* JKR: F_c = √(8π w E* a³) with the Hertz contact radius a = √(R̄δ) (not JKR's own a, which solves
+  a²/R̄ − √(2πwa/E*) = δ); w = the relation's PARTICLE_COHESION;
+* DMT: F_c = 2π w R̄, constant while δ > 0 — the seed's DMT law itself.
+
+The scheme is the deck's Velocity_Verlet (x += v dt + ½a dt², v += ½a dt; forces; v += ½a dt), as
+engines/kratos/deck.py writes it; a pull is Kratos with both bodies' velocities fixed (body 0 at rest, body 1 at
+the pull speed): x advances by v·dt each step, and the force is the law's at each step's overlap.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+JKR, DMT = "jkr", "dmt"
+
+
+def kratos_adhesive_force(kind: str, r_eff: float, e_eff: float, w: float, delta: float) -> float:
+    """The normal force (> 0 repulsive) of Kratos' Hertz_viscous_Coulomb_JKR/_DMT without damping at overlap δ:
+    0 unless δ > 0."""
+    if not delta > 0.0:
+        return 0.0
+    elastic = 4.0 / 3.0 * e_eff * math.sqrt(r_eff) * delta ** 1.5
+    if kind == JKR:
+        a = math.sqrt(r_eff * delta)
+        return elastic - math.sqrt(8.0 * w * math.pi * a * a * a * e_eff)
+    return elastic - 2.0 * math.pi * w * r_eff
+
+
+def pair_impact(force, radius: float, mass: float, x1: float, v1: float, dt: float, steps: int) -> dict:
+    """Body 0 at rest at the origin, body 1 (like it) at x1 moving at v1 along x, ``force(δ)`` between them,
+    stepped by velocity Verlet (Kratos' Velocity_Verlet): the separation speed v1 − v0 and whether the
+    contact is closed at the end (adhesive_impact's ``v_rel`` and ``touching``)."""
+    x = np.array([0.0, float(x1)])
+    v = np.array([0.0, float(v1)])
+
+    def f_on_1():
+        return force(2.0 * radius - (x[1] - x[0]))
+
+    f = f_on_1()
+    for _ in range(steps):
+        a = np.array([-f, f]) / mass
+        x += v * dt + 0.5 * a * dt * dt
+        v += 0.5 * a * dt
+        f = f_on_1()
+        v += 0.5 * np.array([-f, f]) / mass * dt
+    return {"v_rel": float(v[1] - v[0]), "touching": bool(f != 0.0)}
+
+
+def pull(force, r_sum: float, x1: float, speed: float, dt: float, steps: int) -> dict:
+    """Body 1 moved from x1 at ``speed`` (its displacement += v·dt each step, x = x1 + displacement), body 0 held at the origin: the overlap and the
+    force at each step (pull_off's ``delta`` and ``fn``)."""
+    disp, deltas, forces = 0.0, [], []
+    for k in range(steps + 1):
+        if k:
+            disp += speed * dt  # Kratos: DISPLACEMENT += v·dt, x = X0 + DISPLACEMENT
+        d = r_sum - (float(x1) + disp)
+        deltas.append(d)
+        forces.append(force(d))
+    return {"delta": np.array(deltas), "fn": np.array(forces)}
+
+
+def jkr_hertz_radius_pull_off(r_eff: float, e_eff: float, w: float) -> tuple[float, float]:
+    """(largest tension, overlap where it acts) of the JKR law with the Hertz radius, by dF/dδ = 0:
+    2E*√R̄ δ^{1/2} = (3/4)√(8πwE*) R̄^{3/4} δ^{−1/4} ⇒ δ* = ((3/8)√(8πw/E*) R̄^{1/4})^{4/3}."""
+    d = (0.375 * math.sqrt(8.0 * math.pi * w / e_eff) * r_eff ** 0.25) ** (4.0 / 3.0)
+    return -kratos_adhesive_force(JKR, r_eff, e_eff, w, d), d
