@@ -35,3 +35,16 @@ def pytest_collection_modifyitems(config, items):
 @pytest.fixture
 def glass_pair():
     return CASES / "glass-pair.toml"
+
+
+@pytest.fixture(autouse=True)
+def _results_of_this_test_only(monkeypatch):
+    """What demcheck computes itself is cached under a fingerprint of its source (comparisons/result_cache.py). A
+    test that plants a fault in that code at run time (monkeypatch) changes no source file: it must not read a
+    result another test stored. Each test gets a fingerprint of its own (its results are its own, cold then warm
+    within it); tests/test_result_cache.py sets its own where it needs to."""
+    import uuid
+
+    from demcheck.comparisons import result_cache
+
+    monkeypatch.setattr(result_cache, "code_fingerprint", lambda tag=f"test-{uuid.uuid4().hex[:12]}": tag)

@@ -69,7 +69,14 @@ def test_a_local_cluster_gives_the_verdicts_of_one_process(tmp_path):
 
 
 @pytest.mark.engine("lammps")
-def test_a_local_cluster_runs_lammps_and_the_client_stores_its_runs(tmp_path):
+def test_a_local_cluster_runs_lammps_and_the_client_stores_its_runs(tmp_path, monkeypatch):
+    from demcheck.comparisons import result_cache
+    from demcheck.engines import cache as cache_mod
+
+    # the reference's results too (comparisons/result_cache.py): keyed by the source's own fingerprint, as the
+    # workers (other processes) key theirs
+    monkeypatch.setattr(result_cache, "code_fingerprint", cache_mod.code_fingerprint)
+
     def run(jobs, where):
         opts = suite.Options(engines=("lammps",), jobs=jobs, cache=Cache(tmp_path / where))
         return suite.run_suite(SMALL, tmp_path / f"r-{where}", opts, quiet=True)

@@ -21,7 +21,7 @@ OBLIQUE = "suite/oblique-lth.toml"
 
 
 def _same_tables(a, b):
-    for name in ("contact", "particles", "events"):
+    for name in result_cache.KEPT:
         ta, tb = a.table(name), b.table(name)
         assert (ta is None) == (tb is None), name
         if ta is None:
@@ -41,6 +41,7 @@ def test_a_stored_result_reads_back_as_the_same_arrays_and_fields(tmp_path, sour
     assert result_cache.store(cache, k, res)
     back = result_cache.load(cache, k)
     _same_tables(res, back)
+    assert res.table("particles") is not None and back.table("particles") is None  # verify does not read them
     for f in result_cache.FIELDS:
         assert getattr(back, f) == getattr(res, f), f
     assert back.metrics() == res.metrics()
@@ -67,10 +68,14 @@ def test_a_warm_suite_case_solves_nothing_and_gives_the_same_entry(tmp_path, mon
     files = [case_path(OBLIQUE), case_path("suite/normal-hertz-pair.toml"), case_path("suite/beyond-twist.toml")]
     cold = _entries(files, Cache(tmp_path))
 
-    def no_solve(*a, **k):
-        raise AssertionError("solved although cached")
+    real = sources.Source.run
 
-    monkeypatch.setattr(sources.Source, "run", no_solve)
+    def no_adaptive_solve(self, case, *a, **k):
+        if self is sources.ADAPTIVE:
+            raise AssertionError("solved although cached")
+        return real(self, case, *a, **k)  # the verlet method (0.2 ms of kernel) is run again, not stored
+
+    monkeypatch.setattr(sources.Source, "run", no_adaptive_solve)
     warm_cache = Cache(tmp_path)
     warm = _entries(files, warm_cache)
     assert warm_cache.misses == 0 and warm_cache.hits > 0
@@ -153,3 +158,23 @@ def test_a_scenario_solve_with_values_that_are_not_finite_in_its_fields_reads_ba
     for f in result_cache.FIELDS:
         assert json.dumps(getattr(back, f), sort_keys=True) == json.dumps(getattr(res, f), sort_keys=True), f
     assert json.dumps(back.metrics()) == json.dumps(res.metrics())
+
+
+def test_each_fingerprint_has_its_folder_and_a_campaign_keeps_two(tmp_path, monkeypatch):
+    """Entries of one source fingerprint live under results/FINGERPRINT/; pruning keeps the current folder and the
+    newest other one, and removes the rest (the cache holds at most two versions' results)."""
+    import os
+
+    case = load(case_path(OBLIQUE))
+    cache = Cache(tmp_path)
+    for i, fp in enumerate(("v1", "v2", "v3", "v4")):
+        monkeypatch.setattr(result_cache, "code_fingerprint", lambda fp=fp: fp)
+        assert result_cache.store(cache, result_cache.result_key("reference-verlet", case), sources.VERLET.run(case))
+        folder = tmp_path / "results" / fp
+        assert folder.is_dir() and list(folder.rglob("*.npz"))
+        os.utime(folder, (1e9 + i, 1e9 + i))  # v1 the oldest, v4 the newest
+    monkeypatch.setattr(result_cache, "code_fingerprint", lambda: "v2")  # back to an older version
+    assert sorted(result_cache.prune(cache)) == ["v1", "v3"]
+    assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["v2", "v4"]
+    assert result_cache.load(cache, result_cache.result_key("reference-verlet", case)) is not None
+    assert cache._path("ab12").parent == tmp_path / "ab"  # an engine run's key: as before

@@ -89,7 +89,9 @@ def test_the_twin_of_the_jkr_pull_is_the_engine_and_the_textbook_break_is_not():
     seed = scenario.seed(c, "lammps").metrics()
     assert all(abs(eng[k] - twin[k]) <= 1e-12 * abs(twin[k]) for k in twin)  # measured ≤ 2.3e-16
     assert abs(seed["separation_at_pull_off"] / eng["separation_at_pull_off"] - 9 ** (1 / 3)) < 1e-3
-    assert abs(seed["pull_off_force"] / eng["pull_off_force"] - 1) < 1e-12
+    # the largest tension sits at δ_c, where LAMMPS lets go: its last sample before δ_c against the seed's nearest
+    # sample on either side, on a curve flat to second order there (one sample is 1e-4 of the pull's scale)
+    assert abs(seed["pull_off_force"] / eng["pull_off_force"] - 1) < 2e-8
 
 
 @pytest.mark.engine("lammps")

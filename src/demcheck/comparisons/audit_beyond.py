@@ -418,25 +418,8 @@ def _ratio(x: float, ref: float, zero: float = 0.0) -> float:
 
 
 def _engine_vs_twin(out: dict, zero: float) -> float:
-    """The largest relative engine − twin difference; a pull's separation measured against the pull's scale, and
-    one sample of the path apart (a break that lands on a sample at δ = 0, where round-off decides: DMT) noted,
-    not counted."""
-    from ..engines.scenario import PULL_STEPS
-
+    """The largest relative engine − twin difference; a pull's separation measured against the pull's scale."""
     metrics = dict(out["metrics"])
-    sep = metrics.get("separation_at_pull_off")
-    if sep is not None and zero > 0 and math.isfinite(sep["engine"] - sep["twin"]):
-        gap = abs(sep["engine"] - sep["twin"]) / zero
-        step = 2.5 / PULL_STEPS  # one sample of the pull, in units of its scale
-        force = metrics["pull_off_force"]
-        f_gap = abs(force["engine"] - force["twin"]) / abs(force["twin"]) if force["twin"] else math.inf
-        if 0 < gap <= 1.01 * step and f_gap <= 1.01 * step ** 1.5:  # the Hertz part over one sample: (Δ/scale)^1.5
-            metrics.pop("separation_at_pull_off")
-            metrics.pop("pull_off_force")
-            out.setdefault("notes_run", []).append(
-                f"separation at pull-off: engine {sep['engine']:.4g}, twin {sep['twin']:.4g}, one sample of the pull "
-                f"apart (the break lands on a sample where round-off decides), the pull-off force {f_gap:.2g} apart "
-                f"(≤ (Δ/scale)^1.5 = {step ** 1.5:.2g}); neither counted in engine − twin")
     return _gap(metrics, "engine", "twin", zero) if metrics else math.nan  # nothing left to compare: no number
 
 

@@ -1,22 +1,27 @@
-"""The reference's own results in the run cache: a warm ``verify`` solves nothing it solved before.
+"""The reference's own results in the run cache: a warm ``verify`` solves nothing costly it solved before.
 
 An engine run is cached by its deck (engines/cache.py); what demcheck computes itself — the reference's adaptive
-and verlet solves of a case, an engine's twin and the seed model's verlet run at an engine's step — is a pure
-function of the case, of demcheck's code and of the numerical libraries on this CPU. Each is cached under a key
-made of what it is (``kind``: the source's label and the step), the case's hash and
-:func:`engines.cache.code_fingerprint` (every source file of demcheck, numpy's, numba's and scipy's versions
-and the CPU the kernels are compiled for): a changed law, scheme, metric or case never reads an old result.
+solve of a case (the suite's converged answer: Walton's sticking variants take seconds), an engine's twin and the
+seed model's verlet run at an engine's step (their metrics), a scenario's reference solve — is a pure function of
+the case, of demcheck's code and of the numerical libraries on this CPU. Each is cached under a key made of what
+it is (``kind``: the source's label and what fixes its run), the case's hash and
+:func:`engines.cache.code_fingerprint` (every source file of demcheck, numpy's, numba's and scipy's versions and
+the CPU the kernels are compiled for): a changed law, scheme, metric or case never reads an old result.
 
-A Result is one entry: its three tables (contact, particles, events) side by side, their columns' dtypes and an
-events table's labels in the metadata with the Result's fields; it is stored only when its status is ok and every
-value is finite, and read back as the same arrays (tests/test_result_cache.py: the suite's entries of a case
-run cold and warm are equal). Metrics alone (twins, seed runs) are one row (engines/cache.py ``put_metrics``).
+The entries of one fingerprint live in a folder of their own, ``results/FINGERPRINT/`` in the cache; a campaign
+removes the folders of other fingerprints but the newest one (:func:`prune`), so the cache holds the results of at
+most two versions of demcheck, not one per edit of its source. A Result is one entry: its contact and events tables
+(what verify reads of it; not its particles) side by side, their columns' dtypes and an events table's labels in
+the metadata with the Result's fields; it is stored only when its status is ok and its tables are finite, and read
+back as the same arrays (tests/test_result_cache.py: the suite's entries of a case run cold and warm are equal).
+Metrics alone (twins, seed runs) are one row (engines/cache.py ``put_metrics``).
 """
 
 from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -28,9 +33,32 @@ FIELDS = ("source", "method", "case_name", "case_hash", "model", "params", "dt",
           "status", "message", "meta")
 
 
+FOLDER = "results"
+KEPT = ("contact", "events")  # the tables verify reads of a reference result
+
+
 def result_key(kind: str, case) -> str:
-    """The entry of the result ``kind`` (a source's label and what fixes its run, e.g. its step) of ``case``."""
-    return key("demcheck", code_fingerprint(), json.dumps({"kind": kind, "case": case.hash}), {})
+    """The entry of the result ``kind`` (a source's label and what fixes its run, e.g. its step) of ``case``, in
+    the folder of the current source fingerprint."""
+    fingerprint = code_fingerprint()
+    h = key("demcheck", fingerprint, json.dumps({"kind": kind, "case": case.hash}), {})
+    return f"{FOLDER}/{fingerprint}/{h}"
+
+
+def prune(cache) -> list[str]:
+    """Remove the result folders of other source fingerprints than the current one, but the newest of them (a
+    second version in use beside this one keeps its results); returns the folders removed. Nothing is removed from
+    a cache opened with ``refresh`` either: only folders this version does not read."""
+    import shutil
+
+    root = Path(cache.dir) / FOLDER
+    if not root.is_dir():
+        return []
+    others = sorted((p for p in root.iterdir() if p.is_dir() and p.name != code_fingerprint()),
+                    key=lambda p: p.stat().st_mtime, reverse=True)
+    for old in others[1:]:
+        shutil.rmtree(old, ignore_errors=True)
+    return [p.name for p in others[1:]]
 
 
 def cached_result(cache, kind: str, case, compute) -> Result:
@@ -66,11 +94,11 @@ def cached_metrics(cache, kind: str, case, compute) -> dict:
 
 
 def store(cache, k: str, res: Result) -> bool:
-    """``res`` under ``k``, one entry: its tables side by side (each column named ``table.column``, the shorter
+    """``res`` under ``k``, one entry: its contact and events tables side by side (each column named ``table.column``, the shorter
     tables padded with zeros, each table's rows, dtypes and labels in the metadata) and its fields. False when
     anything is not storable (a field JSON cannot hold, a table value that is not finite)."""
     parts, layouts = {}, {}
-    for name in TABLES:
+    for name in KEPT:
         cols = res.table(name)
         if cols is None:
             continue
@@ -105,7 +133,7 @@ def _complete(frame: pd.DataFrame, meta: dict) -> str | None:
     fields, layouts = meta["fields"], meta["tables"]
     if not isinstance(fields, dict) or set(fields) != set(FIELDS):
         return "the result's fields are not all there"
-    if not isinstance(layouts, dict) or not set(layouts) <= set(TABLES):
+    if not isinstance(layouts, dict) or not set(layouts) <= set(KEPT):
         return "no table layout"
     for name, lay in layouts.items():
         cols = lay.get("columns") if isinstance(lay, dict) else None

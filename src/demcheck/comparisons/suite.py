@@ -156,7 +156,8 @@ def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
 def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=None) -> tuple:
     """The reference's two methods in ``entry`` and their comparisons in ``comps``: the adaptive one (the seed
     model's converged answer: returned with its metrics) against the closed forms, the verlet one at the case's
-    step against it. With ``cache``, each solve is read from it where it was made before (result_cache.py)."""
+    step against it. With ``cache``, the adaptive solve is read from it where it was made before
+    (result_cache.py)."""
     adaptive = cached_result(cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
     scales = entry["scales"]
     ref = adaptive.metrics()
@@ -166,7 +167,7 @@ def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=N
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
         comps.append(verdicts.judge_closed_form(metric, ref[metric], exact, scales, tol))
-    verlet = cached_result(cache, sources.VERLET.label, case, lambda: sources.VERLET.run(case))
+    verlet = sources.VERLET.run(case)  # 0.2 ms of kernel: its tables (up to 60 000 rows) are not worth storing
     mv = verlet.metrics()
     label = sources.VERLET.label
     entry["sources"][label] = _source(verlet)
@@ -313,6 +314,10 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
     interrupted: KeyboardInterrupt | None = None  # SIGINT, or SIGTERM (engines.run.Terminated)
     runner.reset()
     shipped = replace(opts, cache=None, baseline=None)  # what a task needs of the options (its cache is its own)
+    if opts.cache is not None:
+        from .result_cache import prune
+
+        prune(opts.cache)  # the results of older versions of demcheck (at most one other is kept)
     with dispatch.Campaign(opts.jobs, opts.scheduler, cache=opts.cache, sources=opts.engines) as campaign:
         try:
             with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),

@@ -89,7 +89,10 @@ class Cache:
         self._unwritable: set[Path] = set()
 
     def _path(self, k: str) -> Path:
-        return self.dir / k[:2] / f"{k}.npz"
+        """An entry's file: ``k[:2]/k.npz``; a key ``NAMESPACE/NAME/…/HASH`` goes under ``NAMESPACE/NAME/…``
+        (the results demcheck computes itself: one folder per source fingerprint, comparisons/result_cache.py)."""
+        folder, _, name = k.rpartition("/")
+        return self.dir / folder / name[:2] / f"{name}.npz"
 
     def get(self, k: str, columns: tuple[str, ...] = (), meta_keys: Iterable[str] | Mapping[str, Callable] = (),
             min_rows: int = 0, check: Callable[[pd.DataFrame, dict], str | None] | None = None

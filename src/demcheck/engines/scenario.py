@@ -147,7 +147,9 @@ def layout(case: Case, laws: dict) -> Layout:
         scale = laws.get("pull_scale") or overlap_scale(case)  # an engine's law may pull from further in
         dt = 1e-6
         speed = 2.5 * scale / (PULL_STEPS * dt)
-        return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale, 0.0, 0.0)),
+        # from δ = scale + half a step: no sample lands on δ = 0, where DMT and sjkr let go and round-off would
+        # decide which sample is the last in contact
+        return Layout(s, dt, PULL_STEPS, 1, ((0.0, 0.0, 0.0), (r0 + r1 - scale - 0.5 * speed * dt, 0.0, 0.0)),
                       ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2, speed)
     if s == "adhesive_impact":
         law, pair = model.slot("adhesion"), model.pair
