@@ -105,3 +105,41 @@ def test_the_yade_scenario_guard_refuses_a_changed_script():
     text = scenario.deck(c, "yade").text
     with pytest.raises(DemcheckError):
         scenario.deck(c, "yade").check(text.replace("O.step()", "__import__('os')"), {})
+
+
+def _run_script(tmp_path, text):
+    import subprocess
+
+    from demcheck.engines import discovery
+
+    (tmp_path / "s.py").write_text(text)
+    exe = discovery.find("yade").executable
+    r = subprocess.run([exe, "-x", "-n", "s.py"], cwd=tmp_path, env=discovery.engine_env(), capture_output=True,
+                       text=True, timeout=900)
+    assert r.returncode == 0, (r.stdout + r.stderr)[-2000:]
+
+
+@pytest.mark.engine("yade")
+@pytest.mark.parametrize("change", ["no always_use_moment_law", "poisson 0"])
+def test_yade_traps_of_the_cohesion_moment_law(tmp_path, change):
+    """Run by hand (the guard refuses a changed script): without always_use_moment_law a contact without cohesion
+    gets no moments, and ν = 0 leaves no shear, rolling or twisting stiffness — the incline's sphere rolls freely
+    (θc ≈ 0, measured 8.6e-7) or slides without turning (ω = 0), far from atan μr."""
+    import re
+
+    from demcheck.engines import registry
+    from demcheck.reference.scenarios import stepped_metrics
+
+    c = case("incline-linear", EXACT_CASES["incline-linear"])
+    dk = scenario.deck(c, "yade")
+    text = dk.text.replace("always_use_moment_law=True", "always_use_moment_law=False") \
+        if change.startswith("no") else re.sub(r"poisson=[0-9.e-]+", "poisson=0.0", dk.text)
+    assert text != dk.text
+    _run_script(tmp_path, text)
+    eng = registry.get("yade")
+    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
+    data = eng.read_scenario(c, scenario.layout(c, laws), tmp_path)
+    angle = stepped_metrics(c, data)["incline_critical_angle"]
+    assert abs(angle) < 0.5 * math.atan(0.1) or angle < 0.0, angle
+    if change == "poisson 0":
+        assert abs(data["omega"][-1]).max() == 0.0
