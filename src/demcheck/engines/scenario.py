@@ -237,8 +237,8 @@ def step(case: Case, laws: dict, lay: Layout) -> dict:
     """The scenario stepped with ``laws`` (normal, fcrit, tangential, rolling, twisting, adhesion, heat) at the
     layout's step: the run reference/scenarios.stepped_metrics reads."""
     s = case.run.scenario
-    if "step" in laws:  # an engine's own stepping of its laws (Kratos: reference/beyond_kratos.py)
-        return laws["step"](case, lay)
+    if "stepper" in laws:  # an engine whose scheme is not fix nve/sphere's (Yade's leap-frog, Kratos' own laws)
+        return laws["stepper"](case, laws, lay)
     if s in WALL:
         mass, radius = case.mass(0), case.particles[0].radius
         w = case.walls[0]

@@ -79,16 +79,16 @@ def mapping(case: Case) -> Mapping:
 
 def twin_laws(case: Case, nat: Native) -> dict:
     """Kratos' law (reference/beyond_kratos.py), with its stepping: engines/scenario.step hands the run to
-    ``step``."""
+    ``stepper``."""
     p = nat.props
     force = functools.partial(_bk.kratos_adhesive_force, p["kind"], p["r_eff"], nat.normal_args[0], p["cohesion"])
-    laws = {"step": functools.partial(_step, force)}
+    laws = {"stepper": functools.partial(_step, force)}
     if p["kind"] == "jkr":  # start the pull at twice the overlap of Kratos' largest tension (past it)
         laws["pull_scale"] = 2.0 * _bk.jkr_hertz_radius_pull_off(p["r_eff"], nat.normal_args[0], p["cohesion"])[1]
     return laws
 
 
-def _step(force, case: Case, lay) -> dict:
+def _step(force, case: Case, laws: dict, lay) -> dict:
     r0, r1 = (c.radius for c in case.particles)
     if case.run.scenario == "pull_off":
         return _bk.pull(force, r0 + r1, lay.positions[1][0], lay.pull_speed, lay.dt, lay.steps)

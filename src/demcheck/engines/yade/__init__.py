@@ -127,8 +127,10 @@ class Yade(PackageEngine):
     def check_deck(self, text: str, files: dict | None = None) -> None:
         """The guard of the template the script opens as: a packing script's (its first line), else the
         collision script's; both refuse anything their template does not write."""
-        from . import deck, packing
+        from . import deck, packing, scenario
 
+        if scenario.is_scenario_script(text):
+            return scenario.check_script(text, files)
         (packing.check_script if packing.is_packing_script(text) else deck.check_script)(text, files)
 
     def read_collision(self, workdir):
