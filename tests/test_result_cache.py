@@ -65,17 +65,15 @@ def _entries(files, cache, engines=()):
 
 
 def test_a_warm_suite_case_solves_nothing_and_gives_the_same_entry(tmp_path, monkeypatch):
+    """The adaptive solve comes back as a Result; the verlet run as what the entry keeps of it (its source line,
+    series and curve distances)."""
     files = [case_path(OBLIQUE), case_path("suite/normal-hertz-pair.toml"), case_path("suite/beyond-twist.toml")]
     cold = _entries(files, Cache(tmp_path))
 
-    real = sources.Source.run
+    def no_solve(*a, **k):
+        raise AssertionError("solved although cached")
 
-    def no_adaptive_solve(self, case, *a, **k):
-        if self is sources.ADAPTIVE:
-            raise AssertionError("solved although cached")
-        return real(self, case, *a, **k)  # the verlet method (0.2 ms of kernel) is run again, not stored
-
-    monkeypatch.setattr(sources.Source, "run", no_adaptive_solve)
+    monkeypatch.setattr(sources.Source, "run", no_solve)
     warm_cache = Cache(tmp_path)
     warm = _entries(files, warm_cache)
     assert warm_cache.misses == 0 and warm_cache.hits > 0
@@ -178,3 +176,13 @@ def test_each_fingerprint_has_its_folder_and_a_campaign_keeps_two(tmp_path, monk
     assert sorted(p.name for p in (tmp_path / "results").iterdir()) == ["v2", "v4"]
     assert result_cache.load(cache, result_cache.result_key("reference-verlet", case)) is not None
     assert cache._path("ab12").parent == tmp_path / "ab"  # an engine run's key: as before
+
+
+def test_a_json_value_comes_back_as_stored_cold_or_warm(tmp_path):
+    case = load(case_path(OBLIQUE))
+    cache = Cache(tmp_path)
+    value = {"a": (1.5, float("nan")), "b": [float("inf"), "x"], "c": None}
+    cold, hit = result_cache.cached_json(cache, "j", case, lambda: value)
+    assert not hit and cold["a"][0] == 1.5 and isinstance(cold["a"], list)
+    warm, hit = result_cache.cached_json(cache, "j", case, lambda: pytest.fail("computed although cached"))
+    assert hit and json.dumps(warm) == json.dumps(cold)

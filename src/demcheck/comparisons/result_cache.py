@@ -93,6 +93,25 @@ def cached_metrics(cache, kind: str, case, compute) -> dict:
     return metrics
 
 
+def cached_json(cache, kind: str, case, compute):
+    """(``compute()``'s value — what JSON holds: numbers (NaN and ±inf too), text, lists, objects — for ``case``,
+    whether it came from ``cache``). A value computed here is stored and returned as read back (a tuple as a list),
+    so a cold and a warm run hand their callers the same thing. ``cache`` None: computed."""
+    if cache is None:
+        return compute(), False
+    k = result_key(kind, case)
+    hit = cache.get(k, columns=("stored",), meta_keys=("value",))
+    if hit is not None:
+        return hit[1]["value"], True
+    value = compute()
+    try:
+        meta = json.loads(json.dumps({"value": value}))
+    except (TypeError, ValueError):  # not JSON as it is: used, not stored
+        return value, False
+    cache.put(k, pd.DataFrame({"stored": [1.0]}), meta)
+    return meta["value"], False
+
+
 def store(cache, k: str, res: Result) -> bool:
     """``res`` under ``k``, one entry: its contact and events tables side by side (each column named ``table.column``, the shorter
     tables padded with zeros, each table's rows, dtypes and labels in the metadata) and its fields. False when

@@ -36,7 +36,7 @@ from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..laws.model import resolve
 from . import curves, dispatch, sources, verdicts
-from .result_cache import cached_metrics, cached_result
+from .result_cache import cached_json, cached_metrics, cached_result
 
 # the suite's engine runs go through each engine's long-lived worker (one per engine per process running cases), a
 # failed worker run made again as a process of its own (engines/run.py, OR_PROCESS): the same dumps, without an
@@ -167,22 +167,37 @@ def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=N
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
         comps.append(verdicts.judge_closed_form(metric, ref[metric], exact, scales, tol))
-    verlet = sources.VERLET.run(case)  # 0.2 ms of kernel: its tables (up to 60 000 rows) are not worth storing
-    mv = verlet.metrics()
     label = sources.VERLET.label
-    entry["sources"][label] = _source(verlet)
-    entry["series"].append(_series(verlet.contact, label))
-    entry["curves"][label] = curves.distances(verlet.contact, adaptive.contact, adaptive.events)
+    # what the entry keeps of the verlet run (its tables, up to 60 000 rows, are not worth storing)
+    started = time.perf_counter()
+    part, hit = cached_json(cache, f"{label} against {sources.ADAPTIVE.label}", case,
+                            lambda: _verlet_part(case, adaptive))
+    if hit:
+        part["source"].update(cached=True, wall_time=time.perf_counter() - started)
+    mv = part["source"]["metrics"]
+    entry["sources"][label] = part["source"]
+    entry["series"].append(part["series"])
+    entry["curves"][label] = part["curves"]
     spc = case.run.steps_per_contact
-    if verlet.status != "ok":
+    if part["source"]["status"] != "ok":
         # the case's own time step does not give a healthy run (docs/reliability.md): the case fails, whatever
         # the engines do at that step
-        comps.append(verdicts.status_comparison(label, verdicts.FAILED, f"{verlet.status}: {verlet.message}"))
+        comps.append(verdicts.status_comparison(label, verdicts.FAILED,
+                                                f"{part['source']['status']}: {part['source']['message']}"))
     else:
         tol_v = replace(tol, verlet_rtol=case.run.verlet_rtol) if case.run.verlet_rtol else tol
         for metric in ref:
             comps.append(verdicts.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
     return adaptive, ref
+
+
+def _verlet_part(case: Case, adaptive) -> dict:
+    """The verlet method at the case's step as the entry keeps it: its source line, its plot series, its curves'
+    distances from the adaptive solve."""
+    verlet = sources.VERLET.run(case)
+    label = sources.VERLET.label
+    return {"source": _source(verlet), "series": _series(verlet.contact, label),
+            "curves": curves.distances(verlet.contact, adaptive.contact, adaptive.events)}
 
 
 def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, comps: list, opts: Options,
