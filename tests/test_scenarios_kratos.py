@@ -25,9 +25,9 @@ import math
 import pytest
 
 from demcheck.case import load, loads
-from demcheck.comparisons.sources import ADAPTIVE
 from demcheck.comparisons.verdicts import AGREE, EXPECTED
 from demcheck.resources import case_path
+from tests.scenario_rows import engine_scenario_rows
 
 # case → {metric: verdict}, the fidelity of the mapping
 EXPECT = {
@@ -47,16 +47,7 @@ def dmt_pull():
 
 @functools.lru_cache(maxsize=None)
 def rows(name):
-    from demcheck.comparisons.scenario_rows import engine_rows
-    from demcheck.comparisons.suite import Options, discover
-    from demcheck.laws.model import resolve
-
-    c = case(name)
-    opts = Options(engines=("kratos",))
-    entry = {"model": resolve(c).describe(), "scales": {}, "sources": {}}
-    comps = []
-    engine_rows(c, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(c).metrics())
-    return entry, comps
+    return engine_scenario_rows(case(name), "kratos")
 
 
 @pytest.mark.engine("kratos")

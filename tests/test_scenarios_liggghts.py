@@ -20,19 +20,11 @@ from demcheck.case import load
 from demcheck.comparisons.sources import plan
 from demcheck.comparisons.verdicts import AGREE, EXPECTED, NOT_EXPRESSIBLE
 from demcheck.resources import case_path
+from tests.scenario_rows import engine_scenario_rows
 
 
 def rows(c):
-    from demcheck.comparisons.scenario_rows import engine_rows
-    from demcheck.comparisons.sources import ADAPTIVE
-    from demcheck.comparisons.suite import Options, discover
-    from demcheck.laws.model import resolve
-
-    opts = Options(engines=("liggghts",))
-    entry = {"model": resolve(c).describe(), "scales": {}, "sources": {}}
-    comps = []
-    engine_rows(c, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(c).metrics())
-    return entry, comps
+    return engine_scenario_rows(c, "liggghts")
 
 
 @pytest.mark.engine("liggghts")

@@ -17,6 +17,7 @@ from demcheck.comparisons.sources import plan
 from demcheck.comparisons.verdicts import AGREE, EXPECTED, NOT_EXPRESSIBLE
 from demcheck.engines import scenario
 from demcheck.resources import case_path
+from tests.scenario_rows import engine_scenario_rows
 
 # the dashpot-free variants of the suite's linear cases: Yade's CohFrictPhys expresses them exactly
 EXACT_CASES = {
@@ -59,16 +60,7 @@ def test_the_yade_twin_meets_the_closed_forms():
 
 
 def rows(c):
-    from demcheck.comparisons.scenario_rows import engine_rows
-    from demcheck.comparisons.sources import ADAPTIVE
-    from demcheck.comparisons.suite import Options, discover
-    from demcheck.laws.model import resolve
-
-    opts = Options(engines=("yade",))
-    entry = {"model": resolve(c).describe(), "scales": {}, "sources": {}}
-    comps = []
-    engine_rows(c, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(c).metrics())
-    return entry, comps
+    return engine_scenario_rows(c, "yade")
 
 
 @pytest.mark.engine("yade")

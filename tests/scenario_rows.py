@@ -1,0 +1,17 @@
+"""The suite's rows of one engine on a scenario case (comparisons/scenario_rows.engine_rows), for the engines'
+scenario tests: (entry, comparisons) as the suite builds them, judged against the reference's solve."""
+
+from __future__ import annotations
+
+
+def engine_scenario_rows(case, engine: str):
+    from demcheck.comparisons.scenario_rows import engine_rows
+    from demcheck.comparisons.sources import ADAPTIVE
+    from demcheck.comparisons.suite import Options, discover
+    from demcheck.laws.model import resolve
+
+    opts = Options(engines=(engine,))
+    entry = {"model": resolve(case).describe(), "scales": {}, "sources": {}}
+    comps = []
+    engine_rows(case, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(case).metrics())
+    return entry, comps
