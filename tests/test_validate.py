@@ -684,7 +684,8 @@ def test_validate_end_to_end_with_the_installed_engines(tmp_path):
 
     # the second run reads every engine run from the cache and judges the same numbers
     warm = json.loads((tmp_path / "r2" / "latest-validate" / "results.json").read_text())
-    assert warm["cache"]["hits"] == len(files) * len(installed) and warm["cache"]["misses"] == 0
+    # every engine run, and the reference's own solves (comparisons/result_cache.py), read back: nothing run again
+    assert warm["cache"]["hits"] >= len(files) * len(installed) and warm["cache"]["misses"] == 0
     assert [(c["source"], c["deviation"]) for c in runs[1]["validation"]["checks"]] == \
         [(c["source"], c["deviation"]) for c in checks]
 
