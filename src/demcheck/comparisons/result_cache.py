@@ -31,8 +31,6 @@ from ..result import TABLES, Result
 
 FIELDS = ("source", "method", "case_name", "case_hash", "model", "params", "dt", "rtol", "engine_version",
           "status", "message", "meta")
-
-
 FOLDER = "results"
 KEPT = ("contact", "events")  # the tables verify reads of a reference result
 
@@ -47,8 +45,8 @@ def result_key(kind: str, case) -> str:
 
 def prune(cache) -> list[str]:
     """Remove the result folders of other source fingerprints than the current one, but the newest of them (a
-    second version in use beside this one keeps its results); returns the folders removed. Nothing is removed from
-    a cache opened with ``refresh`` either: only folders this version does not read."""
+    second version in use beside this one keeps its results); returns the folders removed. Only folders this
+    version does not read are removed, whether or not the cache was opened with ``refresh``."""
     import shutil
 
     root = Path(cache.dir) / FOLDER
@@ -113,9 +111,10 @@ def cached_json(cache, kind: str, case, compute):
 
 
 def store(cache, k: str, res: Result) -> bool:
-    """``res`` under ``k``, one entry: its contact and events tables side by side (each column named ``table.column``, the shorter
-    tables padded with zeros, each table's rows, dtypes and labels in the metadata) and its fields. False when
-    anything is not storable (a field JSON cannot hold, a table value that is not finite)."""
+    """``res`` under ``k``, one entry: its contact and events tables side by side (each column named
+    ``table.column``, the shorter tables padded with zeros, each table's rows, dtypes and labels in the metadata)
+    and its fields. False when anything is not storable (a field JSON cannot hold, a table value that is not
+    finite)."""
     parts, layouts = {}, {}
     for name in KEPT:
         cols = res.table(name)
