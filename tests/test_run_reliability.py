@@ -356,11 +356,20 @@ def _engine_under(proc, within=240.0) -> int:
     pytest.fail(f"no engine started within {within} s")
 
 
+def _hang_up_by_default() -> None:
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)
+
+
 def _hang_up(args, tmp_path, env=None) -> tuple[subprocess.Popen, list[int]]:
     """demcheck started in a session of its own (as from a terminal), a SIGHUP to its whole process group once its
-    engine runs (a closed terminal's hang-up); (the process, every process that was under it then)."""
+    engine runs (a closed terminal's hang-up); (the process, every process that was under it then).
+
+    The hang-up's disposition is reset to the default in the child: a terminal's process has it, while pytest run
+    under ``nohup`` (or from a background job that ignores it) would hand its SIG_IGN down, and demcheck keeps an
+    ignored SIGHUP ignored by design (test_sighup_ignored_stays_ignored): the run would then go on to its end."""
     proc = subprocess.Popen([sys.executable, "-m", "demcheck", *map(str, args)], cwd=tmp_path, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=_hang_up_by_default)
     engine = _engine_under(proc)
     assert group_alive(engine), "the engine ended before the signal: the run must last longer"
     under = _descendants(proc.pid)
