@@ -1,6 +1,25 @@
 """Small builders shared by the tests."""
 
 from demcheck import case as C
+from demcheck import cli
+
+
+def cli_main(argv, capsys) -> tuple[int, str, str]:
+    """``demcheck ARGV`` in this process: (exit code, stdout, stderr)."""
+    try:
+        cli.main([str(a) for a in argv])
+        code = 0
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def write_deck(tmp_path, text, name="in.deck"):
+    """``text`` written to ``tmp_path / name``; its path."""
+    p = tmp_path / name
+    p.write_text(text)
+    return p
 
 GLASS = """
 name = "t"

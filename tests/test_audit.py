@@ -17,7 +17,7 @@ from demcheck.errors import ConfigError
 from demcheck.inputs.script import ScriptError
 
 from .conftest import ROOT
-from .helpers import glass_case
+from .helpers import glass_case, write_deck as _deck
 
 DECKS = Path(__file__).parent / "decks"
 HEAD = """units si
@@ -34,12 +34,6 @@ timestep 2e-8
 
 def demcheck(*args, cwd=ROOT):
     return subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, cwd=cwd)
-
-
-def _deck(tmp_path, text, name="in.deck"):
-    p = tmp_path / name
-    p.write_text(text)
-    return p
 
 
 def _codes(result, pair):

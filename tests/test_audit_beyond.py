@@ -16,6 +16,8 @@ from demcheck.engines import scenario as sc
 from demcheck.errors import DemcheckError
 from demcheck.reference.beyond import capture_velocity_closed
 
+from .helpers import write_deck as _deck
+
 LAMMPS_DECK = """# glass beads (type 1) and soft adhesive beads (type 2) poured onto a floor
 units           si
 atom_style      sphere
@@ -74,12 +76,6 @@ run		1000
 """
 
 G = 9.81
-
-
-def _deck(tmp_path, text, name="in.deck"):
-    p = tmp_path / name
-    p.write_text(text)
-    return p
 
 
 def _rows(report, pair):

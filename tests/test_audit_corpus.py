@@ -14,18 +14,13 @@ from demcheck.comparisons import audit as A
 from demcheck.errors import EngineInterrupted
 
 from .conftest import ROOT
+from .helpers import write_deck as _deck
 
 HERTZ_C = 2.0 * (15.0 / 16.0) ** 0.4 * 1.4716  # 2(15/16)^{2/5}·(2/5)B(2/5, 1/2), B-part 1.4716… (seed 001: 2.868)
 
 
 def demcheck(*args):
     return subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, cwd=ROOT)
-
-
-def _deck(tmp_path, text, name="in.deck"):
-    p = tmp_path / name
-    p.write_text(text)
-    return p
 
 
 def _entry(r, label):

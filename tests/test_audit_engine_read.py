@@ -15,6 +15,7 @@ from demcheck.engines.lammps import read as R
 from demcheck.inputs.script import ScriptError
 
 from .conftest import ROOT
+from .helpers import write_deck as _deck
 
 HEAD = """units si
 atom_style sphere
@@ -27,12 +28,6 @@ LAW = """pair_style granular
 pair_coeff * * hertz/material 63e9 0.9 0.3 damping coeff_restitution tangential linear_nohistory 0 0
 timestep 2e-8
 """
-
-
-def _deck(tmp_path, text, name="in.deck"):
-    p = tmp_path / name
-    p.write_text(text)
-    return p
 
 
 @pytest.mark.engine("lammps")

@@ -8,12 +8,13 @@ import json
 
 import pytest
 
-from demcheck import cli
 from demcheck.engines import registry
 from demcheck.engines import run as runner
 
 from .conftest import CASES
+from .helpers import cli_main
 from .test_native import TSUJI, _case, to_toml
+
 
 NATIVE = {  # per engine that takes native settings: its table, and a word of it the deck must hold
     "lammps": ({"pair_coeff": TSUJI}, "damping tsuji"),
@@ -30,16 +31,6 @@ def test_every_engine_that_takes_native_settings_is_covered():
     assert takes == set(NATIVE)
 
 
-def _main(argv, capsys) -> tuple[int, str, str]:
-    try:
-        cli.main(argv)
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
-
-
 @pytest.mark.parametrize("dt", [None, "2e-8"])
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in NATIVE])
 def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, monkeypatch):
@@ -48,7 +39,7 @@ def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, 
     path.write_text(to_toml(_case({engine: table})))
     extra = ["--dt", dt] if dt else []
     out_dir = tmp_path / "deck"
-    code, _, err = _main(["deck", str(path), "--engine", engine, "-o", str(out_dir / "in.deck"), *extra], capsys)
+    code, _, err = cli_main(["deck", str(path), "--engine", engine, "-o", str(out_dir / "in.deck"), *extra], capsys)
     assert code == 0, err
     written = (out_dir / "in.deck").read_text()
     beside = {f.name: f.read_text() for f in out_dir.iterdir() if f.name != "in.deck"}
@@ -61,7 +52,7 @@ def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, 
         return real(eng, text, *args, **kwargs)
 
     monkeypatch.setattr(runner, "run", recording)
-    code, out, err = _main(["collide", str(path), "--engine", engine, "--json", *extra], capsys)
+    code, out, err = cli_main(["collide", str(path), "--engine", engine, "--json", *extra], capsys)
     assert code == 0, err
     assert ran, "collide ran no deck"
     assert written == ran[0][0]  # byte for byte: the native law at the step collide used

@@ -6,22 +6,13 @@ from __future__ import annotations
 
 import pytest
 
-from demcheck import cli
 from demcheck.engines import run as runner
 
+from .helpers import cli_main
 from .test_native import _case, to_toml
 
+
 LIGGGHTS = {"pair_style": "gran model hertz tangential history"}
-
-
-def _main(argv, capsys) -> tuple[int, str, str]:
-    try:
-        cli.main([str(a) for a in argv])
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture
@@ -35,7 +26,7 @@ def test_a_native_restitution_liggghts_refuses_is_one_line_before_any_run(tmp_pa
     path.write_text(to_toml(_case({"liggghts": {**LIGGGHTS, "coefficientRestitution": e}})))
     for argv in (["collide", path, "--engine", "liggghts"], ["deck", path, "--engine", "liggghts"],
                  ["verify", path, "--engines", "liggghts", "--report", tmp_path / "r"]):
-        code, _, err = _main(argv, capsys)
+        code, _, err = cli_main(argv, capsys)
         assert code == 2 and err.strip().count("\n") == 0, err
         assert f"engine.liggghts.coefficientRestitution = {float(e)}: must be in (0.05, 1]" in err, err
     assert not (tmp_path / "r").exists()
@@ -45,7 +36,7 @@ def test_calibrate_to_a_restitution_liggghts_cannot_take_is_refused_before_any_e
                                                                                         no_engine):
     path = tmp_path / "c.toml"
     path.write_text(to_toml(_case({"liggghts": LIGGGHTS})))
-    code, _, err = _main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.01"], capsys)
+    code, _, err = cli_main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.01"], capsys)
     assert code == 2 and err.strip().count("\n") == 0 and "out of reach" in err and "[0.05, 1]" in err, err
 
 
@@ -61,7 +52,7 @@ def test_a_failed_confirming_run_keeps_what_the_twin_found(tmp_path, capsys, mon
     path = tmp_path / "c.toml"
     path.write_text(to_toml(_case({"lammps": {"pair_coeff": "hertz/material 63e9 0.6 0.24 damping tsuji "
                                                             "tangential mindlin NULL 1.0 0.5"}})))
-    code, out, err = _main(["calibrate", path, "--engine", "lammps", "--target", "restitution=0.5"], capsys)
+    code, out, err = cli_main(["calibrate", path, "--engine", "lammps", "--target", "restitution=0.5"], capsys)
     assert code == 1, err
     assert "damping tsuji e" in out and "paste:" in out and "NOT CONFIRMED: the confirming lammps run is failed" in out
 
@@ -69,7 +60,7 @@ def test_a_failed_confirming_run_keeps_what_the_twin_found(tmp_path, capsys, mon
 def test_a_target_given_twice_is_refused_not_overwritten(tmp_path, capsys, no_engine):
     path = tmp_path / "c.toml"
     path.write_text(to_toml(_case({"liggghts": LIGGGHTS})))
-    code, _, err = _main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.5",
+    code, _, err = cli_main(["calibrate", path, "--engine", "liggghts", "--target", "restitution=0.5",
                           "--target", "restitution=0.6"], capsys)
     assert code == 2 and "--target = 'restitution=0.6': restitution is given twice" in err, err
 

@@ -11,21 +11,11 @@ from pathlib import Path
 
 import pytest
 
-from demcheck import cli
 from demcheck.comparisons import diff as D
 from demcheck.errors import ConfigError, DemcheckError
 
 from .conftest import CASES
-
-
-def _main(argv, capsys) -> tuple[int, str, str]:
-    try:
-        cli.main([str(a) for a in argv])
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from .helpers import cli_main
 
 
 @pytest.fixture(scope="module")
@@ -102,7 +92,7 @@ def test_json_of_the_wrong_shape_is_one_line_naming_file_place_and_rule(stored, 
     good = tmp_path / "good.json"
     good.write_text(json.dumps(stored[0]))
     for argv in (["diff", good, bad], ["diff", bad, good]):
-        code, out, err = _main(argv, capsys)
+        code, out, err = cli_main(argv, capsys)
         lines = err.strip().splitlines()
         assert code == 2 and len(lines) == 1, (what, err)
         assert lines[0].startswith("demcheck: error: ") and str(bad) in lines[0] and where in lines[0], (what, err)
@@ -117,7 +107,7 @@ def test_json_of_the_wrong_shape_is_one_line_naming_file_place_and_rule(stored, 
 def test_json_that_is_not_strict_or_too_deep_is_one_line(tmp_path, capsys, text, words):
     bad = tmp_path / "bad.json"
     bad.write_text(text)
-    code, _, err = _main(["diff", bad, bad], capsys)
+    code, _, err = cli_main(["diff", bad, bad], capsys)
     assert code == 2 and len(err.strip().splitlines()) == 1 and words in err, err
 
 
@@ -132,7 +122,7 @@ def test_a_bad_baseline_stops_verify_before_any_case_runs(stored, tmp_path, caps
         bad = _planted(stored, "results", lambda d: _first(d["cases"])["comparisons"][0].pop("metric"), tmp_path)
     else:
         bad = _planted(stored, "baseline", edit, tmp_path)
-    code, _, err = _main(["verify", CASES / "hertz-wall.toml", "--engines", "none", "--report", tmp_path / "rep",
+    code, _, err = cli_main(["verify", CASES / "hertz-wall.toml", "--engines", "none", "--report", tmp_path / "rep",
                           "--baseline", bad], capsys)
     assert code == 2 and len(err.strip().splitlines()) == 1 and where in err and "--baseline" in err, err
     assert not (tmp_path / "rep").exists()  # nothing ran, no report

@@ -6,24 +6,16 @@ from __future__ import annotations
 
 import pytest
 
-from demcheck import cli
 from demcheck.case import load
 from demcheck.engines import run as runner
 from demcheck.engines import scenario
 from demcheck.resources import case_path
 
+from .helpers import cli_main
+
+
 NAMES = ("rolling", "rolling-linear", "incline", "incline-linear", "twist", "pull-off", "adhesive-impact",
          "conduction")
-
-
-def _main(argv, capsys) -> tuple[int, str, str]:
-    try:
-        cli.main(argv)
-        code = 0
-    except SystemExit as exc:
-        code = exc.code
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 def _suite_rows(case, engine):
@@ -53,11 +45,11 @@ def test_the_deck_written_is_the_deck_verify_ran(engine, tmp_path, capsys, monke
         path = case_path(f"suite/beyond-{name}.toml")
         case = load(path)
         if scenario.mapping(case, engine).native is None:
-            code, _, err = _main(["deck", str(path), "--engine", engine], capsys)
+            code, _, err = cli_main(["deck", str(path), "--engine", engine], capsys)
             assert code != 0 and "cannot express" in err, (name, err)
             continue
         out_dir = tmp_path / name
-        code, _, err = _main(["deck", str(path), "--engine", engine, "-o", str(out_dir / "in.deck")], capsys)
+        code, _, err = cli_main(["deck", str(path), "--engine", engine, "-o", str(out_dir / "in.deck")], capsys)
         assert code == 0, err
         written = (out_dir / "in.deck").read_text()
         beside = {f.name: f.read_text() for f in out_dir.iterdir() if f.name != "in.deck"}
@@ -65,13 +57,13 @@ def test_the_deck_written_is_the_deck_verify_ran(engine, tmp_path, capsys, monke
         entry = _suite_rows(case, engine)
         assert entry["sources"][engine]["status"] == "ok", (name, entry["sources"][engine])
         assert len(ran) == 1 and ran[0] == (written, beside), name
-        code, out, _ = _main(["deck", str(path), "--engine", engine], capsys)  # stdout: the same deck
+        code, out, _ = cli_main(["deck", str(path), "--engine", engine], capsys)  # stdout: the same deck
         assert code == 0 and out.startswith(written)
         expressed += 1
     assert expressed >= (8 if engine == "lammps" else 3)
 
 
 def test_a_scenario_deck_takes_no_dt(capsys):
-    code, _, err = _main(["deck", str(case_path("suite/beyond-twist.toml")), "--engine", "lammps", "--dt", "1e-6"],
+    code, _, err = cli_main(["deck", str(case_path("suite/beyond-twist.toml")), "--engine", "lammps", "--dt", "1e-6"],
                          capsys)
     assert code == 2 and err.count("\n") == 1 and "--dt" in err and "layout" in err
