@@ -15,6 +15,20 @@ def cli_main(argv, capsys) -> tuple[int, str, str]:
     return code, out.out, out.err
 
 
+def record_engine_runs(monkeypatch) -> list:
+    """engines.run.run recorded, still running: the list of (deck text, the files beside it) of each run."""
+    from demcheck.engines import run as runner
+
+    ran, real = [], runner.run
+
+    def recording(eng, text, *args, **kwargs):
+        ran.append((text, dict(kwargs.get("files") or {})))
+        return real(eng, text, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run", recording)
+    return ran
+
+
 def write_deck(tmp_path, text, name="in.deck"):
     """``text`` written to ``tmp_path / name``; its path."""
     p = tmp_path / name

@@ -9,10 +9,9 @@ import json
 import pytest
 
 from demcheck.engines import registry
-from demcheck.engines import run as runner
 
 from .conftest import CASES
-from .helpers import cli_main
+from .helpers import cli_main, record_engine_runs
 from .test_native import TSUJI, _case, to_toml
 
 
@@ -44,14 +43,7 @@ def test_the_deck_written_is_the_deck_collide_ran(engine, dt, tmp_path, capsys, 
     written = (out_dir / "in.deck").read_text()
     beside = {f.name: f.read_text() for f in out_dir.iterdir() if f.name != "in.deck"}
 
-    ran = []
-    real = runner.run
-
-    def recording(eng, text, *args, **kwargs):
-        ran.append((text, dict(kwargs.get("files") or {})))
-        return real(eng, text, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", recording)
+    ran = record_engine_runs(monkeypatch)
     code, out, err = cli_main(["collide", str(path), "--engine", engine, "--json", *extra], capsys)
     assert code == 0, err
     assert ran, "collide ran no deck"
@@ -80,14 +72,7 @@ def test_a_seed_models_deck_is_the_deck_collide_ran(engine, tmp_path, capsys, mo
     from demcheck.engines.collide import setting_deck
 
     written = setting_deck(case, engine)
-    ran = []
-    real = runner.run
-
-    def recording(eng, text, *args, **kwargs):
-        ran.append((text, dict(kwargs.get("files") or {})))
-        return real(eng, text, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", recording)
+    ran = record_engine_runs(monkeypatch)
     res = run_engine(case, engine)
     assert ran and (written.text, dict(written.files)) == ran[0]
     assert res.ok, res.message

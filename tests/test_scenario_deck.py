@@ -7,11 +7,10 @@ from __future__ import annotations
 import pytest
 
 from demcheck.case import load
-from demcheck.engines import run as runner
 from demcheck.engines import scenario
 from demcheck.resources import case_path
 
-from .helpers import cli_main
+from .helpers import cli_main, record_engine_runs
 
 
 NAMES = ("rolling", "rolling-linear", "incline", "incline-linear", "twist", "pull-off", "adhesive-impact",
@@ -32,14 +31,7 @@ def _suite_rows(case, engine):
 
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])
 def test_the_deck_written_is_the_deck_verify_ran(engine, tmp_path, capsys, monkeypatch):
-    ran = []
-    real = runner.run
-
-    def recording(eng, text, *args, **kwargs):
-        ran.append((text, dict(kwargs.get("files") or {})))
-        return real(eng, text, *args, **kwargs)
-
-    monkeypatch.setattr(runner, "run", recording)
+    ran = record_engine_runs(monkeypatch)
     expressed = 0
     for name in NAMES:
         path = case_path(f"suite/beyond-{name}.toml")
