@@ -209,20 +209,86 @@ def test_a_rolling_resistance_above_friction_is_listed_with_its_reason(tmp_path)
     assert "slides before it rolls" in rows["incline"]["why"]
 
 
-def test_sjkr_cohesion_is_listed_with_its_reason(tmp_path):
-    deck = LIGGGHTS_DECK.replace("fix 		m10 all property/global thermalCapacity peratomtype 840.",
-                                 "fix 		m10 all property/global thermalCapacity peratomtype 840.\n"
-                                 "fix 		m11 all property/global cohesionEnergyDensity peratomtypepair 1 3e5")
-    deck = deck.replace("rolling_friction cdt\npair_coeff", "rolling_friction cdt cohesion sjkr\npair_coeff")
-    r = A.audit(_deck(tmp_path, deck), run_engine=False)
-    _, rows = _rows(r, "1-1")
+COHESION = ("fix 		m10 all property/global thermalCapacity peratomtype 840.",
+            "fix 		m10 all property/global thermalCapacity peratomtype 840.\n"
+            "fix 		m11 all property/global cohesionEnergyDensity peratomtypepair 1 3e5\n"
+            "fix 		m12 all property/global coefficientRestitution peratomtypepair 1 0.9")
+
+
+def _cohesive(law: str, model: str = "hertz") -> str:
+    """The LIGGGHTS deck with ``cohesion LAW`` (kc = 3e5 J/m³) on its pair style, of ``model``."""
+    return LIGGGHTS_DECK.replace(*COHESION).replace(
+        "rolling_friction cdt\npair_coeff", f"rolling_friction cdt cohesion {law}\npair_coeff").replace(
+        "pair_style	gran model hooke/stiffness", f"pair_style	gran model {model}")
+
+
+def test_sjkr_on_a_linear_law_is_listed_with_its_reason(tmp_path):
+    """sjkr's pull-off has its closed form on an elastic Hertz law only: on hooke/stiffness it is listed, with the
+    set-up check of its pull."""
+    r = A.audit(_deck(tmp_path, _cohesive("sjkr", "hooke/stiffness")), run_engine=False)
+    entry, rows = _rows(r, "1-1")
     assert rows["pull-off"]["status"] == "not probed"
-    assert "cohesionEnergyDensity 300000" in rows["pull-off"]["why"]
+    assert "elastic Hertz law" in rows["pull-off"]["why"] and "δ^1" in rows["pull-off"]["why"]
     # the set-up check: kc × the lens π(Rδ − δ²/4) of two like spheres at the head-on probe's largest overlap
-    entry, _ = _rows(r, "1-1")
     delta, radius = entry["probes"][0]["twin"]["max_overlap"], 0.00159
     pull = 3e5 * math.pi * (radius * delta - delta * delta / 4)
     assert f"the cohesion pulls {pull:.4g}" in rows["pull-off"]["notes"][0]
+
+
+def test_sjkr_is_probed_by_a_pull_off_at_the_decks_parameters(tmp_path):
+    """cohesion sjkr on model hertz: two spheres of the deck's radius, E* = E/(2(1 − ν²)) and kc pulled apart; the
+    largest tension against the closed form written out here — (kcπ/2)s² + (3/2)k_H s − kcπR = 0 for s = √δ*,
+    F = kcπ(Rs² − s⁴/4) − k_H s³, k_H = (4/3)E*√(R/2) — to 1e-7 (the pull's samples straddle the maximum: 8e-9
+    measured); the contact ends at δ = 0, met within 1e-3 of the pull's overlap scale (before: listed, not probed)."""
+    r = A.audit(_deck(tmp_path, _cohesive("sjkr")), run_engine=False)
+    entry, rows = _rows(r, "1-1")
+    row = rows["pull-off"]
+    assert row["status"] == "ok", row
+    radius, kc, e_star = 0.00159, 3e5, 5e6 / (2.0 * (1.0 - 0.3 ** 2))
+    k_h = 4.0 / 3.0 * e_star * math.sqrt(radius / 2.0)
+    a, b, c = 0.5 * math.pi * kc, 1.5 * k_h, -math.pi * kc * radius
+    s = (-b + math.sqrt(b * b - 4.0 * a * c)) / (2.0 * a)
+    tension = kc * math.pi * (radius * s * s - s ** 4 / 4.0) - k_h * s ** 3
+    assert row["metrics"]["pull_off_force"]["twin"] == pytest.approx(tension, rel=1e-7)
+    assert row["metrics"]["pull_off_force"]["reference"] == pytest.approx(tension, rel=1e-12)
+    assert row["twin_vs_reference"]["separation_at_pull_off"] == 1.0
+    assert not [f for f in entry["findings"] if f["code"].startswith("beyond") and "pull-off" in f["text"]]
+
+
+@pytest.mark.engine("liggghts")
+@pytest.mark.parametrize("law", ["sjkr", "sjkr2"])
+def test_liggghts_sjkr_pull_off_probe_meets_its_twin_and_closed_form(tmp_path, law):
+    """The probe run in LIGGGHTS: engine = twin ≤ 1e-9 (the mapping's tolerance; 0 and 6e-16 measured), the pull-off
+    force within 1e-7 of the closed form (reference/beyond.sjkr_pull_off_closed, tested on its own), no trap."""
+    r = A.audit(_deck(tmp_path, _cohesive(law)), run_engine=True)
+    entry, rows = _rows(r, "1-1")
+    row = rows["pull-off"]
+    assert row["status"] == "ok" and row["fidelity"] == "exact", row
+    assert row["engine_vs_twin"] <= 1e-9
+    f = row["metrics"]["pull_off_force"]
+    assert f["engine"] == pytest.approx(f["reference"], rel=1e-7)
+    assert not [f for f in entry["findings"] if f["code"].startswith("beyond") and "pull-off" in f["text"]]
+
+
+def test_sjkr_between_unlike_types_is_listed(tmp_path):
+    """Two types of other sizes: the closed form is of like spheres — listed, never probed."""
+    deck = _cohesive("sjkr").replace("create_box	1 reg", "create_box	2 reg").replace(
+        "peratomtypepair 1 ", "peratomtypepair 2 ")
+    deck = (deck.replace("peratomtypepair 2 1e5", "peratomtypepair 2 1e5 1e5 1e5 1e5")
+            .replace("peratomtypepair 2 0.0", "peratomtypepair 2 0.0 0.0 0.0 0.0")
+            .replace("peratomtypepair 2 0.3", "peratomtypepair 2 0.3 0.3 0.3 0.3")
+            .replace("peratomtypepair 2 0.1", "peratomtypepair 2 0.1 0.1 0.1 0.1")
+            .replace("peratomtypepair 2 3e5", "peratomtypepair 2 3e5 3e5 3e5 3e5")
+            .replace("peratomtypepair 2 0.9", "peratomtypepair 2 0.9 0.9 0.9 0.9")
+            .replace("peratomtype 5e6", "peratomtype 5e6 5e6").replace("peratomtype 0.3", "peratomtype 0.3 0.3")
+            .replace("peratomtype 1.0", "peratomtype 1.0 1.0").replace("peratomtype 840.", "peratomtype 840. 840.")
+            .replace("set		atom 1 diameter 0.00318 density 2500 vx 0.02",
+                     "set		atom 1 diameter 0.00318 density 2500 vx 0.02\ncreate_atoms	2 single 0.01 0.0 0.01\n"
+                     "set		atom 2 diameter 0.004 density 2500"))
+    r = A.audit(_deck(tmp_path, deck), run_engine=False)
+    _, rows = _rows(r, "1-2")
+    assert rows["pull-off"]["status"] == "not probed"
+    assert "like spheres" in rows["pull-off"]["why"]
 
 
 def test_a_failed_beyond_probe_is_a_trap_never_clean(tmp_path, monkeypatch):

@@ -10,7 +10,9 @@ probes run:
 * twisting — a sphere spinning at v/R about the plane's normal (``twist``: twist_stop_time = Iω0/(μtw m g));
 * adhesion — LAMMPS ``jkr``/``dmt``: two like spheres pulled apart (``pull_off``: pull_off_force,
   separation_at_pull_off, the textbook's displacement-controlled break) and, for jkr, an impact at the
-  characteristic speed (``adhesive_impact``: restitution, capture_velocity; Thornton & Ning 1998);
+  characteristic speed (``adhesive_impact``: restitution, capture_velocity; Thornton & Ning 1998); LIGGGHTS
+  ``cohesion sjkr``/``sjkr2``: two like spheres on the pair's elastic Hertz law with −kc·A added, pulled apart
+  (``pull_off``: the largest tension in closed form);
 * heat — LAMMPS ``heat radius/area``, LIGGGHTS ``fix heat/gran/conduction``: two like spheres held at the head-on
   probe's largest overlap (``conduction``: heat_time_constant, Batchelor & O'Brien 1977 for LIGGGHTS).
 
@@ -304,16 +306,37 @@ def _epsd3_kr(setup, ps, base, mu, stiffness) -> float:
     return stiffness * nl.k * mu * mu * base["radius"] ** 2
 
 
-def _sjkr_listed(setup, ps, sub, base, entry, speed) -> list:
+def _sjkr(setup, ps, sub, base, entry, speed) -> list:
+    """LIGGGHTS ``cohesion sjkr``/``sjkr2`` (cohesionEnergyDensity kc): two like spheres of the pair's type on the
+    pair's elastic Hertz law (E* read off the engine's twin of the deck's law, its dashpot left out), the cohesion
+    −kc·A added (A the lens for sjkr, the band 2πR_xδ for sjkr2), pulled apart (``pull_off``: pull_off_force, the
+    largest tension of Hertz + kc·A in closed form; the contact ends at δ = 0)."""
+    from ..engines import registry
+
     (kc,) = sub["args"]
     label = f"pull-off ({ps.label})"
     if kc is None:
         return [(label, None, "cohesion needs cohesionEnergyDensity (LIGGGHTS stops without it)", [])]
     notes = [_sjkr_check(ps, sub["law"], kc, base, entry)]
-    return [(label, None, f"cohesion {sub['law']} (cohesionEnergyDensity {kc:g} J/m³) is listed, not probed: its "
-                          "force −kc·A is added to the normal law, which has no closed-form pull-off among "
-                          "demcheck's scenarios (pull_off runs jkr and dmt), and LIGGGHTS-PUBLIC 3.8.0 has no JKR or "
-                          "DMT model to run one", notes)]
+    if ps.j is None:
+        return [(label, None, "the pull-off probe holds two like spheres; a wall's cohesion is the same law against "
+                              "a rigid plane, not a scenario of its own", notes)]
+    if ps.j != ps.i and tuple(base["second"]) != (base["radius"], base["density"]):
+        return [(label, None, f"types {ps.i} and {ps.j} differ in size or density: the sjkr pull-off's closed form "
+                              "is of two like spheres", notes)]
+    nl, _ = registry.get(setup.engine).twin(ps.native, *base["effective"])
+    if nl.a != 1.5:
+        return [(label, None, f"the sjkr pull-off's closed form rests on an elastic Hertz law; the pair's normal "
+                              f"law is F ∝ δ^{nl.a:g}", notes)]
+    e_star = nl.k / (4.0 / 3.0 * math.sqrt(base["effective"][1]))
+    nu = 0.3
+    mat = {"density": base["density"], "youngs_modulus": 2.0 * (1.0 - nu * nu) * e_star, "poisson_ratio": nu,
+           "restitution": 0.9}
+    contact = {"normal": "hertz", "adhesion": "sjkr", "k_c": kc, "area": "band" if sub["law"] == "sjkr2" else "lens"}
+    notes.append(f"E* = {e_star:.6g} of the pair's Hertz law (its dashpot left out: the pull is quasi-static); "
+                 f"kc = {kc:g}, area {contact['area']}")
+    return [(label, _pair_bodies(f"audit-pull-off-{ps.label}", mat, base["radius"], contact,
+                                 {"scenario": "pull_off"}), "", notes)]
 
 
 def _sjkr_check(ps, law_id: str, kc: float, base: dict, entry: dict) -> str:
@@ -338,7 +361,7 @@ def _sjkr_check(ps, law_id: str, kc: float, base: dict, entry: dict) -> str:
 
 # the probe of each kind an engine's reader names in its BEYOND_PROBES (slot → kind)
 MAKERS = {"incline_sds": _sds_incline, "twist": _twisting, "pull_off": _jkr_dmt, "held_pair": _heat,
-          "rolling_cdt_epsd3": _cdt_epsd3, "sjkr_listed": _sjkr_listed}
+          "rolling_cdt_epsd3": _cdt_epsd3, "pull_off_sjkr": _sjkr}
 
 
 # ----------------------------------------------------------------------------- the runs
@@ -401,10 +424,9 @@ def _zero_scale(case) -> float:
     sampled path locates it to 1e-4 of that scale), else 0."""
     if case.run.scenario != "pull_off":
         return 0.0
-    from ..engines.scenario import _adhesion_scale
-    from ..laws.model import resolve
+    from ..engines.scenario import overlap_scale
 
-    return _adhesion_scale(resolve(case).slot("adhesion"))
+    return overlap_scale(case)
 
 
 def _ratio(x: float, ref: float, zero: float = 0.0) -> float:

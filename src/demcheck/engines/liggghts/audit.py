@@ -425,7 +425,7 @@ def _pair(setup, spec, where, props, a, b, label) -> PairSetting:
 
 
 # the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS)
-BEYOND_PROBES = {"rolling": "rolling_cdt_epsd3", "adhesion": "sjkr_listed", "heat": "held_pair"}
+BEYOND_PROBES = {"rolling": "rolling_cdt_epsd3", "adhesion": "pull_off_sjkr", "heat": "held_pair"}
 ROLLING_PROPS = ("coefficientRollingFriction", "rollingStiffness", "coefficientRollingViscousDamping")
 
 
