@@ -19,6 +19,9 @@ histories is the identity here):
 
 A sample (every ``every`` steps from step 0) holds x_k and the full-step velocities v_k = v_{k−½} + ½dt F_k/m,
 ω_k = ω_{k−½} + ½dt T_k/I (F_k with the weight), as the deck writes them.
+
+The pair scenarios (engines/yade/pair.py): :func:`pull`, Mindlin's DMT (HertzMindlin.cpp) along a pull that moves
+body 1 by pos += vel·dt; :func:`held`, ThermalEngine's conductance (Thermal.cpp) by its forward Euler.
 """
 
 from __future__ import annotations

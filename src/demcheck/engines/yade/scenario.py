@@ -2,7 +2,8 @@
 ``CohFrictMat`` + ``Ip2_CohFrictMat_CohFrictMat_CohFrictPhys`` + ``Law2_ScGeom6D_CohFrictPhys_CohesionMoment``
 (``useIncrementalForm``, ``always_use_moment_law``) on a fixed box (``Ig2_Box_Sphere_ScGeom6D``: there is no 6-D
 wall geometry); :func:`mapping`, :func:`twin_laws` (Yade's leap-frog and law: reference/beyond_yade.py),
-:func:`deck` (a fixed template with numbers only, checked by :func:`check_script`) and :func:`read`.
+:func:`deck` (a fixed template with numbers only, checked by :func:`check_script`) and :func:`read`. The pair
+scenarios (pull_off, adhesive_impact, conduction) are handed to :mod:`.pair` (Mindlin's DMT, ThermalEngine).
 
 What the CohFrictPhys computes (CohesiveFrictionalContactLaw.cpp, read; measured against the twin): a linear
 normal spring kn = E·R (the box takes the sphere's radius), no normal dashpot; an incremental shear spring
