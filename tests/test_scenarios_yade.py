@@ -119,6 +119,16 @@ def _run_script(tmp_path, text):
     assert r.returncode == 0, (r.stdout + r.stderr)[-2000:]
 
 
+def _run_and_read(tmp_path, c, text):
+    """A changed scenario script run by hand, its output read as the engine's run is."""
+    from demcheck.engines import registry
+
+    _run_script(tmp_path, text)
+    eng = registry.get("yade")
+    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
+    return eng.read_scenario(c, scenario.layout(c, laws), tmp_path)
+
+
 @pytest.mark.engine("yade")
 @pytest.mark.parametrize("change", ["no always_use_moment_law", "poisson 0"])
 def test_yade_traps_of_the_cohesion_moment_law(tmp_path, change):
@@ -127,7 +137,6 @@ def test_yade_traps_of_the_cohesion_moment_law(tmp_path, change):
     (θc ≈ 0, measured 8.6e-7) or slides without turning (ω = 0), far from atan μr."""
     import re
 
-    from demcheck.engines import registry
     from demcheck.reference.scenarios import stepped_metrics
 
     c = case("incline-linear", EXACT_CASES["incline-linear"])
@@ -135,10 +144,7 @@ def test_yade_traps_of_the_cohesion_moment_law(tmp_path, change):
     text = dk.text.replace("always_use_moment_law=True", "always_use_moment_law=False") \
         if change.startswith("no") else re.sub(r"poisson=[0-9.e-]+", "poisson=0.0", dk.text)
     assert text != dk.text
-    _run_script(tmp_path, text)
-    eng = registry.get("yade")
-    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
-    data = eng.read_scenario(c, scenario.layout(c, laws), tmp_path)
+    data = _run_and_read(tmp_path, c, text)
     angle = stepped_metrics(c, data)["incline_critical_angle"]
     assert abs(angle) < 0.5 * math.atan(0.1) or angle < 0.0, angle
     if change == "poisson 0":
@@ -182,7 +188,7 @@ def test_yade_dmt_pull_is_its_twin_and_dmts_closed_form():
     assert abs(got["pull_off_force"] - twin["pull_off_force"]) <= 1e-9 * twin["pull_off_force"]
     assert abs(got["separation_at_pull_off"] - twin["separation_at_pull_off"]) <= 1e-12
     # the largest tension is at the last overlap in contact δ_l ≥ 0 (within one step of the pull, 1.4e-10 m):
-    # 2πwR̄ − (4/3)E*√R̄ δ_l^{3/2} (measured 7.1e-11 m, 5.5e-8 below 2πwR̄)
+    # 2πwR̄ − (4/3)E*√R̄ δ_l^{3/2} (measured 7.1e-11 m, 3.5e-7 below 2πwR̄)
     d_l = got["separation_at_pull_off"]
     assert 0.0 <= d_l < 1.5e-10
     closed = 2.0 * math.pi * W * R_BAR - 4.0 / 3.0 * E_STAR * math.sqrt(R_BAR) * d_l ** 1.5
@@ -197,7 +203,6 @@ def test_yade_traps_of_mindlins_dmt(tmp_path, change, factor):
     doubles DMT's pull-off force (4πwR̄)."""
     import re
 
-    from demcheck.engines import registry
     from demcheck.reference.scenarios import stepped_metrics
 
     c = dmt_pull()
@@ -207,10 +212,7 @@ def test_yade_traps_of_mindlins_dmt(tmp_path, change, factor):
     else:
         changed = re.sub(r"gamma=[0-9.e-]+", f"gamma={W!r}", text)
     assert changed != text
-    _run_script(tmp_path, changed)
-    eng = registry.get("yade")
-    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
-    data = eng.read_scenario(c, scenario.layout(c, laws), tmp_path)
+    data = _run_and_read(tmp_path, c, changed)
     force = stepped_metrics(c, data)["pull_off_force"]
     if factor is None:
         assert math.isnan(force) and data["fn"].min() >= 0.0
@@ -221,11 +223,10 @@ def test_yade_traps_of_mindlins_dmt(tmp_path, change, factor):
 def _thermal_tau(c):
     """Forward Euler's time constant of ThermalEngine's H = 4kR²/(2R − δ) (like spheres), C = m c_p, at the
     layout's step: the difference falls by (1 − dt·H(1/C0 + 1/C1)) a step, so τ = −dt/ln(that)."""
-    from demcheck.engines.scenario import layout
     from demcheck.engines import registry
 
     eng = registry.get("yade")
-    lay = layout(c, eng.scenario_twin_laws(c, scenario.mapping(c, eng).require()))
+    lay = scenario.layout(c, eng.scenario_twin_laws(c, scenario.mapping(c, eng).require()))
     delta, k, cp = c.run.overlap, 45.0, 500.0
     h = 4.0 * k * 2e-3 ** 2 / (2 * 2e-3 - delta)
     cap = c.mass(0) * cp
@@ -252,16 +253,11 @@ def test_yade_conduction_is_its_twin_and_forward_eulers_closed_form():
 def test_yade_thermal_engine_resets_the_temperatures_at_its_first_step(tmp_path):
     """Run by hand: the temperatures set before ThermalEngine's first call are replaced by particleT0 (the pair
     stays at one temperature: nothing is conducted), which is why the script sets them after that step."""
-    from demcheck.engines import registry
-
     c = case("conduction")
     text = scenario.deck(c, "yade").text
     changed = text.replace("O.dt = DT\nO.step()\n", "O.dt = DT\n")
     assert changed != text
-    _run_script(tmp_path, changed)
-    eng = registry.get("yade")
-    laws = eng.scenario_twin_laws(c, scenario.mapping(c, eng).require())
-    data = eng.read_scenario(c, scenario.layout(c, laws), tmp_path)
+    data = _run_and_read(tmp_path, c, changed)
     assert data["dT"][0] == 100.0 and (data["dT"][1:] == 0.0).all()
 
 
