@@ -173,7 +173,8 @@ def deck(case: Case, nat: Native, lay) -> common.Deck:
 
 
 def _pull_lines(nat: Native, lay) -> list[str]:
-    return [f"O.bodies[b].state.vel = {_vec((lay.pull_speed, 0.0, 0.0))}",
+    return ["# body 1 moves at the pull speed (its degrees of freedom blocked: pos += vel dt each step)",
+            f"O.bodies[b].state.vel = {_vec((lay.pull_speed, 0.0, 0.0))}",
             "O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),",
             "              InteractionLoop([Ig2_Sphere_Sphere_ScGeom()],",
             f"                              [Ip2_FrictMat_FrictMat_MindlinPhys(gamma={_num(nat.props['gamma'])})],",
@@ -202,7 +203,9 @@ def _held_lines(case: Case, nat: Native) -> list[str]:
             f"                            particleT0={_num(t0)}, particleAlpha=0.0, fluidBeta=0.0),",
             "              NewtonIntegrator(damping=0.0)]",
             "O.dt = DT",
-            "O.step()",  # ThermalEngine's first call sets every temperature to particleT0: equal, nothing flows
+            "# ThermalEngine's first call sets every body's temperature, k and Cp to particleT0, particleK,",
+            "# particleCp (at one temperature nothing flows): the case's are set after it",
+            "O.step()",
             f"O.bodies[a].state.temp = {_num(t0)}", f"O.bodies[b].state.temp = {_num(t1)}",
             f"O.bodies[a].state.Cp = {_num(m0.specific_heat)}", f"O.bodies[b].state.Cp = {_num(m1.specific_heat)}",
             f"O.bodies[a].state.k = {k}", f"O.bodies[b].state.k = {k}",
