@@ -19,6 +19,9 @@ histories is the identity here):
 
 A sample (every ``every`` steps from step 0) holds x_k and the full-step velocities v_k = v_{k−½} + ½dt F_k/m,
 ω_k = ω_{k−½} + ½dt T_k/I (F_k with the weight), as the deck writes them.
+
+The pair scenarios (engines/yade/pair.py): :func:`pull`, Mindlin's DMT (HertzMindlin.cpp) along a pull that moves
+body 1 by pos += vel·dt; :func:`held`, ThermalEngine's conductance (Thermal.cpp) by its forward Euler.
 """
 
 from __future__ import annotations
@@ -79,3 +82,61 @@ def wall(radius: float, mass: float, x0, v_half, omega_half, gravity, wall_point
     out = {k: np.array(a) for k, a in rows.items()}
     out["t"] = np.arange(samples) * every * dt
     return out
+
+
+# ----------------------------------------------------------------------------- the pair scenarios
+
+
+def mindlin_constants(young0: float, poisson0: float, r0: float, young1: float, poisson1: float, r1: float,
+                      gamma: float) -> tuple[float, float]:
+    """(kno, adhesionForce) of ``Ip2_FrictMat_FrictMat_MindlinPhys`` as HertzMindlin.cpp computes them (in its
+    order of operations): E* = EaEb/((1 − νa²)Eb + (1 − νb²)Ea), R̄ = RaRb/(Ra + Rb), kno = (4/3)E*√R̄ and the
+    DMT adhesion 4πR̄γ (γ the functor's ``gamma``, a surface energy: 2πwR̄ for w = 2γ)."""
+    e = young0 * young1 / ((1.0 - poisson0 ** 2) * young1 + (1.0 - poisson1 ** 2) * young0)
+    r = r0 * r1 / (r0 + r1)
+    return 4.0 / 3.0 * e * math.sqrt(r), 4.0 * math.pi * r * gamma
+
+
+def mindlin_dmt_force(kno: float, adhesion: float, delta: float) -> float:
+    """``Law2_ScGeom_MindlinPhys_Mindlin`` with ``includeAdhesion`` and no damping: Fn = kno δ^{3/2} − adhesion
+    while δ ≥ 0 (> 0 repels), none below (the law erases the contact)."""
+    if delta < 0.0:
+        return 0.0
+    return kno * delta ** 1.5 - adhesion
+
+
+def pull(kno: float, adhesion: float, r_sum: float, x1: float, speed: float, dt: float, steps: int) -> dict:
+    """Body 0 held at the origin, body 1 from x1 along +x with its velocity held at ``speed`` (all its degrees of
+    freedom blocked): NewtonIntegrator moves it by pos += vel·dt each step, after the forces at its position
+    (δ = r0 + r1 − x). The overlap and Mindlin's force at each step (pull_off's ``delta`` and ``fn``)."""
+    x, deltas, forces = float(x1), [], []
+    for _ in range(steps + 1):
+        d = r_sum - x
+        deltas.append(d)
+        forces.append(mindlin_dmt_force(kno, adhesion, d))
+        x += speed * dt
+    return {"delta": np.array(deltas), "fn": np.array(forces)}
+
+
+def thermal_conductance(k0: float, k1: float, r0: float, r1: float, delta: float) -> float:
+    """``ThermalEngine``'s conductance between two spheres (Thermal.cpp, neither useKernMethod nor useHertzMethod):
+    H = 2(k0 + k1) r0 r1 / d, d = r0 + r1 − δ the distance of the centres — the size of the contact does not
+    enter."""
+    return 2.0 * (k0 + k1) * r0 * r1 / (r0 + r1 - delta)
+
+
+def thermal_capacity(cp: float, density: float, radius: float) -> float:
+    """A body's heat capacity as ThermalEngine takes it: Cp·ρ·(4/3)πr³ (the material's density)."""
+    return cp * density * (4.0 / 3.0 * math.pi * radius ** 3)
+
+
+def held(h: float, cap0: float, cap1: float, t0: float, t1: float, dt: float, steps: int, every: int) -> dict:
+    """Two bodies held together exchanging Q = H (T1 − T0) by ThermalEngine's forward Euler (T += Q·dt/C, each
+    step, ``tsSafetyFactor`` ≤ 0), sampled every ``every`` steps from step 0: t and dT = T1 − T0."""
+    diffs = [t1 - t0]
+    for k in range(1, steps + 1):
+        flux = h * (t0 - t1)  # ThermalEngine's fluxij of the pair (body 0 first)
+        t0, t1 = -flux * dt / cap0 + t0, flux * dt / cap1 + t1
+        if k % every == 0:
+            diffs.append(t1 - t0)
+    return {"t": np.arange(len(diffs)) * every * dt, "dT": np.array(diffs)}

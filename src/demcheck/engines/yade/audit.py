@@ -38,6 +38,10 @@ MATERIAL_KEYS = frozenset({"young", "poisson", "density", "frictionAngle", "kn",
                            "label", "material"})  # what the probes read from a material
 PACKS = ("regularHexa", "regularOrtho")  # pack.regular*(predicate, radius=…, gap=…, material=…)
 FRICT_FAMILY = ("FrictMat", "ViscElMat", "CohFrictMat", "FrictViscoMat", "ViscElCapMat", "MortarMat")
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS): Mindlin's DMT
+# (Ip2_FrictMat_FrictMat_MindlinPhys gamma + includeAdhesion) and ThermalEngine's conduction (engines/yade/pair.py)
+BEYOND_PROBES = {"adhesion": "pull_off", "heat": "held_pair"}
+THERMAL_DEFAULTS = {"particleK": 3.0, "particleCp": 750.0, "particleDensity": 0.0}  # ThermalEngine's, 2023.02a
 
 
 def claims(script) -> bool:
@@ -235,7 +239,7 @@ def _calls(value) -> list:
 
 def _engines(st: _State, setup: Setup) -> dict:
     """{"ip2": [Call], "law2": [Call]} of O.engines' InteractionLoop; NewtonIntegrator's damping and gravity."""
-    out = {"ip2": [], "law2": []}
+    out = {"ip2": [], "law2": [], "thermal": None}
     where = f"{st.name}: O.engines"
     if st.engines is None or not isinstance(st.engines, tuple):
         setup.not_audited.append((where, "O.engines", "not given literally at the top level: the contact laws "
@@ -253,6 +257,8 @@ def _engines(st: _State, setup: Setup) -> dict:
             out["law2"] = [c for c in _calls(tuple(lists[2:3])) if c.name.startswith("Law2_")]
         elif e.name == "NewtonIntegrator":
             _newton(e, setup, f"{st.name}:{e.line}")
+        elif e.name == "ThermalEngine" and e.kw.get("dead") in (None, False, 0):
+            out["thermal"] = e  # the heat probe's (_thermal)
         elif e.name in ("GlobalStiffnessTimeStepper", "TimeStepper"):
             setup.not_audited.append((f"{st.name}:{e.line}", e.name, "changes O.dt at run time: the probes take "
                                       "the script's O.dt"))
@@ -456,7 +462,60 @@ def _pairs(st: _State, setup: Setup, types: dict, laws: dict) -> None:
         if why:
             ps.probe = False
             ps.notes.append(f"listed, not probed: {why}")
+        _beyond(ps, ma, mb, ip2, law2, laws, setup, wall)
         setup.pairs.append(ps)
+
+
+def _beyond(ps: PairSetting, ma: Call, mb: Call, ip2, law2, laws: dict, setup: Setup, wall: bool) -> None:
+    """The pair's sub-models beyond sliding (``ps.beyond``): Mindlin's DMT adhesion (a trap where ``gamma`` is
+    set without the Law2's ``includeAdhesion``) and, between spheres, ThermalEngine's conduction."""
+    if ip2 is not None and ip2.name == "Ip2_FrictMat_FrictMat_MindlinPhys" and "gamma" in ip2.kw:
+        _dmt(ps, ma, mb, ip2, law2)
+    if laws.get("thermal") is not None and not wall:
+        _thermal(ps, laws["thermal"], setup)
+
+
+def _dmt(ps: PairSetting, ma: Call, mb: Call, ip2: Call, law2) -> None:
+    gamma = ip2.kw["gamma"]
+    if not _number(gamma):
+        ps.notes.append(f"MindlinPhys gamma is computed at run time ({getattr(gamma, 'why', gamma)}): its adhesion "
+                        "is not probed")
+        return
+    if not gamma > 0:
+        return
+    if law2 is None or law2.kw.get("includeAdhesion") in (None, False, 0):
+        ps.findings.append(Finding(
+            "trap", "yade-adhesion-off", f"Ip2_FrictMat_FrictMat_MindlinPhys(gamma = {gamma:g}) without "
+            "Law2_ScGeom_MindlinPhys_Mindlin(includeAdhesion=True): the DMT adhesion 4πR̄γ is computed and never "
+            "applied (measured: a DMT pull never pulls, docs/findings.md)", ps.where, {"gamma": gamma}))
+        return
+    e, nu = _get(ma, "young"), _get(ma, "poisson")
+    if not (_number(e) and _number(nu)):
+        return
+    ps.beyond["adhesion"] = {"law": "dmt", "args": (e, 0.0, nu, gamma),
+                             "words": f"Mindlin DMT gamma {gamma:g} (w = 2 gamma), includeAdhesion"}
+    ps.notes.append("the collision probes run Mindlin without its adhesion; the adhesion is the pull-off probe's"
+                    + ("" if (e, nu) == (_get(mb, "young"), _get(mb, "poisson")) else
+                       f" (of two spheres of {_label(None, ma)}'s E and ν)"))
+
+
+def _thermal(ps: PairSetting, th: Call, setup: Setup) -> None:
+    """ThermalEngine's conduction between the pair's spheres, asked as Batchelor & O'Brien's 2ks a with ks its
+    ``particleK``; capacities from ``particleCp`` (the first call sets every body's k and Cp to these)."""
+    vals = {k: th.kw.get(k, d) for k, d in THERMAL_DEFAULTS.items()}
+    sub = {"law": "radius", "args": (vals["particleK"],),
+           "words": f"ThermalEngine(particleK = {vals['particleK']}, particleCp = {vals['particleCp']})"}
+    flags = [f for f in ("useKernMethod", "useHertzMethod") if th.kw.get(f) not in (None, False, 0)]
+    if not all(_number(v) for v in vals.values()):
+        sub["refused"] = "ThermalEngine's particleK, particleCp or particleDensity is computed at run time"
+    elif flags:
+        sub["refused"] = (f"ThermalEngine({flags[0]}=True) is not mapped (measured on a steel pair: useKernMethod "
+                          "32× below Batchelor & O'Brien's conductance, useHertzMethod 217× above: docs/findings.md)")
+    elif vals["particleDensity"] > 0:
+        sub["refused"] = "ThermalEngine(particleDensity > 0) replaces the materials' density in the capacities"
+    else:
+        setup.heat = {"cp_all": float(vals["particleCp"]), "where": f"ThermalEngine (line {th.line})"}
+    ps.beyond["heat"] = sub
 
 
 def _series(x: float, y: float) -> float:

@@ -2,7 +2,8 @@
 ``CohFrictMat`` + ``Ip2_CohFrictMat_CohFrictMat_CohFrictPhys`` + ``Law2_ScGeom6D_CohFrictPhys_CohesionMoment``
 (``useIncrementalForm``, ``always_use_moment_law``) on a fixed box (``Ig2_Box_Sphere_ScGeom6D``: there is no 6-D
 wall geometry); :func:`mapping`, :func:`twin_laws` (Yade's leap-frog and law: reference/beyond_yade.py),
-:func:`deck` (a fixed template with numbers only, checked by :func:`check_script`) and :func:`read`.
+:func:`deck` (a fixed template with numbers only, checked by :func:`check_script`) and :func:`read`. The pair
+scenarios (pull_off, adhesive_impact, conduction) are handed to :mod:`.pair` (Mindlin's DMT, ThermalEngine).
 
 What the CohFrictPhys computes (CohesiveFrictionalContactLaw.cpp, read; measured against the twin): a linear
 normal spring kn = E·R (the box takes the sphere's radius), no normal dashpot; an incremental shear spring
@@ -28,6 +29,7 @@ from ...laws.model import resolve
 from ...reference import beyond_yade
 from ...reference.scenarios import _on_wall
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from . import pair
 from .deck import ascii_comment, guard
 
 FIRST_LINE = "# demcheck: a Yade scenario script (Python), generated from a fixed template"
@@ -51,11 +53,14 @@ NODES = (__import__("ast").Module,) + tuple(getattr(__import__("ast"), n) for n 
 
 
 def is_scenario_script(text: str) -> bool:
-    return text.split("\n", 1)[0] == FIRST_LINE
+    return text.split("\n", 1)[0] == FIRST_LINE or pair.is_pair_script(text)
 
 
 def check_script(text: str, files: dict | None = None) -> None:
-    """The guard of the scenario template: only its names, attributes, keywords, strings and numbers."""
+    """The guard of the scenario template (a pair's: pair.py's): only its names, attributes, keywords, strings and
+    numbers."""
+    if pair.is_pair_script(text):
+        return pair.check_script(text, files)
     if not is_scenario_script(text):
         raise DemcheckError("refusing to run a Yade script: it is not demcheck's scenario template")
     guard(text, files, NAMES, ATTRIBUTES, KEYWORDS, STRINGS, NODES, flags=True)
@@ -68,12 +73,8 @@ def mapping(case: Case) -> Mapping:
     """The case's contact in CohFrictPhys terms (``nat.props``: young, poisson, mu, etaRoll, alphaKr, etaTwist,
     alphaKtw, and the pair's kn, ks, kr, ktw, maxRollPl, maxTwistPl)."""
     s = case.run.scenario
-    if s in ("pull_off", "adhesive_impact"):
-        return refused("yade", "Yade 2023.02a has no JKR or DMT normal law written here: its adhesive laws "
-                               "(MindlinPhys includeAdhesion, the cohesive CohFrictPhys) are not mapped to jkr/dmt")
-    if s == "conduction":
-        return refused("yade", "no Yade deck is written for heat conduction: Yade 2023.02a has ThermalEngine "
-                               "(built with THERMAL) but its conductance is not mapped here")
+    if s in pair.PAIR:
+        return pair.mapping(case)
     model = resolve(case)
     radius = case.particles[0].radius
     made = _contact(case, model, radius)
@@ -166,6 +167,8 @@ def _twisting(law, props, radius):
 
 def twin_laws(case: Case, nat: Native) -> dict:
     """The laws the layout reads (the linear normal spring, the shear spring) and Yade's own stepper."""
+    if case.run.scenario in pair.PAIR:
+        return pair.twin_laws(case, nat)
     p = nat.props
     kn = p["kn"]
     return {"normal": lambda d, rate: kn * d, "tangential": (p["ks"], 0.0, p["mu"]),
@@ -197,6 +200,8 @@ def _vec(xs) -> str:
 def deck(case: Case, nat: Native, lay) -> common.Deck:
     """The scenario's script: the sphere at the layout's start (v_{−½} = the layout's velocity), a fixed box
     whose top face is the wall, sampled every ``lay.every`` steps (x_k, the full-step velocities)."""
+    if case.run.scenario in pair.PAIR:
+        return pair.deck(case, nat, lay)
     p, part, wall = nat.props, case.particles[0], case.walls[0]
     if getattr(wall, "material", None) or int(np.count_nonzero(wall.normal)) != 1:
         raise DemcheckError("the Yade scenario script is written for a rigid axis-aligned wall")
@@ -244,6 +249,8 @@ def deck(case: Case, nat: Native, lay) -> common.Deck:
 
 def read(case: Case, lay, workdir) -> dict:
     """The samples as reference/scenarios.stepped_metrics reads them."""
+    if case.run.scenario in pair.PAIR:
+        return pair.read(case, lay, workdir)
     path = Path(workdir) / common.DUMP_FILE
     try:
         rows = np.loadtxt(path, ndmin=2)
