@@ -207,13 +207,40 @@ def test_the_rolling_deck_turns_rolling_friction_on_and_says_its_fidelity():
     rel = json.loads(d.files["MaterialsDEM.json"])["material_relations"]
     assert {(r["Variables"]["DEM_ROLLING_FRICTION_MODEL_NAME"], r["Variables"]["ROLLING_FRICTION_WITH_WALLS"])
             for r in rel} == {("DEMRollingFrictionModelConstantTorque", 0.1)}
-    assert "# mapping fidelity: approximate" in scenario.deck(case("pull-off"), "kratos").text  # JKR's
-    assert "# mapping fidelity: exact" in scenario.deck(dmt_pull(), "kratos").text
     from demcheck.errors import UnsupportedByEngine
 
     with pytest.raises(UnsupportedByEngine, match="holds the string"):
         check(d.text, {**d.files, "MaterialsDEM.json": d.files["MaterialsDEM.json"].replace(
             "DEMRollingFrictionModelConstantTorque", "DEMRollingFrictionModelElse")})
+
+
+def test_the_scenario_decks_header_states_the_scenario_mappings_fidelity():
+    """The adhesive decks too: JKR's approximate mapping with its reason, DMT's exact one — never 'native' (the
+    writer is handed the configuration directly, which alone would make it say so)."""
+    from demcheck.engines import scenario
+
+    head = scenario.deck(case("pull-off"), "kratos").text.split("import json")[0]
+    assert "# mapping fidelity: approximate" in head and "the Hertz radius a = √(R̄δ)" in head
+    assert "native" not in head
+    head = scenario.deck(dmt_pull(), "kratos").text.split("import json")[0]
+    assert "# mapping fidelity: exact" in head and "native" not in head
+
+
+def test_the_twin_turns_the_arm_with_kratos_low_angle_quaternion():
+    """Kratos' OrientationFromRotationAngle below its threshold ((θ/2)⁴/24 < ε) builds q = (1 + φ²/2, …): the arm
+    turns by θ(1 − θ²/4), its tip θ³a/4 short of an exact rotation; above it, an exact rotation."""
+    from demcheck.reference.beyond_kratos import kratos_arm_turn
+    from demcheck.reference.twins_kratos import arm_turn
+
+    a = 1.59e-3
+    arm = np.array([0.0, 0.0, -a])
+    for theta in (1.44e-5, 1e-4):  # the rolling case's ω dt, and a larger step still in the low-angle branch
+        got = kratos_arm_turn(arm, np.array([0.0, theta, 0.0]))
+        exact = arm_turn(arm, np.array([0.0, theta, 0.0]), False)
+        assert abs(exact[0] / (a * math.sin(theta)) + 1) < 1e-12  # the exact tip moves by a sin θ (along −x)
+        assert abs((got[0] - exact[0]) / (a * theta ** 3 / 4) - 1) < 1e-3
+    got = kratos_arm_turn(arm, np.array([0.0, 0.1, 0.0]))  # past the threshold: cos and sin, exact
+    assert np.allclose(got, arm_turn(arm, np.array([0.0, 0.1, 0.0]), False), rtol=1e-13, atol=1e-19)
 
 
 @pytest.mark.engine("kratos")
