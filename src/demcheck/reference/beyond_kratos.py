@@ -1,5 +1,5 @@
-"""Kratos DEM 10.4.4's adhesive laws in the scenarios beyond sliding, stepped as Kratos steps them (the twin of
-engines/kratos/scenario.py).
+"""Kratos DEM 10.4.4's adhesive laws and its rolling friction on a wall in the scenarios beyond sliding, stepped as
+Kratos steps them (the twin of engines/kratos/scenario.py). The rolling sphere: :func:`wall_roll` (its doc).
 
 What Kratos computes (read in applications/DEMApplication/custom_constitutive/DEM_D_JKR_cohesive_law.cpp,
 DEM_D_DMT_cohesive_law.cpp, DEM_compound_constitutive_law.h, DEM_D_Hertz_viscous_Coulomb_CL.cpp, and checked
