@@ -20,7 +20,9 @@ Measured (Kratos 10.4.4; engine vs twin, engine vs reference):
   R − δ (× 1/(1 − δ/R), δ/R = 2.6e-6) and ½dt late (the runner's start: the first half step has no torque): 8e-9
   from that, 2.3e-5 from the bare closed form (agree), the distance 4.05e-5 from it (differs as expected);
 * the same sphere under ViscousTorque (type B, Cr = 1e-8 N·m·s): engine = twin likewise; the e-fold time 2.0e-7
-  from 1.4mR²/Cr.
+  from 1.4mR²/Cr;
+* beyond-incline-linear with type A (kt = 1e6 N/m, so that Kratos' Linear law holds it): engine = twin to 2e-11 in
+  every sample, the angle 5.5e-7 from atan μr.
 
 The rolling closed forms: the angular momentum about the contact point L = (7/5) m R v (rolling without slip)
 falls at the rate of the rolling torque M = μr Rr |Fn| (the friction force has no moment about that point), so
@@ -153,6 +155,13 @@ MASS = RHO_GLASS * 4.0 / 3.0 * math.pi * R_GLASS ** 3
 C_R = 1e-8  # the viscous variant's Cr (N·m·s): small enough that the sphere rolls without slip (Cr ω0 < μ m g R)
 
 
+def incline_type_a():
+    """beyond-incline-linear with type A and a tangential spring Kratos' Linear law can hold (kt = Kn: ν = 0)."""
+    return loads(case_path("suite/beyond-incline-linear.toml").read_text().replace(
+        'rolling = "epsd"\nmu_r = 0.1\nk_r = 0.1', 'rolling = "constant_torque"\nmu_r = 0.1').replace(
+        "kt = 1e5", "kt = 1e6"))
+
+
 def viscous_rolling():
     return loads(case_path("suite/beyond-rolling-linear.toml").read_text().replace(
         'rolling = "constant_torque"\nmu_r = 0.1', f'rolling = "viscous"\nc_r = {C_R}'))
@@ -164,7 +173,7 @@ def sampled(which):
     from demcheck.engines import registry, scenario
     from demcheck.engines import run as runner
 
-    c = case("rolling-linear") if which == "constant" else viscous_rolling()
+    c = {"constant": case("rolling-linear"), "viscous": viscous_rolling(), "incline": incline_type_a()}[which]
     eng = registry.get("kratos")
     mp, nat, lay, dk = scenario._planned_deck(c, eng)
     out = runner.run("kratos", dk.text, files=dk.files, timeout=900)
@@ -244,15 +253,15 @@ def test_the_twin_turns_the_arm_with_kratos_low_angle_quaternion():
 
 
 @pytest.mark.engine("kratos")
-@pytest.mark.parametrize("which", ["constant", "viscous"])
+@pytest.mark.parametrize("which", ["constant", "viscous", "incline"])
 def test_kratos_rolling_run_is_its_twin_in_every_sample(which):
     c, lay, got, twin = sampled(which)
     assert got["x"].shape == twin["x"].shape == (lay.steps // lay.every + 1, 3)
     # relative to the series' largest component (v_z, ω_x, ω_z, the total force's z are round-off); the force and
     # the moment hold the tangential increment, where Kratos' low-angle quaternion shows (kratos_arm_turn: with an
     # exact rotation the force missed by 1.9e-8)
-    stopped = np.nonzero(twin["v"][:, 0] <= 0.0)[0]
-    stop = int(stopped[0]) if stopped.size else len(twin["v"])
+    stopped = np.nonzero(twin["v"][:, 0] <= 0.0)[0]  # a roll's stop (the incline starts at rest and never stops)
+    stop = int(stopped[0]) if stopped.size and twin["v"][0, 0] > 0.0 else len(twin["v"])
     for key in ("x", "v", "omega", "f", "torque"):
         scale = abs(twin[key]).max()
         diff = abs(got[key] - twin[key]).max(axis=1) / scale
@@ -283,6 +292,17 @@ def test_kratos_rolling_stops_at_the_closed_form_half_a_step_late():
     assert abs(m["rolling_distance"] / (V0 * V0 / (2 * a) + 0.5 * lay.dt * V0) - 1) < 1e-5  # measured 2.3e-6
     assert 2e-5 < m["rolling_stop_time"] / t_bare - 1 < 2.5e-5  # the half step is 2.0e-5, the arm 2.6e-6
     assert 3.5e-5 < m["rolling_distance"] / s_bare - 1 < 4.5e-5
+
+
+@pytest.mark.engine("kratos")
+def test_kratos_type_a_incline_gives_the_closed_form_angle():
+    """On a 10° slope a type A sphere rolls from rest (ConstantTorque is 0 while ω = 0) with a = (5/7) g (sin θ −
+    μr cos θ): its angle atan μr (the torque's arm R − δ lengthens μr by δ/R, 1e-6 here)."""
+    from demcheck.reference.scenarios import stepped_metrics
+
+    c, lay, got, _ = sampled("incline")
+    got = stepped_metrics(c, got)["incline_critical_angle"]
+    assert abs(got / math.atan(MU_R) - 1) < 1e-5  # measured 5.5e-7
 
 
 @pytest.mark.engine("kratos")
