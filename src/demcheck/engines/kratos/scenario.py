@@ -77,7 +77,8 @@ JKR_REASON = ("Kratos' DEM_D_Hertz_viscous_Coulomb_JKR subtracts √(8πwE*a³) 
 
 
 def mapping(case: Case) -> Mapping:
-    """The case's scenario in Kratos' words: the adhesive scenarios through the cohesive laws, the others none."""
+    """The case's scenario in Kratos' words: the adhesive scenarios through the cohesive laws, a sphere on a wall
+    through a rolling friction model (:func:`_rolling`), twist and conduction none."""
     s = case.run.scenario
     if s in WHY_NOT:
         return refused("kratos", WHY_NOT[s])
@@ -134,7 +135,7 @@ def _rolling(case: Case, model) -> Mapping:
     nat.comments = [*nat.comments, f"RollingFrictionOption = true, {name}, ROLLING_FRICTION = "
                                    f"ROLLING_FRICTION_WITH_WALLS = {mu:.10g}"]
     return Mapping("kratos", APPROXIMATE, [*base.reasons, reason, HALF_STEP], nat,
-                   {**base.keywords, reason: name, HALF_STEP: "RollingFrictionOption"})
+                   {**base.keywords, reason: name})  # HALF_STEP is the runner's start, no Kratos setting
 
 
 def _static_overlap(nat: Native, mass: float, radius: float, weight: float) -> float:
