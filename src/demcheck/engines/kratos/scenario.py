@@ -135,7 +135,7 @@ def _rolling(case: Case, model) -> Mapping:
     nat.comments = [*nat.comments, f"RollingFrictionOption = true, {name}, ROLLING_FRICTION = "
                                    f"ROLLING_FRICTION_WITH_WALLS = {mu:.10g}"]
     return Mapping("kratos", APPROXIMATE, [*base.reasons, reason, HALF_STEP], nat,
-                   {**base.keywords, reason: name})  # HALF_STEP is the runner's start, no Kratos setting
+                   {**base.keywords, reason: name, HALF_STEP: "DEMAnalysisStage.Initialize (v, ω set after it)"})
 
 
 def _static_overlap(nat: Native, mass: float, radius: float, weight: float) -> float:
