@@ -153,7 +153,7 @@ def test_marshall_takes_mu_t_from_the_pairs_friction():
 def test_engines_refuse_a_scenario_they_do_not_run():
     from demcheck.comparisons.sources import Source
 
-    with pytest.raises(UnsupportedByEngine, match="no Kratos deck is written for a sphere rolling on a wall"):
+    with pytest.raises(UnsupportedByEngine, match="the sphere.s contact with the wall: Kratos. tangential force is"):
         api.collide(case_path("suite/beyond-rolling.toml"), source="kratos")
     with pytest.raises(ConfigError, match="adaptive reference only"):
         Source.reference("verlet").run(load("twist"))

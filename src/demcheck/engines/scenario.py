@@ -214,11 +214,14 @@ def _wall_layout(case: Case, laws: dict) -> Layout:
 
 
 def _wall_duration(case: Case, mass: float, radius: float, g: float, theta: float) -> float:
-    """1.25 × the closed form's stop (rolling, twist); the time to roll R/4 down the incline."""
+    """1.25 × the closed form's stop (rolling, twist; 1.5 × the time constant of a viscous rolling torque, which
+    never stops); the time to roll R/4 down the incline."""
     model = resolve(case)
     if case.run.scenario == "rolling":
         law, p, n = model.slot("rolling"), case.particles[0], np.asarray(case.walls[0].normal, dtype=float)
         v = np.asarray(p.velocity, dtype=float)
+        if law.id == "viscous":  # type B never stops: 1.5 × its time constant (the e-fold time is measured)
+            return 1.5 * _b.rolling_viscous_closed(law.c_r, mass, radius, 1.0)[0]
         return 1.25 * _b.rolling_stop_closed(law.mu_r, law.r_roll, radius, float(np.linalg.norm(v - (v @ n) * n)),
                                             g)[0]
     if case.run.scenario == "twist":

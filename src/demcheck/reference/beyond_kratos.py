@@ -1,5 +1,5 @@
-"""Kratos DEM 10.4.4's adhesive laws in the scenarios beyond sliding, stepped as Kratos steps them (the twin of
-engines/kratos/scenario.py).
+"""Kratos DEM 10.4.4's adhesive laws and its rolling friction on a wall in the scenarios beyond sliding, stepped as
+Kratos steps them (the twin of engines/kratos/scenario.py). The rolling sphere: :func:`wall_roll` (its doc).
 
 What Kratos computes (read in applications/DEMApplication/custom_constitutive/DEM_D_JKR_cohesive_law.cpp,
 DEM_D_DMT_cohesive_law.cpp, DEM_compound_constitutive_law.h, DEM_D_Hertz_viscous_Coulomb_CL.cpp, and checked
@@ -21,6 +21,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
+
+from .. import KERNEL_CACHE
+from ..laws.normal_force import normal_force
+from ..laws.tangential_force import _cross, _dot
+from .twins_kratos import tangential
 
 JKR, DMT = "jkr", "dmt"
 
@@ -75,3 +81,119 @@ def jkr_hertz_radius_pull_off(r_eff: float, e_eff: float, w: float) -> tuple[flo
     2E*√R̄ δ^{1/2} = (3/4)√(8πwE*) R̄^{3/4} δ^{−1/4} ⇒ δ* = ((3/8)√(8πw/E*) R̄^{1/4})^{4/3}."""
     d = (0.375 * math.sqrt(8.0 * math.pi * w / e_eff) * r_eff ** 0.25) ** (4.0 / 3.0)
     return -kratos_adhesive_force(JKR, r_eff, e_eff, w, d), d
+
+
+# ----------------------------------------------------------------------------- a sphere rolling on a wall
+
+CONSTANT_TORQUE, VISCOUS_TORQUE = 0, 1  # DEMRollingFrictionModelConstantTorque, …ViscousTorque
+
+
+def wall_roll(nl, kp, model: int, mu_roll: float, radius: float, mass: float, x0, v0, omega0, gravity,
+              wall_point, wall_normal, dt: float, steps: int, every: int) -> dict:
+    """One sphere on a rigid face under gravity, stepped as reference/twins_kratos.kratos_3d steps Kratos' wall
+    contact (Velocity_Verlet with Direct_Integration of the spin; the tangential law's incremental spring, dashpot
+    and cap with the arm R − δ; the normal force ``nl`` held ≥ 0) plus the rolling friction model of the
+    relation (``model``; ``mu_roll`` its ROLLING_FRICTION), added to the contact's moment from the spin ω the
+    node holds when the forces are computed (the half step's, after the predictor):
+
+    * ConstantTorque: M = −μ |Fn| (R − δ) ω/|ω| (none while ω = 0);
+    * ViscousTorque: M = −μ |Fn| (R − δ) · (R − δ) ω.
+
+    Returns, at steps 0, every, 2·every, …: t, x, v, ω, and the total force (the weight included, as Kratos'
+    TOTAL_FORCES) ``f`` and moment ``torque`` (rows × 3)."""
+    rows = _wall_roll(np.asarray(nl, dtype=float), np.asarray(kp, dtype=float), int(model), float(mu_roll),
+                      float(radius), float(mass), *(np.array(a, dtype=float) for a in (x0, v0, omega0, gravity,
+                                                                                         wall_point, wall_normal)),
+                      float(dt), int(steps), int(every))
+    return {"t": np.arange(len(rows)) * every * dt, "x": rows[:, 0:3], "v": rows[:, 3:6], "omega": rows[:, 6:9],
+            "f": rows[:, 9:12], "torque": rows[:, 12:15]}
+
+
+@njit(cache=KERNEL_CACHE)
+def _wall_roll(nl, kp, model, mu_roll, radius, mass, x, v, w, g, p, nw, dt, steps, every):
+    n = -nw
+    inertia = 0.4 * mass * radius * radius
+    out = np.empty((steps // every + 1, 15))
+    hist = np.zeros(3)
+    dmax = 0.0
+    f, tq = np.zeros(3), np.zeros(3)
+    delta = radius - _dot(x - p, nw)
+    if delta > 0.0:  # Kratos' forces before the first step: the bodies still at rest (the runner sets v, ω after)
+        f = -abs(normal_force(nl, delta, 0.0, delta)) * n
+    _row(out, 0, x, v, w, f + mass * g, tq)
+    for k in range(1, steps + 1):
+        v += 0.5 * dt * (f / mass + g)
+        dx = dt * v
+        x += dx
+        w += 0.5 * dt * tq / inertia
+        dth = dt * w
+        delta = radius - _dot(x - p, nw)
+        f, tq = np.zeros(3), np.zeros(3)
+        if delta > 0.0:
+            arm = radius - delta
+            vr = v + _cross(w, arm * n)
+            rate = _dot(vr, n)
+            vt = vr - rate * n
+            dmax = max(dmax, delta)
+            fn = abs(normal_force(nl, delta, rate, dmax))
+            du = dx + kratos_arm_turn(arm * n, dth)
+            hist = hist - _dot(hist, n) * n
+            ft, hist, _ = tangential(kp, fn, delta, delta - _dot(du, n), du - _dot(du, n) * n, vt, hist)
+            f = -fn * n + ft
+            tq = _cross(arm * n, ft) + _rolling_moment(model, mu_roll, fn, arm, w)
+        else:
+            hist = np.zeros(3)
+            dmax = 0.0
+        v += 0.5 * dt * (f / mass + g)
+        w += 0.5 * dt * tq / inertia
+        if k % every == 0:
+            _row(out, k // every, x, v, w, f + mass * g, tq)
+    return out
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def kratos_arm_turn(arm, dtheta):
+    """The wall contact point's displacement by the sphere's rotation over the step as Kratos computes it
+    (SphericParticle::ComputeBallToRigidFaceContactForceAndMoment): a − q(−Δθ) a, with q from
+    GeometryFunctions::OrientationFromRotationAngle and turned by Quaternion::RotateVector3.
+
+    Below (|Δθ|/2)⁴/24 < ε (every DEM step: |Δθ| < 5.4e-4 rad) that function takes its "Taylor: low angle"
+    branch, q = (1 + φ²/2, φ̂·φ(1 − φ²/6)) normalised, φ = |Δθ|/2: the scalar part's sign is wrong (cos φ ≈
+    1 − φ²/2), and after the normalisation q turns by θ(1 − θ²/4), θ = |Δθ|. The arm's tip moves by θ³R/4 less
+    than a rotation by θ — on a rolling contact, where the slip increment is the small difference of the
+    translation and this turn, that is 1e-5 of the increment (docs/findings.md, "Kratos beyond sliding")."""
+    half = -0.5 * dtheta
+    phi = math.sqrt(half[0] * half[0] + half[1] * half[1] + half[2] * half[2])
+    if phi * phi * phi * phi / 24.0 < 2.220446049250313e-16:
+        aux = 1.0 - phi * phi / 6.0
+        qw = 1.0 + phi * phi / 2.0
+    else:
+        aux = math.sin(phi) / phi
+        qw = math.cos(phi)
+    qx, qy, qz = half[0] * aux, half[1] * aux, half[2] * aux
+    norm2 = qx * qx + qy * qy + qz * qz + qw * qw
+    if norm2 > 0.0 and norm2 != 1.0:
+        norm = math.sqrt(norm2)
+        qx, qy, qz, qw = qx / norm, qy / norm, qz / norm, qw / norm
+    b0 = 2.0 * (qy * arm[2] - qz * arm[1])
+    b1 = 2.0 * (qz * arm[0] - qx * arm[2])
+    b2 = 2.0 * (qx * arm[1] - qy * arm[0])
+    old = np.array([arm[0] + b0 * qw + (qy * b2 - qz * b1), arm[1] + b1 * qw + (qz * b0 - qx * b2),
+                    arm[2] + b2 * qw + (qx * b1 - qy * b0)])
+    return arm - old
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _row(out, i, x, v, w, f, tq):
+    out[i, 0:3], out[i, 3:6], out[i, 6:9], out[i, 9:12], out[i, 12:15] = x, v, w, f, tq
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _rolling_moment(model, mu, fn, arm, w):
+    """The rolling friction model's moment on the sphere (Kratos' order of the products)."""
+    if model == VISCOUS_TORQUE:
+        return -mu * fn * arm * (arm * w)
+    size = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    if size == 0.0:
+        return np.zeros(3)
+    return -(w / size) * mu * fn * arm

@@ -3,11 +3,12 @@
 A run is one subprocess, ``python in.deck`` in the work directory (the Python that has KratosMultiphysics and
 KratosDEMApplication installed). The deck is :data:`TEMPLATE` with its one data line ``CASE = {...}`` (numbers
 only, written with repr) and the files beside it: ``ProjectParameters.json`` (Velocity_Verlet, the case's
-gravity, no global damping, no rolling friction, a neighbour search every step), ``MaterialsDEM.json`` (one
-material a particle, the rigid face's material, one relation a pair with the law, the mapping's friction —
-none without a tangential law — and FRICTION_DECAY) and ``caseDEM.mdpa`` / ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid
-triangle in the wall's plane covering the whole scene). The runner sets each pair's DAMPING_GAMMA after
-Kratos has initialised, the bodies' velocities and spins, and writes every step's states as a LAMMPS-style
+gravity, no global damping, no rolling friction unless a scenario sets a model, a neighbour search every step),
+``MaterialsDEM.json`` (one material a particle, the rigid face's material, one relation a pair with the law, the
+mapping's friction — none without a tangential law — and FRICTION_DECAY) and ``caseDEM.mdpa`` /
+``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid triangle in the wall's plane covering the whole
+scene). The runner sets each pair's DAMPING_GAMMA after Kratos has initialised, the bodies' velocities and spins,
+and writes every step's states as a LAMMPS-style
 ``dump custom`` (%.17g) to ``dump.txt``.
 
 :func:`check` is the last guard before Kratos runs: the script must be the template line for line (comment
@@ -118,6 +119,9 @@ PULL_LINES = """        for body in CASE["fixed"]:
 """
 PULL_TEMPLATE = TEMPLATE.replace("        self.demcheck_step = 0\n", PULL_LINES + "        self.demcheck_step = 0\n", 1)
 COHESIVE = ("DEM_D_Hertz_viscous_Coulomb_JKR", "DEM_D_Hertz_viscous_Coulomb_DMT")  # the scenarios' adhesive laws
+# the rolling scenarios' torque models (engines/kratos/scenario.py); Bounded is the relation's default name, unused
+# while RollingFrictionOption is off
+ROLLING_MODELS = ("DEMRollingFrictionModelConstantTorque", "DEMRollingFrictionModelViscousTorque")
 
 def _case_literal(steps: int, bodies: list, gamma: list, fixed: list | None = None) -> str:
     """The runner's data line: numbers only, each written with repr (float → shortest exact text); ``fixed``
@@ -138,18 +142,26 @@ def _case_literal(steps: int, bodies: list, gamma: list, fixed: list | None = No
 
 
 def _check_options(options: dict) -> None:
-    """``copies`` (1 only); a scenario's ``steps`` and ``fixed`` (engines/kratos/scenario.py)."""
+    """``copies`` (1 only); a scenario's ``steps``, ``fixed``, ``rolling`` and ``mapping``
+    (engines/kratos/scenario.py)."""
     if options.get("copies", 1) != 1:
         raise UnsupportedByEngine("Kratos decks are written for one copy of a collision")
-    if set(options) - {"copies", "steps", "fixed"}:
-        raise TypeError(f"unknown deck options {sorted(set(options) - {'copies', 'steps', 'fixed'})}")
+    known = {"copies", "steps", "fixed", "rolling", "mapping"}
+    if set(options) - known:
+        raise TypeError(f"unknown deck options {sorted(set(options) - known)}")
+    rolling = options.get("rolling")
+    if rolling is not None and (rolling[0] not in ROLLING_MODELS or not math.isfinite(float(rolling[1]))
+                                or float(rolling[1]) < 0.0):
+        raise UnsupportedByEngine(f"no Kratos rolling friction model {rolling!r} is written here")
 
 
 def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
     """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
     model). One copy of the collision only (no batched copies). A scenario's (engines/kratos/scenario.py):
     ``steps`` its layout's length (the bodies where its case puts them), ``fixed`` the pull's held velocities
-    (PULL_TEMPLATE)."""
+    (PULL_TEMPLATE), ``rolling`` (model name, ROLLING_FRICTION) the relation's rolling friction model with
+    RollingFrictionOption on, ``mapping`` the scenario mapping (its fidelity and reasons go into the header,
+    not the contact's alone)."""
     _check_options(options)
     fixed = options.get("fixed")
     sc = common.scene(case, dt, length) if options.get("steps") is None else _scenario_scene(case, dt, options["steps"])
@@ -179,7 +191,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         a, b = i + 1, (wall_id if j is None else j + 1)
         gamma += [(a, b, pn.damping_coeff)] + ([(b, a, pn.damping_coeff)] if a != b and j is not None else [])
     bodies = [(p.radius, p.velocity, p.angular_velocity) for p in case.particles]
-    lines = common.header("kratos", sc, mp, VERSION_NOTE, "python") + common.notes(nat.comments)
+    lines = common.header("kratos", sc, options.get("mapping") or mp, VERSION_NOTE, "python")
+    lines += common.notes(nat.comments)
     lines.append(common.comment(f"time scheme {SCHEME}; files read: {', '.join(FILES)}"))
     data = _case_literal(sc.steps, bodies, gamma, fixed)
     text = "\n".join(lines) + "\n" + (TEMPLATE if fixed is None else PULL_TEMPLATE).replace(CASE_LINE, data, 1)
@@ -197,16 +210,8 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
         "DeltaTimeSafetyFactor": 1.0, "MaxTimeStep": float(sc.dt), "FinalTime": float(sc.dt) * (sc.steps + 10),
         "NeighbourSearchFrequency": 1, "GraphExportFreq": 1e30, "VelTrapGraphExportFreq": 1e30,
         "OutputTimeStep": 1e30, "PostVelocity": False, "problem_name": PROBLEM}
-    friction = [float(nat.props.get(k, 0.0)) for k in ("mu_s", "mu_d", "decay")]
-    relation = {"STATIC_FRICTION": friction[0], "DYNAMIC_FRICTION": friction[1], "FRICTION_DECAY": friction[2],
-                "ROLLING_FRICTION": 0.0,
-                "ROLLING_FRICTION_WITH_WALLS": 0.0, "COEFFICIENT_OF_RESTITUTION": 1.0,
-                "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME": nat.normal,
-                "DEM_ROLLING_FRICTION_MODEL_NAME": "DEMRollingFrictionModelBounded"}
-    if nat.normal == CUSTOM:  # its Kn, Kt are the contact's (the relation's) K_NORMAL, K_TANGENTIAL
-        relation.update(K_NORMAL=float(nat.props["k_normal"]), K_TANGENTIAL=float(nat.props["k_tangential"]))
-    if nat.normal in COHESIVE:  # the cohesive laws read the relation's PARTICLE_COHESION (w, J/m²)
-        relation["PARTICLE_COHESION"] = float(nat.props["cohesion"])
+    relation = _relation(nat, options.get("rolling"))
+    params["RollingFrictionOption"] = options.get("rolling") is not None
     materials = [{"material_name": f"particle{k + 1}", "material_id": k + 1,
                   "Variables": {"PARTICLE_DENSITY": float(mats[k].density), "YOUNG_MODULUS": float(youngs[k]),
                                 "POISSON_RATIO": float(nus[k])}} for k in range(n)]
@@ -225,6 +230,26 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, 
              f"{PROBLEM}DEM.mdpa": _spheres_mdpa(case),
              f"{PROBLEM}DEM_FEM_boundary.mdpa": _wall_mdpa(sc, wall_id) if case.walls else _empty_mdpa()}
     return common.Deck("kratos", text, files, dt=sc.dt, check=check)
+
+
+def _relation(nat, rolling) -> dict:
+    """A relation's Variables: the law, the mapping's friction, the law's own numbers (Custom_Constants' Kn and Kt,
+    a cohesive law's PARTICLE_COHESION), and ``rolling`` (model name, ROLLING_FRICTION) or no rolling friction."""
+    friction = [float(nat.props.get(k, 0.0)) for k in ("mu_s", "mu_d", "decay")]
+    relation = {"STATIC_FRICTION": friction[0], "DYNAMIC_FRICTION": friction[1], "FRICTION_DECAY": friction[2],
+                "ROLLING_FRICTION": 0.0,
+                "ROLLING_FRICTION_WITH_WALLS": 0.0, "COEFFICIENT_OF_RESTITUTION": 1.0,
+                "DEM_DISCONTINUUM_CONSTITUTIVE_LAW_NAME": nat.normal,
+                "DEM_ROLLING_FRICTION_MODEL_NAME": "DEMRollingFrictionModelBounded"}
+    if nat.normal == CUSTOM:  # its Kn, Kt are the contact's (the relation's) K_NORMAL, K_TANGENTIAL
+        relation.update(K_NORMAL=float(nat.props["k_normal"]), K_TANGENTIAL=float(nat.props["k_tangential"]))
+    if nat.normal in COHESIVE:  # the cohesive laws read the relation's PARTICLE_COHESION (w, J/m²)
+        relation["PARTICLE_COHESION"] = float(nat.props["cohesion"])
+    if rolling is not None:  # the relation's model and coefficient (a wall's contact reads them too)
+        name, mu = rolling
+        relation.update(ROLLING_FRICTION=float(mu), ROLLING_FRICTION_WITH_WALLS=float(mu),
+                        DEM_ROLLING_FRICTION_MODEL_NAME=name)
+    return relation
 
 
 _f = common.float_literal
@@ -396,7 +421,7 @@ PARAMETER_KEYS = frozenset({
     "K_NORMAL", "K_TANGENTIAL", "PARTICLE_COHESION"})
 KNOWN_STRINGS = frozenset({"sphere_strategy", "MaterialsDEM.json", "Ascii", "single_file", "SphericPartDEMElement3D",
                            SCHEME, "Direct_Integration", PROBLEM, "DEMRollingFrictionModelBounded", "wall",
-                           *LAWS, *COHESIVE})
+                           *LAWS, *COHESIVE, *ROLLING_MODELS})
 NAME = re.compile(r"particle[0-9]{1,3}|SpheresPart\.Body[0-9]{1,3}|RigidFacePart\.Wall")
 
 
