@@ -1,0 +1,83 @@
+"""The packing loop at scale (issue 33): what its speed-ups keep — the fused integration pass is the unfused
+velocity Verlet bit for bit; a share's far buffer is added in over the rows it can reach. How fast, only in
+benchmarks/bench_packing_scale.py and docs/packing.md ("At scale")."""
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from demcheck import case as C
+from demcheck.reference import packing as P
+from demcheck.reference.collision3d import rules_array
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+
+def _unfused(case, st, dt, steps):
+    """Velocity Verlet written out as the engines' fix nve/sphere reads — a half kick and a drift, the forces, a
+    half kick, each a pass of its own over the particles (numpy) — around the loop's own force and rebuild kernels,
+    from the loop's own setup: the loop as it was before its passes were fused."""
+    sp, laws_n, laws_t, wall_n, wall_t = P.resolve_laws(case)
+    lawn, lawt = P.law_table(laws_n, laws_t, wall_n, wall_t)
+    walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+    g = np.asarray(case.run.gravity, float)
+    lo, hi, periodic = P.box_of(case, st.x, st.rad)
+    rules = rules_array(None)
+    x, v, w, rad, mass, n = st.x, st.v, st.w, st.rad, st.mass, len(st.rad)
+    inertia, period, skin, _, _, x_ref, f, tq, start, nbj, hist, dmax, _ = P._setup(
+        x, v, w, rad, mass, sp, laws_n.shape[0], lawn, lawt, walls, lo, hi, periodic, dt, steps, 1, st.start, st.nbj,
+        st.hist, st.dmax, rules)
+    ke, rebuilds = [], 0
+    for _ in range(steps):
+        v += 0.5 * dt * (f / mass[:, None] + g)
+        x += dt * v
+        w += 0.5 * dt * tq / inertia[:, None]
+        for k in range(2):
+            below, above = x[:, k] < lo[k], x[:, k] >= hi[k]
+            x[below, k] += hi[k] - lo[k]
+            x[above & ~below, k] -= hi[k] - lo[k]
+        d = x - x_ref
+        if (d[:, 0] ** 2 + d[:, 1] ** 2 + d[:, 2] ** 2).max() > (0.5 * skin) ** 2:
+            start, nbj, hist, dmax = P._rebuild(x, rad, lo, hi, periodic, skin, start, nbj, hist, dmax,
+                                                n * walls.shape[0])
+            x_ref = x.copy()
+            rebuilds += 1
+        f[:], tq[:] = 0.0, 0.0
+        P._contact_forces(np.int64(0), n, x, v, w, rad, sp, laws_n.shape[0], lawn, lawt, walls, period, start, nbj,
+                          hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules)
+        v += 0.5 * dt * (f / mass[:, None] + g)
+        w += 0.5 * dt * tq / inertia[:, None]
+        e = 0.0
+        for i in range(n):  # in the loop's order
+            e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
+        ke.append(e)
+    return ke, rebuilds, hist, dmax
+
+
+@pytest.mark.parametrize("threads", [0, 1])
+def test_the_fused_integration_pass_is_the_unfused_velocity_verlet_bit_for_bit(threads, monkeypatch):
+    """The loop makes one pass over the particles a step besides the force loop (the second half kick, the next
+    step's first half kick and drift, the forces zeroed) where velocity Verlet reads as three: the same arithmetic
+    per particle in the same order, so the same bits — positions, velocities, spins, contact states and the
+    kinetic energy — on a polydisperse pour through its first collisions, list rebuilds included; the serial
+    kernel and the threaded one on one thread alike."""
+    case = C.load(CASES / "optin" / "poured-small-poly.toml")
+    dt, steps = P.packing_dt(case), 6000
+    landing = P.simulate(case, duration=0.03)  # the first spheres on the floor, the rest falling
+    ref = copy.deepcopy(landing)
+    ke, rebuilds, hist, dmax = _unfused(case, ref, dt, steps)
+    if threads:
+        P._prefer_openmp()
+        monkeypatch.setattr(P, "run", lambda *args: P.run_threaded(*args, threads))
+    st = copy.deepcopy(landing)
+    ke_loop, _, flags = P.advance(case, st, dt, steps, ke_every=1)
+    assert rebuilds >= 3 and (dmax != 0.0).sum() > 20 and flags[1] == 0  # rebuilds, contacts
+    for name in ("x", "v", "w"):
+        np.testing.assert_array_equal(getattr(st, name), getattr(ref, name), err_msg=name)
+    np.testing.assert_array_equal(st.hist, hist)
+    np.testing.assert_array_equal(st.dmax, dmax)
+    # the energy summed here in Python (numpy scalars) and there compiled: the loop before the fusion read the
+    # same, a few of the 6000 values one unit of the last place apart
+    np.testing.assert_allclose(ke_loop[1:], ke, rtol=1e-15, atol=0.0)
