@@ -341,8 +341,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
     torque_radius = rules[R_TORQUE_ARM] == ARM_RADIUS
     record = records.shape[0] > 0
+    # the pairs' law and the walls' law, each as tuples, fetched again only when it changes: a particle on a wall
+    # would otherwise switch between the two twice a row — a wall contact cost three pair contacts (docs/packing.md)
     law = np.int64(0)  # (not a literal: its first value would compile _law for it while the types are inferred)
-    nl, tl = _law(laws_n, laws_t, law)
+    pair_nl, pair_tl = _law(laws_n, laws_t, law)
+    wall_law = np.int64(n_species * n_species)
+    wall_nl, wall_tl = _law(laws_n, laws_t, wall_law)
     for i in range(lo, hi):
         end = start[i + 1]
         for e in range(start[i], end + n_w):
@@ -375,6 +379,10 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 u1 = vr1 + o2 * n0 - o0 * n2
                 u2 = vr2 + o0 * n1 - o1 * n0
                 p = species[i] * n_species + species[j]
+                if p != law:  # another law: its tuples (once per change, not per contact)
+                    pair_nl, pair_tl = _law(laws_n, laws_t, p)
+                    law = p
+                nl, tl = pair_nl, pair_tl
             else:  # wall k: a plane through p with normal nw into the domain
                 k = e - end
                 j, bj = -1, 0.0
@@ -395,11 +403,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 u1 = v[i, 1] + ai * (w[i, 2] * n0 - w[i, 0] * n2)
                 u2 = v[i, 2] + ai * (w[i, 0] * n1 - w[i, 1] * n0)
                 p = n_species * n_species + species[i]
+                if p != wall_law:
+                    wall_nl, wall_tl = _law(laws_n, laws_t, p)
+                    wall_law = p
+                nl, tl = wall_nl, wall_tl
             vn = u0 * n0 + u1 * n1 + u2 * n2
             vt0, vt1, vt2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-            if p != law:  # another law: its tuples (once per change, not per contact)
-                nl, tl = _law(laws_n, laws_t, p)
-                law = p
             dm = max(dmax[r], delta)
             dmax[r] = dm
             fn = normal_force(nl, delta, rate, dm)
@@ -603,6 +612,7 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
 
 
+REBALANCE = 50  # steps between two cuts of the threaded loop's shares (besides one at each rebuild)
 CONTACT_COST = 8  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
 
 
@@ -700,6 +710,9 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
             start, nbj, hist, dmax = _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist,
                                                        dmax, n_p * n_w, chunks)
             x_ref[:, :] = x
+            _balance(start, n_w, dmax, chunks)
+            _far_ends(start, nbj, chunks, far)
+        elif step % REBALANCE == 0:  # the contacts formed since (a pour's bed grows between rebuilds)
             _balance(start, n_w, dmax, chunks)
             _far_ends(start, nbj, chunks, far)
         if step == steps:
