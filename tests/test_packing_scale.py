@@ -81,3 +81,44 @@ def test_the_fused_integration_pass_is_the_unfused_velocity_verlet_bit_for_bit(t
     # the energy summed here in Python (numpy scalars) and there compiled: the loop before the fusion read the
     # same, a few of the 6000 values one unit of the last place apart
     np.testing.assert_allclose(ke_loop[1:], ke, rtol=1e-15, atol=0.0)
+
+
+def test_pairs_and_walls_each_keep_their_own_law_in_the_force_loop():
+    """The force loop keeps the pairs' law and the walls' law side by side, each fetched again only when it
+    changes (a sphere on the floor went from one to the other and back in each row). Three species, each sphere
+    on the floor and touching the next, sliding and spinning, so that every row switches between a pair law and a
+    wall law: the forces and torques of all the contacts in one call are those of the pair contacts alone plus
+    the wall contacts alone (each call with one kind of law only), to round-off, and every contact carries load."""
+    case = C.load(CASES / "optin" / "poured-small-poly.toml")
+    sp_case, rep = P.species_of(case)
+    sp, laws_n, laws_t, wall_n, wall_t = P.resolve_laws(case)
+    lawn, lawt = P.law_table(laws_n, laws_t, wall_n, wall_t)
+    species = np.array([2, 0, 1, 2, 0], np.int64) % len(rep)
+    rad = np.array([case.particles[rep[s]].radius for s in species])
+    n = len(rad)
+    x = np.zeros((n, 3))
+    x[:, 2] = rad - 2e-5
+    for i in range(1, n):
+        x[i, 0] = x[i - 1, 0] + np.sqrt((rad[i - 1] + rad[i] - 3e-5) ** 2 - (x[i, 2] - x[i - 1, 2]) ** 2)
+    rng = np.random.default_rng(5)
+    v, w = rng.normal(0.0, 0.05, (n, 3)), rng.normal(0.0, 50.0, (n, 3))
+    floor = np.array([[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]])
+    rules, dt = rules_array(None), 1e-7
+
+    def forces(walls, start, nbj):
+        states = n * walls.shape[0] + len(nbj)
+        hist, dmax = np.zeros((states, 4)), np.zeros(states)
+        f, tq = np.zeros((n, 3)), np.zeros((n, 3))
+        P._contact_forces(np.int64(0), n, x, v, w, rad, species, len(rep), lawn, lawt, walls, (0.0, 0.0), start,
+                          nbj, hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules)
+        assert (dmax > 0.0).all()  # every contact touching
+        return f, tq
+
+    chain = np.array([0, 1, 2, 3, 4, 4], np.int64), np.arange(1, n, dtype=np.int64)
+    f_all, tq_all = forces(floor, *chain)
+    f_pairs, tq_pairs = forces(np.zeros((0, 6)), *chain)
+    f_walls, tq_walls = forces(floor, np.zeros(n + 1, np.int64), np.zeros(0, np.int64))
+    scale = np.abs(f_all).max()
+    np.testing.assert_allclose(f_all, f_pairs + f_walls, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(tq_all, tq_pairs + tq_walls, rtol=0, atol=1e-12 * np.abs(tq_all).max())
+    assert np.abs(f_walls[:, :2]).min() > 0.0 and np.abs(f_pairs[:, 0]).min() > 0.0  # friction on the floor, loads
