@@ -613,7 +613,7 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
 
 
 REBALANCE = 50  # steps between two cuts of the threaded loop's shares (besides one at each rebuild)
-CONTACT_COST = 8  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
+CONTACT_COST = 6  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
 
 
 @njit(cache=KERNEL_CACHE)
