@@ -122,3 +122,27 @@ def test_pairs_and_walls_each_keep_their_own_law_in_the_force_loop():
     np.testing.assert_allclose(f_all, f_pairs + f_walls, rtol=0, atol=1e-12 * scale)
     np.testing.assert_allclose(tq_all, tq_pairs + tq_walls, rtol=0, atol=1e-12 * np.abs(tq_all).max())
     assert np.abs(f_walls[:, :2]).min() > 0.0 and np.abs(f_pairs[:, 0]).min() > 0.0  # friction on the floor, loads
+
+
+def test_a_share_s_far_buffer_is_added_in_over_every_row_its_list_reaches():
+    """Two threads: what a share adds for a later share's particle goes into its far buffer, which the later
+    share adds in only below far[share] (_far_ends) — so far[share] must lie above every particle the share's
+    rows list, and it is one past the largest (a layer above the cut, not the whole next share), for shares that
+    are uneven, empty or single rows."""
+    rng = np.random.default_rng(11)
+    n, r = 300, 1e-3
+    x = rng.uniform(0.0, 1.2e-2, (n, 3))
+    x = x[np.argsort(x[:, 2])]  # a layered order, as a pour's lattice
+    lo, hi, periodic = np.zeros(3), np.full(3, 1.2e-2), np.array([True, True])
+    empty = (np.zeros(n + 1, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0))
+    start, nbj, _, _ = P._rebuild(x, np.full(n, r), lo, hi, periodic, 0.3 * r, *empty, 0)
+    for cut in ([0, 150, 300], [0, 0, 299, 300], [0, 1, 2, 300]):
+        chunks = np.array(cut, np.int64)
+        far = np.zeros(len(cut) - 1, np.int64)
+        P._far_ends(start, nbj, chunks, far)
+        for c in range(len(cut) - 1):
+            listed = nbj[start[cut[c]]:start[cut[c + 1]]]
+            assert far[c] == (listed.max() + 1 if listed.size else 0)
+    half = np.zeros(2, np.int64)
+    P._far_ends(start, nbj, np.array([0, 150, 300], np.int64), half)
+    assert 150 < half[0] < 300  # the first share's list reaches into the second, not to its end
