@@ -168,9 +168,10 @@ def test_pack_on_two_threads_settles_the_column_as_on_one():
 
 
 def test_a_run_that_goes_non_finite_stops_in_the_serial_loop_s_state(monkeypatch):
-    """A state that is not finite (one sphere's speed NaN: what a blown-up step leaves) stops the run after the
-    kick of its first step. The threaded loop on one thread stops where the serial one does — without the next
-    step's drift, which it fuses into that step — and leaves the same state, bit for bit."""
+    """A state that is not finite (one sphere's speed NaN: what a blown-up step leaves) stops the run at its first
+    step (the kinetic energy not finite after the kick, the next step's half kick and drift done in the same pass:
+    both loops fuse them). The threaded loop on one thread stops where the serial one does and leaves the same
+    state, bit for bit."""
     case = C.load(CASES / "optin" / "poured-small-poly.toml")
     dt = P.packing_dt(case)
 

@@ -341,8 +341,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
     torque_radius = rules[R_TORQUE_ARM] == ARM_RADIUS
     record = records.shape[0] > 0
+    # the pairs' law and the walls' law, each as tuples, fetched again only when it changes: a particle on a wall
+    # would otherwise switch between the two twice a row — a wall contact cost three pair contacts (docs/packing.md)
     law = np.int64(0)  # (not a literal: its first value would compile _law for it while the types are inferred)
-    nl, tl = _law(laws_n, laws_t, law)
+    pair_nl, pair_tl = _law(laws_n, laws_t, law)
+    wall_law = np.int64(n_species * n_species)
+    wall_nl, wall_tl = _law(laws_n, laws_t, wall_law)
     for i in range(lo, hi):
         end = start[i + 1]
         for e in range(start[i], end + n_w):
@@ -375,6 +379,10 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 u1 = vr1 + o2 * n0 - o0 * n2
                 u2 = vr2 + o0 * n1 - o1 * n0
                 p = species[i] * n_species + species[j]
+                if p != law:  # another law: its tuples (once per change, not per contact)
+                    pair_nl, pair_tl = _law(laws_n, laws_t, p)
+                    law = p
+                nl, tl = pair_nl, pair_tl
             else:  # wall k: a plane through p with normal nw into the domain
                 k = e - end
                 j, bj = -1, 0.0
@@ -395,11 +403,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 u1 = v[i, 1] + ai * (w[i, 2] * n0 - w[i, 0] * n2)
                 u2 = v[i, 2] + ai * (w[i, 0] * n1 - w[i, 1] * n0)
                 p = n_species * n_species + species[i]
+                if p != wall_law:
+                    wall_nl, wall_tl = _law(laws_n, laws_t, p)
+                    wall_law = p
+                nl, tl = wall_nl, wall_tl
             vn = u0 * n0 + u1 * n1 + u2 * n2
             vt0, vt1, vt2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-            if p != law:  # another law: its tuples (once per change, not per contact)
-                nl, tl = _law(laws_n, laws_t, p)
-                law = p
             dm = max(dmax[r], delta)
             dmax[r] = dm
             fn = normal_force(nl, delta, rate, dm)
@@ -464,39 +473,75 @@ def _contact_table(start, nbj, records, contacts):
 
 @njit(cache=KERNEL_CACHE, inline="always")
 def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref):
-    """The first half kick and the drift of particles lo…hi−1, wrapped into the periodic box; returns the
-    largest squared displacement since the last rebuild."""
+    """The first half kick and the drift of particles lo…hi−1, wrapped into the periodic box, their force and
+    torque then zeroed for the next force loop; returns the largest squared displacement since the last rebuild."""
     moved = 0.0
+    half = 0.5 * dt
     for i in range(lo, hi):
-        for k in range(3):
-            v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
-            x[i, k] += dt * v[i, k]
-            w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
-        for k in range(2):
-            if periodic[k]:
-                L = box_hi[k] - box_lo[k]
-                if x[i, k] < box_lo[k]:
-                    x[i, k] += L
-                elif x[i, k] >= box_hi[k]:
-                    x[i, k] -= L
-        dd = (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
+        m, j = mass[i], inertia[i]
+        v0 = v[i, 0] + half * (f[i, 0] / m + gravity[0])
+        v1 = v[i, 1] + half * (f[i, 1] / m + gravity[1])
+        v2 = v[i, 2] + half * (f[i, 2] / m + gravity[2])
+        v[i, 0], v[i, 1], v[i, 2] = v0, v1, v2
+        w[i, 0] += half * tq[i, 0] / j
+        w[i, 1] += half * tq[i, 1] / j
+        w[i, 2] += half * tq[i, 2] / j
+        f[i, 0] = f[i, 1] = f[i, 2] = 0.0
+        tq[i, 0] = tq[i, 1] = tq[i, 2] = 0.0
+        dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref)
         if dd > moved:
             moved = dd
     return moved
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
-def _kick(lo, hi, v, w, f, tq, mass, inertia, gravity, dt):
-    """The second half kick of particles lo…hi−1; returns their translational and rotational kinetic energy."""
+def _kick_and_next(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref, drift):
+    """The second half kick of particles lo…hi−1 and, with ``drift``, the next step's first half kick and drift,
+    in one pass over each particle (its force and torque then zeroed for the next force loop): the arithmetic of
+    a kick, a kick and a drift (:func:`_kick_drift`) one after the other, the same bits, at a third of the memory
+    traffic — these passes took as long as the force loop in a pour's onset (docs/packing.md, "At scale").
+    Returns (translational and rotational kinetic energy after the first kick, the largest squared displacement
+    since the last rebuild)."""
     e = 0.0
     e_rot = 0.0
+    moved = 0.0
+    half = 0.5 * dt
     for i in range(lo, hi):
-        for k in range(3):
-            v[i, k] += 0.5 * dt * (f[i, k] / mass[i] + gravity[k])
-            w[i, k] += 0.5 * dt * tq[i, k] / inertia[i]
-        e += 0.5 * mass[i] * (v[i, 0] ** 2 + v[i, 1] ** 2 + v[i, 2] ** 2)
-        e_rot += 0.5 * inertia[i] * (w[i, 0] ** 2 + w[i, 1] ** 2 + w[i, 2] ** 2)
-    return e, e_rot
+        m, j = mass[i], inertia[i]
+        a0, a1, a2 = f[i, 0] / m + gravity[0], f[i, 1] / m + gravity[1], f[i, 2] / m + gravity[2]
+        s0, s1, s2 = half * tq[i, 0] / j, half * tq[i, 1] / j, half * tq[i, 2] / j
+        v0, v1, v2 = v[i, 0] + half * a0, v[i, 1] + half * a1, v[i, 2] + half * a2
+        w0, w1, w2 = w[i, 0] + s0, w[i, 1] + s1, w[i, 2] + s2
+        e += 0.5 * m * (v0 ** 2 + v1 ** 2 + v2 ** 2)
+        e_rot += 0.5 * j * (w0 ** 2 + w1 ** 2 + w2 ** 2)
+        if drift:
+            v0, v1, v2 = v0 + half * a0, v1 + half * a1, v2 + half * a2
+            w0, w1, w2 = w0 + s0, w1 + s1, w2 + s2
+            f[i, 0] = f[i, 1] = f[i, 2] = 0.0
+            tq[i, 0] = tq[i, 1] = tq[i, 2] = 0.0
+            dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref)
+            if dd > moved:  # (not max(): the same choice as before where dd is NaN)
+                moved = dd
+        v[i, 0], v[i, 1], v[i, 2] = v0, v1, v2
+        w[i, 0], w[i, 1], w[i, 2] = w0, w1, w2
+    return e, e_rot, moved
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
+    """Particle i's drift by dt at the velocity (v0, v1, v2), wrapped into the periodic box; returns its squared
+    displacement since the last rebuild."""
+    x[i, 0] += dt * v0
+    x[i, 1] += dt * v1
+    x[i, 2] += dt * v2
+    for k in range(2):
+        if periodic[k]:
+            L = box_hi[k] - box_lo[k]
+            if x[i, k] < box_lo[k]:
+                x[i, k] += L
+            elif x[i, k] >= box_hi[k]:
+                x[i, k] -= L
+    return (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
 
 
 @njit(cache=KERNEL_CACHE)
@@ -547,8 +592,10 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
         start, nbj, hist, dmax, rules)
+    # one pass over the particles a step besides the force loop: the second half kick fused with the next step's
+    # first half kick and drift (_kick_and_next), as the threaded loop does
+    moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
     for step in range(1, steps + 1):
-        moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
         # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
         if moved > (0.5 * skin) ** 2:
             start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
@@ -556,17 +603,17 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
             x_ref[:, :] = x
         if step == steps:
             records = _new_records(start)
-        f[:, :] = 0.0
-        tq[:, :] = 0.0
         _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start,
                         nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules)
-        e, e_rot = _kick(0, n_p, v, w, f, tq, mass, inertia, gravity, dt)
+        e, e_rot, moved = _kick_and_next(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi,
+                                         periodic, x_ref, step < steps)
         if not _energy(ke, flags, step, ke_every, e, e_rot):
             break
     return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
 
 
-CONTACT_COST = 8  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
+REBALANCE = 50  # steps between two cuts of the threaded loop's shares (besides one at each rebuild)
+CONTACT_COST = 6  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
 
 
 @njit(cache=KERNEL_CACHE)
@@ -597,18 +644,26 @@ def _balance(start, n_walls, dmax, chunks):
     chunks[m] = n
 
 
-@njit(cache=KERNEL_CACHE, inline="always")
-def _zero_rows(a, lo, hi):
-    for i in range(lo, hi):
-        a[i, 0] = a[i, 1] = a[i, 2] = 0.0
+@njit(cache=KERNEL_CACHE)
+def _far_ends(start, nbj, chunks, far):
+    """For each share, one past the largest particle its rows list (``far``): what it adds into its far buffer
+    lies below, so that the shares after it add in only their rows below that (:func:`_gather`) — the particles a
+    share's contacts reach across its cut, a layer of the packing, not all of the next share's."""
+    for c in range(chunks.shape[0] - 1):
+        top = 0
+        for e in range(start[chunks[c]], start[chunks[c + 1]]):
+            if nbj[e] >= top:
+                top = nbj[e] + 1
+        far[c] = top
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
-def _gather(lo, hi, share, f_far, tq_far, f, tq):
+def _gather(lo, hi, share, far, f_far, tq_far, f, tq):
     """Into f and tq of particles lo…hi−1 (share ``share``'s), what the shares before it added for them into
-    their far buffers; each row read is zeroed for the next step."""
+    their far buffers (share c's below far[c] only: nothing lies beyond); each row read is zeroed for the next
+    step."""
     for c in range(share):
-        for i in range(lo, hi):
+        for i in range(lo, min(hi, far[c])):
             for k in range(3):
                 f[i, k] += f_far[c, i, k]
                 tq[i, k] += tq_far[c, i, k]
@@ -633,7 +688,9 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
         start, nbj, hist, dmax, rules)
     chunks = np.empty(threads + 1, np.int64)  # each share's rows of the list, and its particles
+    far = np.empty(threads, np.int64)  # each share's far buffer holds particles below far[share] only
     _balance(start, n_w, dmax, chunks)
+    _far_ends(start, nbj, chunks, far)
     f_far = np.zeros((threads, n_p, 3))  # per share: what it adds for particles of the shares after it
     tq_far = np.zeros((threads, n_p, 3))
     moved = np.zeros(threads)
@@ -654,21 +711,21 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
                                                        dmax, n_p * n_w, chunks)
             x_ref[:, :] = x
             _balance(start, n_w, dmax, chunks)
+            _far_ends(start, nbj, chunks, far)
+        elif step % REBALANCE == 0:  # the contacts formed since (a pour's bed grows between rebuilds)
+            _balance(start, n_w, dmax, chunks)
+            _far_ends(start, nbj, chunks, far)
         if step == steps:
             records = _new_records(start)
         for c in prange(threads):
-            _zero_rows(f, chunks[c], chunks[c + 1])
-            _zero_rows(tq, chunks[c], chunks[c + 1])
             _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
                             start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules)
         for b in prange(threads):
-            _gather(chunks[b], chunks[b + 1], b, f_far, tq_far, f, tq)
-            e_share[b], e_rot_share[b] = _kick(chunks[b], chunks[b + 1], v, w, f, tq, mass, inertia, gravity, dt)
-            # the next step's first half kick and drift, unless the run is over or stops here (a non-finite share:
-            # the serial loop stops after the kick; on one thread the same state)
-            if step < steps and math.isfinite(e_share[b] + e_rot_share[b]):
-                moved[b] = _kick_drift(chunks[b], chunks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
-                                       box_hi, periodic, x_ref)
+            _gather(chunks[b], chunks[b + 1], b, far, f_far, tq_far, f, tq)
+            # the kick, and the next step's first half kick and drift in the same pass unless the run is over
+            e_share[b], e_rot_share[b], moved[b] = _kick_and_next(chunks[b], chunks[b + 1], x, v, w, f, tq, mass,
+                                                                  inertia, gravity, dt, box_lo, box_hi, periodic,
+                                                                  x_ref, step < steps)
         e = 0.0
         e_rot = 0.0
         for b in range(threads):
