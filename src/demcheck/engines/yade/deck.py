@@ -161,8 +161,7 @@ def materials(nat, case: Case, sc) -> tuple[str, str]:
 
 def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.0, native=None,
          **options) -> common.Deck:
-    """The script of a collision case, written with ``engine``'s mapping (the Engine that runs it; ``native``: a
-    configuration used instead of the case's mapped model)."""
+    """The script of a collision case, by ``engine``'s mapping (``native``: a configuration used instead of it)."""
     if options.get("copies", 1) != 1:
         raise UnsupportedByEngine("Yade scripts are written for one copy of a collision")
     sc = common.scene(case, dt, length)
