@@ -10,8 +10,9 @@ and the binary's identity) follow the build, not the engine.
 A labelled build enters the registry as a :class:`BuildEngine`: the engine's own object seen through a label
 and an executable — its vocabulary, decks, twin and rules are the engine's, unchanged — so every part of
 demcheck that looks an engine up by its source name (mappings, runs, twins, discovery, reports) runs it with
-no change to the engine's package. The engine's deck writers are handed the build itself (:attr:`BuildEngine.HANDED`):
-a build's decks are written by the build, never by the engine registered under the engine's name.
+no change to the engine's package. The engine's deck writers are handed the build itself
+(:attr:`BuildEngine.HANDED`): a build's decks are written by the build, never by the engine registered under the
+engine's name.
 """
 
 from __future__ import annotations
