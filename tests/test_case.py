@@ -284,10 +284,9 @@ def test_a_tiny_impact_speed_starts_the_bodies_near_contact(wall, normal):
     assert pair_of(case).impact_speed == pytest.approx(1e-9, rel=1e-6)
     flight = _time_to_contact(case)
     assert 0 < flight <= 50 * _hertz_duration(case)
-    from demcheck.engines.lammps import deck as lammps
-    from demcheck.engines.liggghts import deck as liggghts
+    from demcheck.engines import registry
 
-    for writer in (lammps.deck, liggghts.deck):
+    for writer in (registry.get("lammps").collision_deck, registry.get("liggghts").collision_deck):
         steps = int(next(line.split()[1] for line in writer(case).text.splitlines() if line.startswith("run ")))
         assert steps <= 100 * case.run.steps_per_contact
 
@@ -327,12 +326,12 @@ def test_a_run_too_long_to_write_is_refused(overrides, key):
 
 
 def test_a_deck_dt_too_small_for_the_run_is_refused():
-    from demcheck.engines.lammps import deck as lammps
+    from demcheck.engines import registry
 
     from .helpers import glass_case
 
     with pytest.raises(ConfigError) as info:
-        lammps.deck(glass_case("hertz"), dt=1e-16)
+        registry.get("lammps").collision_deck(glass_case("hertz"), dt=1e-16)
     assert info.value.key == "--dt" and "steps" in info.value.rule
 
 

@@ -313,7 +313,7 @@ def test_engines_run_packings_under_mpi(engine, tmp_path):
 
 @pytest.mark.engine("lammps")
 def test_polydisperse_species_pairs_run_in_the_reference_and_lammps():
-    from demcheck.engines.lammps.packing import deck as lammps_deck
+    from demcheck.engines import registry
     from demcheck.engines.packing import run_engine
 
     from .conftest import CASES
@@ -321,7 +321,7 @@ def test_polydisperse_species_pairs_run_in_the_reference_and_lammps():
     case = C.load(CASES / "optin" / "poured-small-poly.toml", ["packing.duration=0.01"])
     sp, rep = P.species_of(case)
     assert len(rep) == 3
-    assert lammps_deck(case).text.count("pair_coeff") == 6  # every species pair, explicitly
+    assert registry.get("lammps").packing_deck(case).text.count("pair_coeff") == 6  # every species pair, explicitly
     st = P.simulate(case, rest=0.0)
     assert np.all(np.isfinite(st.x)) and st.x[:, 2].min() > 0
     table = run_engine(case, "lammps").table

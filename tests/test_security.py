@@ -20,18 +20,14 @@ import pytest
 
 from demcheck import case as C
 from demcheck.errors import ConfigError, DemcheckError
-from demcheck.engines import mapping
+from demcheck.engines import mapping, registry
 from demcheck.inputs import common, packing_decks
-from demcheck.engines.lammps import deck as L
-from demcheck.engines.lammps import packing as LP
-from demcheck.engines.liggghts import deck as G
-from demcheck.engines.liggghts import packing as GP
 
 from .conftest import CASES, ROOT
 
 ENGINES = ("lammps", "liggghts")
-WRITERS = {"lammps": L.deck, "liggghts": G.deck}
-PACKING_WRITERS = {"lammps": LP.deck, "liggghts": GP.deck}
+WRITERS = {"lammps": registry.get("lammps").collision_deck, "liggghts": registry.get("liggghts").collision_deck}
+PACKING_WRITERS = {"lammps": registry.get("lammps").packing_deck, "liggghts": registry.get("liggghts").packing_deck}
 
 # {f}: a file the injected command would create
 HOSTILE = {

@@ -297,14 +297,34 @@ class Engine(ABC):
 
 
 class PackageEngine(Engine):
-    """An engine whose package keeps its parts in the usual modules: ``mapping.py`` (``map_model(model,
-    contact_params)``, ``twin(native, m̄, R̄)``), ``deck.py`` (``deck(case, dt, length, native=…, **options)``,
-    ``VERSION_NOTE``) and ``packing.py`` (``deck(case, duration, dt)``), imported when first needed."""
+    """An engine whose package keeps its parts in the usual modules, imported when first needed: ``mapping.py``
+    (the vocabulary: ``map_model(model, contact_params)``, ``twin(native, m̄, R̄)``), ``deck.py`` (``deck(engine,
+    case, dt, length, native=…, **options)``, ``VERSION_NOTE``), ``packing.py`` (``deck(engine, case, duration,
+    dt)``) and ``scenario.py`` (``mapping(engine, case)``, ``twin_laws(engine, case, native)``, ``deck(engine,
+    case, native, layout)``, ``read(engine, case, layout, workdir)``).
+
+    Every function of deck.py, packing.py and scenario.py called here gets the Engine object first — this one, or
+    the build (builds.BuildEngine) it runs as — and reaches the vocabulary through it (``engine.map``,
+    ``engine.twin``, ``engines.mapping.contact_mapping(case, engine, …)``), never by looking its engine up by name:
+    a deck is written by the engine that runs it. The package is the one of the class's first package module (a
+    subclass defined elsewhere, a test's double, keeps its engine's parts)."""
+
+    _package: str = ""
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if hasattr(sys.modules.get(cls.__module__), "__path__"):  # defined in an engine package's __init__
+            cls._package = cls.__module__
 
     def _part(self, name: str):
         import importlib
 
-        return importlib.import_module(f"{type(self).__module__}.{name}")
+        return importlib.import_module(f"{self._package}.{name}")
+
+    def _has_part(self, name: str) -> bool:
+        import importlib.util
+
+        return importlib.util.find_spec(f"{self._package}.{name}") is not None
 
     def map(self, model, contact_params: dict) -> Mapping:
         return self._part("mapping").map_model(model, contact_params)
@@ -312,33 +332,30 @@ class PackageEngine(Engine):
     def twin(self, native: Native, m_eff: float, r_eff: float):
         return self._part("mapping").twin(native, m_eff, r_eff)
 
-    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
-        return self._part("deck").deck(case, dt, length, native=native, **options)
+    # the writers below are run as the build too (builds.BuildEngine.HANDED): ``self`` is the engine that runs them,
+    # so they call Engine's defaults by name, not through super() (a build is no subclass)
 
-    def _scenario_part(self):
-        import importlib.util
-        name = f"{type(self).__module__}.scenario"
-        return None if importlib.util.find_spec(name) is None else self._part("scenario")
+    def collision_deck(self, case, dt=None, length=1.0, native=None, **options):
+        return self._part("deck").deck(self, case, dt, length, native=native, **options)
 
     def scenario_mapping(self, case) -> Mapping:
-        part = self._scenario_part()
-        return super().scenario_mapping(case) if part is None else part.mapping(case)
+        if not self._has_part("scenario"):
+            return Engine.scenario_mapping(self, case)
+        return self._part("scenario").mapping(self, case)
 
     def scenario_twin_laws(self, case, native: Native) -> dict:
-        return self._scenario_part().twin_laws(case, native)
+        return self._part("scenario").twin_laws(self, case, native)
 
     def scenario_deck(self, case, native: Native, layout):
-        return self._scenario_part().deck(case, native, layout)
+        return self._part("scenario").deck(self, case, native, layout)
 
     def read_scenario(self, case, layout, workdir) -> dict:
-        return self._scenario_part().read(case, layout, workdir)
+        return self._part("scenario").read(self, case, layout, workdir)
 
     def packing_deck(self, case, duration=None, dt=None):
-        import importlib.util
-
-        if importlib.util.find_spec(f"{type(self).__module__}.packing") is None:  # a package without packings
-            return super().packing_deck(case, duration, dt)
-        return self._part("packing").deck(case, duration, dt)
+        if not self._has_part("packing"):  # a package without packings
+            return Engine.packing_deck(self, case, duration, dt)
+        return self._part("packing").deck(self, case, duration, dt)
 
 
 def case_natives(case, engines) -> dict:

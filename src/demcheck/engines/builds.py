@@ -10,7 +10,9 @@ and the binary's identity) follow the build, not the engine.
 A labelled build enters the registry as a :class:`BuildEngine`: the engine's own object seen through a label
 and an executable — its vocabulary, decks, twin and rules are the engine's, unchanged — so every part of
 demcheck that looks an engine up by its source name (mappings, runs, twins, discovery, reports) runs it with
-no change to the engine's package.
+no change to the engine's package. The engine's deck writers are handed the build itself
+(:attr:`BuildEngine.HANDED`): a build's decks are written by the build, never by the engine registered under the
+engine's name.
 """
 
 from __future__ import annotations
@@ -51,7 +53,14 @@ class BuildEngine:
     def candidates(self) -> list[str]:
         return [self.base.build_executable(self.executable)]
 
+    # the engine's methods that hand the engine object to its package's writers (base.PackageEngine): run as the
+    # build, so that the writers get the build (its label, title, version), not the engine it wraps
+    HANDED = ("collision_deck", "packing_deck", "scenario_mapping", "scenario_twin_laws", "scenario_deck",
+              "read_scenario")
+
     def __getattr__(self, attr):  # the vocabulary, decks, launch, rules, banner: the engine's
+        if attr in self.HANDED:
+            return getattr(type(self.base), attr).__get__(self)
         return getattr(self.base, attr)
 
 

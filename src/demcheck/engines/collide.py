@@ -15,14 +15,8 @@ from ..errors import ConfigError
 from ..inputs import common
 from ..reference import health
 from ..result import Result
-from . import cache as cache_checks, dumps, registry, run as runner, states
-from .mapping import contact_mapping, native_summary, twin_model
-
-
-
-def as_engine(engine):
-    """The Engine ``engine`` names (an Engine is returned as it is): the functions here take either."""
-    return registry.get(engine) if isinstance(engine, str) else engine
+from . import cache as cache_checks, dumps, run as runner, states
+from .mapping import as_engine, contact_mapping, native_summary, twin_model
 
 
 def deck(case: Case, engine, dt: float | None = None, length: float = 1.0, native=None,
@@ -119,7 +113,7 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
     not "ok" is kept and named."""
     eng = as_engine(engine)  # an Engine, or its registered name
     engine = eng.name
-    mp = contact_mapping(case, engine, native)
+    mp = contact_mapping(case, eng, native)
     mp.require()  # the decks get ``native`` as given (None: the seed model's mapping, type pair by type pair), so
     # that the deck run is the deck `demcheck deck` writes
     started = time.perf_counter()
@@ -273,7 +267,7 @@ def twin_states(case: Case, engine, dt: float, native=None) -> Result:
     from ..laws.model import resolve
 
     eng = as_engine(engine)
-    mp = contact_mapping(case, eng.name, native)
+    mp = contact_mapping(case, eng, native)
     nat = mp.require()
     model = twin_model(resolve(case), nat)
     res = states.restate(eng.twin_collide(case, model, nat, dt), case)

@@ -24,8 +24,8 @@ from ..laws.model import ResolvedModel, resolve
 from . import registry
 from .base import APPROXIMATE, EXACT, NATIVE, NONE_, Mapping, Native, refused, worst
 
-__all__ = ["APPROXIMATE", "EXACT", "NATIVE", "NONE_", "Mapping", "Native", "refused", "worst", "map_model",
-           "pair_mapping", "contact_mapping", "twin_model", "table", "by_model", "native_summary",
+__all__ = ["APPROXIMATE", "EXACT", "NATIVE", "NONE_", "Mapping", "Native", "refused", "worst", "as_engine",
+           "map_model", "pair_mapping", "contact_mapping", "twin_model", "table", "by_model", "native_summary",
            "markdown_table", "mu_of", "HUGE_MU", "SLIDING_XT"]
 
 HUGE_MU = 1e100  # "no Coulomb limit" for a viscous law expressed through a capped one (the cap μ|Fn| then
@@ -33,28 +33,35 @@ HUGE_MU = 1e100  # "no Coulomb limit" for a viscous law expressed through a capp
 SLIDING_XT = 1e4  # a dashpot far above the cap: the regularised slider
 
 
-def map_model(model: ResolvedModel, engine: str, contact_params: dict | None = None) -> Mapping:
-    """The engine configuration for one type pair of a resolved seed model, with its fidelity."""
-    return registry.get(engine).map(model, contact_params or {})
+def map_model(model: ResolvedModel, engine, contact_params: dict | None = None) -> Mapping:
+    """The engine configuration for one type pair of a resolved seed model, with its fidelity. ``engine``: the
+    Engine object (a deck writer passes the one it is handed: a build's own), or its registered name."""
+    return as_engine(engine).map(model, contact_params or {})
 
 
-def pair_mapping(case: Case, engine: str, i: int, j: int | None, native: Native | None = None) -> Mapping:
-    """The mapping of one type pair. Pairs that never touch in this case (a particle with itself) are
-    resolved at the contact's own impact speed, where a model calibrates its stiffness at one. A ``native``
-    configuration given directly (tests of engine traps, twins of configurations no seed model maps to)
-    is used for every pair as it is. A particle–wall pair of a wall the engines' flat walls cannot place
-    (not axis-aligned) is not expressible."""
+def as_engine(engine):
+    """The Engine ``engine`` names (an Engine is returned as it is): the functions here take either."""
+    return registry.get(engine) if isinstance(engine, str) else engine
+
+
+def pair_mapping(case: Case, engine, i: int, j: int | None, native: Native | None = None) -> Mapping:
+    """The mapping of one type pair by ``engine`` (an Engine, or its registered name). Pairs that never touch in
+    this case (a particle with itself) are resolved at the contact's own impact speed, where a model calibrates its
+    stiffness at one. A ``native`` configuration given directly (tests of engine traps, twins of configurations no
+    seed model maps to) is used for every pair as it is. A particle–wall pair of a wall the engines' flat walls
+    cannot place (not axis-aligned) is not expressible."""
     from ..inputs.common import wall_axis
     from ..errors import UnsupportedByEngine
 
+    engine = as_engine(engine)
     if j is None:
         for k, w in enumerate(case.walls):
             try:
                 wall_axis(w, k)
             except UnsupportedByEngine as exc:
-                return refused(engine, str(exc))
+                return refused(engine.name, str(exc))
     if native is not None:
-        return Mapping(engine, NATIVE, ["a native engine configuration, given directly"], native)
+        return Mapping(engine.name, NATIVE, ["a native engine configuration, given directly"], native)
     params = case.contact.params
     if (i, j) != contact_pair(case) and "reference_velocity" not in params:
         v = resolve(case).pair.impact_speed
@@ -67,8 +74,9 @@ def contact_pair(case: Case) -> tuple[int, int | None]:
     return (0, 1) if len(case.particles) == 2 else (0, None)
 
 
-def contact_mapping(case: Case, engine: str, native: Native | None = None) -> Mapping:
-    """The mapping of the contact of interest (particle 0 with particle 1, or with the wall)."""
+def contact_mapping(case: Case, engine, native: Native | None = None) -> Mapping:
+    """The mapping of the contact of interest (particle 0 with particle 1, or with the wall) by ``engine`` (an
+    Engine, or its registered name)."""
     return pair_mapping(case, engine, *contact_pair(case), native=native)
 
 

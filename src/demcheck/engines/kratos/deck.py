@@ -29,6 +29,7 @@ import re
 from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
+from ..base import Engine
 from ..mapping import contact_mapping, pair_mapping
 from .mapping import CUSTOM, LAWS, particle_young
 
@@ -155,24 +156,25 @@ def _check_options(options: dict) -> None:
         raise UnsupportedByEngine(f"no Kratos rolling friction model {rolling!r} is written here")
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
-    """The deck of a collision case (``native``: one configuration for every pair instead of the mapped
-    model). One copy of the collision only (no batched copies). A scenario's (engines/kratos/scenario.py):
-    ``steps`` its layout's length (the bodies where its case puts them), ``fixed`` the pull's held velocities
-    (PULL_TEMPLATE), ``rolling`` (model name, ROLLING_FRICTION) the relation's rolling friction model with
-    RollingFrictionOption on, ``mapping`` the scenario mapping (its fidelity and reasons go into the header,
-    not the contact's alone)."""
+def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.0, native=None,
+         **options) -> common.Deck:
+    """The deck of a collision case, written with ``engine``'s mapping (the Engine that runs it; ``native``: one
+    configuration for every pair instead of the mapped model). One copy of the collision only (no batched copies). A
+    scenario's (engines/kratos/scenario.py): ``steps`` its layout's length (the bodies where its case puts them),
+    ``fixed`` the pull's held velocities (PULL_TEMPLATE), ``rolling`` (model name, ROLLING_FRICTION) the relation's
+    rolling friction model with RollingFrictionOption on, ``mapping`` the scenario mapping (its fidelity and reasons
+    go into the header, not the contact's alone)."""
     _check_options(options)
     fixed = options.get("fixed")
     sc = common.scene(case, dt, length) if options.get("steps") is None else _scenario_scene(case, dt, options["steps"])
-    mp = contact_mapping(case, "kratos", native)
+    mp = contact_mapping(case, engine, native)
     nat = mp.require()
     n = len(case.particles)
     if n > 2:
         raise UnsupportedByEngine("Kratos decks are written for two bodies")
     natives = {}
     for i, j in common.type_pairs(case):
-        pm = pair_mapping(case, "kratos", i, j, native)
+        pm = pair_mapping(case, engine, i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"pair {i + 1} {j + 1 if j is not None else 'wall'}: {'; '.join(pm.reasons)}")
         if pm.native.normal != nat.normal:

@@ -40,7 +40,7 @@ from ...inputs import common
 from ...laws.model import resolve
 from ...reference import beyond_kratos as _bk
 from ...reference.scenarios import _on_wall
-from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
+from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused
 
 JKR_LAW, DMT_LAW = "DEM_D_Hertz_viscous_Coulomb_JKR", "DEM_D_Hertz_viscous_Coulomb_DMT"
 ROLLING_MODELS = {"constant_torque": "DEMRollingFrictionModelConstantTorque",
@@ -76,15 +76,16 @@ JKR_REASON = ("Kratos' DEM_D_Hertz_viscous_Coulomb_JKR subtracts √(8πwE*a³) 
               "captured)")
 
 
-def mapping(case: Case) -> Mapping:
+def mapping(engine: Engine, case: Case) -> Mapping:
     """The case's scenario in Kratos' words: the adhesive scenarios through the cohesive laws, a sphere on a wall
-    through a rolling friction model (:func:`_rolling`), twist and conduction none."""
+    through a rolling friction model (:func:`_rolling`, the contact ``engine``'s mapping), twist and conduction
+    none."""
     s = case.run.scenario
     if s in WHY_NOT:
         return refused("kratos", WHY_NOT[s])
     model = resolve(case)
     if s in ("rolling", "incline"):
-        return _rolling(case, model)
+        return _rolling(engine, case, model)
     rec = model.slot("adhesion")
     if rec.id not in ("jkr", "dmt"):
         return refused("kratos", f"Kratos DEM 10.4.4 has no adhesion law like '{rec.id}' (its cohesive laws are "
@@ -106,15 +107,15 @@ def mapping(case: Case) -> Mapping:
     return Mapping("kratos", APPROXIMATE, [reason], nat, {reason: law})
 
 
-def _rolling(case: Case, model) -> Mapping:
+def _rolling(engine: Engine, case: Case, model) -> Mapping:
     """A sphere on a wall: the case's contact mapped as a collision's (engines/kratos/mapping.py, Kratos' own
     tangential law), its rolling resistance as the relation's rolling friction model with RollingFrictionOption."""
-    from .mapping import FRICTION, map_model
+    from .mapping import FRICTION
 
     rec = model.slot("rolling")
     if rec.id not in ROLLING_MODELS:
         return refused("kratos", NO_SPRING if rec.id == "epsd" else f"no Kratos rolling friction model for '{rec.id}'")
-    base = map_model(model, case.contact.params)
+    base = engine.map(model, case.contact.params)
     if base.native is None:
         return refused("kratos", f"the sphere's contact with the wall: {'; '.join(base.reasons)}")
     nat = base.native
@@ -146,11 +147,11 @@ def _static_overlap(nat: Native, mass: float, radius: float, weight: float) -> f
     return (weight / ln["k_el"]) ** (1.0 / ln["a"])
 
 
-def twin_laws(case: Case, nat: Native) -> dict:
+def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     """Kratos' law (reference/beyond_kratos.py), with its stepping: engines/scenario.step hands the run to
     ``stepper``."""
     if "rolling" in nat.props:
-        return _rolling_laws(case, nat)
+        return _rolling_laws(engine, case, nat)
     p = nat.props
     force = functools.partial(_bk.kratos_adhesive_force, p["kind"], p["r_eff"], nat.normal_args[0], p["cohesion"])
     laws = {"stepper": functools.partial(_step, force)}
@@ -159,14 +160,14 @@ def twin_laws(case: Case, nat: Native) -> dict:
     return laws
 
 
-def _rolling_laws(case: Case, nat: Native) -> dict:
+def _rolling_laws(engine: Engine, case: Case, nat: Native) -> dict:
     """The sphere on a wall: Kratos' contact (its normal spring and dashpot, its tangential law) and the rolling
     friction model, stepped by reference/beyond_kratos.wall_roll; ``normal`` and ``tangential`` set the layout."""
-    from .mapping import law_numbers, tangential_ratio, twin, twin_law_array
+    from .mapping import law_numbers, tangential_ratio, twin_law_array
 
     m, r, g, theta, _ = _on_wall(case)
     ln = law_numbers(nat, m, r)
-    nl, _ = twin(nat, m, r)
+    nl, _ = engine.twin(nat, m, r)
     kt = (ln["rho"] or tangential_ratio(nat)) * ln["kn"]  # × √δ for Hertz: at the static overlap
     if ln["hertz"]:
         kt *= math.sqrt(_static_overlap(nat, m, r, m * g * math.cos(theta)))
@@ -190,7 +191,7 @@ def _step(force, case: Case, laws: dict, lay) -> dict:
     return _bk.pair_impact(force, r0, case.mass(0), lay.positions[1][0], lay.velocities[1][0], lay.dt, lay.steps)
 
 
-def deck(case: Case, nat: Native, lay) -> common.Deck:
+def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
     """The bodies where the layout puts them, the cohesive law on their relation; a pull holds body 1's velocity
     at the pull speed and body 0's at rest (Kratos' fixed velocity degrees of freedom)."""
     from .deck import deck as project
@@ -199,15 +200,15 @@ def deck(case: Case, nat: Native, lay) -> common.Deck:
                                              angular_velocity=tuple(lay.omegas[i]))
                                      for i, p in enumerate(case.particles)])
     fixed = [(1, (0.0, 0.0, 0.0)), (2, (lay.pull_speed, 0.0, 0.0))] if case.run.scenario == "pull_off" else None
-    return project(moved, lay.dt, native=nat, steps=lay.steps, fixed=fixed, rolling=nat.props.get("rolling"),
-                   mapping=mapping(case))
+    return project(engine, moved, lay.dt, native=nat, steps=lay.steps, fixed=fixed,
+                   rolling=nat.props.get("rolling"), mapping=mapping(engine, case))
 
 
 COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
            "fx", "fy", "fz", "tqx", "tqy", "tqz")
 
 
-def read(case: Case, lay, workdir) -> dict:
+def read(engine: Engine, case: Case, lay, workdir) -> dict:
     """The runner's dump (every step) as reference/scenarios.stepped_metrics reads it."""
     from ..dumps import read_dump
 

@@ -14,7 +14,7 @@ from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ...inputs.common import fmt
 from ..mapping import contact_mapping, pair_mapping
-from ..base import Native
+from ..base import Engine, Native
 
 VERSION_NOTE = "written for LAMMPS 22 Jul 2025 (pair_style granular)"
 
@@ -35,15 +35,15 @@ def coeff_args(nat: Native) -> str:
     return text
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Native | None = None,
+def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.0, native: Native | None = None,
          explicit_pairs: bool = True, copies: int = 1) -> common.Deck:
-    """The deck of a collision case. ``native``: one configuration for every type pair instead of the
-    case's mapped model; ``explicit_pairs=False`` writes only the I I coefficients and lets LAMMPS mix the
-    rest (to show its mixing trap — never what demcheck writes otherwise); ``copies``: that many
-    independent copies of the collision in one run, far apart, each body with its own type (atom ids
-    k·n + 1 … k·n + n for copy k), so that engine start-up is paid once."""
+    """The deck of a collision case, written with ``engine``'s mapping (the Engine that runs it). ``native``: one
+    configuration for every type pair instead of the case's mapped model; ``explicit_pairs=False`` writes only the
+    I I coefficients and lets LAMMPS mix the rest (to show its mixing trap — never what demcheck writes otherwise);
+    ``copies``: that many independent copies of the collision in one run, far apart, each body with its own type
+    (atom ids k·n + 1 … k·n + n for copy k), so that engine start-up is paid once."""
     sc = common.scene(case, dt, length)
-    mp = contact_mapping(case, "lammps", native)
+    mp = contact_mapping(case, engine, native)
     mp.require()
     n = len(case.particles)
     lo, hi = sc.box
@@ -72,7 +72,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
     for i, j in common.type_pairs(case):
         if j is None:
             continue
-        pm = pair_mapping(case, "lammps", i, j, native)
+        pm = pair_mapping(case, engine, i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"type pair {i + 1} {j + 1}: {'; '.join(pm.reasons)}")
         coeffs[(i, j)] = coeffs[(j, i)] = coeff_args(pm.native)
@@ -83,7 +83,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native: Nativ
                 continue
             lines.append(f"pair_coeff {a + 1} {b + 1} {coeffs[(a % n, b % n)]}")
     if case.walls:
-        pm = pair_mapping(case, "lammps", 0, None, native)
+        pm = pair_mapping(case, engine, 0, None, native)
         axis = "xyz"[sc.wall_axis]
         where = f"{fmt(sc.wall_position)} NULL" if sc.wall_side == "lo" else f"NULL {fmt(sc.wall_position)}"
         if n > 1:

@@ -6,23 +6,24 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
+from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import VERSION_NOTE, coeff_args
 
 
-def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
     lay = PD.layout(case, duration, dt)
     rep, ns = lay.rep, len(lay.table)
     pairs = {}
     for a in range(ns):
         for b in range(a, ns):
-            mp = pair_mapping(case, "lammps", rep[a], rep[b])
+            mp = pair_mapping(case, engine, rep[a], rep[b])
             if mp.native is None:
                 raise UnsupportedByEngine(f"lammps cannot express this model: {'; '.join(mp.reasons)}")
             pairs[(a, b)] = mp
     walls = []
     if case.walls:
-        walls = [pair_mapping(case, "lammps", r, None) for r in rep]
+        walls = [pair_mapping(case, engine, r, None) for r in rep]
         for mp in walls:
             mp.require()
             if mp.native != walls[0].native:

@@ -23,24 +23,23 @@ from ...laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion
 from ...laws.model import resolve
 from ...laws.rolling import CAP_TOTAL, EpsdRolling
 from ...laws.twisting import MarshallTwisting, SdsTwisting
-from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused, worst
 from ..damping import damping
-from .mapping import map_model, twin
 
 SLOT = {"rolling": "rolling", "incline": "rolling", "twist": "twisting", "pull_off": "adhesion",
         "adhesive_impact": "adhesion", "conduction": "heat"}
 COLUMNS = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz", "fx", "fy", "fz")
 
 
-def mapping(case: Case) -> Mapping:
-    """The case's contact and its scenario's slot record in LAMMPS's words (``nat.props``: ``words``, the
-    sub-model's pair_coeff keywords; ``slots``, the records LAMMPS computes)."""
+def mapping(engine: Engine, case: Case) -> Mapping:
+    """The case's contact (``engine``'s mapping) and its scenario's slot record in LAMMPS's words (``nat.props``:
+    ``words``, the sub-model's pair_coeff keywords; ``slots``, the records LAMMPS computes)."""
     model = resolve(case)
     slot = SLOT[case.run.scenario]
     rec = model.slot(slot)
     if slot == "adhesion":
         return _adhesion(case, model, rec)
-    base = map_model(model, case.contact.params)
+    base = engine.map(model, case.contact.params)
     if base.native is None:
         return base
     nat = base.native
@@ -126,14 +125,14 @@ def _adhesion(case: Case, model, rec) -> Mapping:
     return Mapping("lammps", APPROXIMATE if reasons else EXACT, reasons, nat, {r: words for r in reasons})
 
 
-def twin_laws(case: Case, nat: Native) -> dict:
+def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     """The laws ``nat`` computes, as engines/scenario.step takes them."""
     slots = nat.props.get("slots", {})
     if nat.normal in ("jkr", "dmt"):
         return {"adhesion": slots["adhesion"]}
     model = resolve(case)
     m, r = model.pair.m_eff, model.pair.r_eff
-    nl, _ = twin(nat, m, r)
+    nl, _ = engine.twin(nat, m, r)
     c, b = damping(nat.damping, nat.damping_coeff, nl.k, nl.a, m, r)
 
     def normal(d, rate):
@@ -153,7 +152,7 @@ def twin_laws(case: Case, nat: Native) -> dict:
 # ----------------------------------------------------------------------------- the deck
 
 
-def deck(case: Case, nat: Native, lay) -> common.Deck:
+def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
     """The scenario's deck: the bodies as the layout places them, the contact in ``pair_coeff`` (and the wall's
     ``fix wall/gran granular``), dumped every ``lay.every`` steps."""
     s, heat = case.run.scenario, case.run.scenario == "conduction"
@@ -230,7 +229,7 @@ def _box(case: Case, lay):
 # ----------------------------------------------------------------------------- the output
 
 
-def read(case: Case, lay, workdir) -> dict:
+def read(engine: Engine, case: Case, lay, workdir) -> dict:
     """The dump as the run reference/scenarios.stepped_metrics reads."""
     from ..dumps import read_dump
 

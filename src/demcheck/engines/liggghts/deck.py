@@ -14,6 +14,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ...inputs.common import fmt
+from ..base import Engine
 from ..mapping import contact_mapping, pair_mapping
 
 VERSION_NOTE = "written for LIGGGHTS-PUBLIC 3.8.0 (pair_style gran)"
@@ -83,12 +84,13 @@ def _matrix(name: str, values: np.ndarray) -> str:
             + " ".join(fmt(x) for x in values.ravel()))
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
+def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.0, native=None,
          data_name: str = "data.lmp", copies: int = 1) -> common.Deck:
-    """The deck of a collision case (``native``: one configuration for every type pair instead of the case's
-    mapped model; ``copies``: independent copies of the collision in one run, as in lammps.deck)."""
+    """The deck of a collision case, written with ``engine``'s mapping (the Engine that runs it; ``native``: one
+    configuration for every type pair instead of the case's mapped model; ``copies``: independent copies of the
+    collision in one run, as in lammps.deck)."""
     sc = common.scene(case, dt, length)
-    mp = contact_mapping(case, "liggghts", native)
+    mp = contact_mapping(case, engine, native)
     nat = mp.require()
     n = len(case.particles)
     ntypes = n * copies + (1 if case.walls else 0)
@@ -97,7 +99,7 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     if copies > 1:
         batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
     lines = common.header("liggghts", sc, mp, VERSION_NOTE, "liggghts -in") + common.notes(nat.comments)
-    natives = _type_natives(case, native, nat, n)
+    natives = _type_natives(engine, case, native, nat, n)
 
     def native_of_types(a, b):
         ia = n if (case.walls and a == ntypes - 1) else a % n
@@ -137,12 +139,12 @@ def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None,
     return common.Deck("liggghts", "\n".join(lines), {data_name: data}, dt=sc.dt)
 
 
-def _type_natives(case: Case, native, nat, n: int) -> dict:
+def _type_natives(engine: Engine, case: Case, native, nat, n: int) -> dict:
     """Every type pair's configuration, keyed (i, j) with the wall as type n (it pairs with each particle); LIGGGHTS
     has one gran model per pair style, so every pair must map to the model of ``nat``."""
     natives = {}
     for i, j in common.type_pairs(case):
-        pm = pair_mapping(case, "liggghts", i, j, native)
+        pm = pair_mapping(case, engine, i, j, native)
         if pm.native is None:
             raise UnsupportedByEngine(f"type pair {i + 1} {j + 1 if j is not None else 'wall'}: "
                                       f"{'; '.join(pm.reasons)}")

@@ -6,19 +6,20 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
+from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
 
 
-def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
     lay = PD.layout(case, duration, dt)
     rep, ns = lay.rep, len(lay.table)
     natives = {}
     for a in range(ns):
         for b in range(a, ns):
-            natives[(a, b)] = pair_mapping(case, "liggghts", rep[a], rep[b])
+            natives[(a, b)] = pair_mapping(case, engine, rep[a], rep[b])
         if case.walls:
-            natives[(a, ns)] = pair_mapping(case, "liggghts", rep[a], None)
+            natives[(a, ns)] = pair_mapping(case, engine, rep[a], None)
     for mp in natives.values():
         if mp.native is None:
             raise UnsupportedByEngine(f"liggghts cannot express this model: {'; '.join(mp.reasons)}")

@@ -21,9 +21,8 @@ from ...laws.adhesion import AREA_LENS
 from ...laws.heat import LensHeat
 from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling
 from ...laws.model import resolve
-from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
+from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused
 from .deck import VERSION_NOTE, model_setup, property_matrices
-from .mapping import map_model
 
 WHY_NOT = {
     "twist": "LIGGGHTS-PUBLIC 3.8.0 has no twisting torque model",
@@ -37,14 +36,15 @@ WHY_NOT = {
 }
 
 
-def mapping(case: Case) -> Mapping:
+def mapping(engine: Engine, case: Case) -> Mapping:
+    """The case's contact (``engine``'s mapping) with its scenario's slot in LIGGGHTS's words."""
     s = case.run.scenario
     model = resolve(case)
     if s in ("rolling", "incline"):  # the contact itself first: the case's own reason where LIGGGHTS has none
         if model.slot("rolling").id == "viscous":
             return refused("liggghts", "LIGGGHTS-PUBLIC 3.8.0 has no viscous rolling torque (type B): its rolling "
                                        "models are cdt, epsd, epsd2 and epsd3")
-        base = map_model(model, case.contact.params)
+        base = engine.map(model, case.contact.params)
         if base.native is None:
             return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")
         if s == "rolling":
@@ -52,13 +52,13 @@ def mapping(case: Case) -> Mapping:
         if model.slot("rolling").id == "epsd":
             return _incline(model, base)
     if s == "pull_off" and model.slot("adhesion").id == "sjkr":
-        return _cohesion(model, map_model(model, case.contact.params))
+        return _cohesion(model, engine.map(model, case.contact.params))
     if s in WHY_NOT:
         return refused("liggghts", WHY_NOT[s])
     rec = model.slot("heat")
     if rec.id == "area":
         return refused("liggghts", "LIGGGHTS fix heat/gran/conduction has no conductance per contact area")
-    base = map_model(model, case.contact.params)
+    base = engine.map(model, case.contact.params)
     if base.native is None:
         return base
     r0, r1 = (p.radius for p in case.particles)
@@ -138,7 +138,7 @@ def _incline(model, base: Mapping) -> Mapping:
                    {**base.keywords, **{x: "rolling_friction epsd3" for x in reasons}})
 
 
-def twin_laws(case: Case, nat: Native) -> dict:
+def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     if case.run.scenario == "conduction":
         return {"heat": nat.props["slots"]["heat"]}
     if case.run.scenario == "pull_off":  # hertz/stiffness: kn √R̄ δ^{3/2} (elastic), the cohesion added
@@ -157,7 +157,7 @@ def twin_laws(case: Case, nat: Native) -> dict:
     return laws
 
 
-def deck(case: Case, nat: Native, lay) -> common.Deck:
+def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
     if case.run.scenario == "pull_off":
         return _pull_deck(case, nat, lay)
     return _held_deck(case, nat, lay) if case.run.scenario == "conduction" else _wall_deck(case, nat, lay)
@@ -270,7 +270,7 @@ def _held_deck(case: Case, nat: Native, lay) -> common.Deck:
     return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
 
 
-def read(case: Case, lay, workdir) -> dict:
+def read(engine: Engine, case: Case, lay, workdir) -> dict:
     """The held pair's temperatures, sampled from step 0 (the dump after ``run 0`` starts at the run's step 0);
     the rolling sphere's samples."""
     from ..dumps import read_dump

@@ -19,6 +19,7 @@ import math
 from ...case import Case
 from ...errors import DemcheckError, UnsupportedByEngine
 from ...inputs import common
+from ..base import Engine
 from ..mapping import contact_mapping
 from .mapping import CUNDALL, LUDING, MINDLIN, VISCEL
 
@@ -158,12 +159,13 @@ def materials(nat, case: Case, sc) -> tuple[str, str]:
     raise UnsupportedByEngine(f"no Yade deck for {nat.normal}")
 
 
-def deck(case: Case, dt: float | None = None, length: float = 1.0, native=None, **options) -> common.Deck:
-    """The script of a collision case (``native``: a configuration used instead of the case's mapped model)."""
+def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.0, native=None,
+         **options) -> common.Deck:
+    """The script of a collision case, by ``engine``'s mapping (``native``: a configuration used instead of it)."""
     if options.get("copies", 1) != 1:
         raise UnsupportedByEngine("Yade scripts are written for one copy of a collision")
     sc = common.scene(case, dt, length)
-    mp = contact_mapping(case, "yade", native)
+    mp = contact_mapping(case, engine, native)
     nat = mp.require()
     body_mat, wall_mat = materials(nat, case, sc)
     p = nat.props

@@ -43,6 +43,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
+from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import VERSION_NOTE, ascii_comment, guard
 from .mapping import MINDLIN, VISCEL
@@ -243,18 +244,18 @@ def _material(laws: _Laws, values: dict) -> str:
 # ----------------------------------------------------------------------------- the script
 
 
-def _mappings(case: Case, lay: PD.Layout):
+def _mappings(engine: Engine, case: Case, lay: PD.Layout):
     rep, ns = lay.rep, len(lay.table)
     pairs = {}
     for a in range(ns):
         for b in range(a, ns):
-            mp = pair_mapping(case, "yade", rep[a], rep[b])
+            mp = pair_mapping(case, engine, rep[a], rep[b])
             if mp.native is None:
                 raise UnsupportedByEngine(f"yade cannot express this model: {'; '.join(mp.reasons)}")
             pairs[(a, b)] = mp
     walls = []
     if case.walls:
-        walls = [pair_mapping(case, "yade", r, None) for r in rep]
+        walls = [pair_mapping(case, engine, r, None) for r in rep]
         for mp in walls:
             mp.require()
     kinds = {(mp.native.normal, mp.native.tangential) for mp in [*pairs.values(), *walls]}
@@ -312,9 +313,9 @@ def _vec(xs) -> str:
     return f"Vector3({', '.join(_num(x) for x in xs)})"
 
 
-def deck(case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
+def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | None = None) -> common.Deck:
     lay = PD.layout(case, duration, dt)
-    pairs, walls = _mappings(case, lay)
+    pairs, walls = _mappings(engine, case, lay)
     ns = len(lay.table)
     rad = [s.radius for s in lay.table]
     normal = next(iter(pairs.values())).native.normal

@@ -28,7 +28,7 @@ from ...inputs import common
 from ...laws.model import resolve
 from ...reference import beyond_yade
 from ...reference.scenarios import _on_wall
-from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
+from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused, worst
 from . import pair
 from .deck import ascii_comment, guard
 
@@ -69,9 +69,10 @@ def check_script(text: str, files: dict | None = None) -> None:
 # ----------------------------------------------------------------------------- the mapping
 
 
-def mapping(case: Case) -> Mapping:
+def mapping(engine: Engine, case: Case) -> Mapping:
     """The case's contact in CohFrictPhys terms (``nat.props``: young, poisson, mu, etaRoll, alphaKr, etaTwist,
-    alphaKtw, and the pair's kn, ks, kr, ktw, maxRollPl, maxTwistPl)."""
+    alphaKtw, and the pair's kn, ks, kr, ktw, maxRollPl, maxTwistPl); set here, not by ``engine``'s collision
+    mapping (CohFrictPhys is no collision law of its)."""
     s = case.run.scenario
     if s in pair.PAIR:
         return pair.mapping(case)
@@ -165,7 +166,7 @@ def _twisting(law, props, radius):
 # ----------------------------------------------------------------------------- the twin
 
 
-def twin_laws(case: Case, nat: Native) -> dict:
+def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     """The laws the layout reads (the linear normal spring, the shear spring) and Yade's own stepper."""
     if case.run.scenario in pair.PAIR:
         return pair.twin_laws(case, nat)
@@ -197,7 +198,7 @@ def _vec(xs) -> str:
     return f"Vector3({', '.join(_num(x) for x in xs)})"
 
 
-def deck(case: Case, nat: Native, lay) -> common.Deck:
+def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
     """The scenario's script: the sphere at the layout's start (v_{−½} = the layout's velocity), a fixed box
     whose top face is the wall, sampled every ``lay.every`` steps (x_k, the full-step velocities)."""
     if case.run.scenario in pair.PAIR:
@@ -247,7 +248,7 @@ def deck(case: Case, nat: Native, lay) -> common.Deck:
     return common.Deck("yade", "\n".join(lines), {}, dt=lay.dt, check=check_script)
 
 
-def read(case: Case, lay, workdir) -> dict:
+def read(engine: Engine, case: Case, lay, workdir) -> dict:
     """The samples as reference/scenarios.stepped_metrics reads them."""
     if case.run.scenario in pair.PAIR:
         return pair.read(case, lay, workdir)
