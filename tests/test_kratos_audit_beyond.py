@@ -136,3 +136,22 @@ def test_kratos_jkr_impact_is_a_trap_with_its_numbers(tmp_path):
     assert hit["metrics"]["restitution"]["engine"] == pytest.approx(1.0, abs=1e-5)
     traps = [f for f in pair["findings"] if f["code"] == "beyond-adhesive-impact"]
     assert len(traps) == 1 and "restitution" in traps[0]["text"]
+
+
+@pytest.mark.engine("kratos")
+def test_the_viscous_torque_wall_decays_at_the_closed_form_time_constant(tmp_path):
+    """DEMRollingFrictionModelViscousTorque, ROLLING_FRICTION_WITH_WALLS c: Kratos' moment c|Fn|(R − δ)²ω is type B
+    with Cr = cWR², so v decays as exp(−t/T), T = (7/5)mR²/Cr = 1.4/(c g). c = 50 and v0 = 2 mm/s keep the run
+    short and the roll without slip (the friction it needs, (5/7)c v0·W = 0.07 W, is below μs W = 0.3 W)."""
+    c, v0 = 50.0, 0.002
+    path = _kratos(tmp_path, pair_law="DEM_D_Hertz_viscous_Coulomb", model="DEMRollingFrictionModelViscousTorque")
+    mats = json.loads((tmp_path / "MaterialsDEM.json").read_text())
+    mats["material_relations"][1]["Variables"]["ROLLING_FRICTION_WITH_WALLS"] = c
+    (tmp_path / "MaterialsDEM.json").write_text(json.dumps(mats))
+    r = A.audit(path, speed=v0, run_engine=False, beyond_engine=True)
+    roll = _rows(r["pairs"][1])["rolling"]
+    assert roll["status"] == "ok" and roll["fidelity"] == "approximate", roll.get("why")
+    assert roll["engine_vs_twin"] <= 1e-9  # measured 1.5e-12
+    tau = roll["metrics"]["rolling_time_constant"]
+    assert tau["reference"] == pytest.approx(1.4 / (c * G), rel=1e-12)
+    assert abs(tau["engine"] / tau["reference"] - 1) < 1e-4  # measured 3.5e-5 below
