@@ -13,6 +13,9 @@ probes run:
   characteristic speed (``adhesive_impact``: restitution, capture_velocity; Thornton & Ning 1998); LIGGGHTS
   ``cohesion sjkr``/``sjkr2``: two like spheres on the pair's elastic Hertz law with −kc·A added, pulled apart
   (``pull_off``: the largest tension in closed form);
+* Kratos — a relation on ``DEM_D_Hertz_viscous_Coulomb_JKR``/``_DMT``: the pull-off (and JKR's impact) of two like
+  spheres of its E* and PARTICLE_COHESION w (:func:`_kratos_cohesive`); a wall relation's ConstantTorque /
+  ViscousTorque rolling friction: the level-wall roll on its Linear_viscous_Coulomb law (:func:`_kratos_rolling`);
 * heat — LAMMPS ``heat radius/area``, LIGGGHTS ``fix heat/gran/conduction``: two like spheres held at the head-on
   probe's largest overlap (``conduction``: heat_time_constant, Batchelor & O'Brien 1977 for LIGGGHTS).
 
