@@ -13,6 +13,9 @@ probes run:
   characteristic speed (``adhesive_impact``: restitution, capture_velocity; Thornton & Ning 1998); LIGGGHTS
   ``cohesion sjkr``/``sjkr2``: two like spheres on the pair's elastic Hertz law with −kc·A added, pulled apart
   (``pull_off``: the largest tension in closed form);
+* Kratos — a relation on ``DEM_D_Hertz_viscous_Coulomb_JKR``/``_DMT``: the pull-off (and JKR's impact) of two like
+  spheres of its E* and PARTICLE_COHESION w (:func:`_kratos_cohesive`); a wall relation's ConstantTorque /
+  ViscousTorque rolling friction: the level-wall roll on its Linear_viscous_Coulomb law (:func:`_kratos_rolling`);
 * heat — LAMMPS ``heat radius/area``, LIGGGHTS ``fix heat/gran/conduction``: two like spheres held at the head-on
   probe's largest overlap (``conduction``: heat_time_constant, Batchelor & O'Brien 1977 for LIGGGHTS).
 
@@ -359,9 +362,57 @@ def _sjkr_check(ps, law_id: str, kc: float, base: dict, entry: dict) -> str:
     return text
 
 
+def _kratos_cohesive(setup, ps, sub, base, entry, speed) -> list:
+    """Kratos' ``DEM_D_Hertz_viscous_Coulomb_JKR``/``_DMT`` (args: the relation's E*, the first material's ν, its
+    PARTICLE_COHESION w): LAMMPS's jkr/dmt probes with two like spheres of that E* (E = 2(1 − ν²)E*) and w."""
+    e_star, nu, w = sub["args"]
+    e_mod = 2.0 * (1.0 - nu * nu) * e_star
+    out = _jkr_dmt(setup, ps, {**sub, "args": (e_mod, 0.0, nu, 0.5 * w)}, base, entry, speed)
+    note = (f"w = PARTICLE_COHESION = {w:g}; E* = {e_star:.6g} of the relation (two like spheres of E = {e_mod:.6g}, "
+            f"ν = {nu:g}); the relation's DAMPING_GAMMA left out (the probes are elastic)")
+    return [(label, raw, why, [note, *notes[1:]] if raw is not None else notes) for label, raw, why, notes in out]
+
+
+def _kratos_rolling(setup, ps, sub, base, entry, speed) -> list:
+    """A Kratos wall relation's rolling friction model (args: ROLLING_FRICTION_WITH_WALLS, STATIC_FRICTION, Kratos'
+    Kt/Kn): a sphere of the relation's particle rolling on a level wall at the characteristic speed, on the
+    relation's DEM_D_Linear_viscous_Coulomb (Kn of its E* on a wall, Kt = (Kt/Kn)·Kn, μ = STATIC_FRICTION), with
+    type A μr = ROLLING_FRICTION_WITH_WALLS (Kratos' torque μ|Fn|(R − δ): Rr = R) or type B Cr = μ W R²."""
+    from ..engines import registry
+
+    coef, mu, ratio = sub["args"]
+    label = f"rolling ({ps.label})"
+    g = _gravity_or_none(setup)
+    if g is None:
+        return [(label, None, "the project sets no gravity: a sphere on a wall has no load to roll under", [])]
+    if not speed:
+        return [(label, None, "no characteristic speed to roll at", [])]
+    r, rho = base["radius"], base["density"]
+    nl, _ = registry.get(setup.engine).twin(ps.native, *base["effective"])  # the relation's law on the wall
+    if nl.a != 1.0:
+        raise ValueError(f"the rolling probe is of a linear normal law; the relation's is F ∝ δ^{nl.a:g}")
+    kn = nl.k
+    mat = {"density": rho, "restitution": ps.asked.get("restitution") or 0.9, "friction": mu,
+           "youngs_modulus": 1e9, "poisson_ratio": 0.3}
+    contact = {"normal": "lsd", "kn": kn, "tangential": "spring_sliding", "kt": ratio * kn}
+    weight = rho * 4.0 / 3.0 * math.pi * r ** 3 * g
+    if sub["law"] == "constant_torque":
+        contact.update(rolling="constant_torque", mu_r=coef, full_direction=True)
+        what = f"type A μr = {coef:g} (Rr = R)"
+    else:
+        contact.update(rolling="viscous", c_r=coef * weight * r * r)
+        what = f"type B Cr = {coef:g}·W·R² = {coef * weight * r * r:.6g} N·m·s"
+    notes = [f"{ps.native.normal}: Kn = {kn:.6g} N/m of E* {ps.native.normal_args[0]:.6g} on a wall, Kt = "
+             f"{ratio:.4g}·Kn (4G*/E* of the two materials), μ = STATIC_FRICTION {mu:g} (Kratos' μ at no slip); "
+             f"{what}", f"rolling at the characteristic speed {speed:g}, ω = v/R"]
+    return [(label, _on_plane(f"audit-{label}", mat, r, contact, "rolling", (0.0, 0.0, -g),
+                              velocity=(speed, 0.0, 0.0)), "", notes)]
+
+
 # the probe of each kind an engine's reader names in its BEYOND_PROBES (slot → kind)
 MAKERS = {"incline_sds": _sds_incline, "twist": _twisting, "pull_off": _jkr_dmt, "held_pair": _heat,
-          "rolling_cdt_epsd3": _cdt_epsd3, "pull_off_sjkr": _sjkr}
+          "rolling_cdt_epsd3": _cdt_epsd3, "pull_off_sjkr": _sjkr, "pull_off_kratos": _kratos_cohesive,
+          "rolling_kratos": _kratos_rolling}
 
 
 # ----------------------------------------------------------------------------- the runs

@@ -10,6 +10,12 @@ DAMPING_GAMMA Kratos itself derives from the relation's COEFFICIENT_OF_RESTITUTI
 initialises the relation and the value is read back). Only the head-on probe runs: Kratos' tangential law has a
 twin (reference/twins_kratos.py) but no oblique probe is wired here yet, and a head-on impact has no tangential
 force.
+
+Beyond sliding (``ps.beyond``, probed by comparisons/audit_beyond.py in engines/kratos/scenario.py's scenarios): a
+relation on the cohesive laws ``DEM_D_Hertz_viscous_Coulomb_JKR`` / ``…_DMT`` with its PARTICLE_COHESION w (J/m²)
+gets the pull-off probe (and, for JKR, the adhesive impact); a wall relation's rolling friction model
+(``DEM_ROLLING_FRICTION_MODEL_NAME`` ConstantTorque / ViscousTorque, ``ROLLING_FRICTION_WITH_WALLS``, which Kratos
+defaults to ROLLING_FRICTION) with RollingFrictionOption on gets the sphere rolling on a level wall.
 """
 
 from __future__ import annotations
@@ -22,7 +28,8 @@ from pathlib import Path
 from ...inputs.script import Body, Finding, PairSetting, ScriptError, Setup
 from ..base import Native
 from . import mdpa as M
-from .mapping import AUDITED, HERTZ, LAWS, PARENT
+from .mapping import AUDITED, HERTZ, LAWS, LINEAR, PARENT
+from .scenario import DMT_LAW, JKR_LAW, ROLLING_MODELS
 
 SCHEME = "Velocity_Verlet"  # the scheme of the probes' runs and of the twin
 DEFAULTS = {"TranslationalIntegrationScheme": "Symplectic_Euler", "MaxTimeStep": 5e-5, "Dimension": 3,
@@ -30,6 +37,11 @@ DEFAULTS = {"TranslationalIntegrationScheme": "Symplectic_Euler", "MaxTimeStep":
 MAX_JSON_BYTES = 20_000_000
 SPHERES = ("SphericParticle3D", "SphericContinuumParticle3D")
 OWN_MODULI = False  # the deck writer writes the pair's E* (a rigid face for a wall), not each material's own
+# the audit's probe of each sub-model beyond sliding (comparisons/audit_beyond.py MAKERS): the cohesive laws' pull-off
+# (and JKR's adhesive impact), a wall relation's rolling friction model on a sphere rolling on a level wall
+BEYOND_PROBES = {"adhesion": "pull_off_kratos", "rolling": "rolling_kratos"}
+COHESIVE = {JKR_LAW: "jkr", DMT_LAW: "dmt"}
+BOUNDED = "DEMRollingFrictionModelBounded"  # Kratos 10.4.4's default model name for a relation that names none
 
 
 def claims(script) -> bool:
@@ -137,9 +149,6 @@ def _settings(project: dict, setup: Setup, where: str) -> None:
         setup.findings.append(Finding("note", "global-damping", f"GlobalDamping = {damping:g}: Kratos damps every "
                                       "particle's motion on top of the contact law; the probes run without it (its "
                                       "effect on the restitution is not measured)", where))
-    if project.get("RollingFrictionOption") is True:
-        setup.not_audited.append((where, "RollingFrictionOption true", "rolling friction is not probed (a head-on "
-                                  "impact does not roll)"))
     procs = project.get("processes") if isinstance(project.get("processes"), dict) else {}
     for plist in procs.values():
         for proc in plist if isinstance(plist, list) else []:
@@ -190,7 +199,8 @@ def _materials(doc: dict, name: str, meshes: dict, setup: Setup, project: dict, 
     for pname, key, why in getattr(meshes.get("_FEM_boundary"), "notes", []):
         setup.not_audited.append((f"FEM boundary {pname[:40]}", key, f"{why}: the probes' wall is fixed and "
                                   "not sticky"))
-    _relations(doc, name, mats, setup, wall_mats)
+    rolling_on = project.get("RollingFrictionOption") is True and project.get("RotationOption", True) is True
+    _relations(doc, name, mats, setup, wall_mats, rolling_on)
 
 
 def _parts_nodes(mesh, sub: str) -> list:
@@ -309,7 +319,7 @@ def _e_star(a: dict, b: dict, w: str) -> float:
     return a["E"] * b["E"] / (a["E"] * (1.0 - b["nu"] ** 2) + b["E"] * (1.0 - a["nu"] ** 2))
 
 
-def _relations(doc: dict, name: str, mats: dict, setup: Setup, wall_mats: set) -> None:
+def _relations(doc: dict, name: str, mats: dict, setup: Setup, wall_mats: set, rolling_on: bool = False) -> None:
     pending = []
     for k, rel in enumerate(doc.get("material_relations") or []):
         w = f"{name}: material_relations[{k}]"
@@ -332,11 +342,17 @@ def _relations(doc: dict, name: str, mats: dict, setup: Setup, wall_mats: set) -
         nat = Native("kratos", normal=law or "(none)", normal_args=(e_star,), damping="gamma", damping_coeff=0.0,
                      tangential="none", limit=True, props={"young_eff": e_star, "gamma": 0.0, "wall": wall})
         ps = PairSetting(label, i, None if wall else j, nat, w, {} if cor is None else {"restitution": cor})
-        ps.notes.append(_friction_note(v, w, setup))
+        if setup.dimension == 3:  # a 2-D project's cylinders are not the probes' spheres
+            _beyond(ps, v, w, law, (mats[i], mats[j]), e_star, rolling_on)
+        ps.notes.append(_friction_note(v, w, setup, "rolling" in ps.beyond and not ps.beyond["rolling"].get("refused")))
         if setup.dimension != 3:
             ps.probe = False
             ps.notes.append("listed, not probed: a 2-D project's particles are Kratos' cylinders (its 2-D laws act "
                             "per unit length); the probes are spheres")
+        elif law in COHESIVE:
+            ps.probe = False
+            ps.notes.append(f"listed, not probed by the head-on impact: {law}'s collision is not twinned; its "
+                            "cohesion is the pull-off probe's (beyond sliding)")
         elif law in LAWS and law not in AUDITED:
             ps.probe = False
             ps.notes.append(f"listed, not probed: {law} is twinned but its stiffness is not read by the audit yet "
@@ -360,20 +376,73 @@ def _word(m: dict) -> str:
     return m["name"] if re.fullmatch(r"[A-Za-z0-9_.+-]{1,40}", m["name"]) else f"material{m['id']}"
 
 
-def _friction_note(v: dict, w: str, setup: Setup) -> str:
+def _beyond(ps: PairSetting, v: dict, w: str, law: str, pair: tuple, e_star: float, rolling_on: bool) -> None:
+    """The relation's sub-models beyond sliding: a cohesive law's w, a wall relation's rolling friction model
+    (``rolling_on``: the project's RollingFrictionOption and RotationOption)."""
+    if law in COHESIVE:
+        cohesion = _number(v, "PARTICLE_COHESION", w, 0.0, ("must be >= 0", lambda x: x >= 0))
+        if cohesion > 0:
+            ps.beyond["adhesion"] = {"law": COHESIVE[law], "args": (e_star, pair[0]["nu"], cohesion),
+                                     "words": f"{law}, PARTICLE_COHESION {cohesion:g}"}
+        elif cohesion == 0:
+            ps.notes.append(f"{law} with PARTICLE_COHESION 0 (Kratos' default): no cohesion acts")
+    wall = ps.j is None
+    roll = _number(v, "ROLLING_FRICTION", w, 0.0, ("must be >= 0", lambda x: x >= 0))
+    key = "ROLLING_FRICTION_WITH_WALLS" if wall and "ROLLING_FRICTION_WITH_WALLS" in v else "ROLLING_FRICTION"
+    coef = _number(v, key, w, 0.0, ("must be >= 0", lambda x: x >= 0))
+    if not coef > 0:
+        return
+    if not rolling_on:
+        ps.findings.append(Finding("note", "rolling-friction-off", f"{key} = {coef:g} while the project's "
+                                   "RollingFrictionOption (with RotationOption) is off: Kratos applies no rolling "
+                                   "friction", w, {"rolling_friction": coef}))
+        return
+    model = _text(v, "DEM_ROLLING_FRICTION_MODEL_NAME", w, BOUNDED)
+    ids = {name: k for k, name in ROLLING_MODELS.items()}
+    words = f"{model}{'' if 'DEM_ROLLING_FRICTION_MODEL_NAME' in v else ' (Kratos default)'}, {key} {coef:g}"
+    sub = {"law": ids.get(model, model), "args": (coef, _number(v, "STATIC_FRICTION", w, 0.0, ("", lambda x: True)),
+                                                  _kt_ratio(pair, e_star)), "words": words}
+    sub["refused"] = _rolling_refused(ps, model, law, sub["args"][1], roll)
+    ps.beyond["rolling"] = sub
+
+
+def _rolling_refused(ps: PairSetting, model: str, law: str, mu: float, roll: float) -> str:
+    """Why a relation's rolling friction is listed, not probed ('' where the rolling probe runs)."""
+    if model == BOUNDED:
+        return (f"{BOUNDED} (Irazábal's bounded model: type A's torque cut, each step, to the one that stops the "
+                "spin within the step) has no demcheck law: not mapped (docs/kratos.md)")
+    if model not in ROLLING_MODELS.values():
+        return f"no Kratos 10.4.4 rolling friction model {model[:60]!r} in demcheck's mapping"
+    if ps.j is not None:
+        return ("the rolling probe is a sphere on a wall (engines/kratos/scenario.py maps Kratos' rolling friction "
+                f"on a wall only); the particle–particle ROLLING_FRICTION {roll:g} is not probed")
+    if law != LINEAR:
+        return (f"the rolling probe is wired for {LINEAR} only (the law whose rolling run is measured against "
+                f"Kratos: docs/kratos.md); {law or 'no law'} on this relation is not probed rolling")
+    if not mu > 0:
+        return "STATIC_FRICTION 0: the sphere slides on the wall, it does not roll"
+    return ""
+
+
+def _kt_ratio(pair: tuple, e_star: float) -> float:
+    """Kratos' Kt/Kn = 4G*/E* of the relation's two materials (G* = 1/((2 − ν₁)/G₁ + (2 − ν₂)/G₂))."""
+    return 4.0 / sum((2.0 - m["nu"]) * 2.0 * (1.0 + m["nu"]) / m["E"] for m in pair) / e_star
+
+
+def _friction_note(v: dict, w: str, setup: Setup, rolled: bool = False) -> str:
     mu_s = _number(v, "STATIC_FRICTION", w, 0.0, ("must be >= 0", lambda x: x >= 0))
     mu_d = _number(v, "DYNAMIC_FRICTION", w, mu_s, ("must be >= 0", lambda x: x >= 0))
     decay = _number(v, "FRICTION_DECAY", w, 500.0, ("must be >= 0", lambda x: x >= 0))
-    roll = _number(v, "ROLLING_FRICTION", w, 0.0, ("must be >= 0", lambda x: x >= 0))
     text = (f"STATIC_FRICTION {mu_s:g}, DYNAMIC_FRICTION {mu_d:g}, FRICTION_DECAY {decay:g}"
             + ("" if "FRICTION_DECAY" in v else " (Kratos' default)")
-            + (f", ROLLING_FRICTION {roll:g}" if roll else "") + ": not probed — the audit has no oblique probe of "
+            + ": not probed — the audit has no oblique probe of "
             "Kratos' tangential law yet (its twin: reference/twins_kratos.py); the head-on probe has no tangential "
-            "force, so it measures the normal law whole")
-    if mu_s or mu_d or roll:
-        setup.not_audited.append((w, f"friction μs {mu_s:g}, μd {mu_d:g}, decay {decay:g}"
-                                  + (f", rolling {roll:g}" if roll else ""),
-                                  "no oblique probe of Kratos' tangential law, no twin of its rolling laws yet (head-on probe only)"))
+            "force, so it measures the normal law whole" + ("; the rolling friction is the rolling probe's (beyond "
+                                                            "sliding)" if rolled else ""))
+    if mu_s or mu_d:
+        setup.not_audited.append((w, f"friction μs {mu_s:g}, μd {mu_d:g}, decay {decay:g}",
+                                  "no oblique probe of Kratos' tangential law (head-on probe only)"
+                                  + ("; its rolling friction is the rolling probe's" if rolled else "")))
     return text
 
 
