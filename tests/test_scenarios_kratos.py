@@ -239,17 +239,18 @@ def test_the_twin_turns_the_arm_with_kratos_low_angle_quaternion():
     """Kratos' OrientationFromRotationAngle below its threshold ((θ/2)⁴/24 < ε) builds q = (1 + φ²/2, …): the arm
     turns by θ(1 − θ²/4), its tip θ³a/4 short of an exact rotation; above it, an exact rotation."""
     from demcheck.reference.beyond_kratos import kratos_arm_turn
-    from demcheck.reference.twins_kratos import arm_turn
+    from demcheck.reference.twins_kratos import rotate
 
     a = 1.59e-3
     arm = np.array([0.0, 0.0, -a])
+    y = np.array([0.0, 1.0, 0.0])
     for theta in (1.44e-5, 1e-4):  # the rolling case's ω dt, and a larger step still in the low-angle branch
         got = kratos_arm_turn(arm, np.array([0.0, theta, 0.0]))
-        exact = arm_turn(arm, np.array([0.0, theta, 0.0]), False)
+        exact = arm - rotate(arm, y, -theta)
         assert abs(exact[0] / (a * math.sin(theta)) + 1) < 1e-12  # the exact tip moves by a sin θ (along −x)
         assert abs((got[0] - exact[0]) / (a * theta ** 3 / 4) - 1) < 1e-3
     got = kratos_arm_turn(arm, np.array([0.0, 0.1, 0.0]))  # past the threshold: cos and sin, exact
-    assert np.allclose(got, arm_turn(arm, np.array([0.0, 0.1, 0.0]), False), rtol=1e-13, atol=1e-19)
+    assert np.allclose(got, arm - rotate(arm, y, -0.1), rtol=1e-13, atol=1e-19)
 
 
 @pytest.mark.engine("kratos")
