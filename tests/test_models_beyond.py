@@ -94,3 +94,39 @@ def test_lammps_scenario_mapping_of_marshall_without_a_tangential_spring():
     raw["contact"] = {"normal": "hertz", "twisting": "marshall", "kt": 1e5}
     mp = scenario.mapping(from_dict(raw), "lammps")
     assert mp.fidelity == "none" and mp.native is None and "tangential spring" in mp.reasons[0]
+
+
+def _no_slip_bound(c):
+    """The largest Cr under which the case's sphere rolls on its level wall without slip, from the case's own numbers:
+    rolling, v' = −v/T with T = 1.4 m R²/Cr, and the friction force m|v'| ≤ μ m g at the start: Cr ≤ 1.4 μ m g R²/v0."""
+    import math
+
+    p = c.particles[0]
+    mat = c.materials[p.material]
+    mass = mat.density * 4.0 / 3.0 * math.pi * p.radius ** 3
+    g = math.hypot(*c.run.gravity)
+    return 1.4 * mat.friction * mass * g * p.radius ** 2 / math.hypot(*p.velocity)
+
+
+def test_the_viscous_rolling_example_rolls_without_slip():
+    """`demcheck models` sets type B into the suite's rolling cases with an example Cr derived from the case: half the
+    no-slip bound rounded down (1e-8 N·m·s for the suite's glass sphere, whose bound is 2.19e-8). Its Kratos twin runs
+    and gives the closed form's time constant. (Before: Cr = 1e-7 for every case, 4.6× the bound: the sphere slid,
+    and the rolling time constant came out NaN.)"""
+    import math
+
+    cases, _ = scenario.law_cases("rolling", "viscous")
+    rolling = [c for c in cases if c.run.scenario == "rolling"]
+    assert len(rolling) == 2
+    for c in rolling:
+        bound = _no_slip_bound(c)
+        assert abs(bound / 2.192e-8 - 1) < 1e-3  # the suite's glass sphere at 0.02 m/s, μ 0.3
+        assert 0.25 * bound < c.contact.params["c_r"] <= 0.5 * bound, (c.name, c.contact.params["c_r"], bound)
+        assert abs(scenario.rolling_grip(c)[2] / bound - 1) < 1e-12
+    linear = next(c for c in rolling if c.name.endswith("linear"))
+    res = scenario.twin(linear, "kratos")
+    assert res.ok, res.message
+    p = linear.particles[0]
+    mass = linear.materials[p.material].density * 4.0 / 3.0 * math.pi * p.radius ** 3
+    tau = res.metrics()["rolling_time_constant"]
+    assert abs(tau / (1.4 * mass * p.radius ** 2 / linear.contact.params["c_r"]) - 1) < 1e-3

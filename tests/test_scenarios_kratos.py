@@ -239,17 +239,18 @@ def test_the_twin_turns_the_arm_with_kratos_low_angle_quaternion():
     """Kratos' OrientationFromRotationAngle below its threshold ((θ/2)⁴/24 < ε) builds q = (1 + φ²/2, …): the arm
     turns by θ(1 − θ²/4), its tip θ³a/4 short of an exact rotation; above it, an exact rotation."""
     from demcheck.reference.beyond_kratos import kratos_arm_turn
-    from demcheck.reference.twins_kratos import arm_turn
+    from demcheck.reference.twins_kratos import rotate
 
     a = 1.59e-3
     arm = np.array([0.0, 0.0, -a])
+    y = np.array([0.0, 1.0, 0.0])
     for theta in (1.44e-5, 1e-4):  # the rolling case's ω dt, and a larger step still in the low-angle branch
         got = kratos_arm_turn(arm, np.array([0.0, theta, 0.0]))
-        exact = arm_turn(arm, np.array([0.0, theta, 0.0]), False)
+        exact = arm - rotate(arm, y, -theta)
         assert abs(exact[0] / (a * math.sin(theta)) + 1) < 1e-12  # the exact tip moves by a sin θ (along −x)
         assert abs((got[0] - exact[0]) / (a * theta ** 3 / 4) - 1) < 1e-3
     got = kratos_arm_turn(arm, np.array([0.0, 0.1, 0.0]))  # past the threshold: cos and sin, exact
-    assert np.allclose(got, arm_turn(arm, np.array([0.0, 0.1, 0.0]), False), rtol=1e-13, atol=1e-19)
+    assert np.allclose(got, arm - rotate(arm, y, -0.1), rtol=1e-13, atol=1e-19)
 
 
 @pytest.mark.engine("kratos")
@@ -323,3 +324,36 @@ def test_kratos_runs_the_rolling_case_in_the_suite():
     assert verdicts == {"rolling_stop_time": AGREE, "rolling_distance": EXPECTED}, verdicts
     for x in comps:
         assert abs(x.value - src["twin_metrics"][x.metric]) <= 1e-9 * abs(x.value)
+
+
+def sliding_viscous_rolling():
+    """The rolling sphere under Cr = 1e-7 N·m·s, 4.6× the largest it rolls under without slip (1.4 μ m g R²/v0 =
+    2.19e-8): the torque decelerates the roll at 13.4 m/s² where friction gives μ g = 2.94 m/s²."""
+    return loads(case_path("suite/beyond-rolling-linear.toml").read_text().replace(
+        'rolling = "constant_torque"\nmu_r = 0.1', 'rolling = "viscous"\nc_r = 1e-7'))
+
+
+def test_a_sliding_viscous_roll_is_a_failure_that_names_its_cause():
+    """The twin's and the seed's runs of a sphere that slides have no e-fold time within the run: failed, with the
+    key, its value and the rule it breaks (before: "gave no rolling_time_constant (not finite)", no cause)."""
+    from demcheck.engines import scenario
+
+    c = sliding_viscous_rolling()
+    bound = 1.4 * 0.3 * MASS * G * R_GLASS ** 2 / V0
+    for res in (scenario.twin(c, "kratos"), scenario.seed(c, "kratos")):
+        assert res.status == "failed" and not res.ok
+        assert "contact.c_r = 1e-07: the sphere slides" in res.message, res.message
+        assert f"Cr ≤ {bound:.3g} N·m·s" in res.message and "μ g cos θ = 2.94 m/s²" in res.message
+
+
+@pytest.mark.engine("kratos")
+def test_a_sliding_viscous_roll_in_kratos_is_never_a_verdict():
+    """Kratos runs the sliding sphere; its metric is not finite, so each of its rows is failed with the cause —
+    never agree or differs as expected."""
+    from demcheck.comparisons.verdicts import FAILED
+
+    entry, comps = engine_scenario_rows(sliding_viscous_rolling(), "kratos")
+    src = entry["sources"]["kratos"]
+    assert src["status"] == "failed" and "the sphere slides" in src["message"], src
+    assert comps and all(x.verdict == FAILED for x in comps), [(x.metric, x.verdict) for x in comps]
+    assert all("the sphere slides" in x.reason for x in comps), [x.reason for x in comps]

@@ -272,3 +272,80 @@ def test_the_yade_pair_guard_refuses_a_changed_script():
                     dk.text.replace("O.dt = DT", "O.dt = DT\nO.pause()")):
             with pytest.raises(DemcheckError):
                 dk.check(bad, {})
+
+
+def _euler_x(c):
+    """x = dt·H(1/C0 + 1/C1) of ThermalEngine's forward Euler at the scenario's step, from the case's numbers: the
+    layout's dt is τ_case/20000, τ_case = C/(2 H_case) for like bodies (H_case = 2ks√(R̄δ), Batchelor & O'Brien),
+    and Yade's H = 2(k0 + k1) r0 r1/(r0 + r1 − δ): x = H_yade/H_case/20000."""
+    delta, k, r = c.run.overlap, 45.0, 2e-3
+    h_yade = 4.0 * k * r * r / (2.0 * r - delta)
+    h_case = 2.0 * k * math.sqrt(0.5 * r * delta)
+    return h_yade / h_case / 20000.0
+
+
+@pytest.mark.parametrize("overlap, x", [(4e-12, 1.58), (1e-12, 3.16)])
+def test_a_held_pair_past_forward_eulers_bound_is_refused_with_its_rule(overlap, x):
+    """At a tiny overlap the case's conductance (∝ √δ) is tiny and Yade's (which ignores the contact's size) is not:
+    at the step that resolves the case's law Yade's forward Euler flips T1 − T0's sign every step (x ≥ 1). Refused
+    before any run, in one line naming the key, its value, the rule and the least overlap Yade runs (δ where x = 1:
+    δ·x² here, H_case ∝ √δ). Before: 4e-12 ran and its samples, 100 steps apart, hid the flips — a finite time
+    constant of 1.67 s (Yade's own exchange: 0.36 s) judged "differs as expected"; 1e-12 failed as not finite."""
+    c = case("conduction", [f"run.overlap={overlap}"])
+    assert abs(_euler_x(c) / x - 1) < 5e-3
+    mp = scenario.mapping(c, "yade")
+    assert mp.fidelity == "none" and mp.native is None and len(mp.reasons) == 1
+    line = mp.reasons[0]
+    assert "\n" not in line and line.startswith(f"run.overlap = {overlap:g}: ")
+    assert "dt·H(1/C0 + 1/C1) < 1" in line and f"giving {x:.3g}" in line, line
+    least = 1e-6 * (63.25 / 20000.0) ** 2  # the suite's 1 µm has ratio 63.25 (H_case ∝ √δ)
+    assert "Yade runs this pair from run.overlap = 1.01e-11 m" in line and 1.0e-11 < least < 1.01e-11
+    planned = {p.source.label: p for p in plan(c)}
+    assert planned["yade"].status == NOT_EXPRESSIBLE and "run.overlap = " in planned["yade"].why
+
+
+def test_forward_eulers_rule_for_the_held_pair():
+    """x = dt·H(1/C0 + 1/C1); each step multiplies T1 − T0 by 1 − x: at x = 1.58 it flips sign every step, and
+    samples an even number of steps apart see a decay by 0.58 a step instead."""
+    from demcheck.reference.beyond_yade import euler_factor, held
+
+    assert euler_factor(2.0, 4.0, 4.0, 0.25) == 0.25
+    run = held(1.58, 2.0, 2.0, 300.0, 400.0, 1.0, 6, 1)  # x = 1.58
+    assert (run["dT"][1::2] < 0).all() and (run["dT"][::2] > 0).all()
+    assert held(1.58, 2.0, 2.0, 300.0, 400.0, 1.0, 200, 100)["dT"][1:].min() > 0  # the flips hidden
+
+
+@pytest.mark.parametrize("overlap, every", [(1e-6, 100), (1e-10, 2), (1.02e-11, 1)])
+def test_a_held_pair_within_forward_eulers_bound_is_sampled_to_resolve_its_fall(overlap, every):
+    """Within the bound the mapping stands, and the held pair is sampled so that T1 − T0 falls by no more than 1/e
+    between samples ((1 − x)^every ≥ 1/e, or every step): its time constant is then forward Euler's −dt/ln(1 − x) of Yade's H.
+    The suite's 1 µm keeps 100 steps (x = 3.2e-3). (Before: always 100 steps apart — at 1e-10, x = 0.32, the
+    first sample held (1 − x)^100 of 100 K, 3e-15 K, under the temperatures' round-off, and the twin's τ came out
+    0.3336 s against forward Euler's 0.3020 s; at 1.02e-11 it was exactly 0 and the run failed as not finite.)"""
+    c = case("conduction", [f"run.overlap={overlap}"])
+    x = _euler_x(c)
+    mp = scenario.mapping(c, "yade")
+    assert mp.fidelity == "approximate"
+    from demcheck.engines import registry
+
+    lay = scenario.layout(c, registry.get("yade").scenario_twin_laws(c, mp.native))
+    assert lay.every == every and ((1.0 - x) ** every >= 1.0 / math.e or every == 1)  # every step at the least
+    twin = scenario.twin(c, "yade")
+    assert twin.ok, twin.message
+    assert abs(twin.metrics()["heat_time_constant"] / (-lay.dt / math.log(1.0 - x)) - 1) < 1e-3
+
+
+@pytest.mark.engine("yade")
+@pytest.mark.parametrize("overlap", [1e-10, 1.02e-11])
+def test_yade_runs_a_fast_held_pair_as_its_twin(overlap):
+    """Yade at 1e-10 (x = 0.32, sampled every 2 steps) and just above the bound (x = 0.99, every step): the run is
+    its twin and forward Euler's −dt/ln(1 − x); the verdict against the case's law is the approximate mapping's."""
+    c = case("conduction", [f"run.overlap={overlap}"])
+    entry, comps = rows(c)
+    src = entry["sources"]["yade"]
+    assert src["status"] == "ok" and src["fidelity"] == "approximate", src
+    assert [(x.metric, x.verdict) for x in comps] == [("heat_time_constant", EXPECTED)]
+    tau = comps[0].value
+    assert abs(tau / src["twin_metrics"]["heat_time_constant"] - 1) <= 1e-9
+    x = _euler_x(c)
+    assert abs(tau / (-src["dt"] / math.log(1.0 - x)) - 1) < 1e-3

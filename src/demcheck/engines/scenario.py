@@ -38,6 +38,7 @@ STEPS_PER_PERIOD = 60  # steps per period of the stiffest spring of a sphere on 
 PULL_STEPS = 25000  # samples along a pull (every step): the break is located to 2.5e-4 of its overlap
 IMPACT_STEPS_PER_CONTACT = 2000
 CONDUCTION_STEPS_PER_TAU = 20000  # explicit Euler's error on τ is dt/(2τ) = 2.5e-5
+HELD_EVERY = 100  # the held pair's samples, steps apart (fewer where an engine's exchange is faster: _held_every)
 
 
 @dataclass(frozen=True)
@@ -70,8 +71,45 @@ def _engine(engine):
 # the scenarios that run each slot, and the suite's cases of each (cases/suite/beyond-*.toml)
 SLOT_CASES = {"rolling": ("rolling", "rolling-linear", "incline", "incline-linear"), "twisting": ("twist",),
               "adhesion": ("pull-off", "adhesive-impact"), "heat": ("conduction",)}
-# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it)
-EXAMPLE_PARAMS = {("rolling", "constant_torque"): {"mu_r": 0.1}, ("rolling", "viscous"): {"c_r": 1e-7},
+
+
+def rolling_grip(case: Case) -> tuple[float, float, float]:
+    """A sphere rolling on the case's wall under a viscous torque −Cr ω (type B): (its deceleration at the start,
+    the largest friction can give, the largest Cr it rolls under without slip). Rolling, its angular momentum about
+    the contact point (7/5)mRv falls at the torque's rate Cr v/R (the friction force has no moment about that
+    point): v' = −v/T, T = 1.4mR²/Cr. The friction force m·v' that keeps it rolling is within μ|Fn| = μ m g cos θ
+    while v0/T ≤ μ g cos θ, i.e. Cr ≤ 1.4 μ m g cos θ R²/v0 — the scenario and its closed form assume it; past it
+    the sphere slides, its spin falls faster than its speed and the speed decays at μ g, not as e^{−t/T}."""
+    mass, radius, g, theta, n = _on_wall(case)
+    v = np.asarray(case.particles[0].velocity, dtype=float)
+    v0 = float(np.linalg.norm(v - (v @ n) * n))
+    mu = resolve(case).pair.friction or 0.0
+    grip = mu * g * math.cos(theta)
+    law = resolve(case).slot("rolling")
+    deceleration = v0 / _b.rolling_viscous_closed(law.c_r, mass, radius, v0)[0] if law.id == "viscous" else 0.0
+    return deceleration, grip, 1.4 * mass * radius * radius * grip / v0 if v0 > 0.0 else math.inf
+
+
+def _rolling_viscous_example(case: Case) -> dict:
+    """c_r for a rolling case that runs another rolling law: half the largest Cr the case's sphere rolls under
+    without slip (:func:`rolling_grip`), rounded down to one significant digit (1e-8 N·m·s on the suite's glass
+    sphere, whose bound is 2.19e-8), so that the example always rolls."""
+    from ..errors import ConfigError
+
+    if case.run.scenario != "rolling":
+        return {"c_r": 1e-8}  # any Cr > 0: the scenario refuses type B by its own rule, which the listing shows
+    bound = rolling_grip(case)[2]
+    if not bound > 0.0:
+        raise ConfigError("contact.friction", resolve(case).pair.friction,
+                          "a viscous rolling torque (type B) rolls the sphere only with friction on the wall")
+    half = 0.5 * bound
+    unit = 10.0 ** math.floor(math.log10(half))
+    return {"c_r": math.floor(half / unit) * unit}
+
+
+# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it);
+# a function of the case where the value must fit it (type B's Cr: the sphere must roll without slip)
+EXAMPLE_PARAMS = {("rolling", "constant_torque"): {"mu_r": 0.1}, ("rolling", "viscous"): _rolling_viscous_example,
                   ("rolling", "epsd"): {"mu_r": 0.1, "k_r": 1e-3}, ("twisting", "sds"): {"k_tw": 1e-3, "mu_tw": 1e-4},
                   ("twisting", "marshall"): {"kt": 1e5}, ("adhesion", "jkr"): {"w": 0.1}, ("adhesion", "dmt"): {"w": 0.1},
                   ("adhesion", "sjkr"): {"k_c": 1e5}, ("heat", "radius"): {"k": 45.0}, ("heat", "area"): {"k": 1e6},
@@ -93,15 +131,19 @@ def law_cases(slot: str, law_id: str) -> tuple[list[Case], list[str]]:
 
     cases, refusals = [], []
     for name in SLOT_CASES[slot]:
-        raw = tomllib.loads(case_path(f"suite/beyond-{name}.toml").read_text())
+        text = case_path(f"suite/beyond-{name}.toml").read_text()
+        raw = tomllib.loads(text)
         contact = raw["contact"]
-        if contact.get(slot, "none") != law_id:
-            for key in KEYS.get((slot, contact.get(slot, "none")), ()):
-                if key.name not in KEPT_KEYS:
-                    contact.pop(key.name, None)
-            contact[slot] = law_id
-            contact.update({k: v for k, v in EXAMPLE_PARAMS[(slot, law_id)].items() if k not in contact})
         try:
+            if contact.get(slot, "none") != law_id:
+                example = EXAMPLE_PARAMS[(slot, law_id)]
+                if callable(example):  # of the suite case as it is: its sphere, wall, friction and speed
+                    example = example(from_dict(tomllib.loads(text)))
+                for key in KEYS.get((slot, contact.get(slot, "none")), ()):
+                    if key.name not in KEPT_KEYS:
+                        contact.pop(key.name, None)
+                contact[slot] = law_id
+                contact.update({k: v for k, v in example.items() if k not in contact})
             cases.append(from_dict(raw))
         except ConfigError as exc:
             refusals.append(str(exc))
@@ -164,9 +206,24 @@ def layout(case: Case, laws: dict) -> Layout:
     c0, c1 = _capacities(case)
     tau = _b.heat_time_constant_closed(conductance(model.slot("heat"), case.run.overlap), c0, c1)
     dt = tau / CONDUCTION_STEPS_PER_TAU
-    return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), 100,
+    return Layout(s, dt, int(1.2 * CONDUCTION_STEPS_PER_TAU), _held_every(dt * laws.get("heat_rate", 0.0)),
                   ((0.0, 0.0, 0.0), (r0 + r1 - case.run.overlap, 0.0, 0.0)), ((0.0, 0.0, 0.0),) * 2,
                   ((0.0, 0.0, 0.0),) * 2)
+
+
+def _held_every(x: float) -> int:
+    """The held pair's sampling, steps apart: HELD_EVERY, or fewer where an engine's explicit Euler exchange is
+    faster than the case's law — its laws' ``heat_rate`` H(1/C0 + 1/C1), x = dt·H(1/C0 + 1/C1) the fall of T1 − T0
+    a step (Yade's ThermalEngine: its H ignores the contact's size). The e-fold time is read between two samples
+    (ln(T1 − T0) linear), so the fall between samples, (1 − x)^every, must stay ≥ 1/e: past it the next sample is
+    all but round-off (T1 − T0 is a difference of two temperatures: at x = 0.32, 100 steps apart, (1 − x)^100 of
+    100 K is 3e-15 K, below their 5.7e-14 K spacing at 350 K; the time constant came out 10 % off forward Euler's).
+    x ≥ 1 is no decay at all (the mapping refuses it: engines/yade/pair.py)."""
+    if not x > 0.0:
+        return HELD_EVERY
+    if x >= 1.0:
+        return 1
+    return int(max(1, min(HELD_EVERY, math.floor(-1.0 / math.log1p(-x)))))
 
 
 def overlap_scale(case: Case) -> float:
@@ -320,10 +377,26 @@ def _result(case: Case, source: str, method: str, metrics: dict, lay: Layout, st
     status, message = "ok", extra.pop("message", "")
     if bad and not (case.run.scenario == "adhesive_impact" and bad == ["capture_velocity"]):
         status, message = "failed", f"the {case.run.scenario} run gave no {', '.join(bad)} (not finite)"
+        cause = _why_not_finite(case, lay)
+        message += f": {cause}" if cause else ""
     meta = {"scenario": case.run.scenario, "scenario_metrics": metrics, **extra.pop("meta", {})}
     return Result(source=source, method=method, case_name=case.name, case_hash=case.hash,
                   model=resolve(case).describe(), params=extra.pop("params", {}), contact=None, dt=lay.dt,
                   wall_time=time.perf_counter() - started, status=status, message=message, meta=meta, **extra)
+
+
+def _why_not_finite(case: Case, lay: Layout) -> str:
+    """The cause of a metric that is not finite, where demcheck knows it: a viscous rolling torque (type B) the
+    friction cannot hold (:func:`rolling_grip`) — the sphere slides, and its speed does not fall to v0/e within
+    the run (1.5 T); else that it did not fall so."""
+    if case.run.scenario != "rolling" or resolve(case).slot("rolling").id != "viscous":
+        return ""
+    deceleration, grip, bound = rolling_grip(case)
+    if deceleration > grip:
+        return (f"contact.c_r = {case.contact.params['c_r']:g}: the sphere slides — the viscous torque decelerates "
+                f"the roll at Cr·v0/(1.4 m R²) = {deceleration:.3g} m/s², more than friction gives (μ g cos θ = "
+                f"{grip:.3g} m/s²); it rolls without slip for Cr ≤ {bound:.3g} N·m·s")
+    return f"the speed did not fall to v0/e within the run ({lay.steps * lay.dt:.3g} s)"
 
 
 def _metrics(case: Case, run: dict) -> dict:

@@ -26,7 +26,7 @@ from numba import njit
 from .. import KERNEL_CACHE
 from ..laws.normal_force import normal_force
 from ..laws.tangential_force import _cross, _dot
-from .twins_kratos import tangential
+from .twins_kratos import kratos_arm_turn, tangential
 
 JKR, DMT = "jkr", "dmt"
 
@@ -149,38 +149,6 @@ def _wall_roll(nl, kp, model, mu_roll, radius, mass, x, v, w, g, p, nw, dt, step
         if k % every == 0:
             _row(out, k // every, x, v, w, f + mass * g, tq)
     return out
-
-
-@njit(cache=KERNEL_CACHE, inline="always")
-def kratos_arm_turn(arm, dtheta):
-    """The wall contact point's displacement by the sphere's rotation over the step as Kratos computes it
-    (SphericParticle::ComputeBallToRigidFaceContactForceAndMoment): a − q(−Δθ) a, with q from
-    GeometryFunctions::OrientationFromRotationAngle and turned by Quaternion::RotateVector3.
-
-    Below (|Δθ|/2)⁴/24 < ε (every DEM step: |Δθ| < 5.4e-4 rad) that function takes its "Taylor: low angle"
-    branch, q = (1 + φ²/2, φ̂·φ(1 − φ²/6)) normalised, φ = |Δθ|/2: the scalar part's sign is wrong (cos φ ≈
-    1 − φ²/2), and after the normalisation q turns by θ(1 − θ²/4), θ = |Δθ|. The arm's tip moves by θ³R/4 less
-    than a rotation by θ — on a rolling contact, where the slip increment is the small difference of the
-    translation and this turn, that is 1e-5 of the increment (docs/findings.md, "Kratos beyond sliding")."""
-    half = -0.5 * dtheta
-    phi = math.sqrt(half[0] * half[0] + half[1] * half[1] + half[2] * half[2])
-    if phi * phi * phi * phi / 24.0 < 2.220446049250313e-16:
-        aux = 1.0 - phi * phi / 6.0
-        qw = 1.0 + phi * phi / 2.0
-    else:
-        aux = math.sin(phi) / phi
-        qw = math.cos(phi)
-    qx, qy, qz = half[0] * aux, half[1] * aux, half[2] * aux
-    norm2 = qx * qx + qy * qy + qz * qz + qw * qw
-    if norm2 > 0.0 and norm2 != 1.0:
-        norm = math.sqrt(norm2)
-        qx, qy, qz, qw = qx / norm, qy / norm, qz / norm, qw / norm
-    b0 = 2.0 * (qy * arm[2] - qz * arm[1])
-    b1 = 2.0 * (qz * arm[0] - qx * arm[2])
-    b2 = 2.0 * (qx * arm[1] - qy * arm[0])
-    old = np.array([arm[0] + b0 * qw + (qy * b2 - qz * b1), arm[1] + b1 * qw + (qz * b0 - qx * b2),
-                    arm[2] + b2 * qw + (qx * b1 - qy * b0)])
-    return arm - old
 
 
 @njit(cache=KERNEL_CACHE, inline="always")

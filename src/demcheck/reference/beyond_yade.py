@@ -130,6 +130,14 @@ def thermal_capacity(cp: float, density: float, radius: float) -> float:
     return cp * density * (4.0 / 3.0 * math.pi * radius ** 3)
 
 
+def euler_factor(h: float, cap0: float, cap1: float, dt: float) -> float:
+    """x = dt·H(1/C0 + 1/C1): each step of :func:`held` multiplies T1 − T0 by 1 − x. Below 1 it decays
+    monotonically (its e-fold time −dt/ln(1 − x), the exponential's τ = dt/x to O(x)); between 1 and 2 it flips
+    sign every step while it shrinks — samples an even number of steps apart hide the flips and read a decay of
+    |1 − x| per step, a time constant that is no exchange of heat; from 2 on it grows without bound."""
+    return dt * h * (1.0 / cap0 + 1.0 / cap1)
+
+
 def held(h: float, cap0: float, cap1: float, t0: float, t1: float, dt: float, steps: int, every: int) -> dict:
     """Two bodies held together exchanging Q = H (T1 − T0) by ThermalEngine's forward Euler (T += Q·dt/C, each
     step, ``tsSafetyFactor`` ≤ 0), sampled every ``every`` steps from step 0: t and dT = T1 − T0."""

@@ -12,8 +12,9 @@ into body 1, v_t the slip velocity, force on body 0 = −Fn n + Ft):
   (a pair: the stored force rotated about n_old × n by asin|n_old × n|; a wall: projected), (Hertz) scaled by
   √(δ/δ_prev) when the overlap shrinks, and incremented by −Kt Δu_t, Δu the contact point's relative
   displacement over the step: the bodies' displacements (x_new − x_old) plus the turn of each lever arm by the
-  body's rotation over the step (DELTA_ROTATION = ω dt), by a finite rotation (R(Δθ)a − a for a pair's arms
-  a = ±(R − δ/2) n; a − R(−Δθ)a on a wall, a = (R − δ) n). δ_prev = δ − Δu·n.
+  body's rotation over the step (DELTA_ROTATION = ω dt), by a finite rotation (q(Δθ)a − a for a pair's arms
+  a = ±(R − δ/2) n; a − q(−Δθ)a on a wall, a = (R − δ) n) with Kratos' quaternion of the rotation, whose
+  low-angle branch turns by θ(1 − θ²/4), not θ (:func:`kratos_rotate`). δ_prev = δ − Δu·n.
 * The dashpot −c_t v_t (v_t with the same arms). If |F_e + F_d| > μ|Fn| Kratos splits the cap between spring and
   dashpot: with F_e·F_d ≥ 0, the spring is cut to the cap and the dashpot dropped if |F_e| > cap, else the
   dashpot is cut to cap − |F_e|; with F_e·F_d < 0, the dashpot is cut to (cap + |F_e|)/|F_d| of itself if
@@ -57,16 +58,51 @@ def rotate(v, axis, angle):
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
+def kratos_rotate(v, dtheta):
+    """``v`` turned by the rotation vector ``dtheta`` as Kratos turns it: Quaternion::RotateVector3 with the
+    quaternion of GeometryFunctions::OrientationFromRotationAngle.
+
+    Below (|Δθ|/2)⁴/24 < ε (every DEM step: |Δθ| < 5.4e-4 rad) that function takes its "Taylor: low angle"
+    branch, q = (1 + φ²/2, φ̂·φ(1 − φ²/6)) normalised, φ = |Δθ|/2: the scalar part's sign is wrong (cos φ ≈
+    1 − φ²/2), and after the normalisation q turns by θ(1 − θ²/4), θ = |Δθ|. A lever arm's tip moves by θ³R/4 less
+    than a rotation by θ — on a rolling contact, where the slip increment is the small difference of the
+    translation and this turn, that is 1e-5 of the increment (docs/findings.md, "Kratos beyond sliding"); in a
+    collision 1e-10 of the rebound spin (docs/kratos.md)."""
+    half = 0.5 * dtheta
+    phi = math.sqrt(half[0] * half[0] + half[1] * half[1] + half[2] * half[2])
+    if phi * phi * phi * phi / 24.0 < 2.220446049250313e-16:
+        aux = 1.0 - phi * phi / 6.0
+        qw = 1.0 + phi * phi / 2.0
+    else:
+        aux = math.sin(phi) / phi
+        qw = math.cos(phi)
+    qx, qy, qz = half[0] * aux, half[1] * aux, half[2] * aux
+    norm2 = qx * qx + qy * qy + qz * qz + qw * qw
+    if norm2 > 0.0 and norm2 != 1.0:
+        norm = math.sqrt(norm2)
+        qx, qy, qz, qw = qx / norm, qy / norm, qz / norm, qw / norm
+    b0 = 2.0 * (qy * v[2] - qz * v[1])
+    b1 = 2.0 * (qz * v[0] - qx * v[2])
+    b2 = 2.0 * (qx * v[1] - qy * v[0])
+    return np.array([v[0] + b0 * qw + (qy * b2 - qz * b1), v[1] + b1 * qw + (qz * b0 - qx * b2),
+                     v[2] + b2 * qw + (qx * b1 - qy * b0)])
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def kratos_arm_turn(arm, dtheta):
+    """The wall contact point's displacement by the sphere's rotation ``dtheta`` over the step as Kratos computes
+    it (SphericParticle::ComputeBallToRigidFaceContactForceAndMoment): a − q(−Δθ) a (:func:`kratos_rotate`)."""
+    return arm - kratos_rotate(arm, -dtheta)
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
 def arm_turn(arm, dtheta, forward):
-    """The displacement of a lever arm's tip by the body's rotation ``dtheta`` over the step: R(Δθ)a − a
-    (``forward``, a pair's arms) or a − R(−Δθ)a (a wall's arm)."""
-    angle = _norm(dtheta)
-    if angle == 0.0:
-        return np.zeros(3)
-    axis = dtheta / angle
+    """The displacement of a lever arm's tip by the body's rotation ``dtheta`` over the step, turned as Kratos
+    turns it (:func:`kratos_rotate`): q(Δθ)a − a (``forward``, a pair's arms:
+    RelativeDisplacementAndVelocityOfContactPointDueToRotationQuaternion) or a − q(−Δθ)a (a wall's arm)."""
     if forward:
-        return rotate(arm, axis, angle) - arm
-    return arm - rotate(arm, axis, -angle)
+        return kratos_rotate(arm, dtheta) - arm
+    return kratos_arm_turn(arm, dtheta)
 
 
 @njit(cache=KERNEL_CACHE, inline="always")

@@ -22,9 +22,11 @@ tests/test_scenarios_yade.py):
 from __future__ import annotations
 
 import functools
+import math
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import brentq
 
 from ...case import Case
 from ...errors import DemcheckError
@@ -110,10 +112,52 @@ def _heat(case: Case, model) -> Mapping:
               f"k = ks = {law.k:g} W/(m K) it is {h_yade:.4g} W/K at δ = {delta:g} m, where the case's '{law.id}' "
               f"law gives {h_case:.4g} W/K ({h_yade / h_case:.3g}×: the time constant {h_case / h_yade:.3g}× the "
               "case's)")
+    unstable = _euler_refusal(case, law, h_yade, h_case)
+    if unstable:
+        return refused("yade", unstable)
     nat = Native("yade", normal="FrictPhys", tangential=THERMAL, props={"k": law.k})
     nat.comments = [f"ThermalEngine particleK = {law.k:g} W/(m K) (the case's ks), per-body Cp = the materials' "
                     "specific heat, a dead FlowEngine, advection off, tsSafetyFactor = 0 (every step)"]
     return Mapping("yade", APPROXIMATE, [reason], nat, {reason: "ThermalEngine"})
+
+
+def _capacities(case: Case) -> list[float]:
+    return [beyond_yade.thermal_capacity(m.specific_heat, m.density, p.radius)
+            for m, p in zip(_materials(case), case.particles)]
+
+
+def _euler_refusal(case: Case, law, h_yade: float, h_case: float) -> str:
+    """Why ThermalEngine cannot run the held pair at the scenario's step, or "": its forward Euler (T += Q·dt/C)
+    decays monotonically only while x = dt·H(1/C0 + 1/C1) < 1 (reference/beyond_yade.py ``euler_factor``). The
+    layout's step resolves the case's law (dt = τ_case/CONDUCTION_STEPS_PER_TAU), so x is Yade's H over the case's
+    divided by that number: a tiny overlap, where the case's conductance (∝ √δ) is tiny and Yade's (which ignores the
+    contact's size) is not, passes it. The step stays the case's — the seed's run at the engine's step must span
+    1.2 τ_case, and a step for Yade's faster exchange would need H_yade/H_case times as many steps (4.8e8 at
+    the bound, each a Python-driven O.step) — so the case is refused, naming the least overlap Yade runs."""
+    from .. import scenario
+
+    dt = scenario.layout(case, {}).dt
+    caps = _capacities(case)
+    x = beyond_yade.euler_factor(h_yade, caps[0], caps[1], dt)
+    if x < 1.0:
+        return ""
+    r0, r1 = (p.radius for p in case.particles)
+    per_ratio = x / (h_yade / h_case)  # dt/τ_case: the same at every overlap (the layout's dt ∝ τ_case)
+
+    def excess(log_delta):
+        d = math.exp(log_delta)
+        return math.log(beyond_yade.thermal_conductance(law.k, law.k, r0, r1, d) / conductance(law, d) * per_ratio)
+
+    top = math.log(0.5 * min(r0, r1))
+    least = "no overlap below half the smaller radius passes it"
+    if excess(top) < 0.0:  # the least overlap, rounded up to three digits
+        d = math.exp(brentq(excess, math.log(case.run.overlap), top))
+        unit = 10.0 ** (math.floor(math.log10(d)) - 2)
+        least = f"Yade runs this pair from run.overlap = {math.ceil(d / unit) * unit:.3g} m"
+    return (f"run.overlap = {case.run.overlap:g}: ThermalEngine's forward Euler at the scenario's step (dt = {dt:.3g} s,"
+            f" {per_ratio:.3g} of the case's τ) must shrink T1 − T0 monotonically, dt·H(1/C0 + 1/C1) < 1 (past 1 it "
+            f"flips sign every step, past 2 it grows): Yade's H = {h_yade:.4g} W/K is {h_yade / h_case:.3g}× the "
+            f"case's {h_case:.4g} W/K, giving {x:.3g}; {least}")
 
 
 # ----------------------------------------------------------------------------- the twin
@@ -124,7 +168,12 @@ def _materials(case: Case):
 
 
 def twin_laws(case: Case, nat: Native) -> dict:
-    return {"stepper": functools.partial(_step, nat.props)}
+    laws = {"stepper": functools.partial(_step, nat.props)}
+    if case.run.scenario == "conduction":  # the held pair's sampling resolves Yade's exchange (scenario._held_every)
+        r0, r1 = (p.radius for p in case.particles)
+        h = beyond_yade.thermal_conductance(nat.props["k"], nat.props["k"], r0, r1, case.run.overlap)
+        laws["heat_rate"] = beyond_yade.euler_factor(h, *_capacities(case), 1.0)
+    return laws
 
 
 def _step(props: dict, case: Case, laws: dict, lay) -> dict:
@@ -135,7 +184,7 @@ def _step(props: dict, case: Case, laws: dict, lay) -> dict:
                                                       m1.poisson_ratio, r1, props["gamma"])
         return beyond_yade.pull(kno, adhesion, r0 + r1, lay.positions[1][0], lay.pull_speed, lay.dt, lay.steps)
     h = beyond_yade.thermal_conductance(props["k"], props["k"], r0, r1, r0 + r1 - lay.positions[1][0])
-    caps = [beyond_yade.thermal_capacity(m.specific_heat, m.density, r) for m, r in ((m0, r0), (m1, r1))]
+    caps = _capacities(case)
     t0, t1 = (float(t) for t in case.run.temperatures)
     return beyond_yade.held(h, caps[0], caps[1], t0, t1, lay.dt, lay.steps, lay.every)
 
