@@ -29,6 +29,8 @@ hours here, so every source at every N runs the same first DURATION seconds of t
 argument; the default is printed in the header).
 
 Run: .venv/bin/python benchmarks/bench_packing_scale.py [DURATION] > benchmarks/results/bench_packing_scale.txt
+The two-thread goal alone (the reference on 1 and 2 threads, alternating, ROUNDS each, medians):
+     .venv/bin/python benchmarks/bench_packing_scale.py --threads DURATION 32000,128000 ROUNDS
 """
 
 import json
@@ -187,8 +189,42 @@ def main(duration: float) -> None:
     _report(results, steps)
 
 
+def threads(duration: float, sizes: list[int], rounds: int) -> None:
+    """The two-thread goal alone: the reference on one and on two threads at each size, ``rounds`` times each,
+    alternating (1, 2, 2, 1, …), each run a fresh process as in :func:`main`; the median wall time of each and their
+    ratio. Two threads meet at a barrier twice a step, so any other process on the two cores stretches their
+    waits: the load average is printed with every run, and only a run on an idle machine measures the loop."""
+    import numba
+
+    print(f"the reference on 1 and 2 threads: the poured packing, {duration:g} s of the pour, N = "
+          f"{', '.join(map(str, sizes))}, {rounds} rounds; {datetime.now(timezone.utc):%d %b %Y %H:%M} UTC, git "
+          f"{BP._head()}; {os.cpu_count()} cores, numba {numba.__version__}")
+    print(f"load average (1, 5, 15 min) at the start: {BP._load()}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in sizes:
+            path = Path(tmp) / f"case-{n}.pickle"
+            with open(path, "wb") as fh:
+                pickle.dump(scaled_case(n, duration), fh)
+            walls = {1: [], 2: []}
+            for k in range(rounds):
+                for cores in ((1, 2) if k % 2 == 0 else (2, 1)):
+                    r = _one(path, "reference", cores)
+                    if "error" in r:
+                        print(f"{n:7d}  {cores} thread(s) failed: {r['error']}")
+                        continue
+                    walls[cores].append(r["wall"])
+                    print(f"{n:7d}  {cores} thread(s) {r['wall']:8.2f} s wall {r['cpu']:8.2f} s cpu  load "
+                          f"{os.getloadavg()[0]:.2f}", flush=True)
+            one, two = float(np.median(walls[1])), float(np.median(walls[2]))
+            print(f"N = {n:7d}: median 1 thread {one:.2f} s, 2 threads {two:.2f} s: two threads at {one / two:.2f} x "
+                  f"one; target >= {TWO_CORE}: {'met' if one / two >= TWO_CORE else 'MISSED'}")
+    print(f"load average at the end: {BP._load()}")
+
+
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--child"]:
         child(sys.argv[2], sys.argv[3], int(sys.argv[4]))
+    elif sys.argv[1:2] == ["--threads"]:  # --threads DURATION N[,N…] ROUNDS
+        threads(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]))
     else:
         main(float(sys.argv[1]) if len(sys.argv) > 1 else DURATION)
