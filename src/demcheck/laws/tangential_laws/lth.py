@@ -35,7 +35,7 @@ class LthTangential(TangentialSubModel):
     m_eff: float = 0.0
 
 
-@njit(cache=KERNEL_CACHE)
+@njit(cache=KERNEL_CACHE, inline="always")
 def elastic_part(xi, fn_abs, xm, mu):
     """(Ft,el, √(1 − u)) with u = min(|ξ|, ξm)/ξm, for ξm > 0 and μ|Fn| > 0."""
     hn = _norm(xi)
@@ -47,7 +47,7 @@ def elastic_part(xi, fn_abs, xm, mu):
     return f, root
 
 
-@njit(cache=KERNEL_CACHE)
+@njit(cache=KERNEL_CACHE, inline="always")
 def coulomb_capped(f, cap):
     fm = _norm(f)
     if fm > cap:
