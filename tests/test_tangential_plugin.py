@@ -70,7 +70,8 @@ ARMS = {"slip_arm": "radius", "torque_arm": "radius", "wall_torque_arm": "radius
 free = oblique_case("none", {}, angle=45.0)
 tc = collision3d.collide(free, resolve(free), "adaptive", rules=ARMS).metrics()["contact_time"]
 p = free.particles[0]
-m, r = p.mass, p.radius
+r = p.radius
+m = free.materials[p.material].density * 4.0 / 3.0 * math.pi * r ** 3
 drag = 0.1 * m * math.sqrt(0.5) / tc  # a tenth of the tangential momentum: the slip never stops
 case = oblique_case("constant_drag", {"drag": drag}, angle=45.0)
 model = resolve(case)
