@@ -12,14 +12,29 @@ KERNEL_PACKAGES = ("laws", "reference")  # every compiled kernel lives in one of
 
 
 def reference_fingerprint() -> str:
-    """A hash of the source of every package that holds compiled kernels (the laws' force functions and the
-    reference's solvers, which inline them)."""
+    """A hash of the source of every package that holds compiled kernels (the laws' force functions, their
+    sub-packages, and the reference's solvers, which inline them) and of the plug-in law modules named in
+    ``$DEMCHECK_LAW_PLUGINS`` (found, not imported)."""
     h = _hashlib.sha256()
     root = _Path(__file__).parent
     for package in KERNEL_PACKAGES:
-        for f in sorted((root / package).glob("*.py")):
-            h.update(f"{package}/{f.name}".encode() + b"\0" + f.read_bytes())
+        for f in sorted((root / package).rglob("*.py")):
+            h.update(f"{f.relative_to(root).as_posix()}".encode() + b"\0" + f.read_bytes())
+    for name in filter(None, (m.strip() for m in _os.environ.get("DEMCHECK_LAW_PLUGINS", "").split(","))):
+        h.update(name.encode() + b"\0" + _plugin_source(name))
     return h.hexdigest()[:16]
+
+
+def _plugin_source(name: str) -> bytes:
+    """A plug-in module's source, without importing it (a top-level module; a dotted one imports its parent);
+    b"" where it cannot be found (its import reports that)."""
+    import importlib.util
+
+    try:
+        spec = importlib.util.find_spec(name)
+        return _Path(spec.origin).read_bytes() if spec and spec.origin else b""
+    except (ImportError, ValueError, OSError):
+        return b""
 
 
 def _numba_cache_dir() -> bool:

@@ -1,18 +1,21 @@
-"""Tangential contact models (seed 000 §4), as a registry.
+"""Tangential contact models (seed 000 §4), as a registry of the users' names over the tangential laws.
 
-Each model turns a pair's properties, the ``[contact]`` parameters and the resolved normal law into a
-:class:`TangentialLaw`: plain numbers for the compiled 3-D kernels (``kernels3d.py``). Families:
+Each law is one module of ``laws/tangential_laws/`` (its record, family id and compiled functions; a plug-in
+law is a module named in ``$DEMCHECK_LAW_PLUGINS``, imported at the end of this one). Each seed model here
+turns a pair's properties, the ``[contact]`` parameters and the resolved normal law into a
+:class:`TangentialLaw`: plain numbers for the compiled 3-D kernels. The built-in laws:
 
-* ``SLIDING``          F = −μ|Fn| t̂ (simple sliding friction; sticks when the slip stops and μs|Fn| holds it)
-* ``VISCOUS``          F = −ηt v_t
-* ``VISCOUS_SLIDING``  F = −min(ηt|v_t|, μ|Fn|) t̂
-* ``SPRING``           trial F = −Kt ξ − ηt v_t on a history ξ (tangential overlap), Coulomb-limited by a
+* ``sliding``          F = −μ|Fn| t̂ (simple sliding friction; sticks when the slip stops and μs|Fn| holds it)
+* ``viscous``          F = −ηt v_t
+* ``viscous_sliding``  F = −min(ηt|v_t|, μ|Fn|) t̂
+* ``spring``           trial F = −Kt ξ − ηt v_t on a history ξ (tangential overlap), Coulomb-limited by a
                        truncation rule: ``force`` (cap |F| at μ|Fn| and leave ξ alone, Cundall & Strack),
                        ``overlap`` (adjust ξ so that |Kt ξ + ηt v_t| = μ|Fn|, Maw et al.; what LAMMPS does) or
-                       ``spring`` (cap the spring only, drop the dashpot while slipping; what LIGGGHTS does). Kt constant, or c√(R̄δn) (DDt, TTIt). ηt constant, or a factor
-                       times the normal law's damping prefactor (TTIt: ηt = ηn).
-* ``LTH`` / ``ZZY``    the Langston et al. / Zheng et al. nonlinear laws on ξ with δt_max = μ(2−ν)/(2(1−ν)) δn
-* ``WALTON``           incrementally slipping friction (Walton & Braun 1986) on the tangential load L
+                       ``spring`` (cap the spring only, drop the dashpot while slipping; what LIGGGHTS does).
+                       Kt constant, or c√(R̄δn) (``sqrt_spring``: DDt, TTIt). ηt constant, or a factor times the
+                       normal law's damping prefactor (TTIt: ηt = ηn).
+* ``lth`` / ``zzy``    the Langston et al. / Zheng et al. nonlinear laws on ξ with δt_max = μ(2−ν)/(2(1−ν)) δn
+* ``walton``           incrementally slipping friction (Walton & Braun 1986) on the tangential load L
 
 Coulomb: static μs (``friction``) decides when sticking ends; kinetic μk (``friction_kinetic``, default μs)
 limits the force while slipping.
@@ -23,30 +26,37 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable, ClassVar
+from typing import Callable
 
 import numpy as np
 
 from ..errors import ConfigError
-from .base import SubModel
 from .contact import Pair, kinetic_rule
 from .registry import Registry, contact_number
 from .normal import HYSTERETIC, NormalLaw, Param, contact_choice
 
-NONE, SLIDING, VISCOUS, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON = range(8)
-TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING = 0, 1, 2
-TRUNCATIONS = {"force": TRUNC_CAP, "overlap": TRUNC_MAW, "spring": TRUNC_SPRING}
+from .tangential_slot import (T_ETA, T_ETA1, T_ETA_NORMAL, T_FAMILY, T_FORCE, T_G, T_K0, T_KT,  # noqa: F401
+                              T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_P0, T_PARAMS, T_R, T_RESCALE, T_SIZE, T_TRUNC, T_XI,
+                              TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, TRUNCATIONS, TangentialSubModel, load_plugins,
+                              record_class)
+from .tangential_laws.lth import LTH, LthTangential  # noqa: F401  (the built-in laws, one module each)
+from .tangential_laws.none import NONE, NoTangential  # noqa: F401
+from .tangential_laws.sliding import SLIDING, SlidingTangential  # noqa: F401
+from .tangential_laws.spring import SPRING, SpringTangential, SqrtSpringTangential  # noqa: F401
+from .tangential_laws.viscous import VISCOUS, ViscousTangential  # noqa: F401
+from .tangential_laws.viscous_sliding import VISCOUS_SLIDING, ViscousSlidingTangential  # noqa: F401
+from .tangential_laws.walton import WALTON, WaltonTangential  # noqa: F401
+from .tangential_laws.zzy import ZZY, ZzyTangential  # noqa: F401
 
-# layout of TangentialLaw.array()
-T_FAMILY, T_KT, T_KT_SQRT, T_ETA, T_ETA_NORMAL, T_MU_S, T_MU_K, T_TRUNC, T_R, T_M, T_XI, T_ETA1, T_G, T_K0 = range(14)
-# engine-twin variants of SPRING (verlet method only): the history stores the elastic force (LAMMPS
-# mindlin/force), and is scaled by a/a_prev when the contact radius shrinks (mindlin_rescale)
-T_FORCE, T_RESCALE = 14, 15
-T_SIZE = 16
+_NAMED = 16  # the columns TangentialLaw names; T_P0.. hold a law's other numbers (``params``)
 
 
 @dataclass(frozen=True)
 class TangentialLaw:
+    """The composed law array the compiled kernels read (the ``T_*`` columns of laws/tangential_slot.py): the
+    family id of the law's record and the union of the records' numbers; a record's numbers that no column names
+    are ``params`` (T_P0 on, in the record's field order)."""
+
     family: int = NONE
     kt: float = 0.0  # constant Kt, or c in Kt = c √(R̄ δn) when kt_sqrt
     kt_sqrt: bool = False
@@ -63,208 +73,85 @@ class TangentialLaw:
     k0: float = 0.0  # Walton initial stiffness
     force_history: bool = False  # engine twin: the history is the elastic force, incremented by −Kt v_t dt
     rescale_history: bool = False  # engine twin: history × a/a_prev when the contact radius a shrinks
+    params: tuple[float, ...] = ()  # a law's own numbers (T_P0 on)
+
+    def __post_init__(self):
+        if len(self.params) > T_PARAMS:
+            raise ValueError(f"a tangential law has at most {T_PARAMS} numbers of its own, not {len(self.params)}")
 
     def array(self) -> np.ndarray:
+        extra = [float(x) for x in self.params] + [0.0] * (T_PARAMS - len(self.params))
         return np.array([self.family, self.kt, float(self.kt_sqrt), self.eta, float(self.eta_normal), self.mu_s,
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
-                         self.k0, float(self.force_history), float(self.rescale_history)])
+                         self.k0, float(self.force_history), float(self.rescale_history), *extra])
 
     @classmethod
     def from_array(cls, law) -> "TangentialLaw":
-        """The law of an ``array()`` (the inverse, exactly)."""
+        """The law of an ``array()`` (the inverse, exactly: ``params`` as long as the record has numbers of its own)."""
+        values = [float(x) for x in law]
         (family, kt, kt_sqrt, eta, eta_normal, mu_s, mu_k, truncation, r_eff, m_eff, xi_coef, eta1, g_i, k0,
-         force_history, rescale_history) = (float(x) for x in law)
+         force_history, rescale_history) = values[:_NAMED]
+        own = len(_own_fields(record_class(int(family), kt_sqrt != 0.0)))
         return cls(int(family), kt=kt, kt_sqrt=kt_sqrt != 0.0, eta=eta, eta_normal=eta_normal != 0.0, mu_s=mu_s,
                    mu_k=mu_k, truncation=int(truncation), r_eff=r_eff, m_eff=m_eff, xi_coef=xi_coef, eta1=eta1,
-                   g_i=g_i, k0=k0, force_history=force_history != 0.0, rescale_history=rescale_history != 0.0)
+                   g_i=g_i, k0=k0, force_history=force_history != 0.0, rescale_history=rescale_history != 0.0,
+                   params=tuple(values[_NAMED:_NAMED + own]))
+
+    def _record(self) -> type:
+        return record_class(self.family, self.kt_sqrt)
 
     @property
     def has_history(self) -> bool:
-        return self.family in (SPRING, LTH, ZZY, WALTON)
+        return self._record().history_size > 0
 
     @property
     def passive(self) -> bool:
-        """Whether the law can only store or dissipate energy. A spring capped at μ|Fn| with its history left
-        alone (truncation ``force``, the seed's min()) is not: after a slip the history is far past the cap, and
-        when the slip reverses the capped force keeps pointing the old way — along the new slip — until the
-        history unwinds (Chung & Ooi Test 5 with TTIt: 6 % of the impact energy created, in the adaptive and the
-        verlet method alike; docs/models.md)."""
-        return not (self.family == SPRING and self.truncation == TRUNC_CAP)
+        """Whether the law can only store or dissipate energy (its record's ``passive``)."""
+        return self._as_record().passive
 
     @property
     def pushes_at_onset(self) -> bool:
-        """Whether the friction can push along the slip at contact onset: Maw's truncation (``overlap``) with a
-        Kt ∝ √δ that vanishes there and a dashpot (TTIt, DDt with ηt; docs/models.md finding 9)."""
-        return self.family == SPRING and self.kt_sqrt and self.eta > 0 and self.truncation == TRUNC_MAW
+        """Whether the friction can push along the slip at contact onset (its record's ``pushes_at_onset``)."""
+        return self._as_record().pushes_at_onset
 
     @property
     def caps(self) -> bool:
         """Whether the law limits |Ft| by Coulomb (μ|Fn|) in its slip state."""
-        return self.family in (SLIDING, VISCOUS_SLIDING, SPRING, LTH, ZZY, WALTON)
+        return self._record().caps
+
+    def _as_record(self):
+        cls = self._record()
+        own = _own_fields(cls)
+        named = {n: getattr(self, n) for n in cls.param_names() if n not in own}
+        return cls(**named, **dict(zip(own, self.params)))
 
     def slot(self) -> "TangentialSubModel":
         """The law as its tangential slot's record; ValueError where the law sets a number its record has no
         field for (the record would lose it)."""
-        cls = RECORDS[(self.family, self.kt_sqrt if self.family == SPRING else False)]
+        cls = self._record()
         names = set(cls.param_names())
         default = TangentialLaw()
-        lost = [f.name for f in dataclasses.fields(self) if f.name not in names | {"family", "kt_sqrt"}
+        lost = [f.name for f in dataclasses.fields(self) if f.name not in names | {"family", "kt_sqrt", "params"}
                 and getattr(self, f.name) != getattr(default, f.name)]
+        if len(self.params) > len(_own_fields(cls)):
+            lost.append("params")
         if lost:
             raise ValueError(f"tangential record {cls.id!r} has no field for {', '.join(lost)}")
-        return cls(**{name: getattr(self, name) for name in names})
+        return self._as_record()
 
     @classmethod
     def from_slot(cls, record: "TangentialSubModel") -> "TangentialLaw":
         """The kernels' law of a tangential record (the inverse of :meth:`slot`)."""
-        fields = {name: getattr(record, name) for name in record.param_names()}
-        return cls(record.family, kt_sqrt=record.kt_sqrt, **fields)
+        own = _own_fields(type(record))
+        fields = {name: getattr(record, name) for name in record.param_names() if name not in own}
+        return cls(record.family, kt_sqrt=record.kt_sqrt, **fields,
+                   params=tuple(float(getattr(record, name)) for name in own))
 
 
-# ----------------------------------------------------------------------------- the tangential slot's records
-
-
-@dataclass(frozen=True)
-class TangentialSubModel(SubModel):
-    slot: ClassVar[str] = "tangential"
-    family: ClassVar[int] = NONE  # the kernels' family (read by TangentialLaw.from_slot only)
-    kt_sqrt: ClassVar[bool] = False
-
-
-@dataclass(frozen=True)
-class NoTangential(TangentialSubModel):
-    id: ClassVar[str] = "none"
-    title: ClassVar[str] = "frictionless"
-
-
-@dataclass(frozen=True)
-class SlidingTangential(TangentialSubModel):
-    """F = −μk|Fn| t̂ while sliding; the constraint force (≤ μs|Fn|) while stuck."""
-
-    id: ClassVar[str] = "sliding"
-    family: ClassVar[int] = SLIDING
-    title: ClassVar[str] = "simple sliding friction"
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-@dataclass(frozen=True)
-class ViscousTangential(TangentialSubModel):
-    """F = −ηt v_t (ηt constant, or ``eta`` times the normal dashpot's η(δ) with ``eta_normal``); the friction
-    coefficients are carried (an engine twin's) but not read."""
-
-    id: ClassVar[str] = "viscous"
-    family: ClassVar[int] = VISCOUS
-    title: ClassVar[str] = "viscous damping"
-    eta: float = 0.0
-    eta_normal: bool = False
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-@dataclass(frozen=True)
-class ViscousSlidingTangential(TangentialSubModel):
-    """F = −min(ηt|v_t|, μk|Fn|) t̂."""
-
-    id: ClassVar[str] = "viscous_sliding"
-    family: ClassVar[int] = VISCOUS_SLIDING
-    title: ClassVar[str] = "viscous damping with sliding friction"
-    eta: float = 0.0
-    eta_normal: bool = False
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-@dataclass(frozen=True)
-class SpringTangential(TangentialSubModel):
-    """Trial F = −Kt ξ − ηt v_t on the history ξ, Kt = kt constant, Coulomb-limited by ``truncation``
-    (TRUNCATIONS); the engine twins' variants keep the elastic force as the history (``force_history``) or
-    rescale it as the contact radius shrinks (``rescale_history``)."""
-
-    id: ClassVar[str] = "spring"
-    family: ClassVar[int] = SPRING
-    title: ClassVar[str] = "linear spring (and dashpot) with Coulomb truncation"
-    history_size: ClassVar[int] = 3
-    kt: float = 0.0
-    eta: float = 0.0
-    eta_normal: bool = False
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    truncation: int = TRUNC_MAW
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-    force_history: bool = False
-    rescale_history: bool = False
-
-
-@dataclass(frozen=True)
-class SqrtSpringTangential(SpringTangential):
-    """As ``spring`` with Kt = kt √(R̄ δn) (Mindlin's no-slip stiffness: DDt, TTIt; LAMMPS mindlin)."""
-
-    id: ClassVar[str] = "sqrt_spring"
-    kt_sqrt: ClassVar[bool] = True
-    title: ClassVar[str] = "spring Kt = kt √(R̄δ) (and dashpot) with Coulomb truncation"
-
-
-@dataclass(frozen=True)
-class LthTangential(TangentialSubModel):
-    """Langston, Tüzün & Heyes on the history ξ, δt_max = xi_coef · δn."""
-
-    id: ClassVar[str] = "lth"
-    family: ClassVar[int] = LTH
-    title: ClassVar[str] = "Langston, Tüzün & Heyes"
-    history_size: ClassVar[int] = 3
-    eta: float = 0.0
-    xi_coef: float = 0.0
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-@dataclass(frozen=True)
-class ZzyTangential(TangentialSubModel):
-    """Zheng, Zhu & Yu on the history ξ (viscosity η₁ = eta1, shear modulus G_i = g_i)."""
-
-    id: ClassVar[str] = "zzy"
-    family: ClassVar[int] = ZZY
-    title: ClassVar[str] = "Zheng, Zhu & Yu"
-    history_size: ClassVar[int] = 3
-    eta1: float = 0.0
-    g_i: float = 0.0
-    xi_coef: float = 0.0
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-@dataclass(frozen=True)
-class WaltonTangential(TangentialSubModel):
-    """Walton & Braun's incrementally slipping friction; its history is the load L, the load at the last
-    reversal L* and the last nonzero slip velocity (3 each)."""
-
-    id: ClassVar[str] = "walton"
-    family: ClassVar[int] = WALTON
-    title: ClassVar[str] = "incrementally slipping friction"
-    history_size: ClassVar[int] = 9
-    k0: float = 0.0
-    mu_s: float = 0.0
-    mu_k: float = 0.0
-    r_eff: float = 0.0
-    m_eff: float = 0.0
-
-
-# (family, kt_sqrt) → record: the one place a kernel family names a record (TangentialLaw.slot)
-RECORDS = {(cls.family, cls.kt_sqrt): cls for cls in (
-    NoTangential, SlidingTangential, ViscousTangential, ViscousSlidingTangential, SpringTangential,
-    SqrtSpringTangential, LthTangential, ZzyTangential, WaltonTangential)}
+def _own_fields(record: type) -> tuple[str, ...]:
+    """A record's numbers that no named column of the law array holds (they go to ``params``)."""
+    named = {f.name for f in dataclasses.fields(TangentialLaw)} - {"family", "kt_sqrt", "params"}
+    return tuple(n for n in record.param_names() if n not in named)
 
 
 @dataclass(frozen=True)
@@ -524,3 +411,7 @@ register(TangentialModel(
     source="seed 000 §4.8 'Incrementally Slipping Friction'", params=(*_KT, *_MU), resolve=_walton,
     example={"friction": 0.3},
 ))
+
+
+# plug-in laws last: each registers its record, its compiled functions and its users' name as a built-in does
+load_plugins()

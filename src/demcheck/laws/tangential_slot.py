@@ -1,0 +1,121 @@
+"""The tangential slot's interface: the composed law array's layout (the ``T_*`` columns the compiled kernels
+read), the record every tangential law is (:class:`TangentialSubModel`) and the registry of the laws' compiled
+functions (:func:`compiled`), from which ``tangential_dispatch`` assembles the kernels' switch on the family id.
+
+A tangential law is one module (``laws/tangential_laws/<law>.py``, or a plug-in module named in
+``$DEMCHECK_LAW_PLUGINS``): its record, its family id, its compiled functions and their registration here —
+docs/architecture.md, "Adding a tangential law".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from .base import SUBMODELS, SubModel
+
+# layout of TangentialLaw.array()
+T_FAMILY, T_KT, T_KT_SQRT, T_ETA, T_ETA_NORMAL, T_MU_S, T_MU_K, T_TRUNC, T_R, T_M, T_XI, T_ETA1, T_G, T_K0 = range(14)
+# engine-twin variants of SPRING (verlet method only): the history stores the elastic force (LAMMPS
+# mindlin/force), and is scaled by a/a_prev when the contact radius shrinks (mindlin_rescale)
+T_FORCE, T_RESCALE = 14, 15
+# a law's own numbers that no column above names (its record's other fields, in declaration order)
+T_P0, T_PARAMS = 16, 4
+T_SIZE = T_P0 + T_PARAMS
+
+TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING = 0, 1, 2
+TRUNCATIONS = {"force": TRUNC_CAP, "overlap": TRUNC_MAW, "spring": TRUNC_SPRING}
+
+
+@dataclass(frozen=True)
+class TangentialSubModel(SubModel):
+    """A tangential law's record. ``family``: its id in the kernels' law array (unique per law module; records
+    that share one compiled law share it, as ``spring`` and ``sqrt_spring``); ``caps``: whether it limits |Ft| by
+    Coulomb in its slip state."""
+
+    slot: ClassVar[str] = "tangential"
+    family: ClassVar[int | None] = None  # None: a record with no compiled law (yet)
+    kt_sqrt: ClassVar[bool] = False
+    caps: ClassVar[bool] = False
+
+    @property
+    def passive(self) -> bool:
+        """Whether the law can only store or dissipate energy (TangentialLaw.passive)."""
+        return True
+
+    @property
+    def pushes_at_onset(self) -> bool:
+        """Whether the friction can push along the slip at contact onset (TangentialLaw.pushes_at_onset)."""
+        return False
+
+
+def records(family: int) -> list[type]:
+    """The registered tangential record classes of one family id."""
+    return [cls for (slot, _), cls in SUBMODELS.items() if slot == "tangential" and cls.family == family]
+
+
+def record_class(family: int, kt_sqrt: bool = False) -> type:
+    """The record class of a kernel family (``kt_sqrt`` tells the records of one family apart)."""
+    found = records(family)
+    if len(found) > 1:
+        found = [cls for cls in found if cls.kt_sqrt == kt_sqrt]
+    if len(found) != 1:
+        raise ValueError(f"no tangential record for family {family} (kt_sqrt={kt_sqrt})")
+    return found[0]
+
+
+@dataclass(frozen=True)
+class Kernels:
+    """One tangential law's compiled functions (numba dispatchers), each with the signature of the dispatch
+    function of its name in ``tangential_force``: ``force`` (every law), ``slip_surface`` and ``return_map``
+    (the laws with a history; without them the law has no slip surface and its history maps radially)."""
+
+    family: int
+    force: object
+    slip_surface: object = None
+    return_map: object = None
+
+
+KERNELS: dict[int, Kernels] = {}
+_BUILT: list[bool] = []  # set once the dispatch is assembled: a later law would be missing from it
+
+
+def compiled(record: type, *, force, slip_surface=None, return_map=None) -> Kernels:
+    """Registers the compiled functions of the law whose record class is ``record`` under its family id."""
+    if not (isinstance(record, type) and issubclass(record, TangentialSubModel)):
+        raise TypeError(f"{record!r} is not a tangential record class")
+    if not isinstance(record.family, int) or isinstance(record.family, bool) or record.family < 0:
+        raise ValueError(f"tangential record {record.id!r}: family must be an int >= 0, not {record.family!r}")
+    k = Kernels(record.family, force, slip_surface, return_map)
+    if KERNELS.get(k.family, k) != k:
+        raise ValueError(f"tangential family {k.family} ({record.id!r}) registered twice with other functions")
+    if _BUILT and k.family not in KERNELS:
+        raise RuntimeError(f"tangential law {record.id!r} registered after the kernels' dispatch was assembled: "
+                           "import it before any solver (name it in $DEMCHECK_LAW_PLUGINS)")
+    KERNELS[k.family] = k
+    return k
+
+
+PLUGINS_VARIABLE = "DEMCHECK_LAW_PLUGINS"
+
+
+def plugin_modules() -> list[str]:
+    """The plug-in law modules named in ``$DEMCHECK_LAW_PLUGINS`` (comma-separated, importable)."""
+    import os
+
+    return [m for m in (m.strip() for m in os.environ.get(PLUGINS_VARIABLE, "").split(",")) if m]
+
+
+def load_plugins() -> None:
+    """Imports the plug-in law modules (each registers itself); one that cannot be imported is a ConfigError
+    naming it."""
+    import importlib
+
+    for module in plugin_modules():
+        try:
+            importlib.import_module(module)
+        except Exception as exc:  # noqa: BLE001 - whatever the plug-in's fault, one line names it
+            from ..errors import ConfigError
+
+            raise ConfigError(PLUGINS_VARIABLE, module, f"module {module!r} cannot be imported "
+                              f"({type(exc).__name__}: {exc})") from None
