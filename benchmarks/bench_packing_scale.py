@@ -189,11 +189,23 @@ def main(duration: float) -> None:
     _report(results, steps)
 
 
+def _two_at_once(path: Path) -> list[dict]:
+    """Two one-thread reference runs started together, one on each core: what the two cores cost each other."""
+    procs = [subprocess.Popen([sys.executable, __file__, "--child", str(path), "reference", "1"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate() for p in procs]
+    return [json.loads(o.strip().splitlines()[-1]) if p.returncode == 0 else {"error": e.strip()[-200:]}
+            for p, (o, e) in zip(procs, outs)]
+
+
 def threads(duration: float, sizes: list[int], rounds: int) -> None:
     """The two-thread goal alone: the reference on one and on two threads at each size, ``rounds`` times each,
     alternating (1, 2, 2, 1, …), each run a fresh process as in :func:`main`; the median wall time of each and their
     ratio. Two threads meet at a barrier twice a step, so any other process on the two cores stretches their
-    waits: the load average is printed with every run, and only a run on an idle machine measures the loop."""
+    waits: the load average is printed with every run, and only a run on an idle machine measures the loop.
+    Beside them, two independent one-thread runs at once (one a core): how much the cores slow each other down
+    with no barrier and nothing shared but the machine (caches, memory) — the bound that sharing puts on two
+    threads."""
     import numba
 
     print(f"the reference on 1 and 2 threads: the poured packing, {duration:g} s of the pour, N = "
@@ -205,7 +217,7 @@ def threads(duration: float, sizes: list[int], rounds: int) -> None:
             path = Path(tmp) / f"case-{n}.pickle"
             with open(path, "wb") as fh:
                 pickle.dump(scaled_case(n, duration), fh)
-            walls = {1: [], 2: []}
+            walls, cpus = {1: [], 2: []}, {1: [], 2: []}
             for k in range(rounds):
                 for cores in ((1, 2) if k % 2 == 0 else (2, 1)):
                     r = _one(path, "reference", cores)
@@ -213,11 +225,24 @@ def threads(duration: float, sizes: list[int], rounds: int) -> None:
                         print(f"{n:7d}  {cores} thread(s) failed: {r['error']}")
                         continue
                     walls[cores].append(r["wall"])
+                    cpus[cores].append(r["cpu"])
                     print(f"{n:7d}  {cores} thread(s) {r['wall']:8.2f} s wall {r['cpu']:8.2f} s cpu  load "
                           f"{os.getloadavg()[0]:.2f}", flush=True)
+            together = []
+            for _ in range(rounds):
+                pair = _two_at_once(path)
+                together += [r["cpu"] for r in pair if "error" not in r]
+                print(f"{n:7d}  two 1-thread runs at once: " + ", ".join(
+                    f"{r['wall']:.2f} s wall {r['cpu']:.2f} s cpu" if "error" not in r else f"failed: {r['error']}"
+                    for r in pair) + f"  load {os.getloadavg()[0]:.2f}", flush=True)
             one, two = float(np.median(walls[1])), float(np.median(walls[2]))
             print(f"N = {n:7d}: median 1 thread {one:.2f} s, 2 threads {two:.2f} s: two threads at {one / two:.2f} x "
                   f"one; target >= {TWO_CORE}: {'met' if one / two >= TWO_CORE else 'MISSED'}")
+            if together:
+                alone = float(np.median(cpus[1]))
+                print(f"             one run's CPU alone {alone:.2f} s, beside another {float(np.median(together)):.2f}"
+                      f" s: the cores slow each other {float(np.median(together)) / alone:.2f} x; two threads "
+                      f"spend {float(np.median(cpus[2])) / alone:.2f} x one thread's CPU")
     print(f"load average at the end: {BP._load()}")
 
 
