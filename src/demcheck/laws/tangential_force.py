@@ -4,8 +4,8 @@ slip surface and the return map (Coulomb truncation), each a switch on the law's
 modules (``laws/tangential_laws/``), assembled by ``tangential_dispatch`` from the registered laws; the
 stiffness and dashpot of a spring-like law; Walton's reversal rule and stiffness. Vectors are 3-arrays; the
 normal law's array (laws/normal_force.py) gives the dashpot prefactor η(δ) the TTIt and engine-twin dashpots
-reuse. The switch names no law (a law is its module); the one law named here is Walton, whose reversal rule
-and stiffness the solvers' history code still calls by name (docs/architecture.md, what is not yet one place).
+reuse. The switch names no law (a law is its module); what is named here is Walton's reversal rule and
+stiffness, which the solvers' history code still calls by name (docs/architecture.md, what is not yet one place).
 """
 
 from __future__ import annotations
