@@ -729,8 +729,8 @@ def _sjkr_pull_inputs(case: Case) -> None:
     if len(radii) != 2 or radii[0] != radii[1]:
         raise ConfigError("particles", radii, "the pull_off scenario with adhesion = \"sjkr\" pulls two like spheres "
                           "(equal radii)")
-    nl = _model.resolve(case).normal_law
-    if nl.a != 1.5 or nl.eta != 0.0 or case.contact.normal != "hertz":
+    normal, damping = _model.resolve(case).normal_law.slots()  # the slot records, by id (never exponents)
+    if normal.id != "hertz" or damping.id != "none" or case.contact.normal != "hertz":
         raise ConfigError("contact.normal", case.contact.normal, "the pull_off scenario with adhesion = \"sjkr\" adds "
                           "the cohesion to the elastic Hertz law: normal = \"hertz\"")
 
