@@ -594,3 +594,32 @@ def test_plain_copy_is_a_deep_copy_of_toml_data():
                    "g": (1, [2]), "h": {"z": [[0.0]]}}
     over = apply_overrides(raw, ["a.b.0=7", "h.z=[[2.0]]"])
     assert (over["a"]["b"][0], over["h"]["z"]) == (7, [[2.0]]) and (raw["a"]["b"][0], raw["h"]["z"]) == (1, [[0.0]])
+
+
+def test_cli_refuses_a_viscous_roll_past_the_no_slip_bound_before_any_run(tmp_path):
+    """Rolling type B (rolling = "viscous") above the largest Cr the sphere rolls under without slip, 1.4 μ m g cos θ
+    R²/v0 (2.19e-8 N·m·s for the suite's glass sphere at 0.02 m/s, μ 0.3): one line naming contact.c_r, its value
+    and the bound with its number, exit 2, nothing written (issue 30: before, the case loaded and its runs failed,
+    "the sphere slides"). Just below the bound the same case loads."""
+    import subprocess
+    import sys
+
+    from demcheck.resources import case_path
+
+    text = case_path("suite/beyond-rolling-viscous.toml").read_text()
+    assert "c_r = 1.5e-8" in text
+    deck = tmp_path / "rolling.toml"
+    deck.write_text(text.replace("c_r = 1.5e-8", "c_r = 2.2e-8"))
+    out = tmp_path / "out"
+    out.mkdir()
+    p = subprocess.run([sys.executable, "-m", "demcheck", "collide", str(deck)], capture_output=True, text=True,
+                       timeout=120, cwd=out)
+    assert p.returncode == 2, p.stderr[-2000:]
+    assert p.stdout == "" and p.stderr.count("\n") == 1, p.stderr
+    assert p.stderr.startswith("demcheck: error: contact.c_r = 2.2e-08: must be at most 2.19231e-08 N·m·s"), p.stderr
+    assert "Cr ≤ 1.4 μ m g cos θ R²/v0" in p.stderr and "the sphere slides" in p.stderr, p.stderr
+    assert not list(out.iterdir()), "nothing is written before the case is checked"
+    assert C.loads(text.replace("c_r = 1.5e-8", "c_r = 2.19e-8")).contact.params["c_r"] == 2.19e-8
+    with pytest.raises(ConfigError) as info:
+        C.loads(text.replace("friction = 0.3", "friction = 0.0"))
+    assert info.value.key == "contact.friction" and "viscous" in info.value.rule

@@ -40,6 +40,7 @@ import pytest
 
 from demcheck.case import load, loads
 from demcheck.comparisons.verdicts import AGREE, EXPECTED
+from demcheck.errors import ConfigError
 from demcheck.resources import case_path
 from tests.scenario_rows import engine_scenario_rows
 
@@ -326,34 +327,24 @@ def test_kratos_runs_the_rolling_case_in_the_suite():
         assert abs(x.value - src["twin_metrics"][x.metric]) <= 1e-9 * abs(x.value)
 
 
-def sliding_viscous_rolling():
+def sliding_viscous_rolling(c_r: str = "1e-7"):
     """The rolling sphere under Cr = 1e-7 N·m·s, 4.6× the largest it rolls under without slip (1.4 μ m g R²/v0 =
-    2.19e-8): the torque decelerates the roll at 13.4 m/s² where friction gives μ g = 2.94 m/s²."""
+    2.19e-8): the torque would decelerate the roll at 13.4 m/s² where friction gives μ g = 2.94 m/s²."""
     return loads(case_path("suite/beyond-rolling-linear.toml").read_text().replace(
-        'rolling = "constant_torque"\nmu_r = 0.1', 'rolling = "viscous"\nc_r = 1e-7'))
+        'rolling = "constant_torque"\nmu_r = 0.1', f'rolling = "viscous"\nc_r = {c_r}'))
 
 
-def test_a_sliding_viscous_roll_is_a_failure_that_names_its_cause():
-    """The twin's and the seed's runs of a sphere that slides have no e-fold time within the run: failed, with the
-    key, its value and the rule it breaks (before: "gave no rolling_time_constant (not finite)", no cause)."""
-    from demcheck.engines import scenario
-
-    c = sliding_viscous_rolling()
+def test_a_sliding_viscous_roll_is_refused_when_the_case_loads():
+    """A sphere that would slide is no rolling scenario (its closed form v0 e^{−t/T} assumes the roll): the case is
+    refused as it loads, before any run — one ConfigError naming contact.c_r, its value and the bound with its number
+    (before, issue 30: the twin's, the seed's and Kratos' runs failed at run time, "the sphere slides"). Just below
+    the bound it loads."""
     bound = 1.4 * 0.3 * MASS * G * R_GLASS ** 2 / V0
-    for res in (scenario.twin(c, "kratos"), scenario.seed(c, "kratos")):
-        assert res.status == "failed" and not res.ok
-        assert "contact.c_r = 1e-07: the sphere slides" in res.message, res.message
-        assert f"Cr ≤ {bound:.3g} N·m·s" in res.message and "μ g cos θ = 2.94 m/s²" in res.message
-
-
-@pytest.mark.engine("kratos")
-def test_a_sliding_viscous_roll_in_kratos_is_never_a_verdict():
-    """Kratos runs the sliding sphere; its metric is not finite, so each of its rows is failed with the cause —
-    never agree or differs as expected."""
-    from demcheck.comparisons.verdicts import FAILED
-
-    entry, comps = engine_scenario_rows(sliding_viscous_rolling(), "kratos")
-    src = entry["sources"]["kratos"]
-    assert src["status"] == "failed" and "the sphere slides" in src["message"], src
-    assert comps and all(x.verdict == FAILED for x in comps), [(x.metric, x.verdict) for x in comps]
-    assert all("the sphere slides" in x.reason for x in comps), [x.reason for x in comps]
+    with pytest.raises(ConfigError) as info:
+        sliding_viscous_rolling()
+    e = info.value
+    assert e.key == "contact.c_r" and e.value == 1e-7 and e.exit_code == 2 and "\n" not in str(e)
+    assert f"must be at most {bound:.6g} N·m·s" in e.rule and "μ g cos θ = 2.94 m/s²" in e.rule, e.rule
+    with pytest.raises(ConfigError):
+        sliding_viscous_rolling(f"{bound * 1.001:.6e}")
+    assert sliding_viscous_rolling(f"{bound * 0.999:.6e}").contact.params["c_r"] < bound

@@ -704,6 +704,8 @@ def _check_scenario(case: Case) -> None:
             raise ConfigError("run.gravity", list(case.run.gravity),
                               "the rolling scenario is on a level wall: gravity along -normal (run.scenario = "
                               "\"incline\" for a tilt)")
+        if law == "viscous":
+            _viscous_roll_grips(case)
     if scenario == "twist":
         w, n = np.asarray(case.particles[0].angular_velocity), np.asarray(case.walls[0].normal)
         if not abs(w @ n) > 0:
@@ -720,6 +722,47 @@ def _check_scenario(case: Case) -> None:
         _conduction_inputs(case)
 
 
+def rolling_grip(case: Case) -> tuple[float, float, float]:
+    """A sphere rolling on the case's wall under a viscous torque −Cr ω (type B): (its deceleration at the start,
+    the largest friction can give, the largest Cr it rolls under without slip). Rolling, its angular momentum about
+    the contact point (7/5)mRv falls at the torque's rate Cr v/R (the friction force has no moment about that
+    point): v' = −v/T, T = 1.4mR²/Cr. The friction force m·v' that keeps it rolling is within μ|Fn| = μ m g cos θ
+    while v0/T ≤ μ g cos θ, i.e. Cr ≤ 1.4 μ m g cos θ R²/v0 — the scenario and its closed form assume it; past it
+    the sphere slides, its spin falls faster than its speed and the speed decays at μ g, not as e^{−t/T}."""
+    from .laws import model as _model
+
+    p, n = case.particles[0], np.asarray(case.walls[0].normal, dtype=float)
+    g_vec = np.asarray(case.run.gravity, dtype=float)
+    g = float(np.linalg.norm(g_vec))
+    theta = math.acos(min(1.0, float(-(g_vec @ n)) / g))
+    mass, radius = case.mass(0), p.radius
+    v = np.asarray(p.velocity, dtype=float)
+    v0 = float(np.linalg.norm(v - (v @ n) * n))
+    model = _model.resolve(case)
+    grip = (model.pair.friction or 0.0) * g * math.cos(theta)
+    law = model.slot("rolling")
+    viscous = law is not None and law.id == "viscous"
+    deceleration = v0 / (1.4 * mass * radius * radius / law.c_r) if viscous else 0.0
+    return deceleration, grip, 1.4 * mass * radius * radius * grip / v0 if v0 > 0.0 else math.inf
+
+
+def _viscous_roll_grips(case: Case) -> None:
+    """The rolling scenario under type B rolls without slip (:func:`rolling_grip`): above the bound the sphere
+    slides and the scenario's closed form (v0 e^{−t/T}) does not hold, so the case is refused before any run."""
+    from .laws import model as _model
+
+    deceleration, grip, bound = rolling_grip(case)
+    if not grip > 0.0:
+        raise ConfigError("contact.friction", _model.resolve(case).pair.friction, "must be > 0 with rolling = "
+                          "\"viscous\": a viscous rolling torque (type B) rolls the sphere only with friction on the wall")
+    if deceleration > grip:
+        raise ConfigError("contact.c_r", case.contact.params.get("c_r"),
+                          f"must be at most {bound:.6g} N·m·s, the largest Cr the sphere rolls under without slip "
+                          f"(Cr ≤ 1.4 μ m g cos θ R²/v0): above it the torque decelerates the roll at "
+                          f"Cr·v0/(1.4 m R²) = {deceleration:.3g} m/s², more than friction gives (μ g cos θ = "
+                          f"{grip:.3g} m/s²), and the sphere slides; the rolling scenario's closed form assumes it rolls")
+
+
 def _sjkr_pull_inputs(case: Case) -> None:
     """sjkr's pull-off has its closed form for like spheres under an elastic Hertz law (reference/beyond.py
     ``sjkr_pull_off_closed``)."""
@@ -729,8 +772,8 @@ def _sjkr_pull_inputs(case: Case) -> None:
     if len(radii) != 2 or radii[0] != radii[1]:
         raise ConfigError("particles", radii, "the pull_off scenario with adhesion = \"sjkr\" pulls two like spheres "
                           "(equal radii)")
-    nl = _model.resolve(case).normal_law
-    if nl.a != 1.5 or nl.eta != 0.0 or case.contact.normal != "hertz":
+    normal, damping = _model.resolve(case).normal_law.slots()  # the slot records, by id (never exponents)
+    if normal.id != "hertz" or damping.id != "none" or case.contact.normal != "hertz":
         raise ConfigError("contact.normal", case.contact.normal, "the pull_off scenario with adhesion = \"sjkr\" adds "
                           "the cohesion to the elastic Hertz law: normal = \"hertz\"")
 

@@ -27,8 +27,9 @@ from ..io import number
 from ..inputs import script as deck_script
 from ..reference import collision3d
 from ..laws.model import resolve
-from ..laws.normal import HYSTERETIC
-from ..laws.tangential import NONE, SPRING, VISCOUS_SLIDING
+from ..laws.damping import ConstantDamping, NoDamping, QuarterDamping, SqrtDamping
+from ..laws.normal import HertzNormal, HookeNormal, HysteresisNormal
+from ..laws.tangential import NoTangential, SpringTangential, SqrtSpringTangential, ViscousSlidingTangential
 from ..engines import registry
 from ..engines.collide import collide, twin_states
 from ..engines.mapping import native_summary, twin_model
@@ -273,61 +274,82 @@ def expand_sizes(setup) -> None:
 
 def seed_of(nl, tl, asked: dict) -> tuple[str, str, dict, list[str]]:
     """The nearest seed model of a twin's laws, with what the deck asks for: (normal, tangential, params,
-    reasons why it is only near)."""
-    reasons, params = [], {}
-    if nl.family == HYSTERETIC:
-        normal = "hls"
-        params["kl"] = nl.kl
-    elif nl.a == 1.0:
-        normal = "lsd"
-        params["kn"] = nl.k
-        if "restitution" in asked:
-            params["restitution"] = asked["restitution"]
-        else:
-            params["eta_n"] = nl.eta
-            if nl.b != 0.0:
-                reasons.append(f"the engine's dashpot grows as δ^{nl.b:g}; LSD's is constant")
-    elif nl.eta == 0.0:
-        normal = "hertz"
-    elif nl.b == 0.5:
-        normal = "kk"
-        params["eta_n"] = nl.eta
-    else:
-        normal = "tti"
-        if "restitution" in asked:
-            params["restitution"] = asked["restitution"]
-        else:
-            params["eta_n"] = nl.eta
-        if nl.b != 0.25:
-            reasons.append(f"the engine's dashpot grows as δ^{nl.b:g}; TTIn's as δ^¼")
+    reasons why it is only near). The laws are read as their slot records (NormalLaw.slots, TangentialLaw.slot):
+    the elastic and damping records pick the normal model, the tangential record the tangential one."""
+    normal, damping = nl.slots()
+    params: dict = {}
+    seed, reasons = _seed_normal(normal, damping, asked, params)
     if nl.limit:
         params["limit_force"] = True
-    mu = tl.mu_s
-    if tl.family == NONE or mu == 0.0:
-        tangential = "none"
-    elif tl.family == SPRING and tl.kt_sqrt:
+    tangential, why = _seed_tangential(tl.slot(), tl.mu_s, seed, params)
+    return seed, tangential, params, reasons + why
+
+
+def _hertz(nl) -> bool:
+    """Whether a law's elastic record is Hertz's spring (its stiffness is (4/3)E*√R̄)."""
+    return isinstance(nl.slots()[0], HertzNormal)
+
+
+def _seed_normal(normal, damping, asked: dict, params: dict) -> tuple[str, list[str]]:
+    """The seed normal model of an elastic and a damping record (``params`` filled in), with the reasons why it
+    is only near."""
+    reasons = []
+    eta = getattr(damping, "eta", 0.0)
+    if isinstance(normal, HysteresisNormal):
+        params["kl"] = normal.kl
+        return "hls", reasons
+    if isinstance(normal, HookeNormal):
+        params["kn"] = normal.k
+        if "restitution" in asked:
+            params["restitution"] = asked["restitution"]
+        else:
+            params["eta_n"] = eta
+            if not isinstance(damping, (NoDamping, ConstantDamping)):
+                reasons.append(f"the engine's dashpot grows as δ^{damping.exponent:g}; LSD's is constant")
+        return "lsd", reasons
+    if not isinstance(normal, HertzNormal):
+        raise ValueError(f"no seed normal model near the engine's '{normal.id}' ({normal.title})")
+    if eta == 0.0:
+        return "hertz", reasons
+    if isinstance(damping, SqrtDamping):
+        params["eta_n"] = eta
+        return "kk", reasons
+    if "restitution" in asked:
+        params["restitution"] = asked["restitution"]
+    else:
+        params["eta_n"] = eta
+    if not isinstance(damping, QuarterDamping):
+        reasons.append(f"the engine's dashpot grows as δ^{damping.exponent:g}; TTIn's as δ^¼")
+    return "tti", reasons
+
+
+def _seed_tangential(record, mu: float, normal: str, params: dict) -> tuple[str, list[str]]:
+    """The seed tangential model of a tangential record with friction ``mu`` beside the seed normal model
+    ``normal`` (``params`` filled in: the truncation, Kt and the friction), with the reasons why it is only near."""
+    reasons = []
+    if isinstance(record, NoTangential) or mu == 0.0:
+        return "none", reasons
+    if isinstance(record, SqrtSpringTangential):
         tangential = "tti" if normal == "tti" else "ddt"
         if tangential == "tti":  # TTIt takes a truncation rule (the engines' Maw history); DDt has Maw's only
             params["truncation"] = "overlap"
-    elif tl.family == SPRING:
+    elif isinstance(record, SpringTangential):
         tangential = "spring_sliding"
-        params["kt"] = tl.kt
-    elif tl.family == VISCOUS_SLIDING:
+        params["kt"] = record.kt
+    elif isinstance(record, ViscousSlidingTangential):
         tangential = "sliding"
         reasons.append("the engine's tangential dashpot regularises sliding friction")
     else:
-        tangential = "none"
-        reasons.append("no seed tangential law near the engine's")
-    if tangential != "none":
-        params["friction"] = mu
-    return normal, tangential, params, reasons
+        return "none", ["no seed tangential law near the engine's"]
+    params["friction"] = mu
+    return tangential, reasons
 
 
 def probe_case(setup, ps, speed: float, angle: float, nl, tl, seed, dt: float | None = None) -> Case:
     normal, tangential, params, _ = seed
     params = dict(params)  # the seed's own stays whole (a probe case may be built more than once)
     (r1, rho1), second = _sides(setup, ps)
-    e_star = nl.k / (4.0 / 3.0 * math.sqrt(_effective(setup, ps)[1])) if nl.a == 1.5 else 1e9
+    e_star = nl.k / (4.0 / 3.0 * math.sqrt(_effective(setup, ps)[1])) if _hertz(nl) else 1e9
     nu = 0.3
     if getattr(ps.native, "normal", "") == "hertz/material":
         nu = ps.native.normal_args[1]
@@ -371,10 +393,11 @@ def _metrics(res) -> dict:
 
 def _stability(nl, m_eff: float, max_overlap: float, dt: float) -> float:
     """dt_crit/dt: velocity Verlet is stable for ω dt < 2, ω² = (dF/dδ)/m̄ at the largest overlap."""
-    if nl.family == HYSTERETIC:
-        k = max(nl.kl, nl.ku)
+    normal = nl.slots()[0]
+    if isinstance(normal, HysteresisNormal):
+        k = max(normal.kl, normal.ku)
     else:
-        k = nl.a * nl.k * max(max_overlap, 0.0) ** (nl.a - 1.0)
+        k = normal.exponent * normal.k * max(max_overlap, 0.0) ** (normal.exponent - 1.0)
     if not k > 0:
         return math.inf
     return 2.0 / math.sqrt(k / m_eff) / dt
@@ -902,10 +925,10 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
     normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)
     implied = {"normal_force": f"{nl.k:.6g} δ^{nl.a:g}", "damping": f"{nl.eta:.6g} δ^{nl.b:g} (N·s/m at δ^b)",
                "limit": nl.limit}
-    if nl.a == 1.5:
+    if _hertz(nl):
         implied["E*"] = nl.k / (4.0 / 3.0 * math.sqrt(radius / 2.0))
-    if tl.family == SPRING:
-        implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if tl.kt_sqrt else "")
+    if isinstance(tl.slot(), SpringTangential):
+        implied["kt"] = f"{tl.kt:.6g}" + (" √(R̄δ)" if isinstance(tl.slot(), SqrtSpringTangential) else "")
     # fidelity: the twin's converged contact against the seed model's, at the like pair and ``speed``
     try:
         setup.dt = nl.characteristic_time(m / 2.0, speed) / 1000.0  # the probe case's run.dt (no run uses it)

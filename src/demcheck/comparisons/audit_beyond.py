@@ -93,7 +93,7 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
     overlap under the sphere's weight), μ the deck's. The normal dashpot is left out (the sphere rests)."""
     from ..engines import registry
     from ..engines.mapping import native_summary
-    from ..laws.tangential import SPRING
+    from ..laws.tangential import SpringTangential, SqrtSpringTangential
 
     r, rho = base["radius"], base["density"]
     native, notes = ps.native, ["the contact's elastic normal law on a rigid plane (its dashpot left out: the "
@@ -112,23 +112,36 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
     m = rho * 4.0 / 3.0 * math.pi * r ** 3
     g = setup.gravity[0]
     mat = {"density": rho, "restitution": 0.9, "friction": tl.mu_s, "poisson_ratio": 0.3}
-    if nl.a == 1.5:
+    elastic, spring = _elastic_id(nl), tl.slot()
+    if elastic == "hertz":
         e_star = nl.k / (4.0 / 3.0 * math.sqrt(base["effective"][1]))
         mat["youngs_modulus"] = e_star * (1.0 - 0.09)
         contact = {"normal": "hertz"}
         delta = (m * g / (4.0 / 3.0 * e_star * math.sqrt(r))) ** (2.0 / 3.0)
-    elif nl.a == 1.0:
+    elif elastic == "hooke":
         mat["youngs_modulus"] = 1e9
         contact = {"normal": "lsd", "kn": nl.k}
         delta = m * g / nl.k
     else:
-        raise ValueError(f"the normal law F ∝ δ^{nl.a:g} has no sphere-on-plane probe")
-    if tl.family == SPRING and tl.mu_s > 0:
-        kt = tl.kt * (math.sqrt(r * delta) if tl.kt_sqrt else 1.0)
-        if tl.kt_sqrt:
+        raise ValueError(f"the normal law {_law_text(nl)} has no sphere-on-plane probe")
+    if isinstance(spring, SpringTangential) and tl.mu_s > 0:
+        kt = spring.kt * (math.sqrt(r * delta) if isinstance(spring, SqrtSpringTangential) else 1.0)
+        if isinstance(spring, SqrtSpringTangential):
             notes.append(f"the √(R̄δ) tangential spring taken at the static overlap: kt = {kt:.6g}")
         contact.update(tangential="spring_sliding", kt=kt)
     return mat, contact, notes
+
+
+def _elastic_id(nl) -> str:
+    """The id of a law's elastic record (``hooke``, ``hertz``, ``hls``: NormalLaw.slots), never its exponent."""
+    return nl.slots()[0].id
+
+
+def _law_text(nl) -> str:
+    """A law's elastic record as a reason names it: F ∝ δ^a for a power-law spring, else its id and title."""
+    normal = nl.slots()[0]
+    exponent = getattr(normal, "exponent", None)
+    return f"F ∝ δ^{exponent:g}" if exponent is not None else f"'{normal.id}' ({normal.title})"
 
 
 def _on_plane(name: str, mat: dict, radius: float, contact: dict, scenario: str, gravity, velocity=(0, 0, 0),
@@ -328,9 +341,9 @@ def _sjkr(setup, ps, sub, base, entry, speed) -> list:
         return [(label, None, f"types {ps.i} and {ps.j} differ in size or density: the sjkr pull-off's closed form "
                               "is of two like spheres", notes)]
     nl, _ = registry.get(setup.engine).twin(ps.native, *base["effective"])
-    if nl.a != 1.5:
+    if _elastic_id(nl) != "hertz":
         return [(label, None, f"the sjkr pull-off's closed form rests on an elastic Hertz law; the pair's normal "
-                              f"law is F ∝ δ^{nl.a:g}", notes)]
+                              f"law is {_law_text(nl)}", notes)]
     e_star = nl.k / (4.0 / 3.0 * math.sqrt(base["effective"][1]))
     nu = 0.3
     mat = {"density": base["density"], "youngs_modulus": 2.0 * (1.0 - nu * nu) * e_star, "poisson_ratio": nu,
@@ -389,8 +402,8 @@ def _kratos_rolling(setup, ps, sub, base, entry, speed) -> list:
         return [(label, None, "no characteristic speed to roll at", [])]
     r, rho = base["radius"], base["density"]
     nl, _ = registry.get(setup.engine).twin(ps.native, *base["effective"])  # the relation's law on the wall
-    if nl.a != 1.0:
-        raise ValueError(f"the rolling probe is of a linear normal law; the relation's is F ∝ δ^{nl.a:g}")
+    if _elastic_id(nl) != "hooke":
+        raise ValueError(f"the rolling probe is of a linear normal law; the relation's is {_law_text(nl)}")
     kn = nl.k
     mat = {"density": rho, "restitution": ps.asked.get("restitution") or 0.9, "friction": mu,
            "youngs_modulus": 1e9, "poisson_ratio": 0.3}

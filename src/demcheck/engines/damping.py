@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from ..laws.normal import HookeNormal
 from ..reference.twins import damping_ratio
 
 # Marshall's polynomial α(e) of Tsuji's damping, as LAMMPS 22Jul2025 evaluates it (no √2 factor)
@@ -15,8 +16,9 @@ def tsuji_alpha(e: float) -> float:
     return sum(c * e**i for i, c in enumerate(TSUJI_POLY))
 
 
-def damping(style: str, coeff: float, k_el: float, a: float, m_eff: float, r_eff: float) -> tuple[float, float]:
-    """(c, b) of η(δ) = c δ^b for a damping style, with F_ne = k_el δ^a.
+def damping(style: str, coeff: float, spring, m_eff: float, r_eff: float) -> tuple[float, float]:
+    """(c, b) of η(δ) = c δ^b for a damping style, with F_ne = k_el δ^a the elastic record ``spring`` (HookeNormal or
+    HertzNormal: ``k`` = k_el, its ``exponent`` a; the record, not the exponent, tells a linear spring).
 
     * ``velocity``: η = η0
     * ``mass_velocity``: η = η0 m̄
@@ -27,8 +29,8 @@ def damping(style: str, coeff: float, k_el: float, a: float, m_eff: float, r_eff
     * ``restitution_hertz``: √5 β(e) √(m̄ K) δ^¼ (LIGGGHTS hertz, = LAMMPS coeff_restitution)
     * ``restitution_hooke``: 2β(e)√(m̄k) (LIGGGHTS hooke, = LSD)
     """
-    root = math.sqrt(m_eff * k_el)
-    b_secant = 0.5 * (a - 1.0)  # √(F_ne/δ) = √k δ^{(a−1)/2}
+    root = math.sqrt(m_eff * spring.k)
+    b_secant = 0.5 * (spring.exponent - 1.0)  # √(F_ne/δ) = √k δ^{(a−1)/2}
     if style == "velocity":
         return coeff, 0.0
     if style in ("mass_velocity", "stiffness_hooke"):
@@ -40,7 +42,7 @@ def damping(style: str, coeff: float, k_el: float, a: float, m_eff: float, r_eff
     if style in ("coeff_restitution", "restitution_hertz", "restitution_hooke"):
         if coeff >= 1.0:
             return 0.0, b_secant
-        factor = 2.0 if a == 1.0 else math.sqrt(5.0)
+        factor = 2.0 if isinstance(spring, HookeNormal) else math.sqrt(5.0)
         return factor * damping_ratio(coeff) * root, b_secant
     raise ValueError(f"unknown damping style {style!r}")
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import NormalLaw
+from ...laws.normal import HertzNormal, HookeNormal, NormalLaw
 from ...laws.tangential import TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, TangentialLaw
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
@@ -151,14 +151,14 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     if nat.normal == "hooke":
-        k_el, a = nat.normal_args[0], 1.0
+        spring = HookeNormal(k=nat.normal_args[0])
     elif nat.normal == "hertz":
-        k_el, a = nat.normal_args[0] * math.sqrt(r), 1.5
+        spring = HertzNormal(k=nat.normal_args[0] * math.sqrt(r))
     else:  # hertz/material E ν: E* = E/(2(1−ν²)) for the pair's own coefficients (and for walls)
         e_mod, nu = nat.normal_args
-        k_el, a = 4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu * nu)) * math.sqrt(r), 1.5
-    c, b = damping(nat.damping, nat.damping_coeff, k_el, a, m, r)
-    nl = twins.normal_law(k_el, a, c, b, nat.limit)
+        spring = HertzNormal(k=4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu * nu)) * math.sqrt(r))
+    c, b = damping(nat.damping, nat.damping_coeff, spring, m, r)
+    nl = twins.normal_law(spring.k, spring.exponent, c, b, nat.limit)
     args = nat.tangential_args
     if nat.tangential == "linear_nohistory":
         x_t, mu = args
