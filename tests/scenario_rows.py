@@ -5,13 +5,13 @@ from __future__ import annotations
 
 
 def engine_scenario_rows(case, engine: str):
+    from demcheck.comparisons.records import CaseResult
     from demcheck.comparisons.scenario_rows import engine_rows
     from demcheck.comparisons.sources import ADAPTIVE
     from demcheck.comparisons.suite import Options, discover
     from demcheck.laws.model import resolve
 
     opts = Options(engines=(engine,))
-    entry = {"model": resolve(case).describe(), "scales": {}, "sources": {}}
-    comps = []
-    engine_rows(case, entry, comps, opts, discover(opts.engines), ADAPTIVE.run(case).metrics())
-    return entry, comps
+    entry = CaseResult(case.name, model=resolve(case).describe(), scales={})
+    engine_rows(case, entry, opts, discover(opts.engines), ADAPTIVE.run(case).metrics())
+    return entry.to_json(), entry.comparisons

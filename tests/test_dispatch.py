@@ -62,8 +62,8 @@ def _executable(path: Path, text: str) -> Path:
 
 
 def test_a_local_cluster_gives_the_verdicts_of_one_process(tmp_path):
-    one = suite.run_suite(SMALL, tmp_path / "one", suite.Options(engines=(), jobs=1, cache=None), quiet=True)
-    two = suite.run_suite(SMALL, tmp_path / "two", suite.Options(engines=(), jobs=2, cache=None), quiet=True)
+    one = suite.run_suite(SMALL, tmp_path / "one", suite.Options(engines=(), jobs=1, cache=None), quiet=True).to_json()
+    two = suite.run_suite(SMALL, tmp_path / "two", suite.Options(engines=(), jobs=2, cache=None), quiet=True).to_json()
     assert [c["case"] for c in two["cases"]] == ["glass-pair", "hertz-wall", "hls-constant-pair"]
     assert verdicts(two) == verdicts(one) and two["partial"] is False
 
@@ -79,7 +79,7 @@ def test_a_local_cluster_runs_lammps_and_the_client_stores_its_runs(tmp_path, mo
 
     def run(jobs, where):
         opts = suite.Options(engines=("lammps",), jobs=jobs, cache=Cache(tmp_path / where))
-        return suite.run_suite(SMALL, tmp_path / f"r-{where}", opts, quiet=True)
+        return suite.run_suite(SMALL, tmp_path / f"r-{where}", opts, quiet=True).to_json()
 
     one, two = run(1, "cache-one"), run(2, "cache-two")
     assert verdicts(two) == verdicts(one)
@@ -118,12 +118,12 @@ def test_a_local_cluster_runs_the_engine_in_one_worker_per_dask_worker_and_ends_
     watcher.start()
     try:
         opts = suite.Options(engines=("lammps",), jobs=2, cache=None)
-        two = suite.run_suite(SMALL + [CASES / "oblique-lsd-wall.toml"], tmp_path / "r", opts, quiet=True)
+        two = suite.run_suite(SMALL + [CASES / "oblique-lsd-wall.toml"], tmp_path / "r", opts, quiet=True).to_json()
     finally:
         done.set()
         watcher.join()
     one = suite.run_suite(SMALL + [CASES / "oblique-lsd-wall.toml"], tmp_path / "one",
-                          suite.Options(engines=("lammps",), jobs=1, cache=None), quiet=True)
+                          suite.Options(engines=("lammps",), jobs=1, cache=None), quiet=True).to_json()
     assert verdicts(two) == verdicts(one)
     assert 1 <= len(seen) <= 2, seen  # three LAMMPS runs, in at most one worker per Dask worker
     assert all(f"--parent {os.getpid()}" not in line for line in seen.values())  # started on the Dask workers

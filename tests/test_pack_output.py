@@ -351,7 +351,7 @@ def test_verify_compares_a_poured_packing_s_fabric_by_its_sampling_error(tmp_pat
 
     path = tmp_path / "small.toml"
     path.write_text(SMALL)
-    s = suite.run_suite([path], tmp_path / "r", suite.Options(engines=("lammps",), cache=None), quiet=True)
+    s = suite.run_suite([path], tmp_path / "r", suite.Options(engines=("lammps",), cache=None), quiet=True).to_json()
     (c,) = s["cases"]
     (k,) = [k for k in c["comparisons"] if k["metric"] == "fabric_zz"]
     assert k["source"] == "lammps"

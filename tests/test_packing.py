@@ -281,7 +281,7 @@ def test_verify_runs_the_small_packings_in_every_source(tmp_path):
     from .conftest import CASES
 
     files = [CASES / "packing" / "column-lsd.toml", CASES / "packing" / "layer-kk.toml"]
-    s = suite.run_suite(files, tmp_path / "r", suite.Options(jobs=2, cache=None), quiet=True)
+    s = suite.run_suite(files, tmp_path / "r", suite.Options(jobs=2, cache=None), quiet=True).to_json()
     assert s["failed"] == 0 and {c["case"] for c in s["cases"]} == {"column-lsd", "layer-kk"}
     for c in s["cases"]:
         static = {k["source"]: k for k in c["comparisons"] if k["metric"] == "static_overlap"}
@@ -453,7 +453,7 @@ def test_a_poured_packing_that_has_not_settled_is_flagged():
     from .conftest import CASES
 
     case = C.load(CASES / "optin" / "poured-small.toml", ["packing.duration=0.02"])
-    entry = run_packing(case, SimpleNamespace(engines=[], cache=None, timeout=60.0), {})
+    entry = run_packing(case, SimpleNamespace(engines=[], cache=None, timeout=60.0), {}).to_json()
     settled = next(c for c in entry["comparisons"] if c["metric"].startswith("settled"))
     assert settled["value"] > 100 * SETTLED and settled["verdict"] == V.UNEXPECTED
     assert "lengthen the duration" in settled["reason"] and entry["status"] == "unexpected"

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from demcheck.comparisons import packing_metrics, plots, report, suite, verdicts as V
+from demcheck.comparisons.records import CaseResult
 from demcheck.engines.base import APPROXIMATE
 from demcheck.comparisons.sources import plan
 from demcheck.comparisons.styles import style
@@ -369,7 +370,7 @@ def hostile_run(tmp_path_factory):
     text = re.sub(r'(?m)^name = ".*"$', f'name = "{HOSTILE}"', text, count=1)
     case = tmp / "a$\\frac$b.toml"
     case.write_text(text)
-    s = suite.run_suite([case], tmp / "reports", suite.Options(engines=()), quiet=True, argv=["demcheck", "verify"])
+    s = suite.run_suite([case], tmp / "reports", suite.Options(engines=()), quiet=True, argv=["demcheck", "verify"]).to_json()
     return s, Path(s["report"])
 
 
@@ -642,12 +643,12 @@ def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
     mp = contact_mapping(case, "lammps")
     c = judge(0.52, mp.fidelity, setting=V.mapping_setting(mp))
     assert (c.verdict, c.setting) == (V.EXPECTED, "tangential linear_nohistory")
-    entry, comps = {"sources": {}}, []
+    entry = CaseResult(case.name)
     found = {e: {"found": True} for e in ("lammps", "yade")}
     for planned in plan(case, ("lammps", "yade"), found):
-        V.unavailable(entry, comps, planned)
-    assert entry["settings"] == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
-    assert entry["sources"]["yade"]["status"] == "not expressible"
+        entry.planned(planned)
+    assert entry.settings == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
+    assert entry.sources["yade"].status == "not expressible"
 
 
 # ----------------------------------------------------------------------------- panels: pair or wall, lines
@@ -674,7 +675,7 @@ def test_a_line_per_value_of_a_files_other_variant_labels():
                                     e_in=e_in, variant=[("speed", f"{v:g}"), ("restitution", f"{e_in:g}")]))
     panels = report.speed_panels(cases)
     assert sorted(panels) == ["hertz / none wall (f, restitution=0.5)", "hertz / none wall (f, restitution=0.9)"]
-    assert all(len({c["impact"]["restitution_input"] for c in cs}) == 1 and len(cs) == 3 for cs in panels.values())
+    assert all(len({c.impact["restitution_input"] for c in cs}) == 1 and len(cs) == 3 for cs in panels.values())
     # a label that sets x itself (a velocity setting the angle; a group zipping angle and spin) is the line
     vel = [_collision(f"g[velocity=[{a}]]", "g.toml", {"reference": 0.5}, model=("lsd", "tti"), angle=a, speed=5 + a,
                       variant=[("velocity", f"[{a}, 0.0, -5.0]")]) for a in (5.0, 30.0, 60.0)]
@@ -805,7 +806,7 @@ def engine_report(tmp_path_factory):
              CASES / "suite" / "oblique-spring-sliding.toml", CASES / "hls-constant-pair.toml",
              CASES / "packing" / "column-lsd.toml"]
     opts = suite.Options(engines=("lammps", "liggghts"), jobs=2, cache=Cache(tmp / "cache"))
-    s = suite.run_suite(files, tmp / "reports", opts, quiet=True, argv=["demcheck", "verify"])
+    s = suite.run_suite(files, tmp / "reports", opts, quiet=True, argv=["demcheck", "verify"]).to_json()
     return s, Path(s["report"])
 
 

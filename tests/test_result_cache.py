@@ -61,7 +61,7 @@ def _strip(o):
 def _entries(files, cache, engines=()):
     opts = suite.Options(engines=engines, cache=cache)
     found = suite.discover(engines)
-    return [suite.run_case(c, f, opts, found) for f, c in suite.collect(files)]
+    return [suite.run_case(c, f, opts, found).to_json() for f, c in suite.collect(files)]
 
 
 def test_a_warm_suite_case_solves_nothing_and_gives_the_same_entry(tmp_path, monkeypatch):

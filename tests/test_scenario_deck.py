@@ -18,15 +18,16 @@ NAMES = ("rolling", "rolling-linear", "incline", "incline-linear", "twist", "pul
 
 
 def _suite_rows(case, engine):
+    from demcheck.comparisons.records import CaseResult
     from demcheck.comparisons.scenario_rows import engine_rows
     from demcheck.comparisons.sources import ADAPTIVE
     from demcheck.comparisons.suite import Options, discover
     from demcheck.laws.model import resolve
 
     opts = Options(engines=(engine,))
-    entry = {"model": resolve(case).describe(), "scales": {}, "sources": {}}
-    engine_rows(case, entry, [], opts, discover(opts.engines), ADAPTIVE.run(case).metrics())
-    return entry
+    entry = CaseResult(case.name, model=resolve(case).describe(), scales={})
+    engine_rows(case, entry, opts, discover(opts.engines), ADAPTIVE.run(case).metrics())
+    return entry.to_json()
 
 
 @pytest.mark.parametrize("engine", [pytest.param(e, marks=pytest.mark.engine(e)) for e in ("lammps", "liggghts")])

@@ -63,6 +63,7 @@ def test_an_engine_run_that_never_stops_is_a_failed_source_and_a_failed_verdict(
     from demcheck.case import load
     from demcheck.comparisons import scenario_rows, verdicts
     from demcheck.comparisons.sources import ADAPTIVE
+    from demcheck.comparisons.records import CaseResult
     from demcheck.comparisons.suite import Options
     from demcheck.engines import registry, run as runner
     from demcheck.laws.model import resolve
@@ -76,8 +77,9 @@ def test_an_engine_run_that_never_stops_is_a_failed_source_and_a_failed_verdict(
         "t": np.arange(10.0), "x": np.zeros((10, 3)), "v": np.zeros((10, 3)),
         "omega": np.tile([0.0, 0.0, 50.0], (10, 1))})
     opts = Options(engines=("lammps",))
-    entry, comps = {"model": resolve(c).describe(), "scales": {}, "sources": {}}, []
+    entry = CaseResult(c.name, model=resolve(c).describe(), scales={})
     found = {"lammps": {"found": True}}
-    scenario_rows.engine_rows(c, entry, comps, opts, found, ADAPTIVE.run(c).metrics())
-    assert entry["sources"]["lammps"]["status"] == "failed"
+    scenario_rows.engine_rows(c, entry, opts, found, ADAPTIVE.run(c).metrics())
+    comps = entry.comparisons
+    assert entry.sources["lammps"].status == "failed"
     assert [x.verdict for x in comps] == [verdicts.FAILED] and "not finite" in comps[0].reason

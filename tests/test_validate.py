@@ -734,12 +734,12 @@ def test_the_cli_names_the_law_s_own_misses_and_exits_0_for_them(monkeypatch, tm
 
     from demcheck import cli
     from demcheck.comparisons import validate as V
+    from demcheck.comparisons.records import Summary
 
     law = {"kind": "limit", "source": "reference", "verdict": VA.MISSES, "law": True, "expected": "psi2 = 0.5",
            "file": "thornton-e090-tti-overlap.toml", "deviation": 0.032, "tolerance": 0.024}
     meets = {**law, "verdict": VA.MEETS, "law": None, "file": "thornton-e090.toml"}
-    summary = {"report": str(tmp_path), "engines": [], "failed": 0,
-               "validation": {"checks": [law, meets], "failed": [], "series": []}}
+    summary = Summary(report=str(tmp_path), validation={"checks": [law, meets], "failed": [], "series": []})
     monkeypatch.setattr(V, "run", lambda *a, **k: summary)
     out = CliRunner().invoke(cli.cli, ["validate", "thornton", "--engines", "none", "--jobs", "1", "--report",
                                        str(tmp_path)])

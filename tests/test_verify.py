@@ -128,7 +128,7 @@ def test_bad_expected_differences_file_is_one_clear_line(tmp_path, text, message
 def _run(tmp_path, files, engines=(), **kw):
     opts = suite.Options(engines=tuple(engines), jobs=2, cache=Cache(tmp_path / "cache"), **kw)
     return suite.run_suite([Path(f) for f in files], tmp_path / "reports", opts, quiet=True,
-                           junit=tmp_path / "junit.xml", argv=["demcheck", "verify"])
+                           junit=tmp_path / "junit.xml", argv=["demcheck", "verify"]).to_json()
 
 
 def test_reference_only_suite_writes_every_report(tmp_path):
@@ -371,7 +371,7 @@ def test_an_engine_run_that_is_not_ok_fails_its_case_and_its_metrics_are_not_jud
     monkeypatch.setattr(engine_collide, "collide", unstable)
     found = {"lammps": {"found": True, "version": "fake 1.0", "executable": "lmp", "how_to_install": None}}
     opts = suite.Options(engines=("lammps",), jobs=1, cache=None)
-    entry = suite.run_case(load(CASES / "glass-pair.toml"), CASES / "glass-pair.toml", opts, found)
+    entry = suite.run_case(load(CASES / "glass-pair.toml"), CASES / "glass-pair.toml", opts, found).to_json()
     lam = [k for k in entry["comparisons"] if k["source"] == "lammps"]
     assert [(k["verdict"], k["reason"]) for k in lam] == [(V.FAILED, "unstable: the overlap reached 3.2 radii")]
     assert entry["status"] == "failed" and entry["sources"]["lammps"]["status"] == "unstable"
@@ -384,7 +384,7 @@ def test_a_case_whose_own_time_step_is_unhealthy_fails(tmp_path):
 
     opts = suite.Options(engines=(), jobs=1, cache=None)
     case = load(CASES / "glass-pair.toml", ["run.dt=3e-5"])
-    entry = suite.run_case(case, CASES / "glass-pair.toml", opts, {})
+    entry = suite.run_case(case, CASES / "glass-pair.toml", opts, {}).to_json()
     ver = [k for k in entry["comparisons"] if k["source"] == "reference-verlet"]
     assert [k["verdict"] for k in ver] == [V.FAILED] and ver[0]["reason"].startswith("unresolved:")
     assert entry["status"] == "failed"

@@ -13,6 +13,7 @@ from click.testing import CliRunner
 import demcheck
 from demcheck.cli import cli
 from demcheck.comparisons import suite
+from demcheck.comparisons.records import Summary
 from demcheck.engines import builds, discovery
 from demcheck.errors import ConfigError
 
@@ -27,7 +28,7 @@ def _captured(monkeypatch) -> list:
         calls.append({"files": [str(f) for f in files], "engines": opts.engines, "expected": opts.expected,
                       "timeout": opts.timeout, "jobs": opts.jobs, "refresh": getattr(opts.cache, "refresh", None),
                       "baseline": opts.baseline is not None, "junit": junit})
-        return {"failed": 0, "cases": [], "report": str(report_root)}
+        return Summary(report=str(report_root))
 
     monkeypatch.setattr(suite, "run_suite", record)
     return calls
@@ -108,7 +109,7 @@ def test_a_dask_worker_lacking_a_named_engine_fails_the_case(monkeypatch, named)
     monkeypatch.setattr(dispatch, "missing_here", lambda engines: {e: why for e in engines if e == "lammps"})
     found = {"lammps": {"found": True, "version": "x", "executable": "lmp", "how_to_install": "", "why": None}}
     opts = suite.Options(engines=("lammps",), named=named, cache=None)
-    entry = suite.case_task(load(CASES / "hertz-wall.toml"), str(CASES / "hertz-wall.toml"), opts, found)
+    entry = suite.case_task(load(CASES / "hertz-wall.toml"), str(CASES / "hertz-wall.toml"), opts, found).to_json()
     if named:
         assert entry["sources"]["lammps"] == {"status": verdicts.FAILED, "message": why}
         assert entry["status"] == "failed" and entry["sources"]["reference"]["status"] == "ok"

@@ -12,7 +12,7 @@ from demcheck.resources import case_path
 
 def test_a_zero_separation_is_judged_in_the_pulls_overlap_scale():
     case = load(case_path("suite/beyond-pull-off-sjkr.toml"))
-    entry = suite.run_case(case, case_path("suite/beyond-pull-off-sjkr.toml"), suite.Options(engines=()), {})
+    entry = suite.run_case(case, case_path("suite/beyond-pull-off-sjkr.toml"), suite.Options(engines=()), {}).to_json()
     scale = entry["scales"]["overlap"]
     assert scale == overlap_scale(case) and 0.0 < scale < 1e-4
     assert entry["sources"]["reference"]["metrics"]["separation_at_pull_off"] == 0.0

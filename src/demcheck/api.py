@@ -371,7 +371,7 @@ def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path
     argv = argv if argv is not None else ["demcheck.verify"]
     junit = Path(_path("junit", junit)) if junit is not None else None
     if report is not None:
-        return run_suite(files, Path(report), opts, quiet=quiet, junit=junit, argv=argv)
+        return run_suite(files, Path(report), opts, quiet=quiet, junit=junit, argv=argv).to_json()
     import shutil
     import tempfile
 
@@ -380,8 +380,8 @@ def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path
         out = run_suite(files, tmp, opts, quiet=quiet, junit=junit, argv=argv)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    out["report"] = None
-    return out
+    out.report = None
+    return out.to_json()  # the API's results are the dict results.json holds (with each case's plot series)
 
 
 def _engines(engines, precision, key) -> tuple[tuple[str, ...], bool]:

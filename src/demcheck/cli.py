@@ -621,9 +621,9 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
         click.echo("demcheck: interrupted; the engines were stopped and the finished cases are in the partial "
                    f"report {Path(report_dir) / 'latest-validate'}", err=True)
         sys.exit(runner.interrupt_exit_code(exc))
-    val = summary["validation"]
+    val = summary.validation
     if as_json:
-        emit_json({"report": summary["report"], "engines": summary["engines"], "failed": summary["failed"],
+        emit_json({"report": summary.report, "engines": summary.engines, "failed": summary.failed,
                    "validation": {k: v for k, v in val.items() if k != "series"}})
     else:
         counts: dict = {}
@@ -638,7 +638,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
                 click.echo(f"the law's own miss (not a failure) of {c['expected']} in {c['file']}: "
                            f"{c['deviation']:.3g} > {c['tolerance']:.3g} (its force pushes along the slip at contact "
                            "onset; the report says why)", err=True)
-    sys.exit(0 if summary["failed"] == 0 else 1)
+    sys.exit(0 if summary.failed == 0 else 1)
 
 
 @cli.command()

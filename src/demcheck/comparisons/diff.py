@@ -27,6 +27,7 @@ from ..errors import ConfigError
 from ..io import md_text as _t
 from ..io import number, plain
 from . import schema, verdicts
+from .records import Summary
 
 FORMAT = "demcheck-baseline"
 FORMAT_VERSION = 1
@@ -50,27 +51,23 @@ def _numbers(metrics) -> dict:
     return out
 
 
-def from_summary(summary: dict, path: str = "") -> dict:
-    """A run (results.json's content, or verify's summary) in the form the comparison reads: per case its
+def from_summary(summary: Summary, path: str = "") -> dict:
+    """A run (verify's records.Summary, or results.json's content) in the form the comparison reads: per case its
     hash, scales, sources (status, version, metrics) and verdicts per source and metric."""
+    summary = Summary.of(summary)
     cases = {}
-    for c in summary.get("cases", []):
+    for c in summary.cases:
         judged: dict = defaultdict(dict)
-        for k in c.get("comparisons") or []:
-            src, metric = k["source"], k["metric"]
-            old = judged[src].get(metric)
-            judged[src][metric] = k["verdict"] if old is None else verdicts.worst([old, k["verdict"]])
-        sources = {}
-        for src, s in (c.get("sources") or {}).items():
-            sources[src] = {"status": s.get("status"), "version": s.get("engine_version"),
-                            "metrics": _numbers(s.get("metrics"))}
-        cases[c["case"]] = {"hash": c.get("case_hash"), "scales": _scales(c.get("scales")), "sources": sources,
-                            "verdicts": {s: dict(v) for s, v in judged.items()}}
-    engines = {name: (e.get("version") if e.get("found") else None)
-               for name, e in (summary.get("engines") or {}).items()}
-    return {"path": path, "run_id": summary.get("run_id"), "started": summary.get("started"),
-            "demcheck": summary.get("demcheck"), "partial": bool(summary.get("partial")), "engines": engines,
-            "cases": cases, "tolerances": {}}
+        for k in c.comparisons:
+            old = judged[k.source].get(k.metric)
+            judged[k.source][k.metric] = k.verdict if old is None else verdicts.worst([old, k.verdict])
+        sources = {src: {"status": s.status, "version": s.engine_version, "metrics": _numbers(s.metrics)}
+                   for src, s in c.sources.items()}
+        cases[c.case] = {"hash": c.case_hash, "scales": _scales(c.scales), "sources": sources,
+                         "verdicts": {s: dict(v) for s, v in judged.items()}}
+    engines = {name: (e.get("version") if e.get("found") else None) for name, e in summary.engines.items()}
+    return {"path": path, "run_id": summary.run_id, "started": summary.started, "demcheck": summary.demcheck,
+            "partial": bool(summary.partial), "engines": engines, "cases": cases, "tolerances": {}}
 
 
 def _scales(scales) -> dict:
@@ -127,14 +124,15 @@ def _from_baseline(data: dict, path: str, key: str) -> dict:
             "engines": dict(data.get("engines") or {}), "cases": cases, "tolerances": tol}
 
 
-def baseline(summary: dict, tolerance: float | None = None) -> dict:
-    """The baseline file of a run: every source's metrics and verdicts, the engines' versions, and the
-    tolerances (``default`` for every quantity; ``metrics`` per metric and ``tolerances`` in a source per
-    quantity may be added by hand to loosen one)."""
+def baseline(summary: Summary, tolerance: float | None = None) -> dict:
+    """The baseline file of a run (a records.Summary, or results.json's content): every source's metrics and
+    verdicts, the engines' versions, and the tolerances (``default`` for every quantity; ``metrics`` per metric
+    and ``tolerances`` in a source per quantity may be added by hand to loosen one)."""
+    summary = Summary.of(summary)
     run = from_summary(summary)
     return plain({"format": FORMAT, "version": FORMAT_VERSION, "demcheck": run["demcheck"],
                   "run_id": run["run_id"], "started": run["started"], "partial": run["partial"],
-                  "command": summary.get("command"), "engines": run["engines"],
+                  "command": summary.command, "engines": run["engines"],
                   "tolerances": {"default": default_tolerance() if tolerance is None else tolerance,
                                  "metrics": {}},
                   "cases": run["cases"]})
@@ -349,10 +347,10 @@ def _line(r: dict) -> str:
 # ----------------------------------------------------------------------------- baselines in verify
 
 
-def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) -> dict:
-    """Judge a finished verify run (its summary) against a baseline (``load``): every regression becomes a
-    "differs unexpectedly" comparison of its source and metric (reason "baseline: …"), so the case fails
-    and the report, JUnit and exit code say so; ``summary["baseline"]`` holds the whole comparison. Only the
+def apply_baseline(summary: Summary, base: dict, tolerance: float | None = None) -> dict:
+    """Judge a finished verify run (its records.Summary) against a baseline (``load``): every regression becomes
+    a "differs unexpectedly" comparison of its source and metric (reason "baseline: …"), so the case fails
+    and the report, JUnit and exit code say so; ``summary.baseline`` holds the whole comparison. Only the
     cases that ran are compared."""
     d = compare(base, from_summary(summary, "this run"), tolerance, only_common_cases=True)
     by_case: dict = defaultdict(list)
@@ -361,8 +359,8 @@ def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) ->
             by_case[r["case"]].append(r)
     for i in d["removed"]:
         by_case[i["case"]].append(i)
-    for c in summary["cases"]:
-        for r in by_case.get(c["case"], []):
+    for c in summary.cases:
+        for r in by_case.get(c.case, []):
             if "metric" not in r:
                 comp = verdicts.status_comparison(r["source"], verdicts.UNEXPECTED, f"baseline: {r['source']} {r['what']} "
                                            f"(it ran in the baseline {base['path']})")
@@ -376,13 +374,12 @@ def apply_baseline(summary: dict, base: dict, tolerance: float | None = None) ->
                 absd = abs(r["new"] - r["old"]) if math.isfinite(r["new"]) and math.isfinite(r["old"]) else math.nan
                 comp = verdicts.Comparison(r["source"], r["metric"], r["new"], r["old"], absd, r["moved"], r["tolerance"],
                                     verdicts.UNEXPECTED, "baseline: " + "; ".join(why))
-            c.setdefault("comparisons", []).append(comp.as_dict())
-        if c["case"] in by_case:
-            c["verdict"] = verdicts.worst(k["verdict"] for k in c["comparisons"])
-            c["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(c["verdict"], "ok")
-    summary["failed"] = sum(c["status"] in ("failed", "unexpected") for c in summary["cases"])
-    summary["baseline"] = {k: v for k, v in d.items() if k != "new"} | {"path": base["path"]}
-    return summary["baseline"]
+            c.comparisons.append(comp)
+        if c.case in by_case:
+            c.judged()
+    summary.failed = summary.count_failed()
+    summary.baseline = {k: v for k, v in d.items() if k != "new"} | {"path": base["path"]}
+    return summary.baseline
 
 
 def baseline_markdown(b: dict) -> list[str]:

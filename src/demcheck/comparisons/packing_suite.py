@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import EngineInterrupted, UnsupportedByEngine
 from . import packing_metrics, sources, verdicts
+from .records import CaseResult, SourceResult
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
 TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
@@ -132,31 +133,30 @@ def reference_packing(case, cache=None):
     return st.x.copy(), st.rad.copy(), contacts, list(st.ke), st.time, seconds
 
 
-def run_packing(case, opts, found, file=None) -> dict:
+def run_packing(case, opts, found, file=None) -> CaseResult:
     from ..engines.mapping import pair_mapping
     from ..engines.packing import run_engine
     from ..reference import packing
 
-    entry = {"case": case.name, "file": str(file), "kind": "packing", "case_hash": case.hash, "sources": {},
-             "comparisons": [],
-             "curves": {}, "series": [], "packing": {}}
     from ..laws.model import models_of
 
+    entry = CaseResult(case.name, str(file), case.hash, "packing", packing={}, impact={}, scales={})
     normal, tangential = models_of(case)
-    entry["model"] = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
+    entry.model = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
     box = case.packing.box if case.packing else None
-    comps = []
+    comps = entry.comparisons
     x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
     states = {"reference": (x, rad)}
     ref_forces = contacts[:, 3]
     ref_m = packing_metrics.compute(x, rad, box=box, forces=ref_forces, overlaps=contacts[:, 2],
                        ke=[e for _, e in ke])
-    entry["sources"]["reference"] = {"status": "ok", "metrics": ref_m, "time": t_end, "wall_time": seconds}
-    entry["packing"]["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
+    entry.sources["reference"] = SourceResult("ok", metrics=ref_m, time=t_end, wall_time=seconds,
+                                              keys=("status", "metrics", "time", "wall_time"))
+    entry.packing["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
                                      "profile": packing_metrics.profile(x, rad, box) if box else None}
 
     for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
-        if verdicts.unavailable(entry, comps, planned):
+        if not entry.planned(planned):
             continue
         engine = planned.source.label
         try:
@@ -164,11 +164,11 @@ def run_packing(case, opts, found, file=None) -> dict:
         except EngineInterrupted:
             raise  # the case did not finish: it is left out of the (partial) report
         except UnsupportedByEngine as exc:  # an engine whose package writes no packing decks
-            entry["sources"][engine] = {"status": "not expressible", "message": str(exc)}
+            entry.sources[engine] = SourceResult.status_only(verdicts.NOT_EXPRESSIBLE, str(exc))
             comps.append(verdicts.status_comparison(engine, verdicts.NOT_EXPRESSIBLE, str(exc)))
             continue
         except Exception as exc:  # noqa: BLE001 - any engine failure is reported, never fatal to the suite
-            entry["sources"][engine] = {"status": "failed", "message": str(exc)}
+            entry.sources[engine] = SourceResult.status_only("failed", str(exc))
             comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
             continue
         x = run.table[["x", "y", "z"]].to_numpy()
@@ -177,20 +177,15 @@ def run_packing(case, opts, found, file=None) -> dict:
         fn = run.contacts["fn"].to_numpy()
         m = packing_metrics.compute(x, rad, box=box, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
-        entry["sources"][engine] = {"status": "ok", "metrics": m, "engine_version": run.version}
+        entry.sources[engine] = SourceResult("ok", metrics=m, engine_version=run.version,
+                                             keys=("status", "metrics", "engine_version"))
         dt = packing.packing_dt(case)
-        entry["packing"][engine] = {"ke": [(step * dt, e) for step, e in run.ke],
+        entry.packing[engine] = {"ke": [(step * dt, e) for step, e in run.ke],
                                     "forces": packing_metrics.force_distribution(fn),
                                     "profile": packing_metrics.profile(x, rad, box) if box else None}
         _judge_engine(case, engine, m, ref_m, fn, ref_forces, x, rad, states, box, comps)
     _judge_settled(case, entry, states, comps)
-    entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = verdicts.worst(c.verdict for c in comps)
-    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
-    entry["verdict"] = worst
-    entry["impact"] = {}
-    entry["scales"] = {}
-    return entry
+    return entry.judged()
 
 
 def _judge_engine(case, engine: str, m: dict, ref_m: dict, fn, ref_forces, x, rad, states, box, comps) -> None:
@@ -222,7 +217,7 @@ def _judge_engine(case, engine: str, m: dict, ref_m: dict, fn, ref_forces, x, ra
                                   f"beyond the statistical tolerance {tol:g} between chaotic packings"))
 
 
-def _judge_settled(case, entry: dict, states: dict, comps: list) -> None:
+def _judge_settled(case, entry: CaseResult, states: dict, comps: list) -> None:
     """Each source's settled state: the static overlaps' closed form where there is one, else (a poured packing)
     the kinetic energy left and each bulk metric within its physical range."""
     for src, (x, rad) in states.items():
@@ -234,7 +229,7 @@ def _judge_settled(case, entry: dict, states: dict, comps: list) -> None:
                                       "" if worst <= CLOSED_FORM_RTOL else
                                       "the settled overlaps miss the static closed form (not settled?)"))
         elif case.packing is not None and case.packing.layout == "poured":
-            m = entry["sources"][src]["metrics"]
+            m = entry.sources[src].metrics
             ke = m.get("kinetic_energy", math.nan)
             lift = sum(case.mass(i) for i in range(len(case.particles))) * float(np.linalg.norm(case.run.gravity)) \
                 * 2.0 * float(np.mean(rad))

@@ -9,22 +9,26 @@ from __future__ import annotations
 
 from ..errors import DemcheckError, EngineInterrupted
 from . import sources, verdicts
+from .records import CaseResult, SourceResult
+
+# a scenario engine's row: what it ran, its metrics, its mapping and its twin's and seed run's metrics
+ROW = ("status", "message", "method", "dt", "engine_version", "wall_time", "metrics", "fidelity", "reasons",
+       "twin_metrics", "seed_verlet_metrics")
 
 
-def engine_rows(case, entry: dict, comps: list, opts, found: dict, ref: dict) -> None:
-    """Every engine of ``opts.engines`` on the scenario case: ``entry["sources"]`` and ``comps`` gain its rows;
-    ``ref``: the reference's metrics."""
+def engine_rows(case, entry: CaseResult, opts, found: dict, ref: dict) -> None:
+    """Every engine of ``opts.engines`` on the scenario case: ``entry`` gains its rows and comparisons; ``ref``: the
+    reference's metrics."""
     for planned in sources.plan(case, opts.engines, found):
-        if verdicts.unavailable(entry, comps, planned):
-            continue
-        _engine(case, planned, entry, comps, opts, ref)
+        if entry.planned(planned):
+            _engine(case, planned, entry, opts, ref)
 
 
-def _engine(case, planned, entry: dict, comps: list, opts, ref: dict) -> None:
+def _engine(case, planned, entry: CaseResult, opts, ref: dict) -> None:
     from ..engines import scenario
 
     src, mp = planned.source, planned.mapping
-    label = src.label
+    label, comps = src.label, entry.comparisons
     try:
         res = scenario.run(case, src.engine, timeout=opts.timeout, cache=opts.cache)  # src.run's, cached
         twin = scenario.cached_metrics("twin", case, src.engine, opts.cache)
@@ -32,19 +36,18 @@ def _engine(case, planned, entry: dict, comps: list, opts, ref: dict) -> None:
     except EngineInterrupted:
         raise
     except DemcheckError as exc:
-        entry["sources"][label] = {"status": "failed", "message": str(exc)}
+        entry.sources[label] = SourceResult.status_only("failed", str(exc))
         comps.append(verdicts.status_comparison(label, verdicts.FAILED, str(exc).splitlines()[0]))
         return
-    entry["sources"][label] = {"status": res.status, "message": res.message, "method": res.method, "dt": res.dt,
-                               "engine_version": res.engine_version, "wall_time": res.wall_time,
-                               "metrics": res.metrics(), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
-                               "twin_metrics": twin, "seed_verlet_metrics": seed}
+    entry.sources[label] = SourceResult(res.status, res.message, res.method, res.dt, engine_version=res.engine_version,
+                                        wall_time=res.wall_time, metrics=res.metrics(), fidelity=mp.fidelity,
+                                        reasons=list(mp.reasons), twin_metrics=twin, seed_verlet_metrics=seed, keys=ROW)
     if not res.ok:
         comps.append(verdicts.status_comparison(label, verdicts.FAILED, f"{res.status}: {res.message}"))
         return
     got = res.metrics()
     for metric, value in ref.items():
-        comps.append(verdicts.judge_engine(label, res.engine_version, entry["model"], metric, got[metric], value,
+        comps.append(verdicts.judge_engine(label, res.engine_version, entry.model, metric, got[metric], value,
                                            twin[metric], seed[metric], mp.fidelity, list(mp.reasons),
-                                           entry["scales"], opts.tolerances, opts.expected,
+                                           entry.scales, opts.tolerances, opts.expected,
                                            setting=verdicts.mapping_setting(mp)))

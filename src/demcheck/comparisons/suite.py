@@ -36,6 +36,7 @@ from ..reference.expected import closed_form_metrics
 from ..reference.health import impact_scales
 from ..laws.model import resolve
 from . import curves, dispatch, sources, verdicts
+from .records import CaseResult, SourceResult, Summary
 from .result_cache import cached_json, cached_metrics, cached_result
 
 # the suite's engine runs go through each engine's long-lived worker (one per engine per process running cases), a
@@ -84,11 +85,10 @@ def _series(contact, source: str) -> dict | None:
     return {"source": source, "t": (c["t"] - t0).tolist(), "delta": c["delta"].tolist(), "fn": c["fn"].tolist()}
 
 
-def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
-    entry = {"case": case.name, "file": str(file), "case_hash": case.hash, "kind": case.kind,
-             "sources": {}, "comparisons": [], "curves": {}, "series": []}
-    entry["walls"] = len(case.walls)  # a wall impact or a pair: the report's panels say which
-    entry["variant"] = variant_labels(case.name, file)
+def run_case(case: Case, file: Path, opts: Options, found: dict) -> CaseResult:
+    entry = CaseResult(case.name, str(file), case.hash, case.kind)
+    entry.walls = len(case.walls)  # a wall impact or a pair: the report's panels say which
+    entry.variant = variant_labels(case.name, file)
     if case.kind == "packing":
         from .packing_suite import run_packing
 
@@ -96,73 +96,62 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> dict:
     if case.run.scenario != "collision":
         return run_scenario(case, entry, opts, found)
     model = resolve(case)
-    entry["model"] = model.describe()
-    entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
+    entry.model = model.describe()
+    entry.params = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
     v_in = model.pair.impact_speed
-    entry["impact"] = {"speed": v_in, "restitution_input": model.pair.restitution, **_incidence(case)}
+    entry.impact = {"speed": v_in, "restitution_input": model.pair.restitution, **_incidence(case)}
     # energy in units of the bodies' kinetic energy at impact (translation, spin, and the tangential motion
     # a grazing impact carries: the normal part alone vanishes at 90°)
-    entry["scales"] = impact_scales(case, model)
-    comps: list[verdicts.Comparison] = []
-    adaptive, ref = _reference_sources(case, model, entry, comps, opts.tolerances, opts.cache)
+    entry.scales = impact_scales(case, model)
+    adaptive, ref = _reference_sources(case, model, entry, opts.tolerances, opts.cache)
     seed_cache: dict = {}
     for planned in sources.plan(case, opts.engines, found):
-        if verdicts.unavailable(entry, comps, planned):
-            continue
-        _engine_source(case, model, planned, (adaptive, ref), entry, comps, opts, seed_cache)
-    entry["series"] = [s for s in entry["series"] if s]
-    entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = verdicts.worst(c.verdict for c in comps)
-    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
-    entry["verdict"] = worst
-    return entry
+        if entry.planned(planned):
+            _engine_source(case, model, planned, (adaptive, ref), entry, opts, seed_cache)
+    entry.series = [s for s in entry.series if s]
+    return entry.judged()
 
 
-def run_scenario(case: Case, entry: dict, opts: Options, found: dict) -> dict:
+def run_scenario(case: Case, entry: CaseResult, opts: Options, found: dict) -> CaseResult:
     """A scenario beyond sliding (run.scenario): the reference's solve against its closed forms
     (reference/expected.scenario_closed_forms), then each engine that expresses the case against its twin and the
     reference (comparisons/scenario_rows.py)."""
     from ..reference.expected import scenario_closed_forms
 
     model = resolve(case)
-    entry["scenario"] = case.run.scenario
-    entry["model"] = model.describe()
-    entry["params"] = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
-    entry["impact"] = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
-    entry["scales"] = {}
+    entry.scenario = case.run.scenario
+    entry.model = model.describe()
+    entry.params = {k: v for k, v in model.params.items() if isinstance(v, (int, float, str, bool))}
+    entry.impact = {"speed": model.pair.impact_speed, "restitution_input": model.pair.restitution}
+    entry.scales = {}
     if case.run.scenario == "pull_off":  # a separation of 0 (DMT, sjkr) is judged in units of the pull's overlap
         from ..engines.scenario import overlap_scale
 
-        entry["scales"]["overlap"] = overlap_scale(case)
-    comps: list[verdicts.Comparison] = []
+        entry.scales["overlap"] = overlap_scale(case)
+    comps = entry.comparisons
     adaptive = cached_result(opts.cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
-    entry["sources"]["reference"] = _source(adaptive)
+    entry.sources["reference"] = SourceResult.of_run(adaptive)
     if not adaptive.ok:
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     else:
         got = adaptive.metrics()
         for metric, exact in scenario_closed_forms(case).items():
-            comps.append(verdicts.judge_closed_form(metric, got[metric], exact, entry["scales"], opts.tolerances))
+            comps.append(verdicts.judge_closed_form(metric, got[metric], exact, entry.scales, opts.tolerances))
         from .scenario_rows import engine_rows
 
-        engine_rows(case, entry, comps, opts, found, got)
-    entry["comparisons"] = [c.as_dict() for c in comps]
-    worst = verdicts.worst(c.verdict for c in comps)
-    entry["status"] = {verdicts.FAILED: "failed", verdicts.UNEXPECTED: "unexpected"}.get(worst, "ok")
-    entry["verdict"] = worst
-    return entry
+        engine_rows(case, entry, opts, found, got)
+    return entry.judged()
 
 
-def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=None) -> tuple:
-    """The reference's two methods in ``entry`` and their comparisons in ``comps``: the adaptive one (the seed
-    model's converged answer: returned with its metrics) against the closed forms, the verlet one at the case's
-    step against it. With ``cache``, the adaptive solve is read from it where it was made before
-    (result_cache.py)."""
+def _reference_sources(case: Case, model, entry: CaseResult, tol, cache=None) -> tuple:
+    """The reference's two methods in ``entry``, with their comparisons: the adaptive one (the seed model's
+    converged answer: returned with its metrics) against the closed forms, the verlet one at the case's step
+    against it. With ``cache``, the adaptive solve is read from it where it was made before (result_cache.py)."""
     adaptive = cached_result(cache, sources.ADAPTIVE.label, case, lambda: sources.ADAPTIVE.run(case))
-    scales = entry["scales"]
+    scales, comps = entry.scales, entry.comparisons
     ref = adaptive.metrics()
-    entry["sources"]["reference"] = _source(adaptive)
-    entry["series"].append(_series(adaptive.contact, "reference"))
+    entry.sources["reference"] = SourceResult.of_run(adaptive)
+    entry.series.append(_series(adaptive.contact, "reference"))
     if not adaptive.ok:
         comps.append(verdicts.status_comparison("reference", verdicts.FAILED, f"{adaptive.status}: {adaptive.message}"))
     for metric, exact in closed_form_metrics(model).items():
@@ -172,35 +161,34 @@ def _reference_sources(case: Case, model, entry: dict, comps: list, tol, cache=N
     started = time.perf_counter()
     part, hit = cached_json(cache, f"{label} against {sources.ADAPTIVE.label}", case,
                             lambda: _verlet_part(case, adaptive))
+    verlet = SourceResult.from_json(part["source"])
     if hit:
-        part["source"].update(cached=True, wall_time=time.perf_counter() - started)
-    mv = part["source"]["metrics"]
-    entry["sources"][label] = part["source"]
-    entry["series"].append(part["series"])
-    entry["curves"][label] = part["curves"]
+        verlet.cached, verlet.wall_time = True, time.perf_counter() - started
+    entry.sources[label] = verlet
+    entry.series.append(part["series"])
+    entry.curves[label] = part["curves"]
     spc = case.run.steps_per_contact
-    if part["source"]["status"] != "ok":
+    if not verlet.ok:
         # the case's own time step does not give a healthy run (docs/reliability.md): the case fails, whatever
         # the engines do at that step
-        comps.append(verdicts.status_comparison(label, verdicts.FAILED,
-                                                f"{part['source']['status']}: {part['source']['message']}"))
+        comps.append(verdicts.status_comparison(label, verdicts.FAILED, f"{verlet.status}: {verlet.message}"))
     else:
         tol_v = replace(tol, verlet_rtol=case.run.verlet_rtol) if case.run.verlet_rtol else tol
         for metric in ref:
-            comps.append(verdicts.judge_verlet(metric, mv[metric], ref[metric], spc, scales, tol_v))
+            comps.append(verdicts.judge_verlet(metric, verlet.metrics[metric], ref[metric], spc, scales, tol_v))
     return adaptive, ref
 
 
 def _verlet_part(case: Case, adaptive) -> dict:
-    """The verlet method at the case's step as the entry keeps it: its source line, its plot series, its curves'
-    distances from the adaptive solve."""
+    """The verlet method at the case's step as the entry keeps it: its source row (as JSON: the run cache holds
+    it), its plot series, its curves' distances from the adaptive solve."""
     verlet = sources.VERLET.run(case)
     label = sources.VERLET.label
-    return {"source": _source(verlet), "series": _series(verlet.contact, label),
+    return {"source": SourceResult.of_run(verlet).to_json(), "series": _series(verlet.contact, label),
             "curves": curves.distances(verlet.contact, adaptive.contact, adaptive.events)}
 
 
-def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, comps: list, opts: Options,
+def _engine_source(case: Case, model, planned, converged: tuple, entry: CaseResult, opts: Options,
                    seed_cache: dict) -> None:
     """One engine that can run the case (``planned``, sources.plan): its run (from the cache where it was run
     before), its twin and the seed model's verlet run at its dt, and each metric judged."""
@@ -208,7 +196,7 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
     from ..reference import collision3d
 
     src, mp, native = planned.source, planned.mapping, planned.native
-    engine, (adaptive, ref) = src.label, converged
+    engine, (adaptive, ref), comps = src.label, converged, entry.comparisons
     try:
         # the case's own [engine.NAME] setting at its own step (Source.run's default, engines.collide.setting), as
         # `collide` and `deck` run it: the deck verify runs is the deck `demcheck deck` writes
@@ -216,12 +204,13 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
     except EngineInterrupted:
         raise  # the case did not finish: it is left out of the (partial) report
     except DemcheckError as exc:
-        entry["sources"][engine] = {"status": "failed", "message": str(exc)}
+        entry.sources[engine] = SourceResult.status_only("failed", str(exc))
         comps.append(verdicts.status_comparison(engine, verdicts.FAILED, str(exc).splitlines()[0]))
         return
     if not res.ok:  # a run its health checks refuse (unstable, unresolved, failed): its metrics mean nothing
-        entry["sources"][engine] = {"status": res.status, "message": res.message, "fidelity": mp.fidelity,
-                                    "engine_version": res.engine_version}
+        entry.sources[engine] = SourceResult(res.status, res.message, fidelity=mp.fidelity,
+                                             engine_version=res.engine_version,
+                                             keys=("status", "message", "fidelity", "engine_version"))
         comps.append(verdicts.status_comparison(engine, verdicts.FAILED, f"{res.status}: {res.message}"))
         return
     me = res.metrics()
@@ -232,14 +221,14 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: dict, co
             opts.cache, f"seed verlet {res.dt!r}", case,
             lambda: states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics())
     seed_v = seed_cache[res.dt]
-    entry["sources"][engine] = {**_source(res), "fidelity": mp.fidelity, "reasons": list(mp.reasons),
-                                "twin_metrics": twin, "seed_verlet_metrics": seed_v}
-    entry["series"].append(_series(res.contact, engine))
-    entry["curves"][engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
+    entry.sources[engine] = SourceResult.of_run(res, fidelity=mp.fidelity, reasons=list(mp.reasons),
+                                                twin_metrics=twin, seed_verlet_metrics=seed_v)
+    entry.series.append(_series(res.contact, engine))
+    entry.curves[engine] = curves.distances(res.contact, adaptive.contact, adaptive.events)
     for metric in ref:
-        comps.append(verdicts.judge_engine(engine, res.engine_version, entry["model"], metric, me[metric], ref[metric],
+        comps.append(verdicts.judge_engine(engine, res.engine_version, entry.model, metric, me[metric], ref[metric],
                                            twin[metric], seed_v[metric], mp.fidelity, list(mp.reasons),
-                                           entry["scales"], opts.tolerances, opts.expected,
+                                           entry.scales, opts.tolerances, opts.expected,
                                            setting=verdicts.mapping_setting(mp)))
 
 
@@ -289,13 +278,6 @@ def _incidence(case: Case) -> dict:
             "spin": float(np.linalg.norm(p0.angular_velocity))}
 
 
-def _source(result) -> dict:
-    return {"status": result.status, "message": result.message, "method": result.method, "dt": result.dt,
-            "rtol": result.rtol, "engine_version": result.engine_version, "wall_time": result.wall_time,
-            "metrics": result.metrics(), "cached": result.meta.get("cached"),
-            "warnings": result.meta.get("warnings", [])}
-
-
 def collect(paths) -> list[tuple[Path, Case]]:
     """Every case of the files (each variant), read and checked before any is run: an error names the file
     (and the variant, when case.expand says which) at fault, ``cases/x.toml[speed=2]: key = value: rule``."""
@@ -309,7 +291,7 @@ def collect(paths) -> list[tuple[Path, Case]]:
 
 
 def run_suite(files: list[Path], report_root: Path, opts: Options | None = None, quiet: bool = False,
-              junit: Path | None = None, argv: list[str] | None = None, link: str = "latest") -> dict:
+              junit: Path | None = None, argv: list[str] | None = None, link: str = "latest") -> Summary:
     from ..engines import run as runner
     from . import report
 
@@ -319,13 +301,10 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
     run_id = _dt.datetime.now().strftime("%Y%m%d-%H%M%S") + f"-{os.getpid()}"
     out_dir = report_root / run_id
     found = discover(opts.engines)
-    summary = {"demcheck": __version__, "run_id": run_id, "report": str(out_dir), "partial": True,
-               "started": _dt.datetime.now().isoformat(timespec="seconds"),
-               "command": argv if argv is not None else sys.argv, "engines": found,
-               "tolerances": opts.tolerances.__dict__, "cases": [], "failed": 0}
-    summary["planned"] = len(cases)
+    summary = Summary(__version__, run_id, str(out_dir), True, _dt.datetime.now().isoformat(timespec="seconds"),
+                      argv if argv is not None else sys.argv, found, opts.tolerances.__dict__, planned=len(cases))
     started = time.perf_counter()
-    entries: dict[int, dict] = {}
+    entries: dict[int, CaseResult] = {}
     interrupted: KeyboardInterrupt | None = None  # SIGINT, or SIGTERM (engines.run.Terminated)
     runner.reset()
     shipped = replace(opts, cache=None, baseline=None)  # what a task needs of the options (its cache is its own)
@@ -344,8 +323,8 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                 # an interrupt: the engines stopped and none starts; the cases running finish without them (raising
                 # EngineInterrupted: left out) or, needing none, finish and are reported (dispatch.Campaign)
                 for i, entry in campaign.completed(case_task, tasks):
-                    if "variant" in entry:  # read here, where the case files are
-                        entry["variant"] = variant_labels(entry["case"], cases[i][0])
+                    if entry.variant is not None:  # read here, where the case files are
+                        entry.variant = variant_labels(entry.case, cases[i][0])
                     entries[i] = entry
                     progress.update(task, advance=1, description=cases[i][1].name[:50])
         except KeyboardInterrupt as exc:
@@ -355,24 +334,24 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
             interrupted = exc.__cause__ if isinstance(exc.__cause__, KeyboardInterrupt) else KeyboardInterrupt()
             runner.kill_all()
         finally:
-            summary["cases"] = [entries[i] for i in sorted(entries)]
-            summary["failed"] = sum(e["status"] in ("failed", "unexpected") for e in summary["cases"])
-            summary["wall_time"] = time.perf_counter() - started
-            summary["partial"] = interrupted is not None or len(summary["cases"]) < len(cases)
+            summary.cases = [entries[i] for i in sorted(entries)]
+            summary.failed = summary.count_failed()
+            summary.wall_time = time.perf_counter() - started
+            summary.partial = interrupted is not None or len(summary.cases) < len(cases)
             if opts.cache is not None:
-                summary["cache"] = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
+                summary.cache = {"dir": str(opts.cache.dir), "hits": opts.cache.hits, "misses": opts.cache.misses}
             after = _judge_baseline(summary, opts.baseline)  # a fault here still leaves the report written
             report.write_all(summary, out_dir, report_root, junit=junit, link=link)
     _print(console, summary)
     if interrupted is not None:
         raise interrupted
     if after is not None:
-        raise DemcheckError(f"{summary['baseline_error']} (after the runs; the report of the finished cases is "
+        raise DemcheckError(f"{summary.baseline_error} (after the runs; the report of the finished cases is "
                             f"{out_dir})") from after
     return summary
 
 
-def _judge_baseline(summary: dict, baseline: dict | None) -> Exception | None:
+def _judge_baseline(summary: Summary, baseline: dict | None) -> Exception | None:
     """The finished cases judged against ``baseline`` (diff.apply_baseline); a failure there is returned, noted
     in the summary (``baseline_error``), so that the report of what finished is written before it is raised."""
     if baseline is None:
@@ -382,12 +361,12 @@ def _judge_baseline(summary: dict, baseline: dict | None) -> Exception | None:
     try:
         apply_baseline(summary, baseline)
     except Exception as exc:  # noqa: BLE001 - raised again once the report is written
-        summary["baseline_error"] = f"the baseline check failed: {type(exc).__name__}: {exc}"
+        summary.baseline_error = f"the baseline check failed: {type(exc).__name__}: {exc}"
         return exc
     return None
 
 
-def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> dict:
+def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> CaseResult:
     """One case's entry, where the campaign runs it (comparisons/dispatch.py) with ``cache`` as its run cache. On a
     Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named."""
     lacking = dispatch.missing_here(e for e in opts.engines if found[e]["found"])
@@ -397,40 +376,41 @@ def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> 
     return _safe_case(case, Path(file), replace(opts, cache=cache), found)
 
 
-def _safe_case(case, path, opts, found) -> dict:
+def _safe_case(case, path, opts, found) -> CaseResult:
     try:
         return run_case(case, path, opts, found)
     except EngineInterrupted:
         raise
     except DemcheckError as exc:
-        return {"case": case.name, "file": str(path), "case_hash": case.hash, "status": "failed",
-                "verdict": verdicts.FAILED, "message": str(exc), "sources": {}, "curves": {}, "series": [],
-                "comparisons": [verdicts.status_comparison("reference", verdicts.FAILED, str(exc)).as_dict()]}
+        failed = CaseResult(case.name, str(path), case.hash, message=str(exc),
+                            comparisons=[verdicts.status_comparison("reference", verdicts.FAILED, str(exc))])
+        return failed.judged()
 
 
-def _print(console: Console, summary: dict) -> None:
+def _print(console: Console, summary: Summary) -> None:
     from rich.markup import escape
     from rich.table import Table
 
     counts: dict[str, int] = {}
-    for c in summary["cases"]:
-        for k in c.get("comparisons", []):
-            counts[k["verdict"]] = counts.get(k["verdict"], 0) + 1
-    bad = [c for c in summary["cases"] if c["status"] in ("failed", "unexpected")]
-    for c in bad:
-        for k in c.get("comparisons", []):
-            if k["verdict"] in verdicts.FAILING:
-                said = escape(f"{c['case']} {k['source']} {k['metric']}: {k['reason']}")
-                console.print(f"[red]{k['verdict']}[/] {said}")
-    t = Table(title=f"demcheck verify: {len(summary['cases'])} of {summary['planned']} cases"
-              + (" (PARTIAL)" if summary["partial"] else ""))
+    for c in summary.cases:
+        for k in c.comparisons:
+            counts[k.verdict] = counts.get(k.verdict, 0) + 1
+    for c in summary.cases:
+        if not c.failing:
+            continue
+        for k in c.comparisons:
+            if k.verdict in verdicts.FAILING:
+                said = escape(f"{c.case} {k.source} {k.metric}: {k.reason}")
+                console.print(f"[red]{k.verdict}[/] {said}")
+    t = Table(title=f"demcheck verify: {len(summary.cases)} of {summary.planned} cases"
+              + (" (PARTIAL)" if summary.partial else ""))
     t.add_column("verdict")
     t.add_column("comparisons", justify="right")
     for v in verdicts.VERDICTS:
         if counts.get(v):
             t.add_row(v, str(counts[v]))
     console.print(t)
-    engines = ", ".join(f"{k} {v['version']}" if v["found"] else f"{k} missing" for k, v in summary["engines"].items())
+    engines = ", ".join(f"{k} {v['version']}" if v["found"] else f"{k} missing" for k, v in summary.engines.items())
     console.print(escape(f"engines: {engines or 'none (reference only)'}"))  # a version or reason is text, not markup
-    console.print(f"{summary['failed']} case(s) failing; wall time {summary['wall_time']:.1f} s; "
-                  f"report: {summary['report']}/report.md (and report.html, results.json, junit.xml)")
+    console.print(f"{summary.failed} case(s) failing; wall time {summary.wall_time:.1f} s; "
+                  f"report: {summary.report}/report.md (and report.html, results.json, junit.xml)")

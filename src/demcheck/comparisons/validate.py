@@ -34,6 +34,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import resources
+from .records import CaseResult, Summary
 
 DATA = resources.data_dir() / "benchmarks"
 LINK = "latest-validate"  # <report>/latest is verify's
@@ -550,11 +551,11 @@ def deviation(xs, ys, paper: np.ndarray) -> tuple[float, float, int] | None:
 _NOT_A_SOURCE = ("not expressible", "engine missing")  # comparisons/verdicts.py's statuses of a source left out
 
 
-def _source_metrics(entry: dict, source: str) -> dict | None:
-    s = entry["sources"].get(source) or {}
-    if s.get("status") != "ok" or "metrics" not in s:
+def _source_metrics(entry: CaseResult, source: str) -> dict | None:
+    s = entry.sources.get(source)
+    if s is None or not s.ok or "metrics" not in s.keys:
         return None
-    return dict(s["metrics"])
+    return dict(s.metrics)
 
 
 def judge(bench: Benchmark, groups: dict[str, list[tuple[Impact, dict]]], root: Path = DATA) -> tuple[list, list]:
@@ -763,12 +764,13 @@ def _law_short(case, run_of) -> float:
         return math.nan
 
 
-def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path]], opts,
+def validate(summary: Summary, benches: list[Benchmark], files: dict[str, list[Path]], opts,
              root: Path = DATA) -> dict:
-    """The validation of a finished suite run (its cases' entries): checks and series per benchmark."""
+    """The validation of a finished suite run (its records.Summary: its cases' entries): checks and series per
+    benchmark."""
     from ..case import expand
 
-    entries = {c["case"]: c for c in summary["cases"]}
+    entries = {c.case: c for c in Summary.of(summary).cases}
     out = {"benchmarks": [], "checks": [], "series": []}
     for bench in benches:
         groups: dict[str, list] = {}
@@ -789,8 +791,8 @@ def validate(summary: dict, benches: list[Benchmark], files: dict[str, list[Path
                 if needs_history:  # whether the law slides: its answer on the reference's adaptive run
                     imp = replace(imp, law_short=_law_short(case, run_of))
                 ms = {}
-                for src, got in entry.get("sources", {}).items():
-                    if src == "reference-verlet" or got.get("status") in _NOT_A_SOURCE:
+                for src, got in entry.sources.items():
+                    if src == "reference-verlet" or got.status in _NOT_A_SOURCE:
                         continue  # an engine that cannot express the model is no source here (a failed run is)
                     m = _source_metrics(entry, src)
                     if m is not None:
@@ -845,7 +847,7 @@ def _titled(title: str):
 
 
 def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, junit=None, argv=None,
-        quick: bool = False) -> dict:
+        quick: bool = False) -> Summary:
     """Run the benchmarks' case files through the suite, judge them, and rewrite the run's report with the
     validation section. ``quick``: each benchmark's quick subset alone (QUICK)."""
     from . import report
@@ -860,8 +862,8 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
         raise ConfigError("NAME", names or "(all)", f"no benchmark case files in {root}")
     with _titled("demcheck validate"):
         summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv, link=LINK)
-    summary["validation"] = validate(summary, benches, files, opts)
-    summary["failed"] += len(summary["validation"]["failed"])
-    report.write_all(summary, Path(summary["report"]), report_root, junit=junit, link=LINK)
+    summary.validation = validate(summary, benches, files, opts)
+    summary.failed += len(summary.validation["failed"])
+    report.write_all(summary, Path(summary.report), report_root, junit=junit, link=LINK)
     return summary
 

@@ -14,7 +14,7 @@ Each "differs as expected" carries the engine setting that causes it (``Comparis
 expected-differences entry's ``setting``, or, for an approximate mapping, the native keyword each of the
 mapping's reasons is about (:func:`mapping_setting`, from ``Mapping.keywords``). The report's traps section
 names them. The whole native configuration the mapping chose is recorded per case too (:func:`unavailable`,
-``entry["settings"]``).
+``CaseResult.settings``).
 
 Verdicts: agree, differs as expected, differs unexpectedly, not expressible, engine missing, failed.
 Only "differs unexpectedly" and "failed" fail a run.
@@ -263,19 +263,17 @@ def worst(verdicts) -> str:
     return max(vs, key=order.__getitem__) if vs else AGREE
 
 
-def unavailable(entry: dict, comps: list, planned) -> bool:
-    """Record an engine that cannot run this case (``planned``, comparisons/sources.plan: the model is not
-    expressible, or it is not installed). For one that can express it, the native configuration its mapping chose,
-    in one line of the engine's own words (``entry["settings"][engine]``): the setting the report's traps section
-    names for an approximate mapping."""
-    engine, mp = planned.source.label, planned.mapping
-    if mp.native is not None:
-        entry.setdefault("settings", {})[engine] = native_setting(mp.native)
+def unavailable(planned) -> tuple[str | None, Comparison | None]:
+    """What a case records of an engine source (``planned``, comparisons/sources.plan), edited nowhere: for one that
+    can express the case, the native configuration its mapping chose, in one line of the engine's own words (the
+    case's ``settings``: the setting the report's traps section names for an approximate mapping), else None; and
+    for one that cannot run it (the model is not expressible, or it is not installed) its status comparison
+    (NOT_EXPRESSIBLE, MISSING or FAILED), else None. records.CaseResult.planned notes both."""
+    mp = planned.mapping
+    setting = native_setting(mp.native) if mp.native is not None else None
     if planned.runs:
-        return False
-    entry["sources"][engine] = {"status": planned.status, "message": planned.why}
-    comps.append(status_comparison(engine, planned.status, planned.why))  # NOT_EXPRESSIBLE, MISSING or FAILED
-    return True
+        return setting, None
+    return setting, status_comparison(planned.source.label, planned.status, planned.why)
 
 
 def mapping_setting(mp) -> str:

@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 from ...io import plain, write_json, write_text
+from ..records import Summary
 from .figures import *  # noqa: F401,F403 - the renderers' names, as report.NAME
 from .matrix import *  # noqa: F401,F403
 from .markdown import *  # noqa: F401,F403
@@ -23,12 +24,13 @@ from .junit import render_junit
 from .markdown import _md_packings, render_markdown  # noqa: F401
 
 
-def write_all(summary: dict, out_dir: Path, root: Path, junit: Path | None = None, link: str = "latest") -> None:
+def write_all(summary: Summary, out_dir: Path, root: Path, junit: Path | None = None, link: str = "latest") -> None:
+    """Every report of a run (a records.Summary, or the dict of one) into ``out_dir``: results.json (the summary's
+    JSON without the plots' series), report.md, junit.xml (and ``junit``), report.html; then ``root/link``."""
+    summary = Summary.of(summary)
     out_dir.mkdir(parents=True, exist_ok=True)
-    PLOT_CACHE["dir"] = Path(summary["cache"]["dir"]) / "plots" if "cache" in summary else None
-    data = {k: v for k, v in summary.items()}
-    data["cases"] = [{k: v for k, v in c.items() if k != "series"} for c in summary["cases"]]
-    write_json(out_dir / "results.json", plain(data))
+    PLOT_CACHE["dir"] = Path(summary.cache["dir"]) / "plots" if summary.cache is not None else None
+    write_json(out_dir / "results.json", plain(summary.to_json(series=False)))
     write_text(out_dir / "report.md", render_markdown(summary))
     junit_text = render_junit(summary)
     write_text(out_dir / "junit.xml", junit_text)

@@ -12,11 +12,12 @@ from collections import defaultdict
 from pathlib import Path
 
 from ...io import number, plain, write_text
+from ..records import CaseResult, Summary
 from ..styles import engine_sources
 from .matrix import _model
 
 
-def validation_plots(summary: dict) -> list[tuple[str, str]]:
+def validation_plots(summary: Summary) -> list[tuple[str, str]]:
     """One panel per case file and quantity, drawn like the papers' figures: each source a line over the
     benchmark's axis, the paper's points over them."""
     import matplotlib
@@ -27,7 +28,7 @@ def validation_plots(summary: dict) -> list[tuple[str, str]]:
     from .. import plots
 
     out = []
-    for line in (summary.get("validation") or {}).get("series", []):
+    for line in (Summary.of(summary).validation or {}).get("series", []):
         if not line["x_label"]:
             continue
         fig, ax = plt.subplots(figsize=(5.2, 3.6), layout="constrained")
@@ -130,13 +131,14 @@ def _img(b64: str, alt: str) -> str:
     return f'<img class="plot" alt="{html.escape(alt)}" src="data:image/png;base64,{b64}">'
 
 
-def case_panels(entry: dict) -> str | None:
+def case_panels(entry: CaseResult) -> str | None:
     """Force–overlap loop and force–time curve of one case, one line per source."""
-    series = entry.get("series") or []
+    entry = CaseResult.from_json(entry)
+    series = entry.series
     if not series:
         return None
-    return _cached({"case": entry["case"], "series": series, "v": PLOT_VERSION},
-                   lambda: _png(case_figure(entry["case"], series)), _png_ok)
+    return _cached({"case": entry.case, "series": series, "v": PLOT_VERSION},
+                   lambda: _png(case_figure(entry.case, series)), _png_ok)
 
 
 def case_figure(name, series):
@@ -162,35 +164,30 @@ def case_figure(name, series):
     return fig
 
 
-def _metric_of(entry, source, metric):
-    s = entry.get("sources", {}).get(source, {})
-    return (s.get("metrics") or {}).get(metric)
-
-
-def suite_plots(summary: dict) -> list[tuple[str, str]]:
+def suite_plots(summary: Summary) -> list[tuple[str, str]]:
     """Restitution in vs out; restitution against impact speed; tangential restitution and rebound spin
     against incidence angle — each per model and source."""
     import json
 
-    key = [(c["case"], c.get("file"), _model(c), c.get("impact"), c.get("walls"), c.get("variant"),
-            {s: (v.get("metrics") or {}) for s, v in c.get("sources", {}).items()}) for c in summary["cases"]]
+    key = [(c.case, c.file, _model(c), c.impact, c.walls, c.variant, {s: v.metrics for s, v in c.sources.items()})
+           for c in summary.cases]
     text = _cached({"suite": key, "v": PLOT_VERSION}, lambda: json.dumps(_suite_plots(summary)), _plot_list_ok)
     return [tuple(x) for x in json.loads(text)]
 
 
-def _suite_plots(summary: dict) -> list[tuple[str, str]]:
+def _suite_plots(summary: Summary) -> list[tuple[str, str]]:
     return [(title, _png(fig)) for title, fig in suite_figures(summary)]
 
 
-def _kind(c: dict) -> str:
+def _kind(c: CaseResult) -> str:
     """A wall impact or a pair, by the case's number of walls (never its name); "" when the entry does not say
     (a results.json from before entries carried it)."""
-    walls = c.get("walls")
+    walls = c.walls
     return "" if walls is None else "wall" if walls else "pair"
 
 
-def _lines(cases: list[dict], x_key: str) -> dict:
-    """The cases of each file split into lines along ``x_key``: a file's variant labels (``entry["variant"]``)
+def _lines(cases: list[CaseResult], x_key: str) -> dict:
+    """The cases of each file split into lines along ``x_key``: a file's variant labels (``CaseResult.variant``)
     other than those that set x keep cases apart — a file varying the speed and limit_force draws a line per
     limit_force. A label sets x when, within the file, its texts and the x values go one to one (``speed``
     for impact.speed, ``velocity`` for a particle's velocity that sets the incidence angle, a group zipping
@@ -198,18 +195,18 @@ def _lines(cases: list[dict], x_key: str) -> dict:
     none (a file without variants, a results.json from before entries carried them)."""
     by_file = defaultdict(list)
     for c in cases:
-        by_file[c.get("file") or c["case"]].append(c)
+        by_file[c.file or c.case].append(c)
     out = {}
     for file, cs in by_file.items():
-        keys = [k for k, _ in cs[0].get("variant") or []]
-        labelled = bool(keys) and all([k for k, _ in c.get("variant") or []] == keys for c in cs)
+        keys = [k for k, _ in cs[0].variant or []]
+        labelled = bool(keys) and all([k for k, _ in c.variant or []] == keys for c in cs)
         keep = []
         for i in range(len(keys) if labelled else 0):
-            pairs = {(c["variant"][i][1], round(float(c["impact"][x_key]), 9)) for c in cs}
+            pairs = {(c.variant[i][1], round(float(c.impact[x_key]), 9)) for c in cs}
             if not len(pairs) == len({t for t, _ in pairs}) == len({x for _, x in pairs}):
                 keep.append(i)  # not x's own label: its values are lines of their own
         for c in cs:
-            labels = tuple((keys[i], c["variant"][i][1]) for i in keep) if labelled else None
+            labels = tuple((keys[i], c.variant[i][1]) for i in keep) if labelled else None
             out.setdefault((file, labels), []).append(c)
     return out
 
@@ -218,34 +215,34 @@ def _label_text(labels) -> str:
     return "".join(f", {k}={v}" for k, v in labels or ())
 
 
-def speed_panels(cases: list[dict]) -> dict:
+def speed_panels(cases: list[CaseResult]) -> dict:
     """The panels of "restitution against impact speed": one per case file (its variants over speed) and
     value of its other variant labels (:func:`_lines`), titled by the model, pair or wall, the file and those
     labels — a line never joins the cases of two files, nor two values of another key."""
-    groups = defaultdict(list)
-    with_speed = [c for c in cases if c["impact"].get("speed") is not None]
+    groups, cases = defaultdict(list), [CaseResult.from_json(c) for c in cases]
+    with_speed = [c for c in cases if c.impact.get("speed") is not None]
     for (file, labels), cs in _lines(with_speed, "speed").items():
         for c in cs:
             groups[(_model(c), _kind(c), file, labels)].append(c)
     return {" ".join(x for x in (model, kind) if x) + f" ({Path(file).stem}{_label_text(labels)})": cs
-            for (model, kind, file, labels), cs in groups.items() if len({c["impact"]["speed"] for c in cs}) > 1}
+            for (model, kind, file, labels), cs in groups.items() if len({c.impact["speed"] for c in cs}) > 1}
 
 
-def angle_panels(cases: list[dict]) -> dict:
+def angle_panels(cases: list[CaseResult]) -> dict:
     """The panels against incidence angle: one per case file and value of its other variant labels
     (:func:`_lines`: the initial spin's among them, titled by them); a file whose entries carry no labels, one
     per initial spin (titled by it)."""
-    groups = defaultdict(list)
-    with_angle = [c for c in cases if c["impact"].get("angle") is not None]
+    groups, cases = defaultdict(list), [CaseResult.from_json(c) for c in cases]
+    with_angle = [c for c in cases if c.impact.get("angle") is not None]
     for (file, labels), cs in _lines(with_angle, "angle").items():
         for c in cs:
-            spin = round(c["impact"].get("spin") or 0.0, 6) if labels is None else None
+            spin = round(c.impact.get("spin") or 0.0, 6) if labels is None else None
             groups[(file, labels, spin)].append(c)
     return {f"{_model(cs[0])}{'' if spin is None else f', spin {spin:g}'} ({Path(file).stem}{_label_text(labels)})": cs
             for (file, labels, spin), cs in groups.items() if len(cs) > 1}
 
 
-def suite_figures(summary: dict) -> list[tuple[str, object]]:
+def suite_figures(summary: Summary) -> list[tuple[str, object]]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -255,13 +252,13 @@ def suite_figures(summary: dict) -> list[tuple[str, object]]:
 
     out = []
     sources = ["reference", *engine_sources()]
-    collisions = [c for c in summary["cases"] if c.get("kind") != "packing" and c.get("impact")]
-    normal = [c for c in collisions if c.get("model") and c["model"]["tangential"] == "none"]
-    with_input = [c for c in normal if c["impact"].get("restitution_input") is not None]
+    collisions = [c for c in Summary.of(summary).cases if c.kind != "packing" and c.impact]
+    normal = [c for c in collisions if c.model and c.model["tangential"] == "none"]
+    with_input = [c for c in normal if c.impact.get("restitution_input") is not None]
     if with_input:
         fig, ax = plt.subplots(figsize=(4.6, 4.2), layout="constrained")
         for src in sources:
-            pts = [(c["impact"]["restitution_input"], _metric_of(c, src, "restitution")) for c in with_input]
+            pts = [(c.impact["restitution_input"], c.metric(src, "restitution")) for c in with_input]
             pts = [(x, y) for x, y in pts if y is not None and math.isfinite(y)]
             if pts:
                 plots.source_line(ax, *zip(*pts), src, line=False)
@@ -276,8 +273,8 @@ def suite_figures(summary: dict) -> list[tuple[str, object]]:
         out.append(("restitution against impact speed",
                     panel_grid(panels, sources, "speed", "restitution", "impact speed (m/s)", "restitution",
                                log_x=True)))
-    oblique = [c for c in collisions if c.get("model") and c["model"]["tangential"] != "none"
-               and c["impact"].get("angle") is not None]
+    oblique = [c for c in collisions if c.model and c.model["tangential"] != "none"
+               and c.impact.get("angle") is not None]
     panels = angle_panels(oblique)
     for metric, label in (("tangential_restitution", "tangential restitution"),
                           ("rebound_angular_velocity", "rebound spin (rad/s)")):
@@ -301,10 +298,10 @@ def panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_l
                              layout="constrained")
     handles = {}
     for ax, (name, cs) in zip(axes.ravel(), sorted(panels.items())):
-        cs = sorted(cs, key=lambda c: c["impact"][x_key])
+        cs = sorted((CaseResult.from_json(c) for c in cs), key=lambda c: c.impact[x_key])
         ys = []
         for src in sources:
-            pts = [(c["impact"][x_key], _metric_of(c, src, metric)) for c in cs]
+            pts = [(c.impact[x_key], c.metric(src, metric)) for c in cs]
             pts = [p for p in pts if p[1] is not None and math.isfinite(p[1])]
             if pts:
                 handles.setdefault(src, plots.source_line(ax, *zip(*pts), src))
@@ -329,11 +326,12 @@ def panel_grid(panels: dict, sources, x_key: str, metric: str, x_label: str, y_l
     return fig
 
 
-def packing_plots(entry: dict) -> str:
+def packing_plots(entry: CaseResult) -> str:
     """The packing's panels, from the plot cache when the same data was drawn before (its three panels took
     2–3 s a packing to lay out and draw: most of a warm suite's report)."""
-    key = {"packing": entry["packing"], "case": entry.get("case"), "v": PLOT_VERSION,
-           "sources": {src: v.get("status") for src, v in (entry.get("sources") or {}).items()}}
+    entry = CaseResult.from_json(entry)
+    key = {"packing": entry.packing, "case": entry.case, "v": PLOT_VERSION,
+           "sources": {src: v.status for src, v in entry.sources.items()}}
     return _cached(key, lambda: _png(packing_figure(entry)), _png_ok)
 
 
@@ -344,7 +342,7 @@ def force_count(forces: dict) -> int | None:
     return None if n is None else int(n)
 
 
-def packing_figure(entry: dict):
+def packing_figure(entry: CaseResult):
     """Solid fraction against height, P(f/⟨f⟩) and kinetic energy against time, per source. What a panel
     cannot draw is said in it: a source without that output (or one that did not run), a packing without a
     periodic box (no profile), a source with fewer than MIN_CONTACTS contact forces or an unknown count (no
@@ -356,9 +354,10 @@ def packing_figure(entry: dict):
 
     from .. import plots
 
-    data = entry["packing"]
+    entry = CaseResult.from_json(entry)
+    data = entry.packing
     order = sorted(data, key=plots.source_order)
-    absent = [f"{src} ({v.get('status', 'no output')})" for src, v in entry.get("sources", {}).items()
+    absent = [f"{src} ({v.status if 'status' in v.keys else 'no output'})" for src, v in entry.sources.items()
               if src not in data]
     fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(12, 3.6), layout="constrained")
     notes: dict = {a1: [], a2: [], a3: []}

@@ -6,9 +6,11 @@ from __future__ import annotations
 import functools
 import html
 import logging
+from dataclasses import replace
 
 from ...io import number
 from .. import verdicts
+from ..records import Summary
 from .figures import _img, case_panels, packing_plots, suite_plots, validation_plots
 from .markdown import _md_disagreements, _md_header, _md_packings, _md_traps, validation_markdown
 from .matrix import MATRIX_METRICS, _LEGEND, _SHORT, _matrix_sources, _md, _model, matrix
@@ -60,7 +62,7 @@ def _markdown():
     return MarkdownIt("commonmark", {"html": False, "breaks": True}).enable("table")
 
 
-def _matrix_html(summary: dict) -> str:
+def _matrix_html(summary: Summary) -> str:
     """The agreement matrix as a table: a column per source and metric, each cell coloured by its verdict
     (VERDICT_CLASS), with a legend."""
     esc = html.escape
@@ -115,20 +117,20 @@ def _plot(what: str, render, draw: bool = True):
                       f"({html.escape(type(exc).__name__)}: {html.escape(first)}); the numbers are in the tables.</p>")
 
 
-def render_html(summary: dict, draw: bool = True) -> str:
+def render_html(summary: Summary, draw: bool = True) -> str:
     """report.html. ``draw`` off: no plot is drawn (write_all's page when the run was interrupted while they
     were), and the page says so."""
     from .. import plots
 
-    esc = html.escape
+    esc, summary = html.escape, Summary.of(summary)
     parts = ["<!doctype html><html><head><meta charset='utf-8'>",
-             f"<title>demcheck {'validate' if summary.get('validation') else 'verify'} {esc(summary['run_id'])}</title>"
+             f"<title>demcheck {'validate' if summary.validation else 'verify'} {esc(summary.run_id)}</title>"
              f"<style>{_STYLE}</style>{_SCRIPT}</head><body>",
-             f"<h1>demcheck verification {esc(summary['run_id'])}</h1>"]
-    if summary["partial"]:
-        parts.append(f"<p class='partial'>PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of "
-                     f"{summary['planned']} cases finished.</p>")
-    header = _md_header({**summary, "partial": False})  # the partial note is above, in its own box
+             f"<h1>demcheck verification {esc(summary.run_id)}</h1>"]
+    if summary.partial:
+        parts.append(f"<p class='partial'>PARTIAL REPORT: the run was interrupted; {len(summary.cases)} of "
+                     f"{summary.planned} cases finished.</p>")
+    header = _md_header(replace(summary, partial=False))  # the partial note is above, in its own box
     parts.append(_markdown_html(header))
     parts.append("<h2>Agreement matrix</h2>" + _matrix_html(summary))
     parts.append(_markdown_html(_md_traps(summary)))
@@ -144,14 +146,14 @@ def render_html(summary: dict, draw: bool = True) -> str:
     parts.append(note)
     for title, b64 in items or []:
         parts.append(f"<h3>{esc(title)}</h3>{_img(b64, title)}")
-    packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
+    packings = [c for c in summary.cases if c.kind == "packing"]
     if packings:
         parts.append(_markdown_html(_md_packings(summary)))
         for c in packings:
-            if c.get("packing"):
-                b64, note = _plot(f"the packing panels of {c['case']}", lambda c=c: packing_plots(c), draw)
-                parts.append(f"<h3>packing {esc(c['case'])}</h3>" + (_img(b64, f"packing {c['case']}") if b64 else note))
-    if summary.get("validation"):
+            if c.packing:
+                b64, note = _plot(f"the packing panels of {c.case}", lambda c=c: packing_plots(c), draw)
+                parts.append(f"<h3>packing {esc(c.case)}</h3>" + (_img(b64, f"packing {c.case}") if b64 else note))
+    if summary.validation:
         parts.append(_markdown_html(validation_markdown(summary)))
         items, note = _plot("the validation plots", lambda: validation_plots(summary), draw)
         parts.append(note)
@@ -159,25 +161,25 @@ def render_html(summary: dict, draw: bool = True) -> str:
     parts.append("<h2>Cases</h2>")
     # one plot per case file (its first variant), every case's numbers in a table
     shown = set()
-    for c in summary["cases"]:
-        cls = {"ok": "status-ok", "unexpected": "status-unexpected", "failed": "status-failed"}.get(c["status"], "")
-        parts.append(f"<details><summary><span class='{cls}'>{esc(c['status'])}</span> {esc(c['case'])} — "
+    for c in summary.cases:
+        cls = {"ok": "status-ok", "unexpected": "status-unexpected", "failed": "status-failed"}.get(c.status, "")
+        parts.append(f"<details><summary><span class='{cls}'>{esc(c.status)}</span> {esc(c.case)} — "
                      f"{esc(_model(c))}</summary>")
-        if c.get("kind") != "packing" and c["file"] not in shown:
-            b64, note = _plot(f"the force curves of {c['case']}", lambda c=c: case_panels(c), draw)
+        if c.kind != "packing" and c.file not in shown:
+            b64, note = _plot(f"the force curves of {c.case}", lambda c=c: case_panels(c), draw)
             if b64:
-                parts.append(_img(b64, f"force curves of {c['case']}"))
+                parts.append(_img(b64, f"force curves of {c.case}"))
             if b64 or note:
                 parts.append(note)
-                shown.add(c["file"])
+                shown.add(c.file)
         parts.append("<table><tr><th>source</th><th>metric</th><th>value</th><th>reference</th><th>scaled diff"
                      "</th><th>tolerance</th><th>verdict</th><th>reason</th></tr>")
-        for k in c.get("comparisons", []):
-            parts.append(f"<tr><td>{esc(k['source'])}</td><td>{esc(k['metric'])}</td><td>{number(k['value'])}</td>"
-                         f"<td>{number(k['reference'])}</td><td>{number(k['rel_diff'], '.3g')}</td>"
-                         f"<td>{number(k['tolerance'], '.3g')}</td>"
-                         f"<td class='{VERDICT_CLASS.get(k['verdict'], '')}'>{esc(k['verdict'])}</td>"
-                         f"<td>{esc(k['reason'])}</td></tr>")
+        for k in c.comparisons:
+            parts.append(f"<tr><td>{esc(k.source)}</td><td>{esc(k.metric)}</td><td>{number(k.value)}</td>"
+                         f"<td>{number(k.reference)}</td><td>{number(k.rel_diff, '.3g')}</td>"
+                         f"<td>{number(k.tolerance, '.3g')}</td>"
+                         f"<td class='{VERDICT_CLASS.get(k.verdict, '')}'>{esc(k.verdict)}</td>"
+                         f"<td>{esc(k.reason)}</td></tr>")
         parts.append("</table></details>")
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"

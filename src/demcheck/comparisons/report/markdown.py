@@ -8,45 +8,47 @@ from collections import defaultdict
 
 from ...io import number
 from .. import verdicts
+from ..records import Summary
 from .matrix import MATRIX_METRICS, _SHORT, _cell, _code, _engine_text, _matrix_sources, _md, _model, matrix, traps
 
 
 # ----------------------------------------------------------------------------- markdown
 
 
-def render_markdown(summary: dict) -> str:
-    lines = [f"# demcheck verification {summary['run_id']}", ""]
+def render_markdown(summary: Summary) -> str:
+    summary = Summary.of(summary)
+    lines = [f"# demcheck verification {summary.run_id}", ""]
     for section in (_md_header, _md_matrix, _md_traps, _md_disagreements, _md_packings, _md_cases,
                     validation_markdown):
         lines += section(summary)
     return "\n".join(lines) + "\n"
 
 
-def _md_header(summary: dict) -> list[str]:
+def _md_header(summary: Summary) -> list[str]:
     lines = []
-    if summary["partial"]:
-        lines += [f"**PARTIAL REPORT: the run was interrupted; {len(summary['cases'])} of {summary['planned']} "
+    if summary.partial:
+        lines += [f"**PARTIAL REPORT: the run was interrupted; {len(summary.cases)} of {summary.planned} "
                   "cases finished and are reported below.**", ""]
-    lines += [f"demcheck {summary['demcheck']} · started {summary['started']} · wall time "
-              f"{summary.get('wall_time', 0):.1f} s", "", f"Engines: {_engine_text(summary)}", ""]
-    if "cache" in summary:
-        lines += [f"Engine-run cache: {summary['cache']['hits']} hits, {summary['cache']['misses']} misses "
-                  f"({_md(summary['cache']['dir'])})", ""]
+    lines += [f"demcheck {summary.demcheck} · started {summary.started} · wall time "
+              f"{summary.wall_time or 0:.1f} s", "", f"Engines: {_engine_text(summary)}", ""]
+    if summary.cache is not None:
+        lines += [f"Engine-run cache: {summary.cache['hits']} hits, {summary.cache['misses']} misses "
+                  f"({_md(summary.cache['dir'])})", ""]
     counts: dict = defaultdict(int)
-    for c in summary["cases"]:
-        for k in c.get("comparisons", []):
-            counts[k["verdict"]] += 1
+    for c in summary.cases:
+        for k in c.comparisons:
+            counts[k.verdict] += 1
     lines += ["| verdict | comparisons |", "|---|---|"]
     lines += [f"| {v} | {counts[v]} |" for v in verdicts.VERDICTS if counts[v]]
-    lines += ["", f"**{summary['failed']} case(s) with an unexpected difference or a failure.**", ""]
-    if "baseline" in summary:
+    lines += ["", f"**{summary.failed} case(s) with an unexpected difference or a failure.**", ""]
+    if summary.baseline is not None:
         from ..diff import baseline_markdown
 
-        lines += baseline_markdown(summary["baseline"])
+        lines += baseline_markdown(summary.baseline)
     return lines
 
 
-def _md_matrix(summary: dict) -> list[str]:
+def _md_matrix(summary: Summary) -> list[str]:
     """The agreement matrix: models × sources × metrics, the worst verdict over each model's collision cases."""
     mat = matrix(summary)
     sources = _matrix_sources(summary)
@@ -69,14 +71,14 @@ def _md_matrix(summary: dict) -> list[str]:
     return lines + [""]
 
 
-def _md_disagreements(summary: dict) -> list[str]:
+def _md_disagreements(summary: Summary) -> list[str]:
     """Every comparison that does not agree, grouped by verdict, source and reason."""
     lines = ["## Disagreements and their reasons", ""]
     reasons: dict = defaultdict(list)
-    for c in summary["cases"]:
-        for k in c.get("comparisons", []):
-            if k["verdict"] in (verdicts.EXPECTED, verdicts.UNEXPECTED, verdicts.FAILED, verdicts.NOT_EXPRESSIBLE, verdicts.MISSING):
-                reasons[(k["verdict"], k["source"], k["reason"])].append((c["case"], k["metric"], k["rel_diff"]))
+    for c in summary.cases:
+        for k in c.comparisons:
+            if k.verdict in (verdicts.EXPECTED, verdicts.UNEXPECTED, verdicts.FAILED, verdicts.NOT_EXPRESSIBLE, verdicts.MISSING):
+                reasons[(k.verdict, k.source, k.reason)].append((c.case, k.metric, k.rel_diff))
     if not reasons:
         lines.append("None: every source agrees with the seed model on every metric.")
     for (verdict, source, reason), hits in sorted(reasons.items(), key=lambda x: (-len(x[1]), x[0])):
@@ -90,7 +92,7 @@ def _md_disagreements(summary: dict) -> list[str]:
     return lines + [""]
 
 
-def _md_traps(summary: dict) -> list[str]:
+def _md_traps(summary: Summary) -> list[str]:
     """The traps: for each expected difference met, the engine setting a user's own deck would meet it with."""
     lines = ["## Traps", "",
              "Each expected difference met in this run, by the engine setting that causes it: the setting to look "
@@ -108,8 +110,8 @@ def _md_traps(summary: dict) -> list[str]:
     return lines + [""]
 
 
-def _md_packings(summary: dict) -> list[str]:
-    packings = [c for c in summary["cases"] if c.get("kind") == "packing"]
+def _md_packings(summary: Summary) -> list[str]:
+    packings = [c for c in Summary.of(summary).cases if c.kind == "packing"]
     if not packings:
         return []
     lines = ["## Packings", "", "Bulk values per source (the trajectories are chaotic: compared by these, "
@@ -119,39 +121,39 @@ def _md_packings(summary: dict) -> list[str]:
              "max overlap / d | static closed form |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for c in packings:
-        for src, v in c["sources"].items():
-            m = v.get("metrics") or {}
+        for src, v in c.sources.items():
+            m = v.metrics
 
             def comp(metric, src=src, c=c):
-                return next((k for k in c["comparisons"] if k["source"] == src and k["metric"] == metric), None)
+                return next((k for k in c.comparisons if k.source == src and k.metric == metric), None)
 
             cf, ks, fz = comp("static_overlap"), comp("force_distribution_ks"), comp("fabric_zz")
-            lines.append(f"| {_cell(c['case'])} | {_cell(src)} | {number(m.get('solid_fraction'), '.4f')} | "
+            lines.append(f"| {_cell(c.case)} | {_cell(src)} | {number(m.get('solid_fraction'), '.4f')} | "
                          f"{number(m.get('coordination_number'), '.3f')} | {number(m.get('bed_height'), '.5g')} | "
                          f"{number(m.get('mean_contact_force'), '.4g')} | "
-                         f"{number(ks['value'], '.3f') + ' (' + number(ks['tolerance'], '.3f') + ') ' + ks['verdict'] if ks else '—'} | "
+                         f"{number(ks.value, '.3f') + ' (' + number(ks.tolerance, '.3f') + ') ' + ks.verdict if ks else '—'} | "
                          f"{_fabric_cell(m, fz)} | "
                          f"{number(m.get('max_overlap_ratio'), '.3g')} | "
-                         f"{number(cf['value'], '.2e') + ' ' + cf['verdict'] if cf else '—'} |")
+                         f"{number(cf.value, '.2e') + ' ' + cf.verdict if cf else '—'} |")
     return lines + [""]
 
 
-def _fabric_cell(metrics: dict, comp: dict | None) -> str:
+def _fabric_cell(metrics: dict, comp: verdicts.Comparison | None) -> str:
     """A source's φ_zz (the contact fabric's vertical component) and, where verify compares it (a poured
     packing's engines), its distance to the reference's against the critical one and the verdict."""
     text = number(metrics.get("fabric_zz"), ".4f")
     if comp:
-        text += f"; {number(comp['rel_diff'], '.4f')} ({number(comp['tolerance'], '.4f')}) {comp['verdict']}"
+        text += f"; {number(comp.rel_diff, '.4f')} ({number(comp.tolerance, '.4f')}) {comp.verdict}"
     return text
 
 
-def _md_cases(summary: dict) -> list[str]:
+def _md_cases(summary: Summary) -> list[str]:
     lines = ["## Cases", "", "| case | model | status | sources | worst curve distance (force–time max) |",
              "|---|---|---|---|---|"]
-    for c in summary["cases"]:
-        srcs = ", ".join(f"{k}: {v.get('status', '—')}" for k, v in c.get("sources", {}).items())
-        worst_curve = max((d.get("force_time_max") or 0.0 for d in c.get("curves", {}).values()), default=0.0)
-        lines.append(f"| {_cell(c['case'])} | {_cell(_model(c))} | {_cell(c['status'])} | {_cell(srcs)} | "
+    for c in summary.cases:
+        srcs = ", ".join(f"{k}: {v.status if 'status' in v.keys else '—'}" for k, v in c.sources.items())
+        worst_curve = max((d.get("force_time_max") or 0.0 for d in c.curves.values()), default=0.0)
+        lines.append(f"| {_cell(c.case)} | {_cell(_model(c))} | {_cell(c.status)} | {_cell(srcs)} | "
                      f"{number(worst_curve, '.3g')} |")
     return lines
 
@@ -159,10 +161,10 @@ def _md_cases(summary: dict) -> list[str]:
 # ----------------------------------------------------------------------------- validation (demcheck validate)
 
 
-def validation_markdown(summary: dict) -> list[str]:
+def validation_markdown(summary: Summary) -> list[str]:
     """The published-benchmark verdicts (comparisons/validate.py): each source against each exact limit and
     each paper's curve, largest deviation, tolerance and what it stands for."""
-    val = summary.get("validation")
+    val = Summary.of(summary).validation
     if not val:
         return []
     lines = ["", "## Validation against published benchmarks", "",

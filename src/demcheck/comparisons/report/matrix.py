@@ -7,26 +7,29 @@ from collections import defaultdict
 
 from ...io import md_text, number
 from .. import verdicts
+from ..records import CaseResult, Summary
 from ..styles import engine_sources
 
 
 # ----------------------------------------------------------------------------- helpers
 
 
-def _model(c: dict) -> str:
-    m = c.get("model") or {}
+def _model(c: CaseResult) -> str:
+    """The case's model in one line (a case's entry as a record, or as results.json holds it)."""
+    c = CaseResult.from_json(c)
+    m = c.model or {}
     if not m:
         return "—"
     text = f"{m['normal']} / {m['tangential']}"
     text += "".join(f" + {slot} {m[slot]}" for slot in ("rolling", "twisting", "adhesion", "heat") if slot in m)
-    if c.get("scenario"):
-        text += f" ({c['scenario']})"
+    if c.scenario:
+        text += f" ({c.scenario})"
     return text + (" (limit_force)" if m.get("limit_force") else "")
 
 
-def _engine_text(summary: dict) -> str:
+def _engine_text(summary: Summary) -> str:
     parts = []
-    for name, e in summary["engines"].items():
+    for name, e in summary.engines.items():
         parts.append(f"{_md(name)} {_md(e['version'])}" if e["found"] else
                      f"{_md(name)}: missing ({_md(e['how_to_install'])})")
     return "; ".join(parts) if parts else "none selected (reference only)"
@@ -40,14 +43,14 @@ def _cell(text) -> str:
     return _md(text)
 
 
-def matrix(summary: dict) -> dict:
+def matrix(summary: Summary) -> dict:
     """(model, source, metric) → worst verdict over the collision cases (the packings have their own table)."""
     out: dict = defaultdict(list)
-    for c in summary["cases"]:
-        if c.get("kind") == "packing":
+    for c in Summary.of(summary).cases:
+        if c.kind == "packing":
             continue
-        for k in c.get("comparisons", []):
-            out[(_model(c), k["source"], k["metric"])].append(k["verdict"])
+        for k in c.comparisons:
+            out[(_model(c), k.source, k.metric)].append(k.verdict)
     return {key: verdicts.worst(vs) for key, vs in out.items()}
 
 
@@ -63,8 +66,8 @@ MATRIX_METRICS = (("restitution", "e", "restitution"), ("contact_time", "t", "co
 REFERENCE_SOURCES = ("closed-form", "reference-verlet")
 
 
-def _matrix_sources(summary: dict) -> list[str]:
-    return [*REFERENCE_SOURCES, *[s for s in engine_sources() if s in summary["engines"]]]
+def _matrix_sources(summary: Summary) -> list[str]:
+    return [*REFERENCE_SOURCES, *[s for s in engine_sources() if s in summary.engines]]
 
 
 APPROXIMATE = "approximate mapping: "
@@ -78,7 +81,7 @@ def _generic(text: str) -> str:
     return re.sub(r"(=\s*)(?!0(?![\w.]))[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(?![\w.])", r"\1…", text)
 
 
-def traps(summary: dict) -> list[dict]:
+def traps(summary: Summary) -> list[dict]:
     """Every expected difference of an engine met in the run, grouped by (engine, setting, reason with its
     numbers left out), the setting being what causes it: an entry of data/expected_differences.toml (its
     ``setting`` and ``source``), or an approximate mapping (the native keyword each of its reasons is about,
@@ -88,32 +91,32 @@ def traps(summary: dict) -> list[dict]:
     # setting of a comparison from a results.json written before comparisons carried it
     documented = {f"{e.reason} ({e.source})" if e.source else e.reason: e for e in verdicts.load_expected()}
     groups: dict = {}
-    for c in summary["cases"]:
-        for k in c.get("comparisons", []):
-            if k["verdict"] != verdicts.EXPECTED or k["source"] in (*REFERENCE_SOURCES, "reference"):
+    for c in Summary.of(summary).cases:
+        for k in c.comparisons:
+            if k.verdict != verdicts.EXPECTED or k.source in (*REFERENCE_SOURCES, "reference"):
                 continue
-            reason = k["reason"]
+            reason = k.reason
             entry = documented.get(reason)
             approximate = reason.startswith(APPROXIMATE)
-            if not (approximate or entry is not None or k.get("setting")):
+            if not (approximate or entry is not None or k.setting):
                 continue  # not an engine setting's doing (a poured packing outside its physical range)
             if approximate:
                 # the keywords, "; "-joined; a results.json from before comparisons carried them: the whole
                 # native configuration the case recorded
-                setting = k.get("setting") or _generic((c.get("settings") or {}).get(k["source"], ""))
+                setting = k.setting or _generic((c.settings or {}).get(k.source, ""))
                 settings = [x for x in setting.split("; ") if x]
                 text, kind, source = reason[len(APPROXIMATE):], "approximate mapping", MAPPING_DOC
             else:
-                setting = k.get("setting") or (entry.setting if entry else "")
+                setting = k.setting or (entry.setting if entry else "")
                 settings = [setting] if setting else []
                 text, kind = (entry.reason if entry else reason), "expected difference"
                 source = entry.source if entry else ""
             text = _generic(text)
-            g = groups.setdefault((k["source"], setting, text, kind), {
-                "engine": k["source"], "settings": settings, "reason": text, "kind": kind, "source": source,
+            g = groups.setdefault((k.source, setting, text, kind), {
+                "engine": k.source, "settings": settings, "reason": text, "kind": kind, "source": source,
                 "cases": set(), "metrics": set(), "comparisons": 0})
-            g["cases"].add(c["case"])
-            g["metrics"].add(k["metric"])
+            g["cases"].add(c.case)
+            g["metrics"].add(k.metric)
             g["comparisons"] += 1
     out = [{**g, "cases": sorted(g["cases"]), "metrics": sorted(g["metrics"])} for g in groups.values()]
     return sorted(out, key=lambda g: (-g["comparisons"], g["engine"], g["settings"], g["reason"]))

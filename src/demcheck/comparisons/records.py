@@ -1,0 +1,246 @@
+"""The suite's results as typed records: a source's row (:class:`SourceResult`), a case's entry
+(:class:`CaseResult`) and a run's summary (:class:`Summary`), built once in the suite (comparisons/suite.py,
+packing_suite.py, scenario_rows.py) and read by attribute in the renderers (report/), diff, validate, the API and
+the command line.
+
+JSON is the edge: ``to_json()`` writes a record as the dict results.json, a baseline and the API always held (the
+same keys, in the same order), ``from_json()`` reads one back — an old results.json too, its missing keys left at
+their defaults and keys this release does not know kept as they were (``extra``). The renderers take a record or
+such a dict (:meth:`Summary.of`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+
+from . import verdicts
+
+OK, FAILED, UNEXPECTED = "ok", "failed", "unexpected"
+
+
+def _comparison(d) -> verdicts.Comparison:
+    """A comparison of a results.json as its record (a key a release before this one did not write: default)."""
+    if isinstance(d, verdicts.Comparison):
+        return d
+    nan = float("nan")
+    known = {f.name for f in fields(verdicts.Comparison)}
+    values = {"value": nan, "reference": nan, "abs_diff": nan, "rel_diff": nan, "tolerance": nan,
+              **{k: v for k, v in d.items() if k in known}}
+    values.setdefault("source", "")
+    values.setdefault("metric", "")
+    values.setdefault("verdict", verdicts.AGREE)
+    values["parts"] = dict(values.get("parts") or {})
+    values["reason"] = values.get("reason") or ""
+    values["setting"] = values.get("setting") or ""
+    return verdicts.Comparison(**values)
+
+
+@dataclass
+class SourceResult:
+    """One source's row of a case: its status and message, and what it ran (method, dt, rtol, version, wall time),
+    its metrics, and for an engine its mapping's fidelity and reasons, its twin's and the seed model's verlet
+    metrics at its step. ``keys``: the fields the row carries in JSON, in their order (a source that could not run
+    carries its status and message alone; a packing's its metrics)."""
+
+    status: str | None
+    message: str | None = None
+    method: str | None = None
+    dt: float | None = None
+    rtol: float | None = None
+    engine_version: str | None = None
+    wall_time: float | None = None
+    metrics: dict = field(default_factory=dict)
+    cached: bool | None = None
+    warnings: list = field(default_factory=list)
+    fidelity: str | None = None
+    reasons: list = field(default_factory=list)
+    twin_metrics: dict | None = None
+    seed_verlet_metrics: dict | None = None
+    time: float | None = None  # a packing's simulated time
+    keys: tuple = ("status", "message")
+    extra: dict = field(default_factory=dict)  # keys of a stored row this release does not know
+
+    RUN = ("status", "message", "method", "dt", "rtol", "engine_version", "wall_time", "metrics", "cached",
+           "warnings")
+    MAPPED = ("fidelity", "reasons", "twin_metrics", "seed_verlet_metrics")
+
+    @classmethod
+    def of_run(cls, result, **mapped) -> "SourceResult":
+        """A Result's row (``mapped``: an engine's fidelity, reasons, twin and seed metrics)."""
+        return cls(result.status, result.message, result.method, result.dt, result.rtol, result.engine_version,
+                   result.wall_time, result.metrics(), result.meta.get("cached"),
+                   result.meta.get("warnings", []), **mapped, keys=cls.RUN + tuple(mapped))
+
+    @classmethod
+    def status_only(cls, status: str, message: str) -> "SourceResult":
+        """A source that produced no numbers: not expressible, engine missing, failed."""
+        return cls(status, message)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == OK
+
+    def to_json(self) -> dict:
+        return {k: (self.extra[k] if k in self.extra else getattr(self, k)) for k in self.keys}
+
+    @classmethod
+    def from_json(cls, d: dict) -> "SourceResult":
+        known = {f.name for f in fields(cls)} - {"keys", "extra"}
+        values = {k: v for k, v in d.items() if k in known}
+        for k in ("metrics",):
+            values[k] = values.get(k) or {}
+        for k in ("warnings", "reasons"):
+            values[k] = list(values.get(k) or [])
+        return cls(**{"status": None, **values}, keys=tuple(d),
+                   extra={k: v for k, v in d.items() if k not in known})
+
+
+# a case's keys in JSON, in the order each kind of entry always had them (a key whose value is None is left out)
+_COLLISION = ("case", "file", "case_hash", "kind", "sources", "comparisons", "curves", "series", "walls", "variant",
+              "scenario", "model", "params", "impact", "scales", "settings", "status", "verdict")
+_PACKING = ("case", "file", "kind", "case_hash", "sources", "comparisons", "curves", "series", "packing", "model",
+            "settings", "status", "verdict", "impact", "scales")
+_FAILED = ("case", "file", "case_hash", "status", "verdict", "message", "sources", "curves", "series",
+           "comparisons")
+
+
+@dataclass
+class CaseResult:
+    """One case's entry: the case (name, file, hash, kind), its model, parameters, impact and scales, every source's
+    row (by label) and every comparison, the curves' distances and the plots' series, the engines' native settings
+    (one line each), and its status and worst verdict. A case the suite could not run carries the reason
+    (``message``); a packing its panels' data (``packing``)."""
+
+    case: str
+    file: str | None = None
+    case_hash: str | None = None
+    kind: str | None = None
+    sources: dict = field(default_factory=dict)  # label -> SourceResult
+    comparisons: list = field(default_factory=list)  # verdicts.Comparison
+    curves: dict = field(default_factory=dict)
+    series: list = field(default_factory=list)
+    walls: int | None = None
+    variant: list | None = None
+    scenario: str | None = None
+    model: dict | None = None
+    params: dict | None = None
+    impact: dict | None = None
+    scales: dict | None = None
+    settings: dict | None = None
+    status: str = OK
+    verdict: str = verdicts.AGREE
+    message: str | None = None
+    packing: dict | None = None
+    extra: dict = field(default_factory=dict)  # keys of a stored entry this release does not know
+
+    def judged(self) -> "CaseResult":
+        """Its verdict (the worst of its comparisons) and status (failed, unexpected or ok) set; itself."""
+        self.verdict = verdicts.worst(c.verdict for c in self.comparisons)
+        self.status = {verdicts.FAILED: FAILED, verdicts.UNEXPECTED: UNEXPECTED}.get(self.verdict, OK)
+        return self
+
+    @property
+    def failing(self) -> bool:
+        return self.status in (FAILED, UNEXPECTED)
+
+    def planned(self, planned) -> bool:
+        """An engine source of the case (comparisons/sources.plan) noted: the native configuration its mapping
+        chose (``settings``), and, when it cannot run, its row and comparison (verdicts.unavailable). True when it
+        runs."""
+        setting, comparison = verdicts.unavailable(planned)
+        label = planned.source.label
+        if setting is not None:
+            self.settings = {**(self.settings or {}), label: setting}
+        if comparison is None:
+            return True
+        self.sources[label] = SourceResult.status_only(planned.status, planned.why)
+        self.comparisons.append(comparison)
+        return False
+
+    def metric(self, source: str, metric: str):
+        """A source's metric (None where the source or the metric is not there)."""
+        s = self.sources.get(source)
+        return None if s is None else s.metrics.get(metric)
+
+    def to_json(self, series: bool = True) -> dict:
+        order = _FAILED if self.message is not None else _PACKING if self.kind == "packing" else _COLLISION
+        out = {}
+        for k in order:
+            v = getattr(self, k)
+            if k == "sources":
+                v = {name: s.to_json() for name, s in v.items()}
+            elif k == "comparisons":
+                v = [c.as_dict() for c in v]
+            elif k == "series" and not series:
+                continue
+            if v is not None:
+                out[k] = v
+        return out | self.extra
+
+    @classmethod
+    def from_json(cls, d: dict) -> "CaseResult":
+        if isinstance(d, CaseResult):
+            return d
+        known = {f.name for f in fields(cls)} - {"extra"}
+        values = {k: v for k, v in d.items() if k in known}
+        values["sources"] = {name: SourceResult.from_json(s) for name, s in (d.get("sources") or {}).items()}
+        values["comparisons"] = [_comparison(c) for c in d.get("comparisons") or []]
+        values["curves"] = dict(d.get("curves") or {})
+        values["series"] = list(d.get("series") or [])
+        return cls(**{"case": "", **values}, extra={k: v for k, v in d.items() if k not in known})
+
+
+@dataclass
+class Summary:
+    """A run: demcheck's version, its id, report folder, start, command line, the engines found (discovery's
+    record by name), the tolerances, every finished case (:class:`CaseResult`), how many fail, how many were
+    planned, its wall time, whether it is partial; the run cache's hits and misses, a baseline check
+    (comparisons/diff.apply_baseline) and a validation (comparisons/validate.py) where there are."""
+
+    demcheck: str | None = None
+    run_id: str | None = None
+    report: str | None = None
+    partial: bool = False
+    started: str | None = None
+    command: list | None = None
+    engines: dict = field(default_factory=dict)
+    tolerances: dict | None = None
+    cases: list = field(default_factory=list)  # CaseResult
+    failed: int = 0
+    planned: int | None = None
+    wall_time: float | None = None
+    cache: dict | None = None
+    baseline: dict | None = None
+    baseline_error: str | None = None
+    validation: dict | None = None
+    extra: dict = field(default_factory=dict)
+
+    def count_failed(self) -> int:
+        """How many cases fail (an unexpected difference or a failure)."""
+        return sum(c.failing for c in self.cases)
+
+    def to_json(self, series: bool = True) -> dict:
+        out = {}
+        for f in fields(self):
+            if f.name == "extra":
+                continue
+            v = getattr(self, f.name)
+            if f.name == "cases":
+                v = [c.to_json(series) for c in v]
+            if v is not None or f.name in ("started", "run_id", "demcheck", "report", "command", "tolerances",
+                                           "planned", "wall_time"):
+                out[f.name] = v
+        return out | self.extra
+
+    @classmethod
+    def from_json(cls, d: dict) -> "Summary":
+        known = {f.name for f in fields(cls)} - {"extra"}
+        values = {k: v for k, v in d.items() if k in known}
+        values["cases"] = [CaseResult.from_json(c) for c in d.get("cases") or []]
+        values["engines"] = dict(d.get("engines") or {})
+        return cls(**values, extra={k: v for k, v in d.items() if k not in known})
+
+    @classmethod
+    def of(cls, summary) -> "Summary":
+        """``summary`` as a record: itself, or a results.json's dict read (:meth:`from_json`)."""
+        return summary if isinstance(summary, Summary) else cls.from_json(summary)

@@ -1,0 +1,102 @@
+"""The suite's typed results (comparisons/records.py): built once in the suite, read by attribute, and written at the
+JSON edge as results.json always held them — the same keys in the same order — and read back from such a file."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from demcheck.comparisons import report, sources, suite, verdicts as V
+from demcheck.comparisons.records import CaseResult, SourceResult, Summary
+from demcheck.io import plain
+
+from .conftest import CASES
+
+# the keys of a case's entry and of a source's row in results.json, in the order the suite wrote them before the
+# records (main 166af39: suite.run_case, suite._safe_case, suite._source)
+COLLISION_KEYS = ["case", "file", "case_hash", "kind", "sources", "comparisons", "curves", "series", "walls",
+                  "variant", "model", "params", "impact", "scales", "status", "verdict"]
+FAILED_KEYS = ["case", "file", "case_hash", "status", "verdict", "message", "sources", "curves", "series",
+               "comparisons"]
+RUN_KEYS = ["status", "message", "method", "dt", "rtol", "engine_version", "wall_time", "metrics", "cached",
+            "warnings"]
+
+
+def _glass():
+    from demcheck.case import load
+
+    return suite.run_case(load(CASES / "glass-pair.toml"), CASES / "glass-pair.toml", suite.Options(engines=()), {})
+
+
+def test_a_case_is_a_record_whose_json_is_the_entry_results_json_held():
+    entry = _glass()
+    assert isinstance(entry, CaseResult) and isinstance(entry.sources["reference"], SourceResult)
+    assert all(isinstance(c, V.Comparison) for c in entry.comparisons) and entry.comparisons
+    assert entry.status == "ok" and entry.verdict == V.AGREE and entry.walls == 0 and entry.variant == []
+    d = entry.to_json()
+    assert list(d) == COLLISION_KEYS
+    assert list(d["sources"]) == ["reference", "reference-verlet"]
+    assert all(list(s) == RUN_KEYS for s in d["sources"].values())
+    assert d["comparisons"][0] == entry.comparisons[0].as_dict()
+    assert "series" not in entry.to_json(series=False) and d["series"]
+    # read back: the same record, and the same JSON in the same order
+    again = CaseResult.from_json(json.loads(json.dumps(d)))
+    assert json.dumps(again.to_json()) == json.dumps(json.loads(json.dumps(d)))
+    assert again.sources["reference"].metrics["restitution"] == entry.sources["reference"].metrics["restitution"]
+
+
+def test_a_case_the_suite_could_not_run_keeps_its_entry_shape(monkeypatch):
+    from demcheck.case import load
+    from demcheck.errors import DemcheckError
+
+    def broken(*a, **k):
+        raise DemcheckError("no such thing")
+
+    monkeypatch.setattr(suite, "run_case", broken)
+    entry = suite._safe_case(load(CASES / "hertz-wall.toml"), CASES / "hertz-wall.toml", suite.Options(engines=()), {})
+    d = entry.to_json()
+    assert list(d) == FAILED_KEYS and d["status"] == "failed" and d["verdict"] == V.FAILED
+    assert d["message"] == "no such thing" and [c["source"] for c in d["comparisons"]] == ["reference"]
+
+
+def test_unavailable_edits_nothing_and_the_case_notes_what_it_returns():
+    """verdicts.unavailable returns the native setting and the status comparison; CaseResult.planned records them."""
+    from demcheck.case import expand
+
+    case = expand(CASES / "suite" / "oblique-sliding.toml")[0]
+    found = {e: {"found": True} for e in ("lammps", "yade")}
+    lammps, yade = sources.plan(case, ("lammps", "yade"), found)
+    setting, comparison = V.unavailable(lammps)
+    assert setting == "hooke damping coeff_restitution tangential linear_nohistory" and comparison is None
+    setting, comparison = V.unavailable(yade)
+    assert setting is None and comparison.verdict == V.NOT_EXPRESSIBLE and comparison.source == "yade"
+    entry = CaseResult(case.name)
+    assert entry.planned(lammps) is True and entry.planned(yade) is False
+    assert entry.settings == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
+    assert entry.sources["yade"].to_json() == {"status": V.NOT_EXPRESSIBLE, "message": yade.why}
+    assert [c.source for c in entry.comparisons] == ["yade"]
+
+
+def test_a_results_json_of_an_older_release_is_read_with_its_gaps_and_keys_kept():
+    old = {"cases": [{"case": "x", "sources": {"reference": {"status": "ok", "metrics": {"restitution": 0.5},
+                                                              "plot": [1, 2]}},
+                      "comparisons": [{"source": "reference-verlet", "metric": "restitution", "verdict": "agree",
+                                       "value": None}], "later": {"a": 1}}], "engines": None}
+    s = Summary.from_json(old)
+    c = s.cases[0]
+    assert c.walls is None and c.variant is None and c.kind is None  # never said: not made up
+    assert c.metric("reference", "restitution") == 0.5 and c.metric("lammps", "restitution") is None
+    assert c.comparisons[0].setting == "" and c.comparisons[0].value is None and math.isnan(c.comparisons[0].rel_diff)
+    assert c.sources["reference"].to_json() == old["cases"][0]["sources"]["reference"]  # its own keys kept
+    assert c.to_json()["later"] == {"a": 1} and s.engines == {}
+
+
+def test_the_renderers_read_a_record_and_its_json_alike(tmp_path):
+    s = suite.run_suite([CASES / "glass-pair.toml"], tmp_path / "r", suite.Options(engines=()), quiet=True)
+    assert isinstance(s, Summary) and s.failed == 0 and not s.partial and s.planned == 1
+    data = json.loads((tmp_path / "r" / "latest" / "results.json").read_text())
+    assert data == json.loads(json.dumps(plain(s.to_json(series=False))))
+    assert list(data)[:12] == ["demcheck", "run_id", "report", "partial", "started", "command", "engines",
+                               "tolerances", "cases", "failed", "planned", "wall_time"]
+    assert report.render_markdown(s) == report.render_markdown(data)
+    assert report.render_junit(s) == report.render_junit(data)
