@@ -155,3 +155,21 @@ def test_the_viscous_torque_wall_decays_at_the_closed_form_time_constant(tmp_pat
     tau = roll["metrics"]["rolling_time_constant"]
     assert tau["reference"] == pytest.approx(1.4 / (c * G), rel=1e-12)
     assert abs(tau["engine"] / tau["reference"] - 1) < 1e-4  # measured 3.5e-5 below
+
+
+@pytest.mark.engine("kratos")
+def test_a_viscous_torque_wall_past_the_no_slip_bound_is_listed_with_the_c_r_rule(tmp_path):
+    """ViscousTorque with c = 500 at v0 = 2 mm/s: the roll would need the friction (5/7)c v0·W = 0.71 W, above μs W =
+    0.3 W — the sphere slides, and the rolling scenario's case is refused as it loads (case.py rolling_grip). The
+    row is "not probed" with that line, naming contact.c_r and the bound — never a verdict, and nothing runs
+    (issue 30 leftover; before, the scenario ran in Kratos and its twin and the row failed at run time)."""
+    c, v0 = 500.0, 0.002
+    path = _kratos(tmp_path, pair_law="DEM_D_Hertz_viscous_Coulomb", model="DEMRollingFrictionModelViscousTorque")
+    mats = json.loads((tmp_path / "MaterialsDEM.json").read_text())
+    mats["material_relations"][1]["Variables"]["ROLLING_FRICTION_WITH_WALLS"] = c
+    (tmp_path / "MaterialsDEM.json").write_text(json.dumps(mats))
+    r = A.audit(path, speed=v0, run_engine=False, beyond_engine=True)
+    roll = _rows(r["pairs"][1])["rolling"]
+    assert roll["status"] == "not probed", roll
+    assert "contact.c_r = " in roll["why"] and "must be at most" in roll["why"] and "slides" in roll["why"], roll
+    assert "metrics" not in roll
