@@ -29,6 +29,17 @@ E_STEEL, NU_STEEL = 2.0e11, 0.3
 MU_R, MU, V0, G = 0.1, 0.3, 0.02, 9.81
 
 
+def _viscous_torque_roll(tmp_path, c: float, v0: float) -> dict:
+    """The wall's rolling row of an audit of the Kratos project with ViscousTorque, ROLLING_FRICTION_WITH_WALLS c,
+    at the characteristic speed v0."""
+    path = _kratos(tmp_path, pair_law="DEM_D_Hertz_viscous_Coulomb", model="DEMRollingFrictionModelViscousTorque")
+    mats = json.loads((tmp_path / "MaterialsDEM.json").read_text())
+    mats["material_relations"][1]["Variables"]["ROLLING_FRICTION_WITH_WALLS"] = c
+    (tmp_path / "MaterialsDEM.json").write_text(json.dumps(mats))
+    r = A.audit(path, speed=v0, run_engine=False, beyond_engine=True)
+    return _rows(r["pairs"][1])["rolling"]
+
+
 def _kratos(tmp_path, *, pair_law="DEM_D_Hertz_viscous_Coulomb_DMT", model="DEMRollingFrictionModelConstantTorque",
             rolling_option=True, wall_law="DEM_D_Linear_viscous_Coulomb"):
     """Kratos' own test-project layout (test_audit_kratos's two spheres of R = 1 mm and a floor), the spheres of a
@@ -144,14 +155,22 @@ def test_the_viscous_torque_wall_decays_at_the_closed_form_time_constant(tmp_pat
     with Cr = cWR², so v decays as exp(−t/T), T = (7/5)mR²/Cr = 1.4/(c g). c = 50 and v0 = 2 mm/s keep the run
     short and the roll without slip (the friction it needs, (5/7)c v0·W = 0.07 W, is below μs W = 0.3 W)."""
     c, v0 = 50.0, 0.002
-    path = _kratos(tmp_path, pair_law="DEM_D_Hertz_viscous_Coulomb", model="DEMRollingFrictionModelViscousTorque")
-    mats = json.loads((tmp_path / "MaterialsDEM.json").read_text())
-    mats["material_relations"][1]["Variables"]["ROLLING_FRICTION_WITH_WALLS"] = c
-    (tmp_path / "MaterialsDEM.json").write_text(json.dumps(mats))
-    r = A.audit(path, speed=v0, run_engine=False, beyond_engine=True)
-    roll = _rows(r["pairs"][1])["rolling"]
+    roll = _viscous_torque_roll(tmp_path, c, v0)
     assert roll["status"] == "ok" and roll["fidelity"] == "approximate", roll.get("why")
     assert roll["engine_vs_twin"] <= 1e-9  # measured 1.5e-12
     tau = roll["metrics"]["rolling_time_constant"]
     assert tau["reference"] == pytest.approx(1.4 / (c * G), rel=1e-12)
     assert abs(tau["engine"] / tau["reference"] - 1) < 1e-4  # measured 3.5e-5 below
+
+
+@pytest.mark.engine("kratos")
+def test_a_viscous_torque_wall_past_the_no_slip_bound_is_listed_with_the_c_r_rule(tmp_path):
+    """ViscousTorque with c = 500 at v0 = 2 mm/s: the roll would need the friction (5/7)c v0·W = 0.71 W, above μs W =
+    0.3 W — the sphere slides, and the rolling scenario's case is refused as it loads (case.py rolling_grip). The
+    row is "not probed" with that line, naming contact.c_r and the bound — never a verdict, and nothing runs
+    (issue 30 leftover; before, the scenario ran in Kratos and its twin and the row failed at run time)."""
+    c, v0 = 500.0, 0.002
+    roll = _viscous_torque_roll(tmp_path, c, v0)
+    assert roll["status"] == "not probed", roll
+    assert "contact.c_r = " in roll["why"] and "must be at most" in roll["why"] and "slides" in roll["why"], roll
+    assert "metrics" not in roll
