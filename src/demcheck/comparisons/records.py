@@ -143,7 +143,7 @@ class CaseResult:
     def failing(self) -> bool:
         return self.status in (FAILED, UNEXPECTED)
 
-    def planned(self, planned) -> bool:
+    def note_plan(self, planned) -> bool:
         """An engine source of the case (comparisons/sources.plan) noted: the native configuration its mapping
         chose (``settings``), and, when it cannot run, its row and comparison (verdicts.unavailable). True when it
         runs."""
