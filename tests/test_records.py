@@ -71,7 +71,7 @@ def test_unavailable_edits_nothing_and_the_case_notes_what_it_returns():
     setting, comparison = V.unavailable(yade)
     assert setting is None and comparison.verdict == V.NOT_EXPRESSIBLE and comparison.source == "yade"
     entry = CaseResult(case.name)
-    assert entry.planned(lammps) is True and entry.planned(yade) is False
+    assert entry.note_plan(lammps) is True and entry.note_plan(yade) is False
     assert entry.settings == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     assert entry.sources["yade"].to_json() == {"status": V.NOT_EXPRESSIBLE, "message": yade.why}
     assert [c.source for c in entry.comparisons] == ["yade"]

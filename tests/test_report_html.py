@@ -646,7 +646,7 @@ def test_the_verdicts_carry_the_setting_and_the_suite_records_the_mapping():
     entry = CaseResult(case.name)
     found = {e: {"found": True} for e in ("lammps", "yade")}
     for planned in plan(case, ("lammps", "yade"), found):
-        entry.planned(planned)
+        entry.note_plan(planned)
     assert entry.settings == {"lammps": "hooke damping coeff_restitution tangential linear_nohistory"}
     assert entry.sources["yade"].status == "not expressible"
 

@@ -156,7 +156,7 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
                                      "profile": packing_metrics.profile(x, rad, box) if box else None}
 
     for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
-        if not entry.planned(planned):
+        if not entry.note_plan(planned):
             continue
         engine = planned.source.label
         try:

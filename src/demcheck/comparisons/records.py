@@ -61,8 +61,7 @@ class SourceResult:
     extra: dict = field(default_factory=dict)  # keys of a stored row this release does not know
 
     RUN = ("status", "message", "method", "dt", "rtol", "engine_version", "wall_time", "metrics", "cached",
-           "warnings")
-    MAPPED = ("fidelity", "reasons", "twin_metrics", "seed_verlet_metrics")
+           "warnings")  # a Result's row (of_run), an engine's mapping after them
 
     @classmethod
     def of_run(cls, result, **mapped) -> "SourceResult":
@@ -87,10 +86,8 @@ class SourceResult:
     def from_json(cls, d: dict) -> "SourceResult":
         known = {f.name for f in fields(cls)} - {"keys", "extra"}
         values = {k: v for k, v in d.items() if k in known}
-        for k in ("metrics",):
-            values[k] = values.get(k) or {}
-        for k in ("warnings", "reasons"):
-            values[k] = list(values.get(k) or [])
+        values["metrics"] = values.get("metrics") or {}
+        values["warnings"], values["reasons"] = list(values.get("warnings") or []), list(values.get("reasons") or [])
         return cls(**{"status": None, **values}, keys=tuple(d),
                    extra={k: v for k, v in d.items() if k not in known})
 
@@ -143,7 +140,7 @@ class CaseResult:
     def failing(self) -> bool:
         return self.status in (FAILED, UNEXPECTED)
 
-    def planned(self, planned) -> bool:
+    def note_plan(self, planned) -> bool:
         """An engine source of the case (comparisons/sources.plan) noted: the native configuration its mapping
         chose (``settings``), and, when it cannot run, its row and comparison (verdicts.unavailable). True when it
         runs."""
@@ -215,6 +212,8 @@ class Summary:
     validation: dict | None = None
     extra: dict = field(default_factory=dict)
 
+    OPTIONAL = ("cache", "baseline", "baseline_error", "validation")  # in JSON only where there are
+
     def count_failed(self) -> int:
         """How many cases fail (an unexpected difference or a failure)."""
         return sum(c.failing for c in self.cases)
@@ -227,8 +226,7 @@ class Summary:
             v = getattr(self, f.name)
             if f.name == "cases":
                 v = [c.to_json(series) for c in v]
-            if v is not None or f.name in ("started", "run_id", "demcheck", "report", "command", "tolerances",
-                                           "planned", "wall_time"):
+            if v is not None or f.name not in self.OPTIONAL:
                 out[f.name] = v
         return out | self.extra
 

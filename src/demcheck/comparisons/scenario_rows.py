@@ -20,7 +20,7 @@ def engine_rows(case, entry: CaseResult, opts, found: dict, ref: dict) -> None:
     """Every engine of ``opts.engines`` on the scenario case: ``entry`` gains its rows and comparisons; ``ref``: the
     reference's metrics."""
     for planned in sources.plan(case, opts.engines, found):
-        if entry.planned(planned):
+        if entry.note_plan(planned):
             _engine(case, planned, entry, opts, ref)
 
 

@@ -106,7 +106,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> CaseResult:
     adaptive, ref = _reference_sources(case, model, entry, opts.tolerances, opts.cache)
     seed_cache: dict = {}
     for planned in sources.plan(case, opts.engines, found):
-        if entry.planned(planned):
+        if entry.note_plan(planned):
             _engine_source(case, model, planned, (adaptive, ref), entry, opts, seed_cache)
     entry.series = [s for s in entry.series if s]
     return entry.judged()

@@ -268,7 +268,7 @@ def unavailable(planned) -> tuple[str | None, Comparison | None]:
     can express the case, the native configuration its mapping chose, in one line of the engine's own words (the
     case's ``settings``: the setting the report's traps section names for an approximate mapping), else None; and
     for one that cannot run it (the model is not expressible, or it is not installed) its status comparison
-    (NOT_EXPRESSIBLE, MISSING or FAILED), else None. records.CaseResult.planned notes both."""
+    (NOT_EXPRESSIBLE, MISSING or FAILED), else None. records.CaseResult.note_plan notes both."""
     mp = planned.mapping
     setting = native_setting(mp.native) if mp.native is not None else None
     if planned.runs:
