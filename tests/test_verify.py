@@ -44,6 +44,20 @@ def test_agree_within_the_time_steps_own_error():
     assert c.tolerance == pytest.approx(1e-6 + 1.01 * 0.0012)
 
 
+@pytest.mark.parametrize("fidelity", ["exact", "approximate"])
+@pytest.mark.parametrize("ref, seed, which", [(0.9, math.nan, "at the engine's step"), (math.nan, 0.9, "converged")])
+def test_no_verdict_against_a_seed_run_that_is_not_finite(fidelity, ref, seed, which):
+    # engine and twin agree and are finite, but one of the seed model's runs is not: failed, never agree or
+    # "differs as expected" (before, a NaN step share counted as 0 and the engine "agreed")
+    c = judge(value=0.9, ref=ref, twin=0.9, seed=seed, fidelity=fidelity)
+    assert c.verdict == V.FAILED and which in c.reason and "not finite" in c.reason
+
+
+def test_an_engine_off_its_twin_is_still_named_when_the_seed_run_is_not_finite():
+    c = judge(value=0.9, ref=0.9, twin=0.95, seed=math.nan)
+    assert c.verdict == V.UNEXPECTED and "documented formula" in c.reason
+
+
 def test_beyond_the_time_step_error_is_unexpected_for_an_exact_mapping():
     c = judge(value=0.81, ref=0.8, twin=0.81, seed=0.8001)
     assert c.verdict == V.UNEXPECTED and "no documented difference" in c.reason

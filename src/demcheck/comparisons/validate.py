@@ -195,10 +195,10 @@ def law_shortfall(model, contact: dict, events) -> float:
     slip (0: its first stick is the stick a source's force history measures). ``model``: the case's
     ResolvedModel."""
     from ..laws.tangential_force import eta_of
-    from ..laws.tangential import VISCOUS_SLIDING
+    from ..laws.tangential import ViscousSlidingTangential
 
     law = model.tangential_law
-    if law.family != VISCOUS_SLIDING:
+    if not isinstance(law.slot(), ViscousSlidingTangential):
         return 0.0
     k0, k1 = _window(contact, events)
     rows = slice(k0, k1 + 1)
@@ -750,10 +750,10 @@ def _law_short(case, run_of) -> float:
     """law_shortfall of the case's law on the reference's adaptive run (run only for a law that can fall short of
     its cap: viscous sliding); NaN without a run to read."""
     from ..laws.model import resolve
-    from ..laws.tangential import VISCOUS_SLIDING
+    from ..laws.tangential import ViscousSlidingTangential
 
     model = resolve(case)
-    if model.tangential_law.family != VISCOUS_SLIDING:
+    if not isinstance(model.tangential_law.slot(), ViscousSlidingTangential):
         return 0.0
     res = run_of("reference")
     if not res.ok:

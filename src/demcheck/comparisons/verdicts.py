@@ -177,7 +177,9 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
                  message: str = "", setting: str = "") -> Comparison:
     """One metric of an engine run against the seed model. A run whose ``status`` is not "ok" (the
     reference's rules, reference/health.py) is FAILED whatever its values; so is a value that is not finite
-    where the reference or the twin has one (a broken run is never "agree" or "differs as expected").
+    where the reference or the twin has one (a broken run is never "agree" or "differs as expected"), and a
+    finite engine value whose seed-model runs (converged, or at the engine's step) are not: once the engine is
+    checked against its twin, there is nothing to judge it against.
     ``setting``: the native keyword(s) the approximate mapping's reasons are about (:func:`mapping_setting`),
     named on its difference."""
     diff = scaled(value, reference, metric, case_scales)
@@ -211,6 +213,10 @@ def judge_engine(engine: str, version: str | None, model: dict, metric: str, val
             c.verdict = UNEXPECTED
             c.reason = (f"the engine does not compute its own documented formula: {impl:.3g} from its twin at "
                         f"equal dt (bar {tol.implementation:g})")
+        return c
+    if not (_finite(reference) and _finite(seed_verlet)):  # engine = twin holds, but nothing to judge it against
+        which = "converged run" if not _finite(reference) else "run at the engine's step"
+        c.verdict, c.reason = FAILED, f"the seed model's {which} is not finite: the engine's {value:.6g} cannot be judged"
         return c
     if _finite(diff) and diff <= tolerance:
         return c
