@@ -36,10 +36,14 @@ nothing concurrent, meaningful under load; two threads — meaningful on an idle
 
     .venv/bin/python benchmarks/bench_packing_phases.py 0.02 32000,128000 2 > benchmarks/results/bench_packing_phases_idle.txt
 
-The two-thread speed-up alone, idle: bench_packing_scale.py --threads 0.02 32000,128000 3.
+The two-thread speed-up alone, idle: bench_packing_scale.py --threads 0.02 32000,128000 3. The force cut's
+weights (packing.py's ROW_COST …) from a fit of the force loop's CPU time by parts, on one thread:
+
+    .venv/bin/python benchmarks/bench_packing_phases.py --fit 32000 0.02 >> benchmarks/results/bench_packing_phases.txt
 """
 
 import json
+import math
 import os
 import pickle
 import subprocess
@@ -168,6 +172,44 @@ def _excess(one: np.ndarray, two: np.ndarray) -> None:
         print(f"    {label:38s} {v:+8.1f} µs  ({100 * v / t2:+5.1f} % of the two-thread step)")
 
 
+def fit(n: int, duration: float) -> None:
+    """The force loop's cost by parts, for the force cut's weights (packing.py's ROW_COST …): the pour of n spheres
+    run ``duration`` on one thread, then the force loop over blocks of 1/32 of the rows (each the best of 7 runs of
+    its CPU time, on copies of the contact states), and a least-squares fit of the blocks' times against their rows,
+    list entries, touching pairs and wall contacts."""
+    from demcheck.reference.collision3d import rules_array
+
+    case = BS.scaled_case(n, duration)
+    st = P.simulate(case, threads=1)
+    sp, laws_n, laws_t, wall_n, wall_t = P.resolve_laws(case)
+    walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+    lo, hi, periodic = P.box_of(case, st.x, st.rad)
+    table = P.law_table(laws_n, laws_t, wall_n, wall_t)
+    n_w, f, tq = walls.shape[0], np.zeros((n, 3)), np.zeros((n, 3))
+    blocks = np.linspace(0, n, 33).astype(np.int64)
+    rows, times = [], []
+    for a, e in zip(blocks[:-1], blocks[1:]):
+        hist, dmax = st.hist.copy(), st.dmax.copy()
+        best = math.inf
+        for _ in range(7):
+            t = time.thread_time()
+            P._contact_forces(a, e, st.x, st.v, st.w, st.rad, sp, laws_n.shape[0], *table, walls,
+                              P._period(lo, hi, periodic), st.start, st.nbj, hist, dmax, f, tq, f, tq,
+                              np.zeros((0, 3)), 1e-6, np.bool_(True), rules_array(None))
+            best = min(best, time.thread_time() - t)
+        base = n * n_w + st.start[a], n * n_w + st.start[e]
+        rows.append([e - a, st.start[e] - st.start[a], int((dmax[base[0]:base[1]] != 0).sum()),
+                     int((dmax[a * n_w:e * n_w] != 0).sum())])
+        times.append(best)
+    coef = np.linalg.lstsq(np.array(rows, float), np.array(times), rcond=None)[0] * 1e9
+    worst = np.abs(np.array(rows, float) @ coef / 1e9 / np.array(times) - 1).max()
+    print(f"the force loop by parts: the pour of {n} spheres at {duration:g} s, 32 blocks of rows, {n_w} wall(s); "
+          f"load {BP._load()}")
+    print(f"  ns a row {coef[0]:.2f}, a list entry {coef[1]:.2f}, a touching pair {coef[2]:.2f}, a wall contact "
+          f"{coef[3]:.2f} (in entries: row {coef[0] / coef[1]:.1f}, pair {coef[2] / coef[1]:.1f}, wall contact "
+          f"{coef[3] / coef[1]:.1f}); the fit's worst block {100 * worst:.0f} % off")
+
+
 def main(duration: float, sizes: list[int], rounds: int, configs: list[str]) -> None:
     import numba
 
@@ -199,6 +241,8 @@ def main(duration: float, sizes: list[int], rounds: int, configs: list[str]) -> 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--child"]:
         child(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
+    elif sys.argv[1:2] == ["--fit"]:  # --fit N DURATION
+        fit(int(sys.argv[2]), float(sys.argv[3]))
     else:
         a = sys.argv[1:]
         main(float(a[0]) if a else BS.DURATION, [int(x) for x in a[1].split(",")] if len(a) > 1 else list(SIZES),

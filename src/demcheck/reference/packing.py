@@ -723,12 +723,13 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
 
 
 REBALANCE = 50  # steps between two cuts of the threaded loop's shares (besides one at each rebuild)
-# a force share's work, in list entries (a distance test apart, 1.5 ns here): a row (its loop, its particle's walls
-# tested) 9 with the pour's one wall, a touching pair 32 more, a wall contact 20 more. A least-squares fit of the
-# force loop's CPU time over blocks of 1000 rows of the 32 000-sphere pour at 0.02 s gave 13.7 ns a row, 1.5 an entry,
-# 37 a pair contact, 23 a wall contact (24 and 15 entries); at those weights the bed's share of two still ran 1.035 x
-# the mean over the pour (its contacts form between two cuts), at 32 and 20 1.008 x; the weights before (a row
-# 1 + walls, a contact 6) left it at 1.08 x (benchmarks/results/bench_packing_phases.txt)
+# a force share's work, in list entries (a distance test apart): a row (its loop, its particle's walls tested) 9 with
+# the pour's one wall, a touching pair 32 more, a wall contact 20 more. Least-squares fits of the force loop's CPU
+# time over blocks of 1000 rows of the 32 000-sphere pour at 0.02 s (bench_packing_phases.py --fit) give 37–38 ns a
+# touching pair and 23 a wall contact, 12–14 a row and 1.5–2.4 an entry (rows and entries trade off in the fit);
+# the weights were then set by the balance they give over the pour (its contacts form between two cuts): the bed's
+# share of two at 1.008 x the mean (24 and 15 for the contacts: 1.035 x; the weights before, a row 1 + walls and
+# a contact 6: 1.08 x; benchmarks/results/bench_packing_phases.txt)
 ROW_COST, WALL_TEST_COST, PAIR_COST, WALL_COST = 7.0, 2.0, 32.0, 20.0
 
 
