@@ -218,10 +218,7 @@ def main(duration: float, sizes: list[int], rounds: int, configs: list[str]) -> 
           f"{BP._head()}; {os.cpu_count()} cores, numba {numba.__version__}, threading layer: OpenMP first")
     print(f"load average (1, 5, 15 min) at the start: {BP._load()}")
     with tempfile.TemporaryDirectory() as tmp:
-        for n in sizes:
-            path = Path(tmp) / f"case-{n}.pickle"
-            with open(path, "wb") as fh:
-                pickle.dump(BS.scaled_case(n, duration), fh)
+        for n, path in BS.pickled_cases(tmp, sizes, duration):
             runs = {label: [] for label, _, _ in CONFIGS}
             chosen = [c for c in CONFIGS if f"{c[1]}/{c[2]}" in configs]
             for k in range(rounds):
