@@ -870,8 +870,9 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
             most = max(most, moved[b])
         if most > (0.5 * skin) ** 2:
             t = _add(clock, serial, S_OTHER, t)
+            # its rows cut as the kicks' particles: a row's cost there is its cells' search, not its contacts
             start, nbj, hist, dmax = _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist,
-                                                       dmax, n_p * n_w, chunks)
+                                                       dmax, n_p * n_w, kicks)
             t = _add(clock, serial, S_REBUILD, t)
             x_ref[:, :] = x
             _cut(start, n_w, dmax, nbj, chunks, far, kicks)
