@@ -73,6 +73,15 @@ def scaled_case(n: int, duration: float):
                             f"packing.duration={duration!r}"])
 
 
+def pickled_cases(tmp: str, sizes: list[int], duration: float):
+    """(n, the path of the scaled case pickled into ``tmp``) for each size, each written when its turn comes."""
+    for n in sizes:
+        path = Path(tmp) / f"case-{n}.pickle"
+        with open(path, "wb") as fh:
+            pickle.dump(scaled_case(n, duration), fh)
+        yield n, path
+
+
 def _rss_kb() -> int:
     with open("/proc/self/statm") as fh:
         return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") // 1024
@@ -213,10 +222,7 @@ def threads(duration: float, sizes: list[int], rounds: int) -> None:
           f"{BP._head()}; {os.cpu_count()} cores, numba {numba.__version__}")
     print(f"load average (1, 5, 15 min) at the start: {BP._load()}")
     with tempfile.TemporaryDirectory() as tmp:
-        for n in sizes:
-            path = Path(tmp) / f"case-{n}.pickle"
-            with open(path, "wb") as fh:
-                pickle.dump(scaled_case(n, duration), fh)
+        for n, path in pickled_cases(tmp, sizes, duration):
             walls, cpus = {1: [], 2: []}, {1: [], 2: []}
             for k in range(rounds):
                 for cores in ((1, 2) if k % 2 == 0 else (2, 1)):

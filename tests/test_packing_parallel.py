@@ -227,3 +227,54 @@ def test_the_threaded_rebuild_is_the_serial_one(cut, old_skin):
             a, b = a[:new_start[-1]], b[:new_start[-1]]  # the entries (then spare room)
         np.testing.assert_array_equal(a, b, err_msg=name)
     assert (serial[3] != 0.0).sum() > 10  # states were carried over
+
+
+def test_the_kick_regions_own_cut_gathers_every_far_row_once_in_the_force_shares_order():
+    """The kick region cuts the particles by its own work (a particle, and GATHER_COST for each far buffer holding
+    a row of it), not by the force region's contacts: its shares hold about equal cost, and together they add every
+    far-buffer row once, into the particle it belongs to, in the order of the force region's shares — what each
+    particle's force-region share added before (the same sums, bit for bit), each row then zeroed."""
+    rng = np.random.default_rng(7)
+    n = 1000
+    chunks = np.array([0, 300, 700, n], np.int64)
+    far = np.array([650, 1000, n], np.int64)
+    f_far = np.zeros((3, n, 3))
+    tq_far = np.zeros((3, n, 3))
+    for c in range(3):
+        f_far[c, chunks[c + 1]:far[c]] = rng.normal(size=(far[c] - chunks[c + 1], 3))
+        tq_far[c, chunks[c + 1]:far[c]] = rng.normal(size=(far[c] - chunks[c + 1], 3))
+    f, tq = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    want_f, want_tq = f.copy(), tq.copy()
+    for c in range(3):  # the force shares' order: share c's buffer after those before it
+        want_f += f_far[c]
+        want_tq += tq_far[c]
+    kicks = np.empty(4, np.int64)
+    P._kick_cut(chunks, far, kicks)
+    assert kicks[0] == 0 and kicks[-1] == n and np.all(np.diff(kicks) > 0)
+    assert not np.array_equal(kicks, chunks)
+    cost = 1.0 + P.GATHER_COST * sum((np.arange(n) >= chunks[c + 1]) & (np.arange(n) < far[c]) for c in range(3))
+    shares = [cost[kicks[b]:kicks[b + 1]].sum() for b in range(3)]
+    assert max(shares) - min(shares) <= 2 * cost.max()
+    for b in range(3):
+        P._gather(kicks[b], kicks[b + 1], chunks, far, f_far, tq_far, f, tq)
+    np.testing.assert_array_equal(f, want_f)
+    np.testing.assert_array_equal(tq, want_tq)
+    assert not f_far.any() and not tq_far.any()
+
+
+def test_the_force_cut_weighs_contacts_as_measured():
+    """The force region's cut weighs a touching pair PAIR_COST list entries and a wall contact WALL_COST besides
+    the row's ROW_COST (and WALL_TEST_COST a wall): rows alike but for their contacts are cut where the weighted
+    costs are even (the bed's rows, full of contacts, in a smaller share)."""
+    n, n_w = 400, 1
+    start = np.arange(n + 1, dtype=np.int64) * 2  # two entries a row
+    dmax = np.zeros(n * n_w + 2 * n)
+    dmax[n * n_w:n * n_w + 2 * 100] = 1e-6  # rows 0…99: both pairs touching
+    dmax[:100] = 1e-6  # and their walls
+    chunks = np.empty(3, np.int64)
+    P._balance(start, n_w, dmax, chunks)
+    row = P.ROW_COST + P.WALL_TEST_COST + 2
+    cost = np.full(n, row)
+    cost[:100] += 2 * P.PAIR_COST + P.WALL_COST
+    half = np.searchsorted(np.cumsum(cost), cost.sum() / 2)
+    assert abs(chunks[1] - half) <= 1 and chunks[1] < n // 2

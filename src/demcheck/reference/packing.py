@@ -22,7 +22,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .. import KERNEL_CACHE
@@ -566,6 +569,103 @@ def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo
             f, tq, start, nbj, hist, dmax, records)
 
 
+# ----------------------------------------------------------------------------- the loop's own clock
+# A timed run (benchmarks/bench_packing_phases.py) passes ``clock``, an array of (shares + 1) rows of 2 × PHASES
+# columns, into which the loop adds what each phase took: columns 0…PHASES−1 by the time-stamp counter (ticks, wall
+# time), columns PHASES… by the clock of the thread that ran the phase (CPU ns: its work's and the serial phases';
+# a region's launch and wait span two threads and have only the counter's). Row c (c < shares) holds share c's
+# phases, the last row the calling thread's serial ones. An untimed run passes an empty array (0 rows): a test of
+# its length per phase, and no clock is read. Timing changes no arithmetic.
+F_LAUNCH, F_WORK, F_WAIT = 0, 1, 2  # the force region: its start to a share's, the share's work, its end to the region's
+K_LAUNCH, K_GATHER, K_WORK, K_WAIT = 3, 4, 5, 6  # the kick region likewise, the far buffers' gather apart
+S_REBUILD, S_AFTER, S_BALANCE, S_OTHER, S_REBUILDS = 7, 8, 9, 10, 11  # serial: rebuilds (and their count) …
+PHASES = 12
+CLOCK_THREAD_CPUTIME_ID = 3  # Linux's <time.h>
+
+
+@intrinsic
+def _ticks(typingctx):
+    """The processor's time-stamp counter (llvm.readcyclecounter; ~7 ns here): a timed run's wall clock."""
+    def codegen(context, builder, signature, args):
+        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.IntType(64), []),
+                                            "llvm.readcyclecounter")
+        return builder.call(fn, [])
+    return types.int64(), codegen
+
+
+@intrinsic
+def _thread_ns(typingctx):
+    """The calling thread's CPU time in ns (libc's clock_gettime(CLOCK_THREAD_CPUTIME_ID), called by name, so
+    that the kernel stays cacheable; ~0.6 µs here): a timed run's CPU clock."""
+    def codegen(context, builder, signature, args):
+        i64 = ir.IntType(64)
+        ts = cgutils.alloca_once(builder, ir.LiteralStructType([i64, i64]))
+        fnty = ir.FunctionType(ir.IntType(32), [ir.IntType(32), ts.type])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
+        builder.call(fn, [ir.Constant(ir.IntType(32), CLOCK_THREAD_CPUTIME_ID), ts])
+        sec = builder.load(cgutils.gep_inbounds(builder, ts, 0, 0))
+        ns = builder.load(cgutils.gep_inbounds(builder, ts, 0, 1))
+        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), ns)
+    return types.int64(), codegen
+
+
+@njit(cache=KERNEL_CACHE)
+def clock_ticks():
+    """The time-stamp counter now (a timed run's calibration)."""
+    return _ticks()
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _now(clock):
+    """(time-stamp counter, this thread's CPU ns) in a timed run (``clock`` not empty), else (0, 0)."""
+    if clock.shape[0] == 0:
+        return np.int64(0), np.int64(0)
+    return _ticks(), _thread_ns()
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _add(clock, row, phase, since):
+    """clock[row, phase] += the counter's ticks since ``since`` (a pair from :func:`_now`), and the CPU ns into its
+    column PHASES + phase, in a timed run; returns the clocks now ((0, 0) untimed)."""
+    if clock.shape[0] == 0:
+        return np.int64(0), np.int64(0)
+    now = _ticks(), _thread_ns()
+    clock[row, phase] += now[0] - since[0]
+    clock[row, PHASES + phase] += now[1] - since[1]
+    return now
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _begin(clock, row, phase, since):
+    """A share's start in a region: the counter's ticks since the region's start (``since``, the calling thread's
+    clocks) into clock[row, phase] in a timed run; returns this thread's clocks now ((0, 0) untimed)."""
+    if clock.shape[0] == 0:
+        return np.int64(0), np.int64(0)
+    now = _ticks(), _thread_ns()
+    clock[row, phase] += now[0] - since[0]
+    return now
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _count(clock, row, column):
+    """clock[row, column] += 1 in a timed run (a count beside the times)."""
+    if clock.shape[0] > 0:
+        clock[row, column] += 1.0
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _waits(clock, ends, phase, since):
+    """Each share's wait at a region's end (the counter from its work's end, ``ends``, to now) into
+    clock[share, phase]; returns the calling thread's clocks now (its CPU in the region is its share's row's, or
+    spinning)."""
+    if clock.shape[0] == 0:
+        return np.int64(0), np.int64(0)
+    now = _ticks()
+    for c in range(ends.shape[0]):
+        clock[c, phase] += now - ends[c]
+    return now, _thread_ns()
+
+
 @njit(cache=KERNEL_CACHE, inline="always")
 def _energy(ke, flags, step, ke_every, e, e_rot):
     """Keeps the translational kinetic energy e every ke_every steps; False, flagged, once e + e_rot is not
@@ -580,14 +680,14 @@ def _energy(ke, flags, step, ke_every, e, e_rot):
 
 @njit(cache=KERNEL_CACHE, nogil=True)
 def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt, steps,
-        ke_every, start, nbj, hist, dmax, contacts, rules):
+        ke_every, start, nbj, hist, dmax, contacts, rules, clock):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w modified in place; the contact states
     travel with the Verlet list, rebuilt here, the walls' first). Returns (translational kinetic energy every
     ke_every steps, number of pair contacts at the end (their records in ``contacts``), flags [unused,
     non-finite], and the Verlet list with its contact states: start, nbj, hist, dmax). The kinetic energy is
     translational, as the engines' thermo `ke`: these laws have no rolling or twisting resistance, so a
     sphere rolling or spinning about its contact normal keeps its rotational energy in every source. One
-    thread; :func:`run_threaded` is the same on several."""
+    thread; :func:`run_threaded` is the same on several. ``clock``: a timed run's (2 rows of 2 × PHASES), or empty."""
     n_p = x.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
@@ -595,45 +695,63 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     # one pass over the particles a step besides the force loop: the second half kick fused with the next step's
     # first half kick and drift (_kick_and_next), as the threaded loop does
     moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
+    serial = clock.shape[0] - 1
+    t = _now(clock)
     for step in range(1, steps + 1):
         # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
         if moved > (0.5 * skin) ** 2:
+            t = _add(clock, serial, S_OTHER, t)
             start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
                                               n_p * walls.shape[0])
+            t = _add(clock, serial, S_REBUILD, t)
             x_ref[:, :] = x
+            t = _add(clock, serial, S_AFTER, t)
+            _count(clock, serial, S_REBUILDS)
         if step == steps:
             records = _new_records(start)
+        t = _add(clock, serial, S_OTHER, t)
         _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start,
                         nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules)
+        t = _add(clock, 0, F_WORK, t)
         e, e_rot, moved = _kick_and_next(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi,
                                          periodic, x_ref, step < steps)
+        t = _add(clock, 0, K_WORK, t)
         if not _energy(ke, flags, step, ke_every, e, e_rot):
             break
+    _add(clock, serial, S_OTHER, t)
     return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
 
 
 REBALANCE = 50  # steps between two cuts of the threaded loop's shares (besides one at each rebuild)
-CONTACT_COST = 6  # a touching pair's or wall contact's cost against a listed pair apart (a distance test)
+# a force share's work, in list entries (a distance test apart): a row (its loop, its particle's walls tested) 9 with
+# the pour's one wall, a touching pair 32 more, a wall contact 20 more. Least-squares fits of the force loop's CPU
+# time over blocks of 1000 rows of the 32 000-sphere pour at 0.02 s (bench_packing_phases.py --fit) give 37–38 ns a
+# touching pair and 23 a wall contact, 12–14 a row and 1.5–2.4 an entry (rows and entries trade off in the fit);
+# the weights were then set by the balance they give over the pour (its contacts form between two cuts): the bed's
+# share of two at 1.008 x the mean (24 and 15 for the contacts: 1.035 x; the weights before, a row 1 + walls and
+# a contact 6: 1.08 x; benchmarks/results/bench_packing_phases.txt)
+ROW_COST, WALL_TEST_COST, PAIR_COST, WALL_COST = 7.0, 2.0, 32.0, 20.0
 
 
 @njit(cache=KERNEL_CACHE)
 def _balance(start, n_walls, dmax, chunks):
-    """Row bounds ``chunks`` (len = shares + 1) that give each share about the same work: each row costs one,
-    each of its list entries and walls one more, and each contact (a nonzero largest overlap) CONTACT_COST
-    more — the contacts of a pour gather in the bed while the rows above are falling apart."""
+    """Row bounds ``chunks`` (len = shares + 1) that give each share about the same work: each row costs
+    ROW_COST and WALL_TEST_COST a wall, each of its list entries one more, each touching pair (a nonzero largest
+    overlap) PAIR_COST more and each wall contact WALL_COST more — the contacts of a pour gather in the bed while
+    the rows above are falling apart."""
     n = start.shape[0] - 1
     m = chunks.shape[0] - 1
     base = n * n_walls
     cost = np.empty(n + 1)
     cost[0] = 0.0
     for i in range(n):
-        c = 1.0 + n_walls + (start[i + 1] - start[i])
+        c = ROW_COST + WALL_TEST_COST * n_walls + (start[i + 1] - start[i])
         for k in range(n_walls):
             if dmax[i * n_walls + k] != 0.0:
-                c += CONTACT_COST
+                c += WALL_COST
         for e in range(start[i], start[i + 1]):
             if dmax[base + e] != 0.0:
-                c += CONTACT_COST
+                c += PAIR_COST
         cost[i + 1] = cost[i] + c
     chunks[0] = 0
     i = 0
@@ -657,13 +775,52 @@ def _far_ends(start, nbj, chunks, far):
         far[c] = top
 
 
+GATHER_COST = 0.5  # a far-buffer row's gather against a particle's kick (the kick region's cut: :func:`_kick_cut`)
+
+
+@njit(cache=KERNEL_CACHE)
+def _kick_cut(chunks, far, kicks):
+    """The kick region's own cut ``kicks`` (len = shares + 1): particles in about equal work, each costing one
+    and GATHER_COST more for each far buffer that holds a row of it (share c's, below far[c] and past its own
+    particles). The force region's cut (``chunks``) balances contacts — a pour's bed gathers them in the lowest
+    shares — and would leave the kick, whose work is per particle, to the shares above (measured at 32 000
+    spheres: the two kick shares' CPU 1 : 1.4, benchmarks/results/bench_packing_phases.txt)."""
+    m = chunks.shape[0] - 1
+    n = chunks[m]
+    total = float(n)
+    for c in range(m):
+        total += GATHER_COST * max(0, far[c] - chunks[c + 1])
+    kicks[0] = 0
+    i = 0
+    done = 0.0
+    for b in range(1, m):
+        while i < n and done * m < total * b:
+            done += 1.0
+            for c in range(m):
+                if chunks[c + 1] <= i < far[c]:
+                    done += GATHER_COST
+            i += 1
+        kicks[b] = i
+    kicks[m] = n
+
+
+@njit(cache=KERNEL_CACHE)
+def _cut(start, n_walls, dmax, nbj, chunks, far, kicks):
+    """The threaded loop's cuts: the force region's shares (:func:`_balance`), their far ends (:func:`_far_ends`)
+    and the kick region's shares (:func:`_kick_cut`)."""
+    _balance(start, n_walls, dmax, chunks)
+    _far_ends(start, nbj, chunks, far)
+    _kick_cut(chunks, far, kicks)
+
+
 @njit(cache=KERNEL_CACHE, inline="always")
-def _gather(lo, hi, share, far, f_far, tq_far, f, tq):
-    """Into f and tq of particles lo…hi−1 (share ``share``'s), what the shares before it added for them into
-    their far buffers (share c's below far[c] only: nothing lies beyond); each row read is zeroed for the next
-    step."""
-    for c in range(share):
-        for i in range(lo, min(hi, far[c])):
+def _gather(lo, hi, chunks, far, f_far, tq_far, f, tq):
+    """Into f and tq of particles lo…hi−1 (a share of the kick region's cut), what the force region's shares
+    added for them into their far buffers — share c's rows past its own particles and below far[c] (nothing lies
+    beyond) — in the order of the shares, as a particle's own share's thread would; each row read is zeroed for
+    the next step."""
+    for c in range(chunks.shape[0] - 1):
+        for i in range(max(lo, chunks[c + 1]), min(hi, far[c])):
             for k in range(3):
                 f[i, k] += f_far[c, i, k]
                 tq[i, k] += tq_far[c, i, k]
@@ -672,16 +829,18 @@ def _gather(lo, hi, share, far, f_far, tq_far, f, tq):
 
 @njit(cache=KERNEL_CACHE, nogil=True, parallel=True)
 def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt,
-                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, threads):
+                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, clock, threads):
     """:func:`run` on ``threads`` threads (numba's, prange). The particles, and with them the rows of the
     Verlet list, are cut into as many shares of about equal work (:func:`_balance`, again at each rebuild, which
     is threaded too). A share's contacts are computed by one thread, which alone updates their states (a pair's
     sits beside its entry, a wall contact's in its particle's row) and writes the forces and torques of its own
     particles; what it adds for another share's particle (a pair across the cut, j > i) goes into its far
-    buffer, which that share's thread adds in after the loop (:func:`_gather`) and then kicks and drifts its
-    particles. Race-free, and no locks: two parallel regions a step (three more at a rebuild). The same arithmetic
-    per contact as :func:`run`: with one thread the same bits; with more, a particle's force is summed in another
-    order (round-off)."""
+    buffer. The kick region has a cut of its own (:func:`_kick_cut`: its work is per particle, the force region's
+    per contact): each of its shares adds in what the far buffers hold for its particles (:func:`_gather`, in
+    the order of the force region's shares), then kicks and drifts them. Race-free, and no locks: two parallel
+    regions a step (three more at a rebuild). The same arithmetic per contact as :func:`run`: with one thread the
+    same bits; with more, a particle's force is summed in another order (round-off), the same whatever the kick
+    region's cut (only the kinetic energy's partial sums follow it). ``clock``: a timed run's (shares + 1 rows of 2 × PHASES), or empty."""
     n_p = x.shape[0]
     n_w = walls.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
@@ -689,8 +848,8 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
         start, nbj, hist, dmax, rules)
     chunks = np.empty(threads + 1, np.int64)  # each share's rows of the list, and its particles
     far = np.empty(threads, np.int64)  # each share's far buffer holds particles below far[share] only
-    _balance(start, n_w, dmax, chunks)
-    _far_ends(start, nbj, chunks, far)
+    kicks = np.empty(threads + 1, np.int64)  # the kick region's shares of the particles
+    _cut(start, n_w, dmax, nbj, chunks, far, kicks)
     f_far = np.zeros((threads, n_p, 3))  # per share: what it adds for particles of the shares after it
     tq_far = np.zeros((threads, n_p, 3))
     moved = np.zeros(threads)
@@ -700,32 +859,48 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
     # threads' overhead): the forces, then the second half kick fused with the next step's first and its drift
     if steps > 0:
         for b in prange(threads):
-            moved[b] = _kick_drift(chunks[b], chunks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
+            moved[b] = _kick_drift(kicks[b], kicks[b + 1], x, v, w, f, tq, mass, inertia, gravity, dt, box_lo,
                                    box_hi, periodic, x_ref)
+    serial = clock.shape[0] - 1
+    ends = np.zeros(threads, np.int64)  # a timed run's: the end of each share's work in a region
+    t = _now(clock)
     for step in range(1, steps + 1):
         most = 0.0
         for b in range(threads):
             most = max(most, moved[b])
         if most > (0.5 * skin) ** 2:
+            t = _add(clock, serial, S_OTHER, t)
+            # its rows cut as the kicks' particles: a row's cost there is its cells' search, not its contacts
             start, nbj, hist, dmax = _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist,
-                                                       dmax, n_p * n_w, chunks)
+                                                       dmax, n_p * n_w, kicks)
+            t = _add(clock, serial, S_REBUILD, t)
             x_ref[:, :] = x
-            _balance(start, n_w, dmax, chunks)
-            _far_ends(start, nbj, chunks, far)
+            _cut(start, n_w, dmax, nbj, chunks, far, kicks)
+            t = _add(clock, serial, S_AFTER, t)
+            _count(clock, serial, S_REBUILDS)
         elif step % REBALANCE == 0:  # the contacts formed since (a pour's bed grows between rebuilds)
-            _balance(start, n_w, dmax, chunks)
-            _far_ends(start, nbj, chunks, far)
+            t = _add(clock, serial, S_OTHER, t)
+            _cut(start, n_w, dmax, nbj, chunks, far, kicks)
+            t = _add(clock, serial, S_BALANCE, t)
         if step == steps:
             records = _new_records(start)
+        t = _add(clock, serial, S_OTHER, t)
         for c in prange(threads):
+            began = _begin(clock, c, F_LAUNCH, t)
             _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
                             start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules)
+            ends[c] = _add(clock, c, F_WORK, began)[0]
+        t = _waits(clock, ends, F_WAIT, t)
         for b in prange(threads):
-            _gather(chunks[b], chunks[b + 1], b, far, f_far, tq_far, f, tq)
+            began = _begin(clock, b, K_LAUNCH, t)
+            _gather(kicks[b], kicks[b + 1], chunks, far, f_far, tq_far, f, tq)
+            began = _add(clock, b, K_GATHER, began)
             # the kick, and the next step's first half kick and drift in the same pass unless the run is over
-            e_share[b], e_rot_share[b], moved[b] = _kick_and_next(chunks[b], chunks[b + 1], x, v, w, f, tq, mass,
+            e_share[b], e_rot_share[b], moved[b] = _kick_and_next(kicks[b], kicks[b + 1], x, v, w, f, tq, mass,
                                                                   inertia, gravity, dt, box_lo, box_hi, periodic,
                                                                   x_ref, step < steps)
+            ends[b] = _add(clock, b, K_WORK, began)[0]
+        t = _waits(clock, ends, K_WAIT, t)
         e = 0.0
         e_rot = 0.0
         for b in range(threads):
@@ -733,6 +908,7 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
             e_rot += e_rot_share[b]
         if not _energy(ke, flags, step, ke_every, e, e_rot):
             break
+    _add(clock, serial, S_OTHER, t)
     return ke, _contact_table(start, nbj, records, contacts), flags, start, nbj, hist, dmax
 
 
@@ -903,15 +1079,21 @@ def _prefer_openmp():
 
 
 def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = None, laws=None, walls=None,
-            gravity=None, ke_every: int | None = None, threads: int = 1):
+            gravity=None, ke_every: int | None = None, threads: int = 1, clock: np.ndarray | None = None):
     """``steps`` velocity-Verlet steps of the packing state ``st`` (updated): (kinetic energy every ke_every
     steps, number of pair contacts, flags [unused, non-finite]). ``threads``: 1 runs :func:`run`, more
-    :func:`run_threaded` on that many of numba's threads."""
+    :func:`run_threaded` on that many of numba's threads. ``clock``: None, or a timed run's array of
+    (threads + 1, 2 × PHASES) float64 into which the loop adds each phase's time-stamp-counter ticks (the
+    module's clock notes; benchmarks/bench_packing_phases.py)."""
     import numba
 
     from .collision3d import rules_array
 
     threads = check_threads(threads)
+    if clock is None:
+        clock = np.zeros((0, 2 * PHASES))  # untimed
+    elif clock.shape != (threads + 1, 2 * PHASES) or clock.dtype != np.float64 or not clock.flags.c_contiguous:
+        raise ValueError(f"clock: a C-contiguous float64 array of shape {(threads + 1, 2 * PHASES)}, not {clock.shape}")
     sp, laws_n, laws_t, wall_n, wall_t = laws or resolve_laws(case)
     if walls is None:
         walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
@@ -919,7 +1101,7 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
     lo, hi, periodic = box_of(case, st.x, st.rad)
     args = (st.x, st.v, st.w, st.rad, st.mass, sp, laws_n.shape[0], *law_table(laws_n, laws_t, wall_n, wall_t), walls,
             lo, hi, periodic, g, dt, steps, ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax,
-            st.contacts, rules_array(rules))
+            st.contacts, rules_array(rules), clock)
     if threads == 1:
         out = run(*args)
     else:
@@ -936,14 +1118,14 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
 
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 0.0,
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None,
-             threads: int = 1) -> PackState:
+             threads: int = 1, clock: np.ndarray | None = None) -> PackState:
     """Run the packing for ``duration`` (s; default the case's packing.duration) — `pack` and `verify` alike, as
     the engines do: an early stop where the kinetic energy dips (``rest`` × N m g R, off by default) can fall on a
     turning point of a layer bouncing in phase, not on a settled state; dt and the number of steps are case.packing_run's (a run
     past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin. ``threads``: the force
     loop's threads (default 1: the same bits on every run; more: each step the same to round-off, which a pour's
-    collisions amplify — the same packing in its statistics, docs/packing.md)."""
+    collisions amplify — the same packing in its statistics, docs/packing.md). ``clock``: a timed run's (advance)."""
     from ..case import packing_run
     from ..errors import ConfigError
 
@@ -958,7 +1140,7 @@ def simulate(case, duration: float | None = None, dt: float | None = None, rest:
     while done < total:
         n_steps = min(chunk, total - done)
         ke, nc, flags = advance(case, st, dt, n_steps, rules, laws=(sp, laws_n, laws_t, wall_n, wall_t),
-                                walls=walls, gravity=g, threads=threads)
+                                walls=walls, gravity=g, threads=threads, clock=clock)
         if flags[1]:
             raise ConfigError("run.dt", dt, "the packing became non-finite: the time step is too large")
         for k, e in enumerate(ke[1:], start=1):
