@@ -28,7 +28,8 @@ read within this one run. The time budget: the whole pour (0.3 s) at 128 000 sph
 hours here, so every source at every N runs the same first DURATION seconds of the pour (a command-line
 argument; the default is printed in the header).
 
-Run: .venv/bin/python benchmarks/bench_packing_scale.py [DURATION] > benchmarks/results/bench_packing_scale.txt
+Run: .venv/bin/python benchmarks/bench_packing_scale.py [DURATION [N,N…]] > benchmarks/results/bench_packing_scale.txt
+(the sizes default to all four)
 The two-thread goal alone (the reference on 1 and 2 threads, alternating, ROUNDS each, medians):
      .venv/bin/python benchmarks/bench_packing_scale.py --threads DURATION 32000,128000 ROUNDS
 """
@@ -258,4 +259,6 @@ if __name__ == "__main__":
     elif sys.argv[1:2] == ["--threads"]:  # --threads DURATION N[,N…] ROUNDS
         threads(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]))
     else:
+        if len(sys.argv) > 2:  # DURATION N[,N…]: these sizes only
+            SIZES = tuple(int(x) for x in sys.argv[2].split(","))
         main(float(sys.argv[1]) if len(sys.argv) > 1 else DURATION)
