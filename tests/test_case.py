@@ -597,8 +597,8 @@ def test_plain_copy_is_a_deep_copy_of_toml_data():
 
 
 def test_cli_refuses_a_viscous_roll_past_the_no_slip_bound_before_any_run(tmp_path):
-    """Rolling type B (rolling = "viscous") above the largest Cr the sphere rolls under without slip, 1.4 μ m g cos θ
-    R²/v0 (2.19e-8 N·m·s for the suite's glass sphere at 0.02 m/s, μ 0.3): one line naming contact.c_r, its value
+    """Rolling type B (rolling = "viscous") above the largest Cr the sphere rolls under without slip, 1.4 μ m g R²/v0
+    on the level wall (2.19e-8 N·m·s for the suite's glass sphere at 0.02 m/s, μ 0.3): one line naming contact.c_r, its value
     and the bound with its number, exit 2, nothing written (issue 30: before, the case loaded and its runs failed,
     "the sphere slides"). Just below the bound the same case loads."""
     import subprocess
@@ -617,9 +617,36 @@ def test_cli_refuses_a_viscous_roll_past_the_no_slip_bound_before_any_run(tmp_pa
     assert p.returncode == 2, p.stderr[-2000:]
     assert p.stdout == "" and p.stderr.count("\n") == 1, p.stderr
     assert p.stderr.startswith("demcheck: error: contact.c_r = 2.2e-08: must be at most 2.19231e-08 N·m·s"), p.stderr
-    assert "Cr ≤ 1.4 μ m g cos θ R²/v0" in p.stderr and "the sphere slides" in p.stderr, p.stderr
+    assert "Cr ≤ 1.4 μ m g R²/v0 on a level wall" in p.stderr and "the sphere slides" in p.stderr, p.stderr
     assert not list(out.iterdir()), "nothing is written before the case is checked"
     assert C.loads(text.replace("c_r = 1.5e-8", "c_r = 2.19e-8")).contact.params["c_r"] == 2.19e-8
     with pytest.raises(ConfigError) as info:
         C.loads(text.replace("friction = 0.3", "friction = 0.0"))
-    assert info.value.key == "contact.friction" and "viscous" in info.value.rule
+    # the friction is the material's here (line 13 of the case): the key named is the one the case sets
+    assert info.value.key == "materials.*.friction" and "viscous" in info.value.rule
+
+
+@pytest.mark.parametrize("scenario_file", ["suite/beyond-rolling.toml", "suite/beyond-rolling-viscous.toml",
+                                           "suite/beyond-incline.toml"])
+@pytest.mark.parametrize("tangential", ["none", "viscous", "viscous_sliding"])
+def test_a_roll_without_a_law_that_holds_friction_at_rest_is_refused(scenario_file, tangential):
+    """The rolling and incline scenarios roll the sphere without slip (reference/beyond.py assumes it): a tangential
+    law with no force at a resting contact point lets the sphere slide, so the case is refused at load, naming
+    contact.tangential (before, tangential = "none" loaded and the reference agreed with the no-slip closed form)."""
+    from demcheck.resources import case_path
+
+    text = case_path(scenario_file).read_text()
+    assert 'tangential = "spring_sliding"\nkt = 1e5' in text
+    keys = "" if tangential == "none" else "\neta_t = 1e-3"
+    with pytest.raises(ConfigError) as info:
+        C.loads(text.replace('tangential = "spring_sliding"\nkt = 1e5', f'tangential = "{tangential}"{keys}'))
+    assert info.value.key == "contact.tangential" and info.value.value == tangential
+    assert "without slip" in info.value.rule
+
+
+def test_a_roll_with_coulomb_stick_loads():
+    from demcheck.resources import case_path
+
+    text = case_path("suite/beyond-rolling.toml").read_text()
+    case = C.loads(text.replace('tangential = "spring_sliding"\nkt = 1e5', 'tangential = "sliding"'))
+    assert case.contact.tangential == "sliding"

@@ -706,6 +706,8 @@ def _check_scenario(case: Case) -> None:
                               "\"incline\" for a tilt)")
         if law == "viscous":
             _viscous_roll_grips(case)
+    if scenario in ("rolling", "incline"):
+        _tangential_holds(case, scenario)
     if scenario == "twist":
         w, n = np.asarray(case.particles[0].angular_velocity), np.asarray(case.walls[0].normal)
         if not abs(w @ n) > 0:
@@ -726,9 +728,11 @@ def rolling_grip(case: Case) -> tuple[float, float, float]:
     """A sphere rolling on the case's wall under a viscous torque −Cr ω (type B): (its deceleration at the start,
     the largest friction can give, the largest Cr it rolls under without slip). Rolling, its angular momentum about
     the contact point (7/5)mRv falls at the torque's rate Cr v/R (the friction force has no moment about that
-    point): v' = −v/T, T = 1.4mR²/Cr. The friction force m·v' that keeps it rolling is within μ|Fn| = μ m g cos θ
-    while v0/T ≤ μ g cos θ, i.e. Cr ≤ 1.4 μ m g cos θ R²/v0 — the scenario and its closed form assume it; past it
-    the sphere slides, its spin falls faster than its speed and the speed decays at μ g, not as e^{−t/T}."""
+    point): v' = −v/T, T = 1.4mR²/Cr. On the level wall of the rolling scenario (θ = 0, which the scenario
+    requires: on a tilt gravity has a moment about that point and the roll tends to a terminal speed instead) the
+    friction force m·v' that keeps it rolling is within μ|Fn| = μ m g while v0/T ≤ μ g, i.e. Cr ≤ 1.4 μ m g R²/v0 —
+    the scenario and its closed form assume it; past it the sphere slides, its spin falls faster than its speed and
+    the speed decays at μ g, not as e^{−t/T}."""
     from .laws import model as _model
 
     p, n = case.particles[0], np.asarray(case.walls[0].normal, dtype=float)
@@ -746,6 +750,24 @@ def rolling_grip(case: Case) -> tuple[float, float, float]:
     return deceleration, grip, 1.4 * mass * radius * radius * grip / v0 if v0 > 0.0 else math.inf
 
 
+def _tangential_holds(case: Case, scenario: str) -> None:
+    """The rolling and incline scenarios roll the sphere without slip (reference/beyond.py assumes it and checks
+    |Ft| ≤ μ|Fn|): the case's tangential law must hold a friction force while the contact point is at rest — a
+    history spring (the spring family, LTH, ZZY, Walton) or Coulomb's stick (sliding). No friction, or a force
+    only from a slip velocity (viscous, viscous_sliding), lets the sphere slide, and no source would run the
+    physics the closed form describes."""
+    from .laws import model as _model
+    from .laws.tangential import SlidingTangential
+
+    record = _model.resolve(case).tangential_law.slot()
+    if record.history_size > 0 or isinstance(record, SlidingTangential):
+        return
+    raise ConfigError("contact.tangential", case.contact.tangential,
+                      f"run.scenario = \"{scenario}\" rolls the sphere without slip: it needs a tangential law that "
+                      "holds friction with the contact point at rest (a history spring such as \"spring_sliding\", "
+                      "or \"sliding\"), not one whose force needs a slip velocity or is none")
+
+
 def _viscous_roll_grips(case: Case) -> None:
     """The rolling scenario under type B rolls without slip (:func:`rolling_grip`): above the bound the sphere
     slides and the scenario's closed form (v0 e^{−t/T}) does not hold, so the case is refused before any run."""
@@ -753,13 +775,14 @@ def _viscous_roll_grips(case: Case) -> None:
 
     deceleration, grip, bound = rolling_grip(case)
     if not grip > 0.0:
-        raise ConfigError("contact.friction", _model.resolve(case).pair.friction, "must be > 0 with rolling = "
-                          "\"viscous\": a viscous rolling torque (type B) rolls the sphere only with friction on the wall")
+        key = "contact.friction" if "friction" in case.contact.params else "materials.*.friction"
+        raise ConfigError(key, _model.resolve(case).pair.friction, "must be > 0 with rolling = \"viscous\": a "
+                          "viscous rolling torque (type B) rolls the sphere only with friction on the wall")
     if deceleration > grip:
         raise ConfigError("contact.c_r", case.contact.params.get("c_r"),
                           f"must be at most {bound:.6g} N·m·s, the largest Cr the sphere rolls under without slip "
-                          f"(Cr ≤ 1.4 μ m g cos θ R²/v0): above it the torque decelerates the roll at "
-                          f"Cr·v0/(1.4 m R²) = {deceleration:.3g} m/s², more than friction gives (μ g cos θ = "
+                          f"(Cr ≤ 1.4 μ m g R²/v0 on a level wall): above it the torque decelerates the roll at "
+                          f"Cr·v0/(1.4 m R²) = {deceleration:.3g} m/s², more than friction gives (μ g = "
                           f"{grip:.3g} m/s²), and the sphere slides; the rolling scenario's closed form assumes it rolls")
 
 
