@@ -81,6 +81,31 @@ def test_a_planted_move_is_reported_with_its_size_and_exits_1(runs, tmp_path):
     assert "| kk-wall | reference | restitution |" in md and "| 0.00025 | 1e-09 |" in md
 
 
+def test_fields_diff_does_not_read_may_have_any_shape(runs, tmp_path):
+    """results.json fields the schema leaves open and diff never reads (a case's curves and series, a source's
+    warnings, a comparison's parts): an odd shape is kept as it is, and the comparison runs (it was a 41-line
+    traceback, exit 1 — the code of "regressions found")."""
+    _, a, b = runs
+
+    def odd(cases):
+        case = cases["kk-wall"]
+        case["curves"], case["series"] = "x", 5
+        case["sources"]["reference"]["warnings"] = 5
+        case["comparisons"][0]["parts"] = [1, 2]
+
+    p = demcheck("diff", plant(a, tmp_path / "odd.json", odd), b)
+    assert p.returncode == 0, p.stdout + p.stderr[-2000:]
+    assert "**0 regression(s)**" in p.stdout
+
+
+def test_an_entry_without_its_verdict_is_judged_from_its_comparisons():
+    from demcheck.comparisons.records import CaseResult
+
+    bad = {"case": "c", "comparisons": [{"source": "lammps", "metric": "restitution", "verdict": "failed"}]}
+    entry = CaseResult.from_json(bad)
+    assert entry.verdict == "failed" and entry.status == "failed"
+
+
 def test_a_tolerance_lets_a_small_move_pass(runs, tmp_path):
     _, a, b = runs
     new = plant(b, tmp_path / "p.json",

@@ -920,9 +920,9 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
     eng = registry.get(engine)
     try:
         nl, tl = eng.twin(ps.native, m / 2.0, radius / 2.0)
+        normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)  # (a plug-in's twin may have no seed)
     except (ValueError, ArithmeticError) as exc:
         raise ConfigError("SETTING", line, f"no twin: {exc}") from None
-    normal, tangential, params, reasons = seed_of(nl, tl, ps.asked)
     implied = {"normal_force": f"{nl.k:.6g} δ^{nl.a:g}", "damping": f"{nl.eta:.6g} δ^{nl.b:g} (N·s/m at δ^b)",
                "limit": nl.limit}
     if _hertz(nl):

@@ -18,6 +18,17 @@ from . import verdicts
 OK, FAILED, UNEXPECTED = "ok", "failed", "unexpected"
 
 
+
+def _copy(value, kind):
+    """A copy of a container read from a file (``kind`` dict or list; empty for a missing one). A value of another
+    shape is kept as it is: the schema does not check these fields and diff never reads them, so an odd one must
+    not stop a comparison (a ValueError there was a traceback, exit 1, read as "regressions")."""
+    if value is None:
+        return kind()
+    if kind is list and isinstance(value, (list, tuple)) or kind is dict and isinstance(value, dict):
+        return kind(value)
+    return value
+
 def _comparison(d) -> verdicts.Comparison:
     """A comparison of a results.json as its record (a key a release before this one did not write: default)."""
     if isinstance(d, verdicts.Comparison):
@@ -29,7 +40,7 @@ def _comparison(d) -> verdicts.Comparison:
     values.setdefault("source", "")
     values.setdefault("metric", "")
     values.setdefault("verdict", verdicts.AGREE)
-    values["parts"] = dict(values.get("parts") or {})
+    values["parts"] = _copy(values.get("parts"), dict)
     values["reason"] = values.get("reason") or ""
     values["setting"] = values.get("setting") or ""
     return verdicts.Comparison(**values)
@@ -87,7 +98,7 @@ class SourceResult:
         known = {f.name for f in fields(cls)} - {"keys", "extra"}
         values = {k: v for k, v in d.items() if k in known}
         values["metrics"] = values.get("metrics") or {}
-        values["warnings"], values["reasons"] = list(values.get("warnings") or []), list(values.get("reasons") or [])
+        values["warnings"], values["reasons"] = _copy(values.get("warnings"), list), _copy(values.get("reasons"), list)
         return cls(**{"status": None, **values}, keys=tuple(d),
                    extra={k: v for k, v in d.items() if k not in known})
 
@@ -182,9 +193,12 @@ class CaseResult:
         values = {k: v for k, v in d.items() if k in known}
         values["sources"] = {name: SourceResult.from_json(s) for name, s in (d.get("sources") or {}).items()}
         values["comparisons"] = [_comparison(c) for c in d.get("comparisons") or []]
-        values["curves"] = dict(d.get("curves") or {})
-        values["series"] = list(d.get("series") or [])
-        return cls(**{"case": "", **values}, extra={k: v for k, v in d.items() if k not in known})
+        values["curves"] = _copy(d.get("curves"), dict)
+        values["series"] = _copy(d.get("series"), list)
+        case = cls(**{"case": "", **values}, extra={k: v for k, v in d.items() if k not in known})
+        # an entry without its status or verdict (a hand-built dict) is judged from its comparisons, never
+        # read as "ok"/"agree" by default
+        return case if "status" in d and "verdict" in d else case.judged()
 
 
 @dataclass
@@ -235,7 +249,7 @@ class Summary:
         known = {f.name for f in fields(cls)} - {"extra"}
         values = {k: v for k, v in d.items() if k in known}
         values["cases"] = [CaseResult.from_json(c) for c in d.get("cases") or []]
-        values["engines"] = dict(d.get("engines") or {})
+        values["engines"] = _copy(d.get("engines"), dict)
         return cls(**values, extra={k: v for k, v in d.items() if k not in known})
 
     @classmethod
