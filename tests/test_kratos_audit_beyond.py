@@ -164,13 +164,23 @@ def test_the_viscous_torque_wall_decays_at_the_closed_form_time_constant(tmp_pat
 
 
 @pytest.mark.engine("kratos")
-def test_a_viscous_torque_wall_past_the_no_slip_bound_is_listed_with_the_c_r_rule(tmp_path):
-    """ViscousTorque with c = 500 at v0 = 2 mm/s: the roll would need the friction (5/7)c v0·W = 0.71 W, above μs W =
-    0.3 W — the sphere slides, and the rolling scenario's case is refused as it loads (case.py rolling_grip). The
-    row is "not probed" with that line, naming contact.c_r and the bound — never a verdict, and nothing runs
-    (issue 30 leftover; before, the scenario ran in Kratos and its twin and the row failed at run time)."""
-    c, v0 = 500.0, 0.002
-    roll = _viscous_torque_roll(tmp_path, c, v0)
-    assert roll["status"] == "not probed", roll
-    assert "contact.c_r = " in roll["why"] and "must be at most" in roll["why"] and "slides" in roll["why"], roll
-    assert "metrics" not in roll
+def test_a_viscous_torque_wall_past_the_no_slip_bound_is_probed_at_half_the_bound(tmp_path):
+    """ViscousTorque with c = 500 at the characteristic 2 mm/s: the roll would need the friction (5/7)c v0·W = 0.71 W,
+    above μs W = 0.3 W — the sphere would slide, and the rolling scenario's case would be refused (case.py
+    rolling_grip). The probe rolls at half the bound 1.4 μ/c instead (0.42 mm/s), says so in a note, and the deck's
+    law is exercised: Kratos against its twin and the closed form (before: "not probed", no finding — a deck whose
+    rolling law was never run could come out clean; on 166af39 the row failed at run time)."""
+    c, v0, mu = 500.0, 0.002, MU
+    path = _kratos(tmp_path, pair_law="DEM_D_Hertz_viscous_Coulomb", model="DEMRollingFrictionModelViscousTorque")
+    mats = json.loads((tmp_path / "MaterialsDEM.json").read_text())
+    mats["material_relations"][1]["Variables"]["ROLLING_FRICTION_WITH_WALLS"] = c
+    (tmp_path / "MaterialsDEM.json").write_text(json.dumps(mats))
+    r = A.audit(path, speed=v0, run_engine=False, beyond_engine=True)
+    roll = _rows(r["pairs"][1])["rolling"]
+    assert roll["status"] == "ok", roll
+    assert any(f"rolling at {0.7 * mu / c:.6g} m/s" in n and "half the no-slip bound" in n for n in roll["notes"]), roll
+    assert roll["engine_vs_twin"] <= 1e-9
+    tau = roll["metrics"]["rolling_time_constant"]
+    # approximate (Cr ∝ the oscillating |Fn|): T = 0.285 ms is short beside the contact's own oscillation here,
+    # measured 0.90 % off the closed form (3.5e-5 at c = 50 above)
+    assert abs(tau["engine"] / tau["reference"] - 1) < 0.02

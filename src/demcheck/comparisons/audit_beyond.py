@@ -412,14 +412,30 @@ def _kratos_rolling(setup, ps, sub, base, entry, speed) -> list:
     if sub["law"] == "constant_torque":
         contact.update(rolling="constant_torque", mu_r=coef, full_direction=True)
         what = f"type A μr = {coef:g} (Rr = R)"
+        roll = f"rolling at the characteristic speed {speed:g}, ω = v/R"
     else:
         contact.update(rolling="viscous", c_r=coef * weight * r * r)
         what = f"type B Cr = {coef:g}·W·R² = {coef * weight * r * r:.6g} N·m·s"
+        speed, roll = _viscous_roll_speed(speed, coef, mu)
     notes = [f"{ps.native.normal}: Kn = {kn:.6g} N/m of E* {ps.native.normal_args[0]:.6g} on a wall, Kt = "
              f"{ratio:.4g}·Kn (4G*/E* of the two materials), μ = STATIC_FRICTION {mu:g} (Kratos' μ at no slip); "
-             f"{what}", f"rolling at the characteristic speed {speed:g}, ω = v/R"]
+             f"{what}", roll]
     return [(label, _on_plane(f"audit-{label}", mat, r, contact, "rolling", (0.0, 0.0, -g),
                               velocity=(speed, 0.0, 0.0)), "", notes)]
+
+
+def _viscous_roll_speed(speed: float, coef: float, mu: float) -> tuple[float, str]:
+    """The speed a type B probe rolls at, and its note. Kratos' ViscousTorque Cr = c·W·R² rolls without slip
+    while Cr ≤ 1.4 μ m g R²/v0 (case.rolling_grip), i.e. v0 ≤ 1.4 μ/c whatever the sphere: past it the sphere
+    slides and the scenario has no closed form, so the probe rolls at half that bound instead of the
+    characteristic speed — the deck's rolling law is still exercised, not left unprobed."""
+    bound = 1.4 * mu / coef if coef > 0.0 else math.inf
+    if speed <= 0.5 * bound:
+        return speed, f"rolling at the characteristic speed {speed:g}, ω = v/R"
+    slow = 0.5 * bound
+    return slow, (f"rolling at {slow:.6g} m/s, ω = v/R: half the no-slip bound 1.4 μ/c = {bound:.6g} m/s of "
+                  f"ROLLING_FRICTION_WITH_WALLS c = {coef:g} (at the characteristic speed {speed:g} the sphere "
+                  "would slide, and the rolling scenario assumes it rolls)")
 
 
 # the probe of each kind an engine's reader names in its BEYOND_PROBES (slot → kind)
