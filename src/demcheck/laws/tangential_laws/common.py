@@ -30,6 +30,13 @@ def _norm(a):
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
+def reverses(vt, previous):
+    """Whether the slip reverses its direction: v_t turns against the last nonzero slip velocity (a law with
+    F_REVERSAL stores its history there)."""
+    return vt[0] * previous[0] + vt[1] * previous[1] + vt[2] * previous[2] < 0.0
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
 def kt_of(tl, delta):
     if tl[T_KT_SQRT] != 0.0:
         return tl[T_KT] * math.sqrt(tl[T_R] * max(delta, 0.0))
