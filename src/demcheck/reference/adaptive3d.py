@@ -9,7 +9,7 @@ import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
-from ..laws.normal_force import (hls_unloading, L_ETA, L_FAMILY, L_KL, L_LIMIT, viscoelastic_force)
+from ..laws.normal_force import (hls_unloading, L_ETA, L_KL, L_LIMIT, loads_and_unloads, viscoelastic_force)
 from ..laws.tangential import T_MU_K, T_MU_S, T_NEAR_LIMIT, T_RIDE_BAND, T_UNLOAD_MARGIN
 from ..laws.tangential_force import (_cross, _dot, eta_of, F_CONSTRAINT, F_HISTORY, F_OWN_RATE, F_REVERSAL, F_RIDES,
                                      F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES, F_STICK_KINK,
@@ -426,7 +426,7 @@ def _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn
         if nmode == M_FREE:
             if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
-            if nl[L_FAMILY] == 1.0:
+            if loads_and_unloads(nl):
                 # (a float: aux holds the modes as floats, and the other call site passes one)
                 return _normal_mode_force(nl, np.float64(M_UNLOAD), delta, rate, aux[A_DMAX])
             return viscoelastic_force(nl, delta, rate)
@@ -500,7 +500,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     aux = np.zeros(A_SIZE)
     y = y0.copy()
     delta0 = kinematics(y, geo, rules)[0]
-    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_FAMILY] == 1.0 else M_VE)
+    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if loads_and_unloads(nl) else M_VE)
     t = 0.0
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
     # and so would a counter's first, literal, value while the loop's types are being inferred)
@@ -545,8 +545,8 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         # so only the bodies' state is error-controlled then.
         n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
         if has(tl, F_RIDES) and aux[A_NMODE] != M_PRE:
-            # within T_NEAR_LIMIT (1e-6) of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely stiff as x → 0
-            # with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
+            # within T_NEAR_LIMIT (1e-6) of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely
+            # stiff as x → 0 with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
             # integration error, and is left out of the error control (else the steps shrink without end)
             kin = kinematics(y, geo, rules)
             fnow = abs(_contact_force(nl, aux[A_NMODE], kin[0], kin[1], aux[A_DMAX]))
@@ -647,7 +647,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         constraint = has(tl, F_CONSTRAINT)
         if best_event == 0 and best_dir > 0:
             code = EV_START
-            aux[A_NMODE] = M_LOAD if nl[L_FAMILY] == 1.0 else M_VE
+            aux[A_NMODE] = M_LOAD if loads_and_unloads(nl) else M_VE
             aux[A_DMAX] = 0.0
             y[18:21] = 0.0
             aux[A_LSTAR:A_LSTAR + 3] = 0.0
@@ -664,11 +664,11 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         elif best_event == 1 and best_dir < 0:
             code = EV_FORCE_END if not force_ended else -EV_FORCE_END
             force_ended = True
-            if nl[L_FAMILY] == 1.0 or nl[L_LIMIT] != 0.0:
+            if loads_and_unloads(nl) or nl[L_LIMIT] != 0.0:
                 aux[A_NMODE] = M_FREE
         elif best_event == 1:
             code = EV_REENTER
-            aux[A_NMODE] = M_UNLOAD if nl[L_FAMILY] == 1.0 else M_VE
+            aux[A_NMODE] = M_UNLOAD if loads_and_unloads(nl) else M_VE
         elif best_event == 2:
             code = EV_MAX_OVERLAP
             if aux[A_NMODE] == M_LOAD:
