@@ -17,9 +17,9 @@ from .tangential_dispatch import build
 from .tangential_laws.common import _cross, _dot, _norm, eta_of, kt_of, reverses  # noqa: F401
 from .tangential_laws.spring import spring_slip  # noqa: F401
 from .tangential_laws.walton import walton_reverses, walton_stiffness  # noqa: F401
-from .tangential_slot import (F_CONSTRAINT, F_DISCRETE_SLIP, F_HISTORY, F_OWN_RATE, F_REVERSAL,  # noqa: F401
-                              F_RIDES, F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES, F_STICK_KINK,
-                              F_VISCOUS_KINK, has)
+from .tangential_slot import (F_CONSTRAINT, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,  # noqa: F401
+                              F_REVERSAL, F_RIDES, F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES,
+                              F_STICK_KINK, F_VISCOUS_KINK, has)
 
 _dispatch = build()
 tangential_force = _dispatch.tangential_force

@@ -42,6 +42,7 @@ F_RIDES = 256  # no slip state: its history is a load that rides its Coulomb lim
 F_VISCOUS_KINK = 512  # its force switches from the dashpot ηt|v_t| to the cap μk|Fn| (a kink, an event)
 F_OWN_RATE = 1024  # its history grows at its own rate (its history_rate function, not v_t)
 F_DISCRETE_SLIP = 2048  # the engines' scheme slips it by its own rule (its discrete_slip function)
+F_NO_FORCE = 4096  # it applies no tangential force (frictionless): the solvers skip it
 
 TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING = 0, 1, 2
 TRUNCATIONS = {"force": TRUNC_CAP, "overlap": TRUNC_MAW, "spring": TRUNC_SPRING}
@@ -65,6 +66,7 @@ class TangentialSubModel(SubModel):
     stick_kink: ClassVar[bool] = False
     reversal: ClassVar[bool] = False
     viscous_kink: ClassVar[bool] = False
+    no_force: ClassVar[bool] = False
     history_is_load: ClassVar[bool] = False  # its history is a force (its error scale is a force's)
     unload_margin: ClassVar[float] = 0.0  # of |v_t|: a slip ends where λ < −margin |v_t|
     near_limit: ClassVar[float] = 0.0  # > 0: F_RIDES, the load within this fraction of a falling limit is on it
@@ -87,6 +89,7 @@ class TangentialSubModel(SubModel):
                  (self.slip_keeps_history, F_SLIP_KEEPS), (self.slip_reads_surface, F_SLIP_READS_SURFACE),
                  (self.slip_snaps, F_SLIP_SNAPS), (self.stick_kink, F_STICK_KINK), (self.reversal, F_REVERSAL),
                  (self.near_limit > 0.0, F_RIDES), (self.viscous_kink, F_VISCOUS_KINK),
+                 (self.no_force, F_NO_FORCE),
                  (k is not None and k.history_rate is not None, F_OWN_RATE),
                  (k is not None and k.discrete_slip is not None, F_DISCRETE_SLIP))
         return sum(flag for on, flag in pairs if on)

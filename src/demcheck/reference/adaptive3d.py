@@ -11,10 +11,10 @@ from numba import njit
 from .. import KERNEL_CACHE
 from ..laws.normal_force import (hls_unloading, L_ETA, L_KL, L_LIMIT, loads_and_unloads, viscoelastic_force)
 from ..laws.tangential import T_MU_K, T_MU_S, T_NEAR_LIMIT, T_RIDE_BAND, T_UNLOAD_MARGIN
-from ..laws.tangential_force import (_cross, _dot, eta_of, F_CONSTRAINT, F_HISTORY, F_OWN_RATE, F_REVERSAL, F_RIDES,
-                                     F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES, F_STICK_KINK,
-                                     F_VISCOUS_KINK, has, history_rate, limit_margin, _norm, return_map,
-                                     slip_surface, tangential_force)
+from ..laws.tangential_force import (_cross, _dot, eta_of, F_CONSTRAINT, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
+                                     F_REVERSAL, F_RIDES, F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES,
+                                     F_STICK_KINK, F_VISCOUS_KINK, has, history_rate, limit_margin, _norm,
+                                     return_map, slip_surface, tangential_force)
 from .integrator import (crossed, ended_with_it, error, grow, H_MIN, H_START, illinois_step, illinois_trial,
                          LOCATE_ITERATIONS, resume, shrink, solution, stage2, stage3, stage4, stage5, stage6,
                          THETA_TOL)
@@ -122,7 +122,7 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     req_margin = -1.0
     lam = 0.0
     ts = geo[G_TS]
-    if contact:
+    if contact and not has(tl, F_NO_FORCE):
         if has(tl, F_CONSTRAINT) and not slipping:
             # constraint force keeping v_t = 0: v̇_t = A F + b
             amob = 1.0 / geo[G_M0] + a0t * a0s / geo[G_I0]

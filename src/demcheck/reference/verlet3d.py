@@ -13,7 +13,7 @@ from numba import njit
 from .. import KERNEL_CACHE
 from ..laws.normal_force import (normal_force)
 from ..laws.tangential import T_FORCE, T_MU_K, T_MU_S, T_R, T_RESCALE, T_TRUNC, TRUNC_SPRING
-from ..laws.tangential_force import (_cross, discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_OWN_RATE,
+from ..laws.tangential_force import (_cross, discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
                                      F_REVERSAL, has, history_rate, kt_of, _norm, return_map, reverses,
                                      slip_surface, tangential_force)
 from ..laws.tangential_force import spring_slip  # noqa: F401  (reference/packing.py imports it from here)
@@ -200,7 +200,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     else:
                         sliding = False
                     ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
-            else:
+            elif not has(tl, F_NO_FORCE):
                 ft = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), aux[A_TREF:A_TREF + 3])
         else:
             hist[:] = 0.0
