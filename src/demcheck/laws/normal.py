@@ -26,8 +26,8 @@ from .contact import Pair
 from .damping import Damping, NoDamping, damping_of
 from .registry import Registry, contact_number
 
-VISCOELASTIC = 0
-HYSTERETIC = 1
+from .normal_laws.hls import FAMILY as HYSTERETIC  # the law array's family ids (laws/normal_laws/)
+from .normal_laws.viscoelastic import FAMILY as VISCOELASTIC
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,8 @@ from .registry import Registry, contact_number
 from .normal import HYSTERETIC, NormalLaw, Param, contact_choice
 
 from .tangential_slot import (T_ETA, T_ETA1, T_ETA_NORMAL, T_FAMILY, T_FORCE, T_G, T_K0, T_KT,  # noqa: F401
-                              T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_P0, T_PARAMS, T_R, T_RESCALE, T_SIZE, T_TRUNC, T_XI,
+                              T_KT_SQRT, T_M, T_MU_K, T_MU_S, T_NEAR_LIMIT, T_P0, T_PARAMS, T_R, T_RESCALE, T_RIDE_BAND,
+                              T_SIZE, T_TRAITS, T_TRUNC, T_UNLOAD_MARGIN, T_XI,
                               TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, TRUNCATIONS, TangentialSubModel, load_plugins,
                               record_class)
 from .tangential_laws.lth import LTH, LthTangential  # noqa: F401  (the built-in laws, one module each)
@@ -83,7 +84,8 @@ class TangentialLaw:
         extra = [float(x) for x in self.params] + [0.0] * (T_PARAMS - len(self.params))
         return np.array([self.family, self.kt, float(self.kt_sqrt), self.eta, float(self.eta_normal), self.mu_s,
                          self.mu_k, self.truncation, self.r_eff, self.m_eff, self.xi_coef, self.eta1, self.g_i,
-                         self.k0, float(self.force_history), float(self.rescale_history), *extra])
+                         self.k0, float(self.force_history), float(self.rescale_history), *extra,
+                         *self._as_record().trait_columns()])
 
     @classmethod
     def from_array(cls, law) -> "TangentialLaw":
@@ -113,6 +115,11 @@ class TangentialLaw:
     def pushes_at_onset(self) -> bool:
         """Whether the friction can push along the slip at contact onset (its record's ``pushes_at_onset``)."""
         return self._as_record().pushes_at_onset
+
+    @property
+    def history_is_load(self) -> bool:
+        """Whether its history is a force (a load), not a displacement (its record's ``history_is_load``)."""
+        return self._record().history_is_load
 
     @property
     def caps(self) -> bool:

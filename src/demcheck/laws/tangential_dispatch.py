@@ -21,12 +21,16 @@ from pathlib import Path
 from .. import KERNEL_CACHE
 from .tangential_slot import _BUILT, KERNELS, T_FAMILY
 
-# the dispatch functions: name → (arguments, default law function's module and name)
+# the dispatch functions: name → (arguments, the default: a law function's (module, name), or the expression
+# returned where the family registered none)
+_ARGS = "tl, nl, xi, vt, fn_abs, delta"
 SIGNATURES = {
-    "tangential_force": ("tl, nl, xi, vt, fn_abs, delta, slipping, tref", None),
-    "slip_surface": ("tl, nl, xi, vt, fn_abs, delta, mu", ("demcheck.laws.tangential_laws.common", "no_slip_surface")),
-    "return_map": ("tl, nl, xi, vt, fn_abs, delta, mu",
-                   ("demcheck.laws.tangential_laws.common", "radial_return_map")),
+    "tangential_force": (f"{_ARGS}, slipping, tref", "np.zeros(3)"),
+    "slip_surface": (f"{_ARGS}, mu", ("demcheck.laws.tangential_laws.common", "no_slip_surface")),
+    "return_map": (f"{_ARGS}, mu", ("demcheck.laws.tangential_laws.common", "radial_return_map")),
+    "history_rate": (f"{_ARGS}, lstar", "vt"),
+    "limit_margin": (f"{_ARGS}, lstar", "1.0"),
+    "discrete_slip": (f"{_ARGS}, mu", "(xi.copy(), np.zeros(3), False)"),
 }
 DOCS = {
     "tangential_force": "Force on body 0 of the tangential law, in its stick or slip state (SLIDING's stick force "
@@ -34,8 +38,13 @@ DOCS = {
     "slip_surface": "(ψ, w, D): the slip function of the history laws (ψ ≤ 0 sticks), the direction w in history "
                     "space along which a slip reduces ψ, and D = ∇_hψ·w.",
     "return_map": "The history on the slip surface of friction coefficient mu (Coulomb truncation).",
+    "history_rate": "dξ/dt of a law with its own rate (F_OWN_RATE; lstar: the history at the last reversal); "
+                    "else v_t.",
+    "limit_margin": "The fraction of the way left to the Coulomb limit of a riding law (F_RIDES); else 1.",
+    "discrete_slip": "(history, force, sliding) after the engines' increment, by the law's own rule "
+                     "(F_DISCRETE_SLIP; mu: the slip test's coefficient).",
 }
-_FIELD = {"tangential_force": "force", "slip_surface": "slip_surface", "return_map": "return_map"}
+_FIELD = {name: ("force" if name == "tangential_force" else name) for name in SIGNATURES}
 
 
 # each law's function inlined into the switch (numba's IR inlining: the law is not compiled on its own, and the
@@ -67,8 +76,8 @@ def source(kernels=None) -> str:
             lines += [f"from {module} import {fname} as {alias}", f"{alias} = {_INLINE.format(alias)}"]
             test = " or ".join(f"family == {f}" for f in families)
             body += [f"    if {test}:", f"        return {alias}({args})"]
-        if default is None:
-            body.append("    return np.zeros(3)  # no law has this id: none registered it")
+        if isinstance(default, str):
+            body.append(f"    return {default}  # no law of this id registered one")
         else:
             alias = f"_{name}_default"
             lines += [f"from {default[0]} import {default[1]} as {alias}", f"{alias} = {_INLINE.format(alias)}"]

@@ -9,11 +9,12 @@ import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
-from ..laws.normal_force import (hls_unloading, L_ETA, L_FAMILY, L_KL, L_LIMIT, viscoelastic_force)
-from ..laws.tangential import (LTH, NONE, SLIDING, SPRING, T_FAMILY, T_MU_K, T_MU_S, T_TRUNC, TRUNC_CAP,
-                               VISCOUS_SLIDING, WALTON, ZZY)
-from ..laws.tangential_force import (_cross, _dot, eta_of, _norm, return_map, slip_surface, tangential_force,
-                                     walton_margin, WALTON_NEAR_LIMIT, WALTON_RIDE, walton_stiffness)
+from ..laws.normal_force import (hls_unloading, L_ETA, L_KL, L_LIMIT, loads_and_unloads, viscoelastic_force)
+from ..laws.tangential import T_MU_K, T_MU_S, T_NEAR_LIMIT, T_RIDE_BAND, T_UNLOAD_MARGIN
+from ..laws.tangential_force import (_cross, _dot, eta_of, F_CONSTRAINT, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
+                                     F_REVERSAL, F_RIDES, F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES,
+                                     F_STICK_KINK, F_VISCOUS_KINK, has, history_rate, limit_margin, _norm,
+                                     return_map, slip_surface, tangential_force)
 from .integrator import (crossed, ended_with_it, error, grow, H_MIN, H_START, illinois_step, illinois_trial,
                          LOCATE_ITERATIONS, resume, shrink, solution, stage2, stage3, stage4, stage5, stage6,
                          THETA_TOL)
@@ -115,15 +116,14 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     contact = nmode != M_PRE
     fn = _contact_force(nl, nmode, delta, rate, aux[A_DMAX]) if contact else 0.0
     fabs = abs(fn)
-    family = tl[T_FAMILY]
     slipping = aux[A_TMODE] == SLIP
     xi = _tangent_history(y, n)
     ft = np.zeros(3)
     req_margin = -1.0
     lam = 0.0
     ts = geo[G_TS]
-    if contact and family != NONE:
-        if family == SLIDING and not slipping:
+    if contact and not has(tl, F_NO_FORCE):
+        if has(tl, F_CONSTRAINT) and not slipping:
             # constraint force keeping v_t = 0: v̇_t = A F + b
             amob = 1.0 / geo[G_M0] + a0t * a0s / geo[G_I0]
             if geo[G_WALL] == 0.0:
@@ -131,7 +131,7 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
             b = _slip_drift(y, geo, rules, delta, rate, n, ndot, a0s, a1s)
             ft = -b / amob
             req_margin = _norm(ft) - tl[T_MU_S] * fabs
-        elif slipping and (family == LTH or family == ZZY):
+        elif slipping and has(tl, F_SLIP_READS_SURFACE):
             # a slipping history lies on its surface |ξ| = ξm by definition: the force reads it there, not the
             # integrated value, which is not error-controlled while slipping (below) and would drift off it —
             # a drift the viscous term's (1 − |ξ|/ξm)^{1/4} magnifies a thousandfold
@@ -144,31 +144,32 @@ def rhs(y, aux, nl, tl, geo, rules, dy):
     tau1 = _cross(a1t * n, ft)
     _accelerations(y, geo, fvec0, tau0, tau1, dy)
     dy[18:21] = 0.0
-    if contact and (family == SPRING or family == LTH or family == ZZY or family == WALTON):
+    if contact and has(tl, F_HISTORY):
         rot = _dot(xi, ndot) * n
-        if family == WALTON:
-            dh = walton_stiffness(tl, xi, vt, fabs, aux[A_LSTAR:A_LSTAR + 3]) * vt - rot
+        if has(tl, F_OWN_RATE):
+            dh = history_rate(tl, nl, xi, vt, fabs, delta, aux[A_LSTAR:A_LSTAR + 3]) - rot
+        else:
+            dh = vt - rot
+        if has(tl, F_RIDES):
             hn = _norm(xi)
             cap = tl[T_MU_K] * fabs
-            if hn > 0.0 and cap > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
-                # at the Coulomb limit the load rides it, |L|/μ|Fn| held — within WALTON_NEAR_LIMIT of a falling
+            if hn > 0.0 and cap > 0.0 and hn >= (1.0 - tl[T_NEAR_LIMIT]) * cap:
+                # at the Coulomb limit the load rides it, |L|/μ|Fn| held — within T_NEAR_LIMIT of a falling
                 # limit, which carries the load down with it (the verlet method truncates it after each
                 # increment, slip_surface; a load above the limit is put back on it after each step,
-                # _walton_truncate), and within WALTON_RIDE of a rising one: there Kt ∝ x^{1/3} makes the
+                # _ride_truncate), and within T_RIDE_BAND of a rising one: there Walton's Kt ∝ x^{1/3} makes the
                 # approach infinitely stiff, while farther below the lag x of the load behind a rising limit
                 # is physics (the verlet plateau test) and is integrated as it is. The limit's rate by a
                 # one-sided difference along the flow, on the branch of |Fn| of the base point
                 capdot = _limit_rate(y, aux, nl, tl, geo, rules, fn, dy)
-                if capdot < 0.0 or hn >= (1.0 - WALTON_RIDE) * cap:
+                if capdot < 0.0 or hn >= (1.0 - tl[T_RIDE_BAND]) * cap:
                     most = (hn / cap) * capdot
                     u = xi / hn
                     radial = _dot(u, dh)
                     if radial > most:
                         dh = dh - (radial - most) * u
-            dy[18:21] = dh
-        else:
-            dy[18:21] = vt - rot
-        if slipping and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        dy[18:21] = dh
+        if slipping and not has(tl, F_SLIP_KEEPS):
             mu = tl[T_MU_K]
             psi, w, dpsi = slip_surface(tl, nl, xi, vt, fabs, delta, mu)
             # one-sided (forward, second order) along the flow: |ξ| has a kink at ξ = 0, where every slip
@@ -240,19 +241,15 @@ SIMULTANEOUS_THETA = 1e-9
 # and the run stopped with too-many-steps). A stick that short moves no metric by more than its 1e-9 of t_c;
 # the contact lies on its slip surface, where stick and slip give LTH and ZZY the same force.
 GRAZE_SAME_INSTANT = 1e-9
-# LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
-# of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
-# the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
-# whose force, μ|Fn|, is the slip state's). A slip of these laws therefore ends only when sticking would
-# unload the history by more than this fraction of |v_t| (λ < −UNLOAD_MARGIN |v_t|); below it the contact
-# stays on the surface, where stick and slip give the same force, instead of chattering between the two.
-UNLOAD_MARGIN = 1e-4
+# A law whose stick force reaches μ|Fn| through a term of unbounded slope (LTH and ZZY: laws/tangential_laws/lth.py,
+# UNLOAD_MARGIN) declares an unloading margin: its slip ends only when sticking would unload the history by more
+# than that fraction of |v_t|; below it the contact stays on the surface instead of chattering.
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
 def _margin(tl, vt):
-    family = tl[T_FAMILY]
-    return UNLOAD_MARGIN * _norm(vt) if (family == LTH or family == ZZY) else 0.0
+    margin = tl[T_UNLOAD_MARGIN]
+    return margin * _norm(vt) if margin != 0.0 else 0.0
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
@@ -272,13 +269,14 @@ def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
     return tl[T_MU_K] * (-3.0 * fsign * fn + 4.0 * fa - fb) / (2.0 * s)
 
 
-# _walton_truncate, _onto_surface and _settle are inlined into adaptive_3d (one or two call sites each): a function
+# _ride_truncate, _onto_surface and _settle are inlined into adaptive_3d (one or two call sites each): a function
 # numba compiles on its own is a library that links, and optimises once more, the whole right-hand side it calls;
 # inlined, the 3-D solver compiles in ~3/4 of the time (docs/performance.md, "Cold start")
 @njit(cache=KERNEL_CACHE, inline="always")
-def _walton_truncate(y, aux, nl, tl, geo, rules):
-    """Walton's stored load back onto the Coulomb limit where it lies above it (the verlet method's truncation),
-    and onto it where it rides within WALTON_NEAR_LIMIT below a falling limit (rhs): a load that close to a
+def _ride_truncate(y, aux, nl, tl, geo, rules):
+    """A riding law's stored load (F_RIDES: Walton's) back onto the Coulomb limit where it lies above it (the
+    verlet method's truncation), and onto it where it rides within T_NEAR_LIMIT below a falling limit (rhs): a
+    load that close to a
     falling limit meets it at once, and snapping it there keeps the answer from depending on where a step
     happened to enter the band."""
     if aux[A_NMODE] == M_PRE:
@@ -290,7 +288,7 @@ def _walton_truncate(y, aux, nl, tl, geo, rules):
     cap = tl[T_MU_K] * abs(fn)
     if hn > cap:
         y[18:21] = xi * (cap / hn)
-    elif hn > 0.0 and hn >= (1.0 - WALTON_NEAR_LIMIT) * cap:
+    elif hn > 0.0 and hn >= (1.0 - tl[T_NEAR_LIMIT]) * cap:
         dy = np.empty(y.shape[0])
         rhs(y, aux, nl, tl, geo, rules, dy)
         if _limit_rate(y, aux, nl, tl, geo, rules, fn, dy) < 0.0:
@@ -324,19 +322,19 @@ def _settle(y, aux, nl, tl, geo, rules):
     """After an event: a sticking contact whose force exceeds the static limit slips, and a slipping history
     is put back on its slip surface (the cap collapses where Fn passes through 0, and two switches can
     fall inside one step there)."""
-    family = tl[T_FAMILY]
-    if aux[A_NMODE] == M_PRE or family == NONE:
+    if aux[A_NMODE] == M_PRE:
         return
-    if family == WALTON:  # no slip state: its load rides the limit (rhs), and is truncated to it
-        _walton_truncate(y, aux, nl, tl, geo, rules)
+    if has(tl, F_RIDES):  # no slip state: its load rides the limit (rhs), and is truncated to it
+        _ride_truncate(y, aux, nl, tl, geo, rules)
         return
-    if not (family == SPRING or family == LTH or family == ZZY or family == SLIDING):
+    constraint = has(tl, F_CONSTRAINT)
+    if not (has(tl, F_STATES) or constraint):
         return
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     dy = np.empty(y.shape[0])
     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
     if aux[A_TMODE] == SLIP:
-        if family != SLIDING and not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        if not constraint and not has(tl, F_SLIP_KEEPS):
             # back onto the slip surface (the multiplier is least accurate at |Fn|'s kink); a slip that
             # would unload the history (λ < 0) sticks from there
             y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
@@ -344,7 +342,7 @@ def _settle(y, aux, nl, tl, geo, rules):
             if _unloads(tl, lam, vt) and fn != 0.0:
                 aux[A_TMODE] = STICK
         return
-    if family == SLIDING:
+    if constraint:
         if req > 0.0:
             aux[A_TMODE] = SLIP
             fnorm = _norm(ft)
@@ -355,7 +353,7 @@ def _settle(y, aux, nl, tl, geo, rules):
     if psi > 1e-12 * max(tl[T_MU_S] * abs(fn), 1e-300):
         aux[A_TMODE] = SLIP
         y[18:21] = return_map(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])
-        if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+        if not has(tl, F_SLIP_KEEPS):
             # as at a stick→slip event: from the surface, a slip that would unload the history sticks
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
             if _unloads(tl, lam, vt) and fn != 0.0:
@@ -365,7 +363,6 @@ def _settle(y, aux, nl, tl, geo, rules):
 @njit(cache=KERNEL_CACHE)
 def _event_direction(nl, tl, aux, event):
     nmode = aux[A_NMODE]
-    family = tl[T_FAMILY]
     slipping = aux[A_TMODE] == SLIP
     in_contact = nmode != M_PRE
     if event == 0:
@@ -384,13 +381,13 @@ def _event_direction(nl, tl, aux, event):
         return -1 if (nmode == M_VE and nl[L_ETA] != 0.0) else 0
     if event == 4:
         return 1 if nmode == M_UNLOAD else 0
-    history = family == SPRING or family == LTH or family == ZZY
+    states = has(tl, F_STATES) or has(tl, F_CONSTRAINT)
     if event == 5:
-        return 1 if ((history or family == SLIDING) and not slipping) else 0
+        return 1 if (states and not slipping) else 0
     if event == 6:
-        return -1 if ((history or family == SLIDING) and slipping) else 0
+        return -1 if (states and slipping) else 0
     if event == 7:
-        return 2 if (family == WALTON or family == VISCOUS_SLIDING) else 0
+        return 2 if (has(tl, F_REVERSAL) or has(tl, F_VISCOUS_KINK)) else 0
     return 0
 
 
@@ -429,7 +426,7 @@ def _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn
         if nmode == M_FREE:
             if delta <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
-            if nl[L_FAMILY] == 1.0:
+            if loads_and_unloads(nl):
                 # (a float: aux holds the modes as floats, and the other call site passes one)
                 return _normal_mode_force(nl, np.float64(M_UNLOAD), delta, rate, aux[A_DMAX])
             return viscoelastic_force(nl, delta, rate)
@@ -441,22 +438,21 @@ def _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn
     if event == 3:
         s = 1e-7 * geo[G_TS]
         return (_fn_at(y + s * dy, aux, nl, geo, rules) - _fn_at(y - s * dy, aux, nl, geo, rules)) / (2 * s)
-    family = tl[T_FAMILY]
     if event == 5:
-        if family == SLIDING:
+        if has(tl, F_CONSTRAINT):
             return req
         psi, w, d = slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_S])
         return psi
     if event == 6:
-        if family == SLIDING:
+        if has(tl, F_CONSTRAINT):
             return _dot(vt, aux[A_TREF:A_TREF + 3])
-        if family == SPRING and tl[T_TRUNC] == TRUNC_CAP:  # a plain cap sticks when the trial force drops below it
+        if has(tl, F_SLIP_KEEPS):  # a plain cap sticks when the trial force drops below it
             return slip_surface(tl, nl, _tangent_history(y, n), vt, abs(fn), delta, tl[T_MU_K])[0]
         if fn == 0.0:  # a zero cap (limit_force, force ended) admits only the slip state's zero force
             return 1.0
         return lam + _margin(tl, vt)  # falls through 0 where the slip ends (_unloads)
     if event == 7:
-        if family == WALTON:  # a reversal of the slip (walton_reverses)
+        if has(tl, F_REVERSAL):  # a reversal of the slip (tangential_laws.common.reverses)
             return _dot(vt, aux[A_TREF:A_TREF + 3])
         return eta_of(tl, nl, delta) * _norm(vt) - tl[T_MU_K] * abs(fn)
     return 1.0
@@ -504,7 +500,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     aux = np.zeros(A_SIZE)
     y = y0.copy()
     delta0 = kinematics(y, geo, rules)[0]
-    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if nl[L_FAMILY] == 1.0 else M_VE)
+    aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if loads_and_unloads(nl) else M_VE)
     t = 0.0
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
     # and so would a counter's first, literal, value while the loop's types are being inferred)
@@ -548,14 +544,14 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         # slaved to the return map (it diverges where Kt ∝ √δ → 0 under a finite cap, the force does not),
         # so only the bodies' state is error-controlled then.
         n_ctrl = 18 if aux[A_TMODE] == SLIP else 21
-        if tl[T_FAMILY] == WALTON and aux[A_NMODE] != M_PRE:
-            # within 1e-6 of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely stiff as x → 0
-            # with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
+        if has(tl, F_RIDES) and aux[A_NMODE] != M_PRE:
+            # within T_NEAR_LIMIT (1e-6) of the Coulomb limit Walton's Kt ∝ x^{1/3} is non-Lipschitz (infinitely
+            # stiff as x → 0 with a rising |Fn|): the load is then slaved to the limit to within 1e-6 μ|Fn| whatever its
             # integration error, and is left out of the error control (else the steps shrink without end)
             kin = kinematics(y, geo, rules)
             fnow = abs(_contact_force(nl, aux[A_NMODE], kin[0], kin[1], aux[A_DMAX]))
-            if walton_margin(tl, _tangent_history(y, kin[2]), kin[4], fnow, aux[A_LSTAR:A_LSTAR + 3]) \
-                    < WALTON_NEAR_LIMIT:
+            if limit_margin(tl, nl, _tangent_history(y, kin[2]), kin[4], fnow, kin[0], aux[A_LSTAR:A_LSTAR + 3]) \
+                    < tl[T_NEAR_LIMIT]:
                 n_ctrl = 18
         for i in range(n_ctrl):
             sc = scales[i] * rtol
@@ -602,7 +598,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                     best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, np.int64(0), np.int64(1), d0,
                                               dm)
                     best_event, best_dir = 0, 1
-        if best_event < 0 and tl[T_FAMILY] == SPRING and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
+        if best_event < 0 and has(tl, F_STICK_KINK) and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
                 and _event_value(yn, aux, nl, tl, geo, rules, np.int64(5)) > 0.0:
             # a spring's stick that ends past the slip surface with no crossing seen: it began on the surface
             # (a slip→stick switch puts it there), dipped inside and came back out within the step — the trial
@@ -623,14 +619,14 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             y = yn
             if aux[A_NMODE] == M_LOAD:
                 aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
-            if tl[T_FAMILY] == WALTON:
-                _walton_truncate(y, aux, nl, tl, geo, rules)
-            elif tl[T_FAMILY] == SPRING and aux[A_TMODE] == SLIP and tl[T_TRUNC] != TRUNC_CAP:
+            if has(tl, F_RIDES):
+                _ride_truncate(y, aux, nl, tl, geo, rules)
+            elif has(tl, F_SLIP_SNAPS) and aux[A_TMODE] == SLIP:
                 if _onto_surface(y, aux, nl, tl, geo, rules):
                     ev_t[ne], ev_c[ne] = t, EV_SLIP_STICK
                     ne += 1
-            if (tl[T_FAMILY] == SLIDING and aux[A_TMODE] == SLIP) or tl[T_FAMILY] == WALTON:
-                # the slip direction: SLIDING's force direction, Walton's reference for a reversal
+            if (has(tl, F_CONSTRAINT) and aux[A_TMODE] == SLIP) or has(tl, F_REVERSAL):
+                # the slip direction: a constraint law's force direction, the reference for a reversal
                 vt = kinematics(y, geo, rules)[4]
                 vn = _norm(vt)
                 if vn > 0.0:
@@ -648,19 +644,19 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
         code = 0
         terminal = False
-        family = tl[T_FAMILY]
+        constraint = has(tl, F_CONSTRAINT)
         if best_event == 0 and best_dir > 0:
             code = EV_START
-            aux[A_NMODE] = M_LOAD if nl[L_FAMILY] == 1.0 else M_VE
+            aux[A_NMODE] = M_LOAD if loads_and_unloads(nl) else M_VE
             aux[A_DMAX] = 0.0
             y[18:21] = 0.0
             aux[A_LSTAR:A_LSTAR + 3] = 0.0
             aux[A_TMODE] = STICK
             vn = _norm(vt)
             aux[A_TREF:A_TREF + 3] = 0.0
-            if (family == SLIDING or family == WALTON) and vn > 0.0:
+            if (constraint or has(tl, F_REVERSAL)) and vn > 0.0:
                 aux[A_TREF:A_TREF + 3] = vt / vn
-            if family == SLIDING and vn > 0.0:
+            if constraint and vn > 0.0:
                 aux[A_TMODE] = SLIP
         elif best_event == 0:
             code = EV_END
@@ -668,11 +664,11 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         elif best_event == 1 and best_dir < 0:
             code = EV_FORCE_END if not force_ended else -EV_FORCE_END
             force_ended = True
-            if nl[L_FAMILY] == 1.0 or nl[L_LIMIT] != 0.0:
+            if loads_and_unloads(nl) or nl[L_LIMIT] != 0.0:
                 aux[A_NMODE] = M_FREE
         elif best_event == 1:
             code = EV_REENTER
-            aux[A_NMODE] = M_UNLOAD if nl[L_FAMILY] == 1.0 else M_VE
+            aux[A_NMODE] = M_UNLOAD if loads_and_unloads(nl) else M_VE
         elif best_event == 2:
             code = EV_MAX_OVERLAP
             if aux[A_NMODE] == M_LOAD:
@@ -689,13 +685,13 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             dy = np.empty(21)
             lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
             aux[A_TMODE] = SLIP
-            if family == SLIDING:
+            if constraint:
                 fnorm = _norm(ft)
                 if fnorm > 0.0:
                     aux[A_TREF:A_TREF + 3] = -ft / fnorm
             else:
                 y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
-                if not (family == SPRING and tl[T_TRUNC] == TRUNC_CAP):
+                if not has(tl, F_SLIP_KEEPS):
                     # slip only where sticking would push past the surface (λ > 0); else it is a graze —
                     # unless a graze was taken at this very instant already (within GRAZE_SAME_INSTANT: each
                     # retaken graze advances t by an ulp or so): then the first-order test
@@ -707,13 +703,13 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                         graze_t = t
         elif best_event == 6:
             code = EV_SLIP_STICK
-            if family != SLIDING:  # stick from exactly on the surface
+            if not constraint:  # stick from exactly on the surface
                 dy = np.empty(21)
                 lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
                 y[18:21] = return_map(tl, nl, _tangent_history(y, nvec), vt, abs(fn), delta, tl[T_MU_K])
             aux[A_TMODE] = STICK
         elif best_event == 7:
-            if family == WALTON:
+            if has(tl, F_REVERSAL):
                 code = EV_REVERSAL
                 aux[A_LSTAR:A_LSTAR + 3] = _tangent_history(y, nvec)
                 aux[A_TREF:A_TREF + 3] = -aux[A_TREF:A_TREF + 3]  # the slip now runs the other way

@@ -12,7 +12,6 @@ from ..errors import ConfigError
 from ..result import Result
 from . import adaptive3d, kernels, kernels3d as k3, verlet3d
 from ..laws.model import ResolvedModel
-from ..laws.tangential import WALTON
 
 # The seed's own rules: lever arms to the contact point (R − δ/2) for slip velocity and torque; in the
 # verlet method the history is rotated into the new tangent plane keeping its length. A wall's slip arm is the
@@ -91,7 +90,7 @@ def collide(case: Case, model: ResolvedModel, method: str, dt: float | None = No
         l_scale = 0.3 * v * t_c
         f_scale = model.pair.m_eff * v / t_c
         scales = np.concatenate([np.full(3, l_scale), np.full(3, v_scale), np.full(3, v_scale / r0)] * 2
-                                + [np.full(3, f_scale if model.tangential_law.family == WALTON else l_scale)])
+                                + [np.full(3, f_scale if model.tangential_law.history_is_load else l_scale)])
         status, n, rec, ne, ev_t, ev_c = adaptive3d.adaptive_3d(y0, nl, tl, geo, rul, rtol, scales, t_max, POINTS)
         asked = rtol
         floor = _round_off_floor(rec[:n], l_scale)

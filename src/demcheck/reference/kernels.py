@@ -1,7 +1,8 @@
 """Compiled (numba, cached on disk) 1-D normal-impact integrators, adaptive and verlet, and many collisions at once.
 
 The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, limit]; its force is
-laws/normal_force.py's.
+laws/normal_force.py's, and the solver asks its trait (``loads_and_unloads``: the hysteretic law's loading and
+unloading modes), never its family id.
 
 State of the 1-D problem: δ (overlap, > 0 in contact) and r = δ̇ (approach rate); m̄ δ̈ = −F + m̄ a_n.
 """
@@ -14,8 +15,8 @@ import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
-from ..laws.normal_force import (L_A, L_B, L_ETA, L_FAMILY, L_K, L_KL, L_LIMIT, hls_unloading, normal_force, spow,
-                                 viscoelastic_force)
+from ..laws.normal_force import (L_A, L_B, L_ETA, L_K, L_KL, L_LIMIT, hls_unloading, loads_and_unloads, normal_force,
+                                 spow, viscoelastic_force)
 from ..metrics import stepped
 from .health import reading
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
@@ -83,7 +84,7 @@ def _event_value(law, mode, event, d, r, dmax, m, an):
         if mode == M_FREE:
             if d <= 0.0:  # re-entry needs overlap: beyond δ = 0 the contact has ended instead
                 return -1.0
-            if law[L_FAMILY] == 1.0:
+            if loads_and_unloads(law):
                 return _mode_force(law, M_UNLOAD, d, r, dmax)
             return viscoelastic_force(law, d, r)
         return _mode_force(law, mode, d, r, dmax)
@@ -175,7 +176,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
     EF = np.empty(64)
     atol_d, atol_r = rtol * l_scale, rtol * v_scale
     d, r, t = d_init, r_init, 0.0
-    mode = M_PRE if d <= 0.0 else (M_LOAD if law[L_FAMILY] == 1.0 else M_VE)
+    mode = M_PRE if d <= 0.0 else (M_LOAD if loads_and_unloads(law) else M_VE)
     dmax = max(d, 0.0)
     force_ended = False
     n, ne = 0, 0
@@ -240,7 +241,7 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
         if best_event == 0 and best_dir > 0:
             code = EV_START
             d = 0.0
-            mode = M_LOAD if law[L_FAMILY] == 1.0 else M_VE
+            mode = M_LOAD if loads_and_unloads(law) else M_VE
             dmax = 0.0
         elif best_event == 0:
             code = EV_END
@@ -252,11 +253,11 @@ def adaptive_normal(law, m, an, d_init, r_init, rtol, t_scale, l_scale, v_scale,
                 force_ended = True
             else:
                 code = -EV_FORCE_END  # a later force end, kept but not the first
-            if law[L_FAMILY] == 1.0 or law[L_LIMIT] != 0.0:
+            if loads_and_unloads(law) or law[L_LIMIT] != 0.0:
                 mode = M_FREE
         elif best_event == 1:
             code = EV_REENTER
-            mode = M_UNLOAD if law[L_FAMILY] == 1.0 else M_VE
+            mode = M_UNLOAD if loads_and_unloads(law) else M_VE
         elif best_event == 2:
             code = EV_MAX_OVERLAP
             if mode == M_LOAD:

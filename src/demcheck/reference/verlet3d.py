@@ -12,10 +12,11 @@ from numba import njit
 
 from .. import KERNEL_CACHE
 from ..laws.normal_force import (normal_force)
-from ..laws.tangential import (LTH, NONE, SPRING, T_FAMILY, T_FORCE, T_MU_K, T_MU_S, T_R, T_RESCALE, T_TRUNC,
-                               TRUNC_MAW, TRUNC_SPRING, WALTON, ZZY)
-from ..laws.tangential_force import (_cross, eta_of, kt_of, _norm, return_map, slip_surface, tangential_force,
-                                     walton_reverses, walton_stiffness)
+from ..laws.tangential import T_FORCE, T_MU_K, T_MU_S, T_R, T_RESCALE, T_TRUNC, TRUNC_SPRING
+from ..laws.tangential_force import (_cross, discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
+                                     F_REVERSAL, has, history_rate, kt_of, _norm, return_map, reverses,
+                                     slip_surface, tangential_force)
+from ..laws.tangential_force import spring_slip  # noqa: F401  (reference/packing.py imports it from here)
 from .kernels import (M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED)
 from .kernels3d import (A_NMODE, A_SIZE, A_TREF, G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION,
                         record_row, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT, ROT_SCGEOM)
@@ -71,38 +72,6 @@ def project_history(xi0, xi1, xi2, n, rot):
     return xi0, xi1, xi2
 
 
-@njit(cache=KERNEL_CACHE, inline="always")
-def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
-    """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
-    trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
-    force) exceeds ``mu_test`` |Fn|, and is then cut to ``mu_k`` |Fn|: along the trial force with the history
-    kept (force cap), along it with the history put back on the limit (Maw: spring + dashpot = μ|Fn|), or the
-    spring shortened to the limit and the dashpot dropped. Returns (xi0, xi1, xi2, f0, f1, f2, sliding). The one
-    rule of the two-body verlet kernel and the packing loop."""
-    s0, s1, s2 = -kt * xi0 - eta * vt[0], -kt * xi1 - eta * vt[1], -kt * xi2 - eta * vt[2]
-    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
-    hm = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
-    cap_test = mu_test * fabs
-    psi = kt * hm - cap_test if trunc == TRUNC_SPRING else sn - cap_test
-    if psi <= 0.0:
-        return xi0, xi1, xi2, s0, s1, s2, False
-    cap = mu_k * fabs
-    if kt <= 0.0:  # no spring, no history
-        xi0 = xi1 = xi2 = 0.0
-        hm = 0.0
-    if trunc == TRUNC_SPRING:
-        if hm > 0.0:
-            r = cap / (kt * hm)
-            xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
-            return xi0, xi1, xi2, -kt * xi0, -kt * xi1, -kt * xi2, True
-        return xi0, xi1, xi2, 0.0, 0.0, 0.0, True
-    r = cap / sn if sn > 0.0 else 0.0
-    f0, f1, f2 = s0 * r, s1 * r, s2 * r
-    if trunc == TRUNC_MAW and kt > 0.0:
-        xi0, xi1, xi2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
-    return xi0, xi1, xi2, f0, f1, f2, True
-
-
 @njit(cache=KERNEL_CACHE, nogil=True)  # the suite runs cases in threads
 def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     """The engines' scheme (fix nve/sphere, I = 0.4 m R²): half kick, drift, forces from full-step positions
@@ -121,7 +90,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
     a_prev = 0.0
     dmax = 0.0
     sliding = np.bool_(False)  # (not a literal: see adaptive_3d)
-    family = tl[T_FAMILY]
+    history = has(tl, F_HISTORY)
     wall = geo[G_WALL] != 0.0
     touched = False
     touched_now = False  # in contact at the step before (ROT_SCGEOM: a new contact is not turned)
@@ -163,19 +132,19 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                 dmax = delta
             fn = normal_force(nl, delta, rate, dmax)
             fabs = abs(fn)
-            force_hist = family == SPRING and tl[T_FORCE] != 0.0
+            force_hist = tl[T_FORCE] != 0.0  # (engine twins of the spring: no other law sets it)
             if rules[R_ROTATION] == ROT_SCGEOM:
                 if touched_now:
                     spin = 0.5 * dt * (y[6:9] + (0.0 if wall else 1.0) * y[15:18])
                     hist = scgeom_rotate(hist, n_old, n, spin)
                 n_old = n.copy()
                 touched_now = True
-            if family == SPRING and tl[T_RESCALE] != 0.0:
+            if tl[T_RESCALE] != 0.0:
                 # mindlin_rescale: a shrinking contact radius scales the history by a/a_prev first
                 a_now = math.sqrt(tl[T_R] * delta)
                 if a_now < a_prev:
                     hist = hist * (a_now / a_prev)
-            if family == SPRING or family == LTH or family == ZZY or family == WALTON:
+            if history:
                 # (a force history's normal part is a force already: its scale is 1)
                 hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION],
                                                          1.0 if force_hist else kt_of(tl, delta), tl[T_MU_K], fabs)
@@ -207,23 +176,22 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                             hist = ft + eta * vt
                         else:
                             ft = np.zeros(3)
-            elif family == SPRING or family == LTH or family == ZZY or family == WALTON:
-                if family == WALTON:
-                    if walton_reverses(vt, prev_vt):
+            elif history:
+                if has(tl, F_REVERSAL):
+                    if reverses(vt, prev_vt):
                         lstar = hist.copy()
                     if _norm(vt) != 0.0:
                         prev_vt = vt.copy()
-                    hist = hist + walton_stiffness(tl, hist, vt, fabs, lstar) * vt * dt
+                if has(tl, F_OWN_RATE):
+                    hist = hist + history_rate(tl, nl, hist, vt, fabs, delta, lstar) * dt
                 else:
                     hist = hist + vt * dt
-                if family == SPRING and tl[T_RESCALE] != 0.0:
+                if tl[T_RESCALE] != 0.0:
                     a_prev = math.sqrt(tl[T_R] * delta)
                 hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rules[R_ROTATION])
                 mu = tl[T_MU_K] if sliding else tl[T_MU_S]  # a slip goes on while the force exceeds μk|Fn|
-                if family == SPRING:
-                    hist[0], hist[1], hist[2], ft[0], ft[1], ft[2], sliding = spring_slip(
-                        hist[0], hist[1], hist[2], vt, kt_of(tl, delta), eta_of(tl, nl, delta), tl[T_TRUNC], mu,
-                        tl[T_MU_K], fabs)
+                if has(tl, F_DISCRETE_SLIP):
+                    hist, ft, sliding = discrete_slip(tl, nl, hist, vt, fabs, delta, mu)
                 else:
                     psi, w, d = slip_surface(tl, nl, hist, vt, fabs, delta, mu)
                     if psi > 0.0:
@@ -232,7 +200,7 @@ def verlet_3d(y0, nl, tl, geo, rules, dt, t_max, capacity):
                     else:
                         sliding = False
                     ft = tangential_force(tl, nl, hist, vt, fabs, delta, sliding, aux[A_TREF:A_TREF + 3])
-            elif family != NONE:
+            elif not has(tl, F_NO_FORCE):
                 ft = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), aux[A_TREF:A_TREF + 3])
         else:
             hist[:] = 0.0

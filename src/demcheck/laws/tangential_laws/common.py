@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 from ... import KERNEL_CACHE
-from ..normal_force import L_B, L_ETA, L_FAMILY, spow
+from ..normal_force import L_B, L_ETA, loads_and_unloads, spow
 from ..tangential_slot import T_ETA, T_ETA_NORMAL, T_KT, T_KT_SQRT, T_R
 
 
@@ -30,6 +30,13 @@ def _norm(a):
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
+def reverses(vt, previous):
+    """Whether the slip reverses its direction: v_t turns against the last nonzero slip velocity (a law with
+    F_REVERSAL stores its history there)."""
+    return vt[0] * previous[0] + vt[1] * previous[1] + vt[2] * previous[2] < 0.0
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
 def kt_of(tl, delta):
     if tl[T_KT_SQRT] != 0.0:
         return tl[T_KT] * math.sqrt(tl[T_R] * max(delta, 0.0))
@@ -39,7 +46,7 @@ def kt_of(tl, delta):
 @njit(cache=KERNEL_CACHE, inline="always")
 def eta_of(tl, nl, delta):
     if tl[T_ETA_NORMAL] != 0.0:
-        if nl[L_FAMILY] == 1.0:
+        if loads_and_unloads(nl):
             return 0.0
         return tl[T_ETA] * nl[L_ETA] * spow(max(delta, 0.0), nl[L_B])
     return tl[T_ETA]

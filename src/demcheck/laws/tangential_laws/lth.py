@@ -16,6 +16,13 @@ from ..tangential_slot import T_ETA, T_M, T_MU_K, T_XI, TangentialSubModel, comp
 from .common import _norm
 
 LTH = 5
+# LTH and ZZY stick with a force that reaches μ|Fn| continuously, through a viscous term ∝ (1 − |ξ|/ξm)^{1/4}
+# of unbounded slope: a history that leaves its surface inwards by a hair is pulled back at once, and where
+# the stick flow points inwards only weakly the exact solution slides along the surface (a sliding mode
+# whose force, μ|Fn|, is the slip state's). A slip of these laws therefore ends only when sticking would
+# unload the history by more than this fraction of |v_t| (λ < −UNLOAD_MARGIN |v_t|); below it the contact
+# stays on the surface, where stick and slip give the same force, instead of chattering between the two.
+UNLOAD_MARGIN = 1e-4
 
 
 @dataclass(frozen=True)
@@ -25,6 +32,11 @@ class LthTangential(TangentialSubModel):
     id: ClassVar[str] = "lth"
     family: ClassVar[int] = LTH
     caps: ClassVar[bool] = True
+    states: ClassVar[bool] = True
+    slip_reads_surface: ClassVar[bool] = True
+    # its stick force reaches μ|Fn| through a viscous term of unbounded slope: a slip ends only where sticking
+    # would unload the history by more than this fraction of |v_t| (adaptive3d.py, at UNLOAD_MARGIN's use)
+    unload_margin: ClassVar[float] = UNLOAD_MARGIN
     title: ClassVar[str] = "Langston, Tüzün & Heyes"
     history_size: ClassVar[int] = 3
     eta: float = 0.0

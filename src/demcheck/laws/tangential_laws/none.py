@@ -19,6 +19,7 @@ class NoTangential(TangentialSubModel):
     id: ClassVar[str] = "none"
     family: ClassVar[int] = NONE
     title: ClassVar[str] = "frictionless"
+    no_force: ClassVar[bool] = True
 
 
 @njit(cache=KERNEL_CACHE)

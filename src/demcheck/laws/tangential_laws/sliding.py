@@ -22,6 +22,7 @@ class SlidingTangential(TangentialSubModel):
     id: ClassVar[str] = "sliding"
     family: ClassVar[int] = SLIDING
     caps: ClassVar[bool] = True
+    constraint: ClassVar[bool] = True
     title: ClassVar[str] = "simple sliding friction"
     mu_s: float = 0.0
     mu_k: float = 0.0

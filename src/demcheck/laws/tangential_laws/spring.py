@@ -8,6 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -28,6 +30,8 @@ class SpringTangential(TangentialSubModel):
     id: ClassVar[str] = "spring"
     family: ClassVar[int] = SPRING
     caps: ClassVar[bool] = True
+    states: ClassVar[bool] = True
+    stick_kink: ClassVar[bool] = True  # the trial force −Kt ξ − ηt v_t can reverse through 0 within a step
     title: ClassVar[str] = "linear spring (and dashpot) with Coulomb truncation"
     history_size: ClassVar[int] = 3
     kt: float = 0.0
@@ -40,6 +44,16 @@ class SpringTangential(TangentialSubModel):
     m_eff: float = 0.0
     force_history: bool = False
     rescale_history: bool = False
+
+    @property
+    def slip_keeps_history(self) -> bool:
+        """The force cap slips with the history left alone."""
+        return self.truncation == TRUNC_CAP
+
+    @property
+    def slip_snaps(self) -> bool:
+        """Maw's and the spring-only truncation keep a slipping history on the slip surface."""
+        return self.truncation != TRUNC_CAP
 
     @property
     def passive(self) -> bool:
@@ -115,7 +129,46 @@ def spring_tangential_force(tl, nl, xi, vt, fn_abs, delta, slipping, tref):
     return -(cap / hn) * xi if hn > 0.0 else np.zeros(3)
 
 
-compiled(SpringTangential, force=spring_tangential_force, slip_surface=spring_slip_surface,
-         return_map=spring_return_map)
-compiled(SqrtSpringTangential, force=spring_tangential_force, slip_surface=spring_slip_surface,
-         return_map=spring_return_map)
+@njit(cache=KERNEL_CACHE, inline="always")
+def spring_slip(xi0, xi1, xi2, vt, kt, eta, trunc, mu_test, mu_k, fabs):
+    """The spring family's slip test and Coulomb truncation after the increment, as the engines do it: the
+    trial force −Kt ξ − η v_t; it slips when the trial force (or, for the spring-only truncation, the spring
+    force) exceeds ``mu_test`` |Fn|, and is then cut to ``mu_k`` |Fn|: along the trial force with the history
+    kept (force cap), along it with the history put back on the limit (Maw: spring + dashpot = μ|Fn|), or the
+    spring shortened to the limit and the dashpot dropped. Returns (xi0, xi1, xi2, f0, f1, f2, sliding). The one
+    rule of the two-body verlet kernel and the packing loop."""
+    s0, s1, s2 = -kt * xi0 - eta * vt[0], -kt * xi1 - eta * vt[1], -kt * xi2 - eta * vt[2]
+    sn = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    hm = math.sqrt(xi0 * xi0 + xi1 * xi1 + xi2 * xi2)
+    cap_test = mu_test * fabs
+    psi = kt * hm - cap_test if trunc == TRUNC_SPRING else sn - cap_test
+    if psi <= 0.0:
+        return xi0, xi1, xi2, s0, s1, s2, False
+    cap = mu_k * fabs
+    if kt <= 0.0:  # no spring, no history
+        xi0 = xi1 = xi2 = 0.0
+        hm = 0.0
+    if trunc == TRUNC_SPRING:
+        if hm > 0.0:
+            r = cap / (kt * hm)
+            xi0, xi1, xi2 = xi0 * r, xi1 * r, xi2 * r
+            return xi0, xi1, xi2, -kt * xi0, -kt * xi1, -kt * xi2, True
+        return xi0, xi1, xi2, 0.0, 0.0, 0.0, True
+    r = cap / sn if sn > 0.0 else 0.0
+    f0, f1, f2 = s0 * r, s1 * r, s2 * r
+    if trunc == TRUNC_MAW and kt > 0.0:
+        xi0, xi1, xi2 = -(f0 + eta * vt[0]) / kt, -(f1 + eta * vt[1]) / kt, -(f2 + eta * vt[2]) / kt
+    return xi0, xi1, xi2, f0, f1, f2, True
+
+
+@njit(cache=KERNEL_CACHE)
+def spring_discrete_slip(tl, nl, xi, vt, fn_abs, delta, mu):
+    """The engines' step of the spring (spring_slip): (history, force, sliding) after the increment."""
+    x0, x1, x2, f0, f1, f2, sliding = spring_slip(xi[0], xi[1], xi[2], vt, kt_of(tl, delta), eta_of(tl, nl, delta),
+                                                  tl[T_TRUNC], mu, tl[T_MU_K], fn_abs)
+    return np.array([x0, x1, x2]), np.array([f0, f1, f2]), sliding
+
+
+for _record in (SpringTangential, SqrtSpringTangential):
+    compiled(_record, force=spring_tangential_force, slip_surface=spring_slip_surface, return_map=spring_return_map,
+             discrete_slip=spring_discrete_slip)

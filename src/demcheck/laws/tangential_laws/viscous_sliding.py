@@ -22,6 +22,7 @@ class ViscousSlidingTangential(TangentialSubModel):
     id: ClassVar[str] = "viscous_sliding"
     family: ClassVar[int] = VISCOUS_SLIDING
     caps: ClassVar[bool] = True
+    viscous_kink: ClassVar[bool] = True
     title: ClassVar[str] = "viscous damping with sliding friction"
     eta: float = 0.0
     eta_normal: bool = False

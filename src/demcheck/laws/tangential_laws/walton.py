@@ -13,7 +13,7 @@ from numba import njit
 
 from ... import KERNEL_CACHE
 from ..tangential_slot import T_K0, T_MU_K, TangentialSubModel, compiled
-from .common import _dot, _norm, radial_return_map
+from .common import _dot, _norm, radial_return_map, reverses
 
 WALTON = 7
 
@@ -29,6 +29,10 @@ class WaltonTangential(TangentialSubModel):
     id: ClassVar[str] = "walton"
     family: ClassVar[int] = WALTON
     caps: ClassVar[bool] = True
+    reversal: ClassVar[bool] = True  # L* := L where the slip reverses
+    history_is_load: ClassVar[bool] = True
+    near_limit: ClassVar[float] = WALTON_NEAR_LIMIT  # no slip state: the load rides the limit
+    ride_band: ClassVar[float] = WALTON_RIDE
     title: ClassVar[str] = "incrementally slipping friction"
     history_size: ClassVar[int] = 9
     k0: float = 0.0
@@ -75,7 +79,7 @@ def walton_reverses(vt, previous):
     nonzero slip velocity. Only then is the load at the reversal stored (L* := L); the load passing through
     zero while the slip keeps its direction is no reversal. The verlet method and the packing loop test this
     each step; the adaptive method locates the zero of v_t·t̂ (t̂ the slip direction before it) as an event."""
-    return vt[0] * previous[0] + vt[1] * previous[1] + vt[2] * previous[2] < 0.0
+    return reverses(vt, previous)
 
 
 @njit(cache=KERNEL_CACHE)
@@ -91,5 +95,17 @@ def walton_stiffness(tl, xi, vt, fn_abs, lstar):
     return tl[T_K0] * x ** (1.0 / 3.0)
 
 
+@njit(cache=KERNEL_CACHE)
+def walton_history_rate(tl, nl, xi, vt, fn_abs, delta, lstar):
+    """dL/dt = Kt v_t (walton_stiffness)."""
+    return walton_stiffness(tl, xi, vt, fn_abs, lstar) * vt
+
+
+@njit(cache=KERNEL_CACHE)
+def walton_limit_margin(tl, nl, xi, vt, fn_abs, delta, lstar):
+    """The fraction of the way left to the Coulomb limit (walton_margin)."""
+    return walton_margin(tl, xi, vt, fn_abs, lstar)
+
+
 compiled(WaltonTangential, force=walton_tangential_force, slip_surface=walton_slip_surface,
-         return_map=radial_return_map)
+         return_map=radial_return_map, history_rate=walton_history_rate, limit_margin=walton_limit_margin)

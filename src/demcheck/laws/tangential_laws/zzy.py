@@ -12,7 +12,7 @@ from numba import njit
 from ... import KERNEL_CACHE
 from ..tangential_slot import T_ETA1, T_G, T_MU_K, T_XI, TangentialSubModel, compiled
 from .common import _norm
-from .lth import bounded_return_map, bounded_slip_surface, coulomb_capped, elastic_part
+from .lth import UNLOAD_MARGIN, bounded_return_map, bounded_slip_surface, coulomb_capped, elastic_part
 
 ZZY = 6
 
@@ -24,6 +24,11 @@ class ZzyTangential(TangentialSubModel):
     id: ClassVar[str] = "zzy"
     family: ClassVar[int] = ZZY
     caps: ClassVar[bool] = True
+    states: ClassVar[bool] = True
+    slip_reads_surface: ClassVar[bool] = True
+    # its stick force reaches μ|Fn| through a viscous term of unbounded slope: a slip ends only where sticking
+    # would unload the history by more than this fraction of |v_t| (adaptive3d.py, at UNLOAD_MARGIN's use)
+    unload_margin: ClassVar[float] = UNLOAD_MARGIN
     title: ClassVar[str] = "Zheng, Zhu & Yu"
     history_size: ClassVar[int] = 3
     eta1: float = 0.0
