@@ -287,7 +287,7 @@ def test_static_and_kinetic_friction():
 
 
 def test_walton_returns_to_k0_at_reversal_and_saturates():
-    from demcheck.laws.tangential_force import walton_stiffness
+    from demcheck.laws.tangential_laws.walton import walton_stiffness
 
     tl = resolve(law_case("walton")).tangential_law.array()
     k0 = tl[tangential.T_K0]

@@ -14,9 +14,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "src" / "demcheck" / "reference"
-# packing.py is another helper's (its own branches on the family id are not yet traits); expected.py holds the
-# closed forms of named seed models (it asks for the hysteretic normal law by its constant, a mapping, not a solver)
-NOT_SOLVERS = {"packing.py", "expected.py"}
+# expected.py holds the closed forms of named seed models (it asks for the hysteretic normal law by its constant, a
+# mapping, not a solver)
+NOT_SOLVERS = {"expected.py"}
+# the one named fast path: the packing loop's scalar copy of the spring (every deck's law); every other law, and the
+# spring itself without it, goes through the traits (test_the_packing_loop_runs_a_plugin_spring_as_the_builtin)
+FAST_PATHS = {"packing.py": {"SPRING", "T_FAMILY"}}  # its test: tl[T_FAMILY] == SPRING
 
 
 def _family_constants() -> set[str]:
@@ -54,8 +57,9 @@ def test_no_solver_names_a_tangential_or_normal_family():
     assert spring.SPRING in tangential_slot.KERNELS and walton.WALTON in tangential_slot.KERNELS
     solvers = [p for p in sorted(REFERENCE.glob("*.py")) if p.name not in NOT_SOLVERS]
     assert {"adaptive3d.py", "verlet3d.py", "collision3d.py", "kernels.py", "kernels3d.py"} <= {p.name for p in solvers}
+    assert "packing.py" in {p.name for p in solvers}
     for path in solvers:
-        named = _code_names(path) & constants
+        named = _code_names(path) & constants - FAST_PATHS.get(path.name, set())
         assert not named, f"{path.name} names the tangential family {sorted(named)}: ask the law's traits (has)"
         named = _code_names(path) & NORMAL_FAMILIES
         assert not named, f"{path.name} names the normal family {sorted(named)}: ask loads_and_unloads"
@@ -119,3 +123,52 @@ def test_a_plugin_law_with_a_history_runs_as_the_builtin_it_copies(tmp_path):
         assert family == 41.0 and rows > 10, (key, rows, family)
         assert slips, f"{key}: the contact never slipped (the states would not be exercised)"
         assert same, f"{key}: the plug-in spring's contact differs from the built-in spring's"
+
+
+PACK = r'''
+import hashlib, json
+import numpy as np
+from demcheck import case as C
+from demcheck.laws.tangential import T_FAMILY
+from demcheck.reference import packing as P
+
+out = {}
+for mu_k in ("", "friction_kinetic = 0.3\n"):
+    text = open("src/demcheck/cases/optin/poured-small.toml").read()
+    text = text.replace("[contact]\n", "[contact]\n" + mu_k)
+    case = C.loads(text, name="pour")
+    laws = P.resolve_laws(case)
+    sp, ln, lt, wn, wt = laws
+    copy = (sp, ln, lt.copy(), wn, wt.copy())
+    copy[2][..., T_FAMILY] = 41.0
+    copy[4][..., T_FAMILY] = 41.0
+    dt = P.packing_dt(case)
+    digests, contacts = [], []
+    for use in (laws, copy):
+        st = P.PackState(case)
+        ke, nc, flags = P.advance(case, st, dt, 20000, laws=use)
+        digests.append(hashlib.sha256(b"".join(a.tobytes() for a in (st.x, st.v, st.w, st.hist))).hexdigest())
+        contacts.append(int(nc))
+    out[mu_k or "one mu"] = [digests[0] == digests[1], contacts[0], int(st.hist.shape[1]),
+                             float(np.abs(st.hist[:, 3]).max()) if st.hist.shape[1] > 3 else 0.0]
+print(json.dumps(out))
+'''
+
+
+def test_the_packing_loop_runs_a_plugin_spring_as_the_builtin(tmp_path):
+    """The packing loop's traits path (reference/packing.py _other_tangential: history, increment, projection, the
+    law's own discrete slip and its slip state) gives the bits of its named fast path for the spring: a copy of the
+    spring under family 41 runs the pour (150 spheres, 20 000 steps, with one μ and with μk < μs, whose slip state
+    is then used) to the same positions, velocities, spins and histories as the built-in spring."""
+    (tmp_path / "copy_spring_law.py").write_text(COPY)
+    env = dict(os.environ, DEMCHECK_LAW_PLUGINS="copy_spring_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
+    env.pop("NUMBA_CACHE_DIR", None)
+    p = subprocess.run([sys.executable, "-c", PACK], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
+    assert p.returncode == 0, p.stderr[-3000:]
+    out = json.loads(p.stdout.strip().splitlines()[-1])
+    assert len(out) == 2
+    for key, (same, contacts, width, slip_state) in out.items():
+        assert contacts > 10, (key, contacts)  # the pour has landed: contacts exercised (26 with one μ)
+        assert same, f"{key}: the plug-in spring's pour differs from the built-in spring's"
+    assert out["friction_kinetic = 0.3\n"][2] == 4 and out["friction_kinetic = 0.3\n"][3] == 1.0  # slip state used

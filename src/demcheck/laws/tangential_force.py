@@ -5,9 +5,8 @@ discrete slip rule — each a switch on the law's family id over the laws' modul
 assembled by ``tangential_dispatch`` from the registered laws; what a law is (its traits: ``has(tl, F_…)``);
 the stiffness and dashpot of a spring-like law. Vectors are 3-arrays; the normal law's array
 (laws/normal_force.py) gives the dashpot prefactor η(δ) the TTIt and engine-twin dashpots reuse. The switch
-names no law (a law is its module); what is named here is for the packing loop (reference/packing.py, whose
-own branches on the family id are not yet traits): Walton's reversal rule and stiffness, and the spring's
-discrete slip (spring_slip, which it imports through reference/verlet3d.py).
+names no law (a law is its module), and neither does this facade: the solvers, the packing loop included, ask
+the traits; the packing loop's one fast path (the spring's scalars) imports the spring's module itself.
 """
 
 from __future__ import annotations
@@ -15,8 +14,6 @@ from __future__ import annotations
 from . import tangential  # noqa: F401  (every law registered, plug-ins included, before the switch is assembled)
 from .tangential_dispatch import build
 from .tangential_laws.common import _cross, _dot, _norm, eta_of, kt_of, reverses  # noqa: F401
-from .tangential_laws.spring import spring_slip  # noqa: F401
-from .tangential_laws.walton import walton_reverses, walton_stiffness  # noqa: F401
 from .tangential_slot import (F_CONSTRAINT, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,  # noqa: F401
                               F_REVERSAL, F_RIDES, F_SLIP_KEEPS, F_SLIP_READS_SURFACE, F_SLIP_SNAPS, F_STATES,
                               F_STICK_KINK, F_VISCOUS_KINK, has)

@@ -30,12 +30,13 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .. import KERNEL_CACHE
 from ..laws.normal_force import L_LIMIT, normal_force
-from ..laws.tangential_force import (eta_of, kt_of, return_map, slip_surface, tangential_force, walton_reverses,
-                                     walton_stiffness)
+from ..laws.tangential_force import (discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
+                                     F_REVERSAL, has, history_rate, kt_of, return_map, reverses, slip_surface,
+                                     tangential_force)
+from ..laws.tangential_laws.spring import SPRING, spring_slip  # the one fast path's law (_spring_law: its scalars)
 from .kernels3d import ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, wall_arm
-from .verlet3d import project_history, spring_slip, turn_history
-from ..laws.tangential import (LTH, NONE, SPRING, T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, WALTON,
-                               ZZY, TangentialLaw)
+from .verlet3d import project_history, turn_history
+from ..laws.tangential import T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TangentialLaw
 
 # per contact (a row beside its neighbour-list entry): the tangential record's history (history_size: the
 # displacement's 3; Walton's 9 with the load at the last reversal and the last nonzero slip velocity), at least 3;
@@ -45,9 +46,11 @@ HIST_WIDTH, SLIP_HIST_WIDTH = 3, 4
 
 
 def history_width(records) -> int:
-    """The columns of a contact's state row for the packing's tangential records (laws/tangential.py)."""
+    """The columns of a contact's state row for the packing's tangential records (laws/tangential.py): the widest
+    history, and for a law that slips by its own discrete rule (F_DISCRETE_SLIP: the spring family) with μk < μs
+    its slip state too, in the column after its 3-vector history."""
     width = max([HIST_WIDTH, *(r.history_size for r in records)])
-    if any(r.id in ("spring", "sqrt_spring") and r.mu_k != r.mu_s for r in records):
+    if any(r.flags() & F_DISCRETE_SLIP and getattr(r, "mu_k", None) != getattr(r, "mu_s", None) for r in records):
         width = max(width, SLIP_HIST_WIDTH)
     return width
 
@@ -258,28 +261,32 @@ def _law(laws_n, laws_t, p):
 
 @njit(cache=KERNEL_CACHE)
 def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot, zero3):
-    """The tangential force of every law but the updated spring family, into ``ft`` (history ``hist``, one
-    contact's row, updated in place; ``zero3``: zeros, the slip direction these laws do not read — the caller's
-    buffer: a global array is a read-only type of its own, and numba would compile tangential_force for it)."""
-    family = tl[T_FAMILY]
-    if (family == LTH or family == ZZY or family == WALTON) and update:
-        # Langston's and Zheng's laws on their overlap history, Walton's on its load history (with the load at
-        # the last reversal L* in hist[3:6] and the last nonzero slip velocity in hist[6:9]), by kernels3d's functions
-        # in verlet_3d's order
+    """The tangential force of a contact by its law's traits (``has``; every law but the spring's fast path,
+    :func:`_spring_law`), into ``ft`` (history ``hist``, one contact's row, updated in place; ``zero3``: zeros,
+    the slip direction these laws do not read — the caller's buffer: a global array is a read-only type of its
+    own, and numba would compile tangential_force for it). In verlet_3d's order: a law with a history has it
+    turned, incremented (by v_t, or its own rate), projected, then slipped by its own discrete rule or by its
+    slip surface and return map; a law that stores the history at a reversal of the slip keeps it in hist[3:6]
+    and the last nonzero slip velocity in hist[6:9] (Walton's layout)."""
+    if has(tl, F_HISTORY) and update:
         hist[0], hist[1], hist[2] = turn_history(hist[0], hist[1], hist[2], n, rot, kt_of(tl, delta), tl[T_MU_K],
                                                  fabs)
-        if family == WALTON:
-            if walton_reverses(vt, hist[6:9]):  # L* = L
+        if has(tl, F_REVERSAL):
+            if reverses(vt, hist[6:9]):  # L* = L
                 hist[3], hist[4], hist[5] = hist[0], hist[1], hist[2]
             if vt[0] != 0.0 or vt[1] != 0.0 or vt[2] != 0.0:
                 hist[6], hist[7], hist[8] = vt[0], vt[1], vt[2]
-            kw = walton_stiffness(tl, hist[0:3], vt, fabs, hist[3:6])
+        if has(tl, F_OWN_RATE):
+            rate = history_rate(tl, nl, hist[0:3], vt, fabs, delta, hist[3:6])
             for k in range(3):
-                hist[k] += kw * vt[k] * dt
+                hist[k] += rate[k] * dt
         else:
             for k in range(3):
                 hist[k] += vt[k] * dt
         hist[0], hist[1], hist[2] = project_history(hist[0], hist[1], hist[2], n, rot)
+        if has(tl, F_DISCRETE_SLIP):
+            _discrete(nl, tl, delta, vt, hist, fabs, ft)
+            return
         sliding = slip_surface(tl, nl, hist, vt, fabs, delta, tl[T_MU_S])[0] > 0.0
         if sliding:
             mapped = return_map(tl, nl, hist, vt, fabs, delta, tl[T_MU_K])
@@ -288,11 +295,24 @@ def _other_tangential(nl, tl, delta, n, vt, hist, fabs, dt, update, ft, rot, zer
         ft[0], ft[1], ft[2] = out[0], out[1], out[2]
         return
     out = tangential_force(tl, nl, hist, vt, fabs, delta, np.bool_(False), zero3)
-    if family == SPRING:  # setup: the trial force within the static limit, history untouched
+    if has(tl, F_DISCRETE_SLIP):  # setup: the trial force within the static limit, history untouched
         tn = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2)
         cap = tl[T_MU_S] * fabs
         if tn > cap and tn > 0.0:
             out = out * (cap / tn)
+    ft[0], ft[1], ft[2] = out[0], out[1], out[2]
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _discrete(nl, tl, delta, vt, hist, fabs, ft):
+    """A law's own discrete slip after the increment (discrete_slip), with its slip state in hist[3] where μk < μs
+    (a slip goes on while the force exceeds μk|Fn|), as the spring's fast path keeps it."""
+    two_mu = tl[T_MU_K] != tl[T_MU_S]
+    mu = tl[T_MU_K] if two_mu and hist[3] != 0.0 else tl[T_MU_S]
+    xi, out, sliding = discrete_slip(tl, nl, hist[0:3], vt, fabs, delta, mu)
+    hist[0], hist[1], hist[2] = xi[0], xi[1], xi[2]
+    if two_mu:
+        hist[3] = 1.0 if sliding else 0.0
     ft[0], ft[1], ft[2] = out[0], out[1], out[2]
 
 
@@ -415,8 +435,9 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
             dm = max(dmax[r], delta)
             dmax[r] = dm
             fn = normal_force(nl, delta, rate, dm)
-            family = tl[T_FAMILY]
-            if family == SPRING and update:  # every deck's law: scalars only
+            # the spring (every deck's law), updated: its scalar copy, the fast path — the same arithmetic as the
+            # traits' path below gives it (tests/test_tangential_traits.py runs a copy of it under another family)
+            if tl[T_FAMILY] == SPRING and update:
                 two_mu = tl[T_MU_K] != tl[T_MU_S]
                 xi0, xi1, xi2, ft0, ft1, ft2, sliding = _spring_law(nl, tl, delta, (n0, n1, n2), (vt0, vt1, vt2),
                                                                     hist[r, 0], hist[r, 1], hist[r, 2],
@@ -424,7 +445,7 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 hist[r, 0], hist[r, 1], hist[r, 2] = xi0, xi1, xi2
                 if two_mu:
                     hist[r, 3] = 1.0 if sliding else 0.0
-            elif family == NONE:
+            elif has(tl, F_NO_FORCE):
                 ft0 = ft1 = ft2 = 0.0
             else:
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2

@@ -16,7 +16,6 @@ from ..laws.tangential import T_FORCE, T_MU_K, T_MU_S, T_R, T_RESCALE, T_TRUNC, 
 from ..laws.tangential_force import (_cross, discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
                                      F_REVERSAL, has, history_rate, kt_of, _norm, return_map, reverses,
                                      slip_surface, tangential_force)
-from ..laws.tangential_force import spring_slip  # noqa: F401  (reference/packing.py imports it from here)
 from .kernels import (M_VE, ST_NO_CONTACT, ST_NO_SEPARATION, ST_OK, ST_STEPS, ST_UNRESOLVED)
 from .kernels3d import (A_NMODE, A_SIZE, A_TREF, G_GX, G_I0, G_I1, G_M0, G_M1, G_WALL, kinematics, NCOL, R_ROTATION,
                         record_row, ROT_PROJECT, ROT_RESCALE, ROT_RESCALE_SIGNIFICANT, ROT_SCGEOM)
