@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from ..laws import analytic
 from ..laws.model import ResolvedModel
-from ..laws.normal import HYSTERETIC
+from ..laws.normal import HysteresisNormal
 
 
 def closed_form_metrics(model: ResolvedModel) -> dict:
@@ -47,7 +47,7 @@ def closed_form_metrics(model: ResolvedModel) -> dict:
             "peak_force": analytic.hertz_peak_force(m, pair.r_eff, pair.e_eff, v),
             "energy_dissipated": 0.0,
         }
-    if nid == "hls" and law.family == HYSTERETIC:
+    if nid == "hls" and isinstance(law.slots()[0], HysteresisNormal):
         kw = {"s": law.s} if law.ku == 0.0 else {"e": (law.kl / law.ku) ** 0.5}
         e = analytic.hls_restitution(m, law.kl, v, **kw)
         return {

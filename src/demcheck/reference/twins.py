@@ -4,7 +4,8 @@ The engines' normal force is F = F_ne(δ) + η(δ) δ̇ with F_ne = k δ^a; thei
 η(δ) = c δ^b, and their tangential dashpots reuse η(δ) times a factor. These helpers turn an engine's
 coefficients into records of the contact's slots (laws/base.py) and those into the reference's
 :class:`NormalLaw` / :class:`TangentialLaw` numbers, formula by formula as the engines' documentation states
-them (and as the engine tests check against the binaries). Which
+them (and as the engine tests check against the binaries). An engine's twin names its normal law's records itself
+(``NormalLaw.from_slots(HertzNormal(k=…), QuarterDamping(eta=…), limit)``), never exponents or family ids. Which
 engine keyword maps to which helper is the engine package's business (engines/<name>/mapping.py; the
 damping styles in engines/damping.py).
 """
@@ -13,8 +14,6 @@ from __future__ import annotations
 
 import math
 
-from ..laws.damping import damping_of
-from ..laws.normal import ELASTIC_BY_EXPONENT, NormalLaw
 from ..laws.tangential import (TRUNC_MAW, TRUNC_SPRING, NoTangential, SpringTangential, SqrtSpringTangential,
                                TangentialLaw, ViscousSlidingTangential)
 
@@ -24,11 +23,6 @@ def damping_ratio(e: float) -> float:
     e < 1; the engines' docs call it β(e) — not Chung & Ooi's tangential restitution β of validate)."""
     le = math.log(e)
     return -le / math.sqrt(math.pi**2 + le * le)
-
-
-def normal_law(k_el: float, a: float, c: float, b: float, limit: bool) -> NormalLaw:
-    """F_ne = k_el δ^a (the hooke or hertz record) with the dashpot c δ^b δ̇ (its damping record)."""
-    return NormalLaw.from_slots(ELASTIC_BY_EXPONENT[a](k=k_el), damping_of(c, b), limit)
 
 
 def restitution_for_eta(c_over_root: float, factor: float) -> float:
@@ -60,5 +54,5 @@ def no_friction() -> TangentialLaw:
     return TangentialLaw.from_slot(NoTangential())
 
 
-__all__ = ["TRUNC_MAW", "TRUNC_SPRING", "damping_ratio", "normal_law", "no_friction", "restitution_for_eta",
+__all__ = ["TRUNC_MAW", "TRUNC_SPRING", "damping_ratio", "no_friction", "restitution_for_eta",
            "tangential_spring", "tangential_viscous_sliding"]

@@ -27,7 +27,8 @@ import math
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import NormalLaw
+from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping
+from ...laws.normal import HertzNormal, HookeNormal, NormalLaw
 from ...laws.tangential import TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 from ..mapping import mu_of
@@ -173,19 +174,20 @@ def _no_friction_law(normal_id: str, tl) -> str:
 
 
 def law_numbers(nat: Native, m: float, r: float) -> dict:
-    """What a twinned law computes on a pair (m̄, R̄): its normal spring k_el δ^a with the dashpot c δ^b, Kn's
-    coefficient (× √δ for Hertz) and the tangential kernel's options."""
+    """What a twinned law computes on a pair (m̄, R̄): its normal records ``spring`` (hooke or hertz, k_el δ^a) and
+    ``damping`` (the dashpot c δ^b; k_el, a, c, b: their numbers), Kn's coefficient (× √δ for Hertz) and the
+    tangential kernel's options."""
     law, e_star, gamma, wall = nat.normal, nat.normal_args[0], nat.damping_coeff, bool(nat.props.get("wall"))
     parent = PARENT.get(law)
     if parent is None:
         raise ValueError(f"no twin for Kratos law {law!r}")
     out = {"hertz": parent == HERTZ, "rho": None, "gamma": gamma, "minor": None}
     if parent == HERTZ:
-        out.update(kn=2.0 * e_star * math.sqrt(r), k_el=4.0 / 3.0 * e_star * math.sqrt(r), a=1.5, b=0.25,
-                   c=2.0 * gamma * math.sqrt(2.0 * m * e_star * math.sqrt(r)))
+        out.update(kn=2.0 * e_star * math.sqrt(r), spring=HertzNormal(k=4.0 / 3.0 * e_star * math.sqrt(r)),
+                   damping=QuarterDamping(eta=2.0 * gamma * math.sqrt(2.0 * m * e_star * math.sqrt(r))))
     elif parent == LINEAR:
         k = nat.props["k_normal"] if law == CUSTOM else linear_kn(e_star, r, wall, KN_FACTOR.get(law, 1.0))
-        out.update(kn=k, k_el=k, a=1.0, b=0.0, c=2.0 * gamma * math.sqrt(m * k))
+        out.update(kn=k, spring=HookeNormal(k=k), damping=ConstantDamping(eta=2.0 * gamma * math.sqrt(m * k)))
         if law in KN_FACTOR and nat.tangential == FRICTION:
             out["rho"] = tangential_ratio(nat) / KN_FACTOR[law]
         elif law == CUSTOM:
@@ -195,13 +197,16 @@ def law_numbers(nat: Native, m: float, r: float) -> dict:
         if nu is None:
             raise ValueError(f"{law}'s twin needs the deck's POISSON_RATIO (its Kt = ν·Kn)")
         k = particle_young(e_star, [nu, nu], wall) * (r if wall else 2.0 * r)
-        out.update(kn=k, k_el=k, a=1.0, b=0.0, c=0.0, rho=nu, gamma=0.0, minor=False)
+        out.update(kn=k, spring=HookeNormal(k=k), damping=NoDamping(), rho=nu, gamma=0.0, minor=False)
+    # the records' numbers, for the wall and settling scenarios' force closures (kratos/scenario.py)
+    spring, dashpot = out["spring"], out["damping"]
+    out.update(k_el=spring.k, a=spring.exponent, c=getattr(dashpot, "eta", 0.0), b=dashpot.exponent)
     return out
 
 
 def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     ln = law_numbers(nat, m, r)
-    nl = twins.normal_law(ln["k_el"], ln["a"], ln["c"], ln["b"], True)
+    nl = NormalLaw.from_slots(ln["spring"], ln["damping"], True)
     if nat.tangential == FRICTION:
         # the nearest seed record, for the model's description only: the twin's steps are twins_kratos'
         # (Engine.twin_collide), whose history, rotation, cap and arms are Kratos' own

@@ -157,8 +157,7 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     else:  # hertz/material E ν: E* = E/(2(1−ν²)) for the pair's own coefficients (and for walls)
         e_mod, nu = nat.normal_args
         spring = HertzNormal(k=4.0 / 3.0 * e_mod / (2.0 * (1.0 - nu * nu)) * math.sqrt(r))
-    c, b = damping(nat.damping, nat.damping_coeff, spring, m, r)
-    nl = twins.normal_law(spring.k, spring.exponent, c, b, nat.limit)
+    nl = NormalLaw.from_slots(spring, damping(nat.damping, nat.damping_coeff, spring, m, r), nat.limit)
     args = nat.tangential_args
     if nat.tangential == "linear_nohistory":
         x_t, mu = args

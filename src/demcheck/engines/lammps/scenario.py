@@ -133,7 +133,8 @@ def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     model = resolve(case)
     m, r = model.pair.m_eff, model.pair.r_eff
     nl, _ = engine.twin(nat, m, r)
-    c, b = damping(nat.damping, nat.damping_coeff, nl.slots()[0], m, r)
+    dashpot = damping(nat.damping, nat.damping_coeff, nl.slots()[0], m, r)  # a damping record: η δ^b
+    c, b = dashpot.eta, dashpot.exponent
 
     def normal(d, rate):
         return nl.k * d ** nl.a + c * d ** b * rate

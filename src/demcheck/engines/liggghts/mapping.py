@@ -244,18 +244,18 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
                 twins.no_friction())
     if nat.normal == "hooke/stiffness":
         spring = HookeNormal(k=p["kn"])
-        c, b = damping("stiffness_hooke", p["gamman"], spring, m, r)
+        dashpot = damping("stiffness_hooke", p["gamman"], spring, m, r)
         kt, sqrt_law, eta_t = p["kt"], False, m * p["gammat"]
     elif nat.normal == "hertz/stiffness":
         spring = HertzNormal(k=p["kn"] * math.sqrt(r))
-        c, b = damping("stiffness_hertz", p["gamman"], spring, m, r)
+        dashpot = damping("stiffness_hertz", p["gamman"], spring, m, r)
         kt, sqrt_law, eta_t = p["kt"], True, None  # γt = gammat m̄ √(R̄δ): the normal law's δ^½
     elif nat.normal == "hooke":  # characteristic velocity v_c: Kn from Hertz's energy at v_c; Kt = Kn, γt = γn
         y_eff, vc = p["youngs_eff"], p["characteristic_velocity"]
         spring = HookeNormal(k=16.0 / 15.0 * math.sqrt(r) * y_eff * (15.0 * m * vc * vc / (16.0 * math.sqrt(r) * y_eff))
                              ** 0.2)
-        c, b = damping("restitution_hooke", p["restitution"], spring, m, r)
-        kt, sqrt_law, eta_t = spring.k, False, c
+        dashpot = damping("restitution_hooke", p["restitution"], spring, m, r)
+        kt, sqrt_law, eta_t = spring.k, False, dashpot.eta
     elif nat.normal == "edinburgh":
         kl = p["kl"]
         return (NormalLaw.from_slots(HysteresisNormal(kl=kl, ku=kl * p["unloading"]), NoDamping(), nat.limit),
@@ -263,11 +263,11 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     elif nat.normal == "hertz":
         y_eff, g_eff = p["youngs_eff"], p["shear_eff"]
         spring = HertzNormal(k=4.0 / 3.0 * y_eff * math.sqrt(r))
-        c, b = damping("restitution_hertz", p["restitution"], spring, m, r)
+        dashpot = damping("restitution_hertz", p["restitution"], spring, m, r)
         kt, sqrt_law, eta_t = 8.0 * g_eff, True, None
     else:
         raise ValueError(f"no twin for LIGGGHTS model {nat.normal!r}")
-    nl = twins.normal_law(spring.k, spring.exponent, c, b, nat.limit)
+    nl = NormalLaw.from_slots(spring, dashpot, nat.limit)
     mu = p.get("friction", 0.0)
     if nat.tangential == "off" or mu == 0.0 and nat.tangential == "no_history":
         return nl, twins.no_friction()

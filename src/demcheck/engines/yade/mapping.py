@@ -24,7 +24,8 @@ import math
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import HYSTERETIC, NormalLaw
+from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping
+from ...laws.normal import HertzNormal, HookeNormal, HysteresisNormal, NormalLaw
 from ...laws.tangential import (TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw,
                                 ViscousTangential)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
@@ -217,7 +218,7 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
     p = nat.props
     mu = p.get("mu", 0.0)
     if nat.normal == VISCEL:
-        nl = twins.normal_law(p["kn"], 1.0, p["cn"], 0.0, True)
+        nl = NormalLaw.from_slots(HookeNormal(k=p["kn"]), ConstantDamping(eta=p["cn"]), True)
         if nat.tangential == "viscous":
             return nl, TangentialLaw.from_slot(ViscousTangential(eta=p["cs"], mu_s=mu, mu_k=mu, r_eff=r, m_eff=m))
         if nat.tangential == "spring":
@@ -228,7 +229,7 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         return nl, twins.no_friction()
     if nat.normal == MINDLIN:
         c = 2.0 * p["betan"] * math.sqrt(1.5 * m * p["kno"])
-        nl = twins.normal_law(p["kno"], 1.5, c, 0.25, nat.limit)
+        nl = NormalLaw.from_slots(HertzNormal(k=p["kno"]), QuarterDamping(eta=c), nat.limit)
         if nat.tangential == "mindlin":
             factor = (2.0 * p["betas"] * math.sqrt(m * p["kso"]) / c) if c > 0.0 else 0.0
             return nl, TangentialLaw.from_slot(SqrtSpringTangential(
@@ -237,7 +238,8 @@ def twin(nat: Native, m: float, r: float) -> tuple[NormalLaw, TangentialLaw]:
         return nl, twins.no_friction()
     if nat.normal == LUDING:
         # the nearest seed record, for the model's description: the twin's steps are twins_luding's (twin_collide)
-        return NormalLaw(HYSTERETIC, kl=p["kl"], ku=0.0, s=p["s"], limit=True), twins.no_friction()
+        return (NormalLaw.from_slots(HysteresisNormal(kl=p["kl"], ku=0.0, s=p["s"]), NoDamping(), True),
+                twins.no_friction())
     raise ValueError(f"no twin for Yade physics {nat.normal!r}")
 
 
