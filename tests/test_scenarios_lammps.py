@@ -120,7 +120,7 @@ def test_engines_without_a_scenario_deck_say_not_expressible(name):
 
 @pytest.mark.parametrize("name, overrides, why", [
     ("rolling", ["contact.full_direction=true"], "direction from the whole relative spin"),
-    ("rolling", ["contact.tangential=none", "contact.kt=null"], "needs the case's tangential spring"),
+    ("rolling", ["contact.tangential=ddt", "contact.kt=null"], "needs the case's tangential spring"),
     ("conduction", ["contact.heat=lens"], "not the spheres' intersection circle"),
 ])
 def test_lammps_refuses_what_it_cannot_express_with_the_reason(name, overrides, why):
