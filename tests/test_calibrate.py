@@ -81,3 +81,16 @@ def test_cli_bad_target_exits_2_before_any_work(tmp_path):
     p = subprocess.run([sys.executable, "-m", "demcheck", "calibrate", "cases/glass-pair.toml", "--engine", "lammps",
                         "--target", "restitution"], capture_output=True, text=True, cwd=ROOT)
     assert p.returncode == 2 and "--target" in p.stderr and p.stderr.strip().count("\n") == 0
+
+
+def test_a_scenario_case_is_refused_before_any_run():
+    """The twin and the confirming run are Source.run's (comparisons/sources.py), which solves a scenario beyond
+    sliding as that scenario: a restitution target is an impact's, so a scenario case is one ConfigError."""
+    from demcheck.case import expand
+
+    from .conftest import CASES
+
+    case = expand(CASES / "suite" / "beyond-rolling.toml")[0]
+    with pytest.raises(ConfigError) as err:
+        demcheck.calibrate(case, "lammps", {"restitution": 0.6}, confirm=False)
+    assert (err.value.key, err.value.value) == ("run.scenario", "rolling") and "collision" in err.value.rule

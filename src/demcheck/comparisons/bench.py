@@ -31,7 +31,7 @@ import numpy as np
 from ..case import Case
 from ..engines import registry
 from ..errors import ConfigError, DemcheckError, EngineInterrupted, UnsupportedByEngine
-from ..reference.collision import characteristic_time, collide
+from ..reference.collision import characteristic_time
 from ..laws.model import resolve
 
 METRICS = ("restitution", "contact_time", "max_overlap", "peak_force")
@@ -243,26 +243,16 @@ def native_law(case: Case, engine, native, seed: dict | None = None) -> NativeLa
     """The native law of ``engine`` for the case and its converged answer: the twin solved by the adaptive
     method with the engine's kinematic rules, or — a twin with a force history has no adaptive solve — by its
     own scheme at t_c/CONVERGED_STEPS. ``seed``: the seed model's converged metrics, for ``seed_gap``."""
-    from ..engines import states
-    from ..reference import collision3d
     from ..reference.health import impact_scales
-
-    from ..engines.collide import as_engine
+    from .sources import Source
 
     model, t_c = native_contact(case, native)
-    engine = as_engine(engine)  # an Engine, or its name
-    rules = engine.twin_rules(native)
-    tl = model.tangential_law
-    if engine.own_twin(native):  # a kernel of the engine's own (Kratos' friction, Yade's Luding): its scheme only
-        conv = states.restate(engine.twin_collide(case, model, native, t_c / CONVERGED_STEPS), case)
-        how = f"verlet at t_c/{CONVERGED_STEPS}: the engine's own twin kernel has no adaptive solve"
-    elif tl.force_history or tl.rescale_history:  # defined for the engines' scheme only: no adaptive solve
-        conv = states.restate(collision3d.collide(case, model, "verlet", dt=t_c / CONVERGED_STEPS, rules=rules),
-                              case)
-        how = f"verlet at t_c/{CONVERGED_STEPS}: a force history has no adaptive solve"
-    else:
-        conv = collision3d.collide(case, model, "adaptive", rules=rules)
-        how = f"adaptive, rtol {conv.rtol:g}"
+    twin = Source.of(engine, twin=True)  # an Engine, or its name
+    engine = twin.engine
+    conv = twin.run(case, t_c / CONVERGED_STEPS, native=native, converged=True)
+    # a twin without an adaptive solve (the engine's own kernel, a force history): its scheme at t_c/CONVERGED_STEPS
+    how = (f"verlet at t_c/{CONVERGED_STEPS}: {conv.meta['no_adaptive']} has no adaptive solve"
+           if "no_adaptive" in conv.meta else f"adaptive, rtol {conv.rtol:g}")
     m = conv.metrics()
     # the solver's note on a tangential history concerns a contact that slides: none in a head-on impact
     note = conv.message if _defined(m.get("tangential_restitution")) or conv.status != "ok" else ""
@@ -305,7 +295,7 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
 
     model = resolve(case)
     t_c = characteristic_time(model)
-    ref = collide(case, "adaptive").metrics()
+    ref = sources.ADAPTIVE.run(case).metrics()
     res = BenchResult(case.name, model.describe(), t_c, ref)
     planned = sources.plan(case, engines)
     res.natives = {p.source.name: native_law(case, p.source.engine, p.native, ref) for p in planned

@@ -19,8 +19,9 @@ import math
 from ..case import Case, run_length
 from ..errors import ConfigError, DemcheckError
 from ..engines import registry
-from ..engines.collide import collide, setting, twin_states
+from ..engines.collide import setting
 from ..engines.mapping import contact_mapping, native_summary
+from .sources import Source
 
 TARGETS = {"restitution": (0.0, 1.0), "tangential_restitution": (-1.0, 1.0)}
 ROOT_TOL = 1e-6  # |realised − target| the root is found to, in the metric's own (dimensionless) units
@@ -53,6 +54,9 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     if engine not in registry.names():
         raise ConfigError("--engine", engine, f"must be one of {', '.join(registry.names())}")
     eng = registry.get(engine)
+    if case.run.scenario != "collision":
+        raise ConfigError("run.scenario", case.run.scenario, "must be \"collision\": a target metric (restitution) "
+                                                            "is an impact's")
     if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ConfigError("--dt", dt, "must be a number > 0 (s)")
     # the step `demcheck collide --engine` runs the case at (a native setting at its own step): the input found
@@ -63,6 +67,7 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     if "tangential_restitution" in targets and not _oblique(case):
         raise ConfigError("--target tangential_restitution", targets["tangential_restitution"],
                           "needs an oblique impact (impact.angle > 0): a head-on one has no tangential motion")
+    twin = Source.of(eng, twin=True)
     knobs = {}
     for metric in targets:  # every input named before any run
         if eng.knob(native, metric) is None:
@@ -76,7 +81,7 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
         calls = []
 
         def gap(x, knob=knob, metric=metric, target=target):
-            v = twin_states(case, engine, step, native=knob.set(x)).metrics()[metric]
+            v = twin.run(case, step, native=knob.set(x)).metrics()[metric]
             calls.append((x, v))
             if not math.isfinite(v):
                 raise DemcheckError(f"the twin's {metric} is not finite at {knob.name} = {x:g}")
@@ -139,7 +144,7 @@ def confirm_task(case: Case, engine: str, dt: float, native, cache=None):
     lacking = missing_here([engine])
     if lacking:
         raise EngineNotFound(lacking[engine])
-    return collide(case, engine, dt=dt, native=native)
+    return Source.of(engine).run(case, dt, native=native)
 
 
 def _oblique(case: Case) -> bool:

@@ -30,7 +30,7 @@ def _engine(case, planned, entry: CaseResult, opts, ref: dict) -> None:
     src, mp = planned.source, planned.mapping
     label, comps = src.label, entry.comparisons
     try:
-        res = scenario.run(case, src.engine, timeout=opts.timeout, cache=opts.cache)  # src.run's, cached
+        res = src.run(case, timeout=opts.timeout, cache=opts.cache)  # the deck its package writes, cached
         twin = scenario.cached_metrics("twin", case, src.engine, opts.cache)
         seed = scenario.cached_metrics("seed", case, src.engine, opts.cache)
     except EngineInterrupted:

@@ -115,15 +115,19 @@ class Source:
         return setting(case, self.engine, dt)
 
     def run(self, case: Case, dt: float | None = None, *, rtol: float | None = None, native=_SETTING,
-            timeout: float | None = None, **options) -> Result:
+            timeout: float | None = None, restated: bool = False, converged: bool = False, **options) -> Result:
         """The source's Result for ``case`` at ``dt``. The reference: its method at ``dt`` (verlet) or ``rtol``
-        (adaptive); an engine: its deck run for real (``timeout``; ``options`` — cache, worker, copies — go to
-        engines.collide.collide); a twin: the reference computing the engine's formula with its scheme at the
-        engine's dt. ``native``: the engine's setting (default the case's own, at its own step when ``dt`` is
-        None; None: the engine's mapping of the seed model)."""
+        (adaptive); ``restated``: by the two-body kernel, read off its states as an engine's run is
+        (engines.states.restate) — the seed model at an engine's step. An engine: its deck run for real
+        (``timeout``; ``options`` — cache, worker, copies — go to engines.collide.collide). A twin: the reference
+        computing the engine's formula with its scheme at the engine's dt; ``converged``: its converged answer
+        (:func:`_converged_twin`). ``native``: the engine's setting (default the case's own, at its own step when
+        ``dt`` is None; None: the engine's mapping of the seed model)."""
         if case.run.scenario != "collision":
-            return self._scenario(case, timeout)
+            return self._scenario(case, timeout, options.get("cache"))
         if self.kind == REFERENCE:
+            if restated:
+                return _restated(case, self.method, dt, rtol)
             from ..reference.collision import collide
 
             return collide(case, method=self.method, dt=dt, rtol=rtol)
@@ -132,6 +136,8 @@ class Source:
         given = dt
         if native is _SETTING:
             native, dt = self.setting(case, dt)
+        if self.kind == TWIN and converged:
+            return _converged_twin(case, self.engine, native, dt)
         if self.kind == TWIN:
             from ..case import run_length
             from ..engines.collide import twin_states
@@ -145,13 +151,13 @@ class Source:
             return run_engine(case, self.engine, dt=dt, native=native, **options)
 
 
-    def _scenario(self, case: Case, timeout: float | None = None) -> Result:
+    def _scenario(self, case: Case, timeout: float | None = None, cache=None) -> Result:
         """A scenario beyond sliding: the reference's solve (reference/scenarios.py), the engine's run of the deck
-        its package writes, or its twin (engines/scenario.py)."""
+        its package writes (``cache``: engines.cache.Cache), or its twin (engines/scenario.py)."""
         if self.kind == ENGINE:
             from ..engines import scenario
 
-            return scenario.run(case, self.engine, timeout=timeout)
+            return scenario.run(case, self.engine, timeout=timeout, cache=cache)
         if self.kind == TWIN:
             from ..engines import scenario
 
@@ -162,6 +168,37 @@ class Source:
         from ..reference.scenarios import solve
 
         return solve(case)
+
+
+def _restated(case: Case, method: str | None, dt: float | None, rtol: float | None) -> Result:
+    """The seed model's run by the two-body kernel, its contact table read off its states as an engine's is."""
+    from ..engines import states
+    from ..laws.model import resolve
+    from ..reference import collision3d
+
+    return states.restate(collision3d.collide(case, resolve(case), method or case.run.method, dt=dt, rtol=rtol),
+                          case)
+
+
+def _converged_twin(case: Case, engine, native, dt: float) -> Result:
+    """The converged answer of ``engine``'s twin of ``native``: the adaptive method with the engine's kinematic
+    rules, or — a twin without an adaptive solve: the engine's own kernel (Kratos' friction, Yade's Luding), a
+    force history — its own scheme at ``dt``, saying why in ``meta["no_adaptive"]``."""
+    from ..engines.collide import twin_states
+    from ..engines.mapping import contact_mapping, twin_model
+    from ..laws.model import resolve
+    from ..reference import collision3d
+
+    nat = contact_mapping(case, engine, native).require()
+    model = twin_model(resolve(case), nat)
+    tl = model.tangential_law
+    if engine.own_twin(nat) or tl.force_history or tl.rescale_history:
+        res = twin_states(case, engine, dt, native=nat)
+        res.meta["no_adaptive"] = "the engine's own twin kernel" if engine.own_twin(nat) else "a force history"
+        return res
+    res = collision3d.collide(case, model, "adaptive", rules=engine.twin_rules(nat))
+    res.source = engine.name + TWIN_SUFFIX
+    return res
 
 
 ADAPTIVE, VERLET = Source.reference("adaptive"), Source.reference("verlet")

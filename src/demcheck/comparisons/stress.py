@@ -25,9 +25,10 @@ from pathlib import Path
 
 from ..case import Case, _read, from_dict, naming_file
 from ..errors import ConfigError, DemcheckError, EngineInterrupted
-from ..reference.collision import characteristic_time, collide
+from ..reference.collision import characteristic_time
 from ..reference import health
 from ..laws.model import resolve
+from .sources import VERLET
 
 # steps per elastic contact time, coarse to fine: the search grid
 GRID = (1, 1.5, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 100)
@@ -156,7 +157,7 @@ def _stable_reference(case: Case, dt: float, t_c: float) -> tuple[bool, str]:
     """Stability, not resolution: a run with few steps inside the contact is inaccurate (``bench`` measures
     that) but stable as long as it stays finite, bounded and does not create energy."""
     try:
-        r = collide(case, "verlet", dt=dt)
+        r = VERLET.run(case, dt)
     except DemcheckError as exc:
         return False, str(exc).splitlines()[0]
     if r.status not in ("ok", "unresolved", "unstable"):

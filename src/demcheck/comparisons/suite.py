@@ -107,7 +107,7 @@ def run_case(case: Case, file: Path, opts: Options, found: dict) -> CaseResult:
     seed_cache: dict = {}
     for planned in sources.plan(case, opts.engines, found):
         if entry.note_plan(planned):
-            _engine_source(case, model, planned, (adaptive, ref), entry, opts, seed_cache)
+            _engine_source(case, planned, (adaptive, ref), entry, opts, seed_cache)
     entry.series = [s for s in entry.series if s]
     return entry.judged()
 
@@ -188,13 +188,11 @@ def _verlet_part(case: Case, adaptive) -> dict:
             "curves": curves.distances(verlet.contact, adaptive.contact, adaptive.events)}
 
 
-def _engine_source(case: Case, model, planned, converged: tuple, entry: CaseResult, opts: Options,
+def _engine_source(case: Case, planned, converged: tuple, entry: CaseResult, opts: Options,
                    seed_cache: dict) -> None:
     """One engine that can run the case (``planned``, sources.plan): its run (from the cache where it was run
-    before), its twin and the seed model's verlet run at its dt, and each metric judged."""
-    from ..engines import states
-    from ..reference import collision3d
-
+    before), its twin and the seed model's verlet run at its dt (read off its states as the engine's run is), and
+    each metric judged."""
     src, mp, native = planned.source, planned.mapping, planned.native
     engine, (adaptive, ref), comps = src.label, converged, entry.comparisons
     try:
@@ -219,7 +217,7 @@ def _engine_source(case: Case, model, planned, converged: tuple, entry: CaseResu
     if res.dt not in seed_cache:
         seed_cache[res.dt] = cached_metrics(
             opts.cache, f"seed verlet {res.dt!r}", case,
-            lambda: states.restate(collision3d.collide(case, model, "verlet", dt=res.dt), case).metrics())
+            lambda: sources.VERLET.run(case, res.dt, restated=True).metrics())
     seed_v = seed_cache[res.dt]
     entry.sources[engine] = SourceResult.of_run(res, fidelity=mp.fidelity, reasons=list(mp.reasons),
                                                 twin_metrics=twin, seed_verlet_metrics=seed_v)

@@ -721,14 +721,12 @@ def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys, regime: str =
 
 def _result(case, src: str, opts):
     """The source's own Result: the reference's adaptive run again, or the engine's run from the run cache the
-    suite filled."""
-    from ..reference.collision import collide
+    suite filled (its Source.run, as the suite ran it)."""
+    from .sources import ADAPTIVE, Source
 
     if src == "reference":
-        return collide(case, "adaptive")
-    from ..engines.collide import collide as run_engine
-
-    return run_engine(case, src, cache=opts.cache, timeout=opts.timeout)
+        return ADAPTIVE.run(case)
+    return Source.parse(src).run(case, cache=opts.cache, timeout=opts.timeout)
 
 
 def _final_spin_ratio(case, res) -> float | None:
