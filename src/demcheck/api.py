@@ -324,8 +324,12 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     # a key that cannot move the native law, varied or set: refused before any solve
     native_vary_rule(points, source, _under(key["vary"]), _under(key["overrides"]))
     engine = None if source == "reference" else Source.parse(source).name
-    # the command's own loop: an engine's points run in its long-lived worker where it has one
-    with Campaign(jobs, scheduler, sources=[engine] if engine else []) as campaign:
+    # the command's own loop: an engine's points run in its long-lived worker where it has one, which stays in
+    # this process (a campaign's exit would end it: engines/run.py ends it at exit)
+    campaign = Campaign(jobs, scheduler, sources=[engine] if engine else [])
+    if campaign.in_process:
+        return run_sweep(points, method, dt, progress, source=source, campaign=campaign)
+    with campaign:
         return run_sweep(points, method, dt, progress, source=source, campaign=campaign)
 
 

@@ -407,12 +407,21 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
             raise ConfigError("--vary", text, f"{key} is varied twice: give each key once")
         vary[key] = values
     _check_jobs(jobs, scheduler)
-    with Progress(transient=True, disable=as_json) as progress:
-        task = progress.add_task("sweep", total=math.prod(len(v) for v in vary.values()))
+    progress = Progress(transient=True, disable=as_json)
+    task = progress.add_task("sweep", total=math.prod(len(v) for v in vary.values()))
+
+    def advance():  # the bar shows once a point is solved: a refusal before any work prints nothing on stdout
+        if not progress.live.is_started:
+            progress.start()
+        progress.advance(task)
+
+    try:
         table = api.sweep(case_path, vary, source, method, dt, list(overrides), jobs=jobs, scheduler=scheduler,
-                          progress=lambda: progress.advance(task), base=True,
-                          keys={**SET_KEYS, "source": "--engine", "method": "--method", "dt": "--dt",
-                                "vary": "--vary"})
+                          progress=advance, base=True, keys={**SET_KEYS, "source": "--engine", "method": "--method",
+                                                             "dt": "--dt", "vary": "--vary"})
+    finally:
+        if progress.live.is_started:  # (Progress.stop prints a line off a terminal, started or not)
+            progress.stop()
     if csv_path:
         from .io import atomic_path
 
