@@ -110,20 +110,22 @@ def _framed(result: _Result) -> Result:
     return result
 
 
-def _overrides(overrides: Iterable[str] | Mapping[str, Any] | None, keyword: Mapping[str, Any]) -> list:
+def _overrides(overrides: Iterable[str] | Mapping[str, Any] | None, keyword: Mapping[str, Any],
+               key: str = "overrides") -> list:
     """[(dotted key, value)]: ``overrides`` as ``key=value`` texts (--set's form) or a mapping of dotted keys to
-    Python values; keywords with ``__`` for the dots (``contact__normal="tti"``)."""
+    Python values; keywords with ``__`` for the dots (``contact__normal="tti"``). ``key``: the name the errors give
+    the overrides (the command line's ``--set``)."""
     out = []
     rule = "must be a list of KEY=VALUE texts or a dict of dotted keys to values"
     if isinstance(overrides, Mapping):
         for k, v in overrides.items():
-            out.append((_text("overrides", k, "a key must be a dotted case key (text), e.g. impact.speed"), v))
+            out.append((_text(key, k, "a key must be a dotted case key (text), e.g. impact.speed"), v))
     elif overrides is not None:
         if isinstance(overrides, str):
-            raise ConfigError("overrides", overrides, rule + ", not one text")
-        for item in _sequence("overrides", overrides, rule):
+            raise ConfigError(key, overrides, rule + ", not one text")
+        for item in _sequence(key, overrides, rule):
             if not isinstance(item, str) or "=" not in item:
-                raise ConfigError("overrides", item, "must be KEY=VALUE with a dotted key, e.g. contact.normal=hertz")
+                raise ConfigError(key, item, "must be KEY=VALUE with a dotted key, e.g. contact.normal=hertz")
             key, _, text = item.partition("=")
             out.append((key.strip(), _case.parse_value(text.strip())))
     out += [(k.replace("__", "."), v) for k, v in keyword.items()]
@@ -153,23 +155,27 @@ def _check_natives(case: _case.Case) -> _case.Case:
     return case
 
 
-def _build(case, pairs: list) -> _case.Case:
+def _build(case, pairs: list, base: bool = False) -> _case.Case:
     raw = _raw(case)
     for key, value in pairs:
         _case.set_path(raw, key, value)
-    if "variants" in raw:
+    if "variants" in raw and not base:
         raise ConfigError("variants", sorted(raw["variants"]), "a file with [variants] is several cases: "
                                                                "use verify, or load one with its keys overridden")
     return _check_natives(_case.from_dict(raw))
 
 
-def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword) -> _case.Case:
+def load(case, overrides: Iterable[str] | Mapping[str, Any] | None = (), *, keys: Mapping[str, str] | None = None,
+         base: bool = False, **keyword) -> _case.Case:
     """A validated Case from a case file's path, a dict shaped like one, or a Case, with overrides applied:
     ``key=value`` texts as ``--set`` takes them, a dict of dotted keys to values, or keywords with ``__`` for
-    the dots. A Case passed with no override is returned as it is."""
+    the dots. A Case passed with no override is returned as it is. A file with ``[variants]`` is several cases (a
+    ConfigError) unless ``base``: then its base case, without the variants (what the single-case commands run).
+    ``keys``: the names the errors give the arguments (``{"overrides": "--set"}``: the command line's; every
+    command loads its case here)."""
     if isinstance(case, _case.Case) and not overrides and not keyword:
         return case
-    return _build(case, _overrides(overrides, keyword))
+    return _build(case, _overrides(overrides, keyword, (keys or {}).get("overrides", "overrides")), _flag("base", base))
 
 
 def models(model_id: str | None = None, key: str = "model_id") -> list[dict]:
@@ -286,7 +292,9 @@ def collide_many(cases: Iterable, method: str | None = None, dt: float | None = 
 
 
 def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method: str | None = None,
-          dt: float | None = None, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword):
+          dt: float | None = None, overrides: Iterable[str] | Mapping[str, Any] | None = (), *, jobs: int = 1,
+          scheduler: str | None = None, progress=None, keys: Mapping[str, str] | None = None, base: bool = False,
+          **keyword):
     """Metrics over a grid of case keys → a DataFrame: one row per point (its values, every metric, and its
     status). ``vary`` maps dotted keys to their values (``{"impact.angle": [0, 30, 60]}``); several keys make a
     grid. ``source`` as :func:`collide` takes it: an engine and its twin run the case's ``[engine.NAME]``
@@ -295,35 +303,66 @@ def sweep(case, vary: Mapping[str, Iterable], source: str = "reference", method:
     change, nor a ``materials.*`` key the setting does not read: such a sweep is a ConfigError. Every point is
     validated before any is solved; a point whose solve fails keeps its row with the error as its status. An
     engine's points run in its long-lived worker, which stays (idle) until the interpreter exits or
-    ``demcheck.engines.run.shutdown_workers()`` ends it."""
-    from .comparisons.sweep import Points, check_source, native_vary_rule, run_sweep
+    ``demcheck.engines.run.shutdown_workers()`` ends it. ``jobs``/``scheduler``: where the points run
+    (``demcheck sweep``'s --jobs and --scheduler: comparisons/dispatch.py); ``progress``: called once a point
+    (or a batch) is solved; ``keys``: the names the errors give the arguments (the command line's options);
+    ``base`` as :func:`load` takes it."""
+    from .comparisons.dispatch import Campaign
+    from .comparisons.sources import Source
+    from .comparisons.sweep import check_source, native_vary_rule, run_sweep
 
-    check_source(source, method, ("source", "method", "dt"))  # the command's checks, with the API's names
-    _positive("dt", dt, "s")
+    key = {"source": "source", "method": "method", "dt": "dt", "vary": "vary", "overrides": "overrides",
+           **(keys or {})}
+    check_source(source, method, (key["source"], key["method"], key["dt"]))  # the command's checks
+    _positive(key["dt"], dt, "s")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
+        raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
+    points = _sweep_points(case, vary, _overrides(overrides, keyword, key["overrides"]), key["vary"],
+                           _flag("base", base))
+    if key["overrides"].startswith("--"):  # the command line's --set: its texts, as typed, in the errors
+        points.overrides = list(overrides)
+    # a key that cannot move the native law, varied or set: refused before any solve
+    native_vary_rule(points, source, _under(key["vary"]), _under(key["overrides"]))
+    engine = None if source == "reference" else Source.parse(source).name
+    # the command's own loop: an engine's points run in its long-lived worker where it has one, which stays in
+    # this process (a campaign's exit would end it: engines/run.py ends it at exit)
+    campaign = Campaign(jobs, scheduler, sources=[engine] if engine else [])
+    if campaign.in_process:
+        return run_sweep(points, method, dt, progress, source=source, campaign=campaign)
+    with campaign:
+        return run_sweep(points, method, dt, progress, source=source, campaign=campaign)
+
+
+def _under(key: str) -> str:
+    """The prefix of a case key in an error: ``--vary impact.speed`` (an option's), ``vary.impact.speed``."""
+    return key + (" " if key.startswith("--") else ".")
+
+
+def _sweep_points(case, vary, pairs: list, key: str = "vary", base: bool = False):
+    """The grid of :func:`sweep` as comparisons.sweep.Points, every point's case built and checked before any is
+    solved."""
+    from .comparisons.sweep import Points
+
     if not isinstance(vary, Mapping) or not vary:
-        raise ConfigError("vary", _shown(vary), "must be a dict of dotted case keys to lists of values")
+        raise ConfigError(key, _shown(vary), "must be a dict of dotted case keys to lists of values")
     axes = []
-    for key, values in vary.items():
-        key = _text("vary", key, "a key must be a dotted case key (text), e.g. impact.speed")
+    for k, values in vary.items():
+        k = _text(key, k, "a key must be a dotted case key (text), e.g. impact.speed")
         values = [values] if isinstance(values, str) else _sequence(
-            f"vary.{key}", values, "must be a list of values, e.g. [0.5, 1.0, 2.0]")
+            _under(key) + k, values, "must be a list of values, e.g. [0.5, 1.0, 2.0]")
         if not values:
-            raise ConfigError(f"vary.{key}", values, "must be a non-empty list of values")
-        axes.append((key, values))
+            raise ConfigError(_under(key) + k, values, "must be a non-empty list of values")
+        axes.append((k, values))
     total = math.prod(len(v) for _, v in axes)
     if total > MAX_POINTS:
-        raise ConfigError("vary", {k: len(v) for k, v in axes}, f"makes a grid of {total} points; at most "
-                                                                 f"{MAX_POINTS}")
-    pairs = _overrides(overrides, keyword)
-    _build(case, pairs)  # the base case must be valid on its own
+        raise ConfigError(key, {k: len(v) for k, v in axes}, f"makes a grid of {total} points; at most "
+                                                              f"{MAX_POINTS}")
+    _build(case, pairs, base)  # the base case must be valid on its own
     points = Points(overrides=pairs)
     for combo in itertools.product(*(v for _, v in axes)):
         values = {k: (v.item() if hasattr(v, "item") else v) for (k, _), v in zip(axes, combo)}
-        points.append((values, _build(case, [*pairs, *values.items()])))
-    # a key that cannot move the native law, varied or set: refused before any solve
-    native_vary_rule(points, source, "vary.", "overrides.")
-    # the command's own loop: an engine's points run in its long-lived worker where it has one
-    return run_sweep(points, method, dt, source=source)
+        points.append((values, _build(case, [*pairs, *values.items()], base)))
+    return points
 
 
 def verify(paths, engines: Iterable[str] | str | None = None, report: str | Path | None = None, jobs: int = 1,
@@ -465,12 +504,16 @@ def audit(path, engine: str | None = None, speed: float | None = None, run_engin
 
 
 def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None = None,
-              confirm: bool = True, overrides: Iterable[str] | Mapping[str, Any] | None = (), **keyword) -> dict:
+              confirm: bool = True, overrides: Iterable[str] | Mapping[str, Any] | None = (), *, jobs: int = 1,
+              scheduler: str | None = None, keys: Mapping[str, str] | None = None, base: bool = False,
+              **keyword) -> dict:
     """The native input of ``engine`` that realises ``targets`` (``{"restitution": 0.6}``; also
     ``tangential_restitution``) for the case's contact at ``dt``: root finding on the engine's twin, confirmed
     by one engine run (``confirm``). Returns a dict with the input, the line to paste, and the realised
-    values (twin and engine)."""
+    values (twin and engine). ``jobs``/``scheduler``: where the confirming run goes (``demcheck calibrate``'s
+    --jobs and --scheduler: comparisons/dispatch.py); ``keys`` and ``base`` as :func:`load` takes them."""
     from .comparisons.calibrate import calibrate as run, check_targets
+    from .comparisons.dispatch import Campaign
 
     _text("engine", engine, "must be an engine's name (text)")
     if not isinstance(targets, Mapping):
@@ -479,8 +522,11 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
     check_targets(dict(targets))
     _positive("dt", dt, "s")
     _flag("confirm", confirm)
-    c = load(case, overrides, **keyword)
-    return run(c, engine, dict(targets), dt=dt, confirm=confirm)
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
+        raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
+    c = load(case, overrides, keys=keys, base=base, **keyword)
+    with Campaign(jobs, scheduler, sources=[engine]) as campaign:
+        return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign)
 
 
 def packing_universe(path, dt: float = 1.0):

@@ -16,7 +16,6 @@ import click
 from . import __version__
 from .errors import ConfigError, DemcheckError
 from . import cli_text, resources
-from .cli_text import show
 from .io import check_output, console, plain
 
 
@@ -153,14 +152,14 @@ def _campaign(jobs: int, scheduler: str | None, sources=()):
     return Campaign(jobs, scheduler, sources=sources)
 
 
-def _load(case_path: str, overrides) -> "object":
-    from . import case as case_mod
-    from .engines import registry
-    from .engines.base import case_natives
+SET_KEYS = {"overrides": "--set"}  # the API's argument names as the command line's options
 
-    case = case_mod.load(case_path, list(overrides))
-    case_natives(case, registry.all_engines())  # [engine.NAME] settings read by their engines before any work
-    return case
+
+def _load(case_path: str, overrides) -> "object":
+    """The case (api.load: the one loader, its [engine.NAME] settings read by their engines before any work)."""
+    from . import api
+
+    return api.load(case_path, list(overrides), keys=SET_KEYS, base=True)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -246,41 +245,24 @@ _set_option = click.option("--set", "overrides", multiple=True, metavar="KEY=VAL
                    "yade-float128, yade-mpfr150), e.g. to show a difference is the scheme's and not round-off")
 def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, timeout, precision):
     """Solve one collision case and print its metrics (per source, side by side)."""
-    from .comparisons.sources import Source
-    from .errors import EngineNotFound, UnsupportedByEngine
+    from . import api
 
-    if engine == "all" and precision:
-        raise ConfigError("--precision", precision, "names the builds of engines given by name (--engine yade), "
-                          "not all")
-    if engine == "all":
-        sources = ["reference", *ENGINE_NAMES]
-    else:  # the reference and engines or builds (engines/builds.py), each checked before any work
-        from .engines import discovery
-
-        specs = [s.strip() for s in engine.split(",") if s.strip()]
-        if not specs:
-            raise ConfigError("--engine", engine, "must name a source: reference, an engine, a build or all")
-        from .engines.builds import with_precision
-
-        rest = [s for s in specs if s != "reference"]
-        if precision and not rest:
-            raise ConfigError("--precision", precision, "applies to an engine (--engine yade)")
-        rest = with_precision(",".join(rest), precision).split(",") if rest else []
-        labels = iter(discovery.resolve(",".join(rest), "--engine") if rest else [])
-        sources = ["reference" if s == "reference" else next(labels) for s in specs]
-        if len(sources) == 1:
-            engine = sources[0]
+    sources = _collide_sources(engine, precision)  # each checked before any work
+    if engine != "all" and len(sources) == 1:
+        engine = sources[0]
     case = _load(case_path, overrides)
-    results, skipped = {}, {}
-    for src in sources:
-        source = Source.reference(method) if src == "reference" else Source.parse(src, "--engine")
-        try:  # an engine: [engine.NAME] (a build reads its engine's table) at the native law's own step, what
-            # `deck` writes
-            results[src] = source.run(case, dt, timeout=timeout)
-        except (UnsupportedByEngine, EngineNotFound) as exc:
-            if engine != "all":
-                raise
-            skipped[src] = str(exc)
+    skipped = {}
+    if engine == "all":  # what can run the case: comparisons.sources.plan, the suite's answer
+        from .comparisons.sources import plan
+        from .comparisons.verdicts import NOT_EXPRESSIBLE
+
+        for p in plan(case, sources[1:]):
+            if not p.runs:
+                skipped[p.source.label] = (f"{p.source.label} cannot express this model: {p.why}"
+                                           if p.status == NOT_EXPRESSIBLE else p.why)
+    # an engine: [engine.NAME] (a build reads its engine's table) at the native law's own step, what `deck` writes
+    results = {src: api.collide(case, src, method if src == "reference" else None, dt, timeout=timeout)
+               for src in sources if src not in skipped}
     first = next(iter(results.values()), None)
     if csv_path and first is not None:
         from .io import atomic_path
@@ -307,6 +289,28 @@ def collide(case_path, engine, method, dt, overrides, as_json, plot, csv_path, t
         click.echo(f"demcheck: {r.source}: {r.status}: {r.message}", err=True)
     if bad:
         sys.exit(1)
+
+
+def _collide_sources(engine: str, precision: str | None) -> list[str]:
+    """``collide --engine``'s sources: reference, engines and builds (engines/builds.py, each registered under its
+    label), or all (the reference and every registered engine); checked before any work."""
+    if engine == "all":
+        if precision:
+            raise ConfigError("--precision", precision, "names the builds of engines given by name (--engine yade), "
+                              "not all")
+        return ["reference", *ENGINE_NAMES]
+    from .engines import discovery
+    from .engines.builds import with_precision
+
+    specs = [s.strip() for s in engine.split(",") if s.strip()]
+    if not specs:
+        raise ConfigError("--engine", engine, "must name a source: reference, an engine, a build or all")
+    rest = [s for s in specs if s != "reference"]
+    if precision and not rest:
+        raise ConfigError("--precision", precision, "applies to an engine (--engine yade)")
+    rest = with_precision(",".join(rest), precision).split(",") if rest else []
+    labels = iter(discovery.resolve(",".join(rest), "--engine") if rest else [])
+    return ["reference" if s == "reference" else next(labels) for s in specs]
 
 
 def _print_side_by_side(summaries: dict, skipped: dict) -> None:
@@ -392,15 +396,32 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     a materials.* key the setting does not read is refused: it would not change the law that runs."""
     from rich.progress import Progress
 
-    from .comparisons.sweep import native_vary_rule, parse_vary, plot_sweep, run_sweep, sweep_points, sweep_source
+    from . import api
+    from .comparisons.sweep import parse_vary, plot_sweep, sweep_source
 
-    source, engine = sweep_source(source, method)  # the source's label and its engine (or build), before any work
-    points = sweep_points(case_path, overrides, list(varies))  # every point checked before any is run
-    native_vary_rule(points, source)
-    with _campaign(jobs, scheduler, [engine] if engine else []) as campaign, \
-            Progress(transient=True, disable=as_json) as progress:
-        task = progress.add_task("sweep", total=len(points))
-        table = run_sweep(points, method, dt, lambda: progress.advance(task), source=source, campaign=campaign)
+    source, _ = sweep_source(source, method)  # the source's label (a build registered under it), before any work
+    vary = {}
+    for text in varies:
+        key, values = parse_vary(text)
+        if key in vary:
+            raise ConfigError("--vary", text, f"{key} is varied twice: give each key once")
+        vary[key] = values
+    _check_jobs(jobs, scheduler)
+    progress = Progress(transient=True, disable=as_json)
+    task = progress.add_task("sweep", total=math.prod(len(v) for v in vary.values()))
+
+    def advance():  # the bar shows once a point is solved: a refusal before any work prints nothing on stdout
+        if not progress.live.is_started:
+            progress.start()
+        progress.advance(task)
+
+    try:
+        table = api.sweep(case_path, vary, source, method, dt, list(overrides), jobs=jobs, scheduler=scheduler,
+                          progress=advance, base=True, keys={**SET_KEYS, "source": "--engine", "method": "--method",
+                                                             "dt": "--dt", "vary": "--vary"})
+    finally:
+        if progress.live.is_started:  # (Progress.stop prints a line off a terminal, started or not)
+            progress.stop()
     if csv_path:
         from .io import atomic_path
 
@@ -411,14 +432,7 @@ def sweep(case_path, varies, source, method, dt, overrides, as_json, csv_path, p
     if as_json:
         emit_json({"vary": [parse_vary(v)[0] for v in varies], "rows": table.to_dict(orient="records")})
     else:
-        from rich.table import Table
-
-        t = Table()
-        for c in table.columns:
-            t.add_column(c, justify="right")
-        for _, row in table.iterrows():
-            t.add_row(*[show(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
-        console().print(t)
+        console().print(cli_text.sweep_table(table))
     if (table["status"] != "ok").any():
         sys.exit(1)
 
@@ -458,8 +472,6 @@ def cases_command(name, as_json):
     packing/, benchmarks/ (`demcheck validate`) and optin/ (long cases, run by naming them). Every command takes a
     shipped case by its name (`demcheck collide glass-pair`). With NAME: that file's text, to copy and edit
     (`demcheck cases glass-pair > my-case.toml`)."""
-    import tomllib
-
     if name is not None:
         path = resources.case_path(name, "NAME")
         if as_json:
@@ -467,28 +479,11 @@ def cases_command(name, as_json):
         else:
             click.echo(path.read_text(), nl=False)
         return
-    root = resources.cases_dir()
-    rows = []
-    for stem, path in resources.shipped_cases().items():
-        raw = tomllib.loads(path.read_text())
-        contact = raw.get("contact") or {}
-        folder = path.parent.relative_to(root).as_posix()
-        rows.append({"name": stem, "folder": "" if folder == "." else folder, "kind": raw.get("kind", "collision"),
-                     "normal": contact.get("normal"), "tangential": contact.get("tangential", "none"),
-                     "in_default_suite": not resources.NAMED_ONLY & set(path.relative_to(root).parts),
-                     "path": str(path)})
+    root, rows = resources.cases_dir(), resources.case_rows()
     if as_json:
         emit_json({"root": str(root), "cases": rows})
         return
-    click.echo(f"shipped case files ({len(rows)}), in {root}:")
-    for folder in dict.fromkeys(r["folder"] for r in rows):
-        group = [r for r in rows if r["folder"] == folder]
-        what = "in the default suite" if group[0]["in_default_suite"] else "run by naming them"
-        click.echo(f"\n{folder or '.'}/ ({len(group)}, {what})")
-        for r in group:
-            law = r["kind"] if r["kind"] == "packing" else f"{r['normal']} + {r['tangential']}"
-            click.echo(f"  {r['name']:44s} {law}")
-    click.echo("\nrun one by its name (demcheck collide glass-pair); copy one: demcheck cases NAME > my-case.toml")
+    click.echo("\n".join(cli_text.cases_listing(root, rows)))
 
 
 # ----------------------------------------------------------------------------- verify
@@ -626,18 +621,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
         emit_json({"report": summary.report, "engines": summary.engines, "failed": summary.failed,
                    "validation": {k: v for k, v in val.items() if k != "series"}})
     else:
-        counts: dict = {}
-        for c in val["checks"]:
-            counts[(c["kind"], c["verdict"])] = counts.get((c["kind"], c["verdict"]), 0) + 1
-        click.echo("validation: " + ", ".join(f"{k} {v}: {n}" for (k, v), n in sorted(counts.items())), err=True)
-        for c in val["failed"]:
-            click.echo(f"reference misses {c['expected']} in {c['file']}: {c['deviation']:.3g} > {c['tolerance']:.3g}",
-                       err=True)
-        for c in val["checks"]:  # reported, not failed: the model's finding, which the reference computes faithfully
-            if c.get("law") and c["source"] == "reference":
-                click.echo(f"the law's own miss (not a failure) of {c['expected']} in {c['file']}: "
-                           f"{c['deviation']:.3g} > {c['tolerance']:.3g} (its force pushes along the slip at contact "
-                           "onset; the report says why)", err=True)
+        click.echo("\n".join(cli_text.validation(val)), err=True)
     sys.exit(0 if summary.failed == 0 else 1)
 
 
@@ -731,13 +715,7 @@ def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, x
     if as_json:
         emit_json(out)
         return
-    click.echo(f"{case.name} in {out['source']}: {out['particles']} particles")
-    for k, v in m.items():
-        if k == "fabric":  # the 3 × 3 tensor, a row a line
-            for label, row in zip(("fabric (x)", "       (y)", "       (z)"), v):
-                click.echo(f"  {label:22s} {' '.join(f'{show(c):>16s}' for c in row)}")
-        else:
-            click.echo(f"  {k:22s} {show(v)}")
+    click.echo("\n".join(cli_text.packing(out)))
 
 
 def _check_pack_duration(case, duration) -> None:
@@ -797,7 +775,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides, jobs, sc
     order of convergence and find the cheapest step for each target error."""
     from rich.progress import Progress
 
-    from .case import load, naming_file
+    from .case import naming_file
     from .comparisons import bench
     from .comparisons.perf_report import new_run_dir, write_bench
 
@@ -805,14 +783,10 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides, jobs, sc
     grid = bench.STEPS_PER_CONTACT
     if steps:
         grid = tuple(number("--steps", x, lo=1, hi=1e6, unit="steps per contact") for x in steps.split(","))
-    from .engines import registry
-    from .engines.base import case_natives
-
     cases = []
     for f in _case_files(paths):  # every file read and checked before any work; an error names the file
         with naming_file(f):
-            cases.append(load(f, list(overrides)))
-            case_natives(cases[-1], registry.all_engines())  # [engine.NAME] settings read before any work
+            cases.append(_load(f, overrides))
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
@@ -923,12 +897,13 @@ def audit(deck_path, engine, speed, as_json, report_dir):
     engine, its twin and the nearest seed model; the traps it falls into. The deck is read, never run as written.
     Exit 0: every pair and wall probed or listed, nothing found; 1: a trap; 2: a line it cannot read; 3: nothing
     probed (never "clean"). --json prints one JSON object in every case, a refusal included."""
+    from . import api
     from .comparisons import audit
     from .errors import DemcheckError, EngineInterrupted
     from .io import write_text
 
     try:
-        result = audit.audit(deck_path, engine, speed)
+        result = api.audit(deck_path, engine, speed)
     except EngineInterrupted:
         raise
     except DemcheckError as exc:
@@ -972,6 +947,7 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
     """The native input (the coefficient of restitution or damping an engine reads, k_t, …) that realises a
     target metric in ENGINE at the run's dt: root finding on the engine's twin, confirmed by one engine run;
     prints the line to paste. Exit 0: confirmed; 1: the engine run misses the target; 2: bad input."""
+    from . import api
     from .comparisons import calibrate
 
     wanted = {}
@@ -983,9 +959,9 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
             raise ConfigError("--target", item, f"{key.strip()} is given twice: give each metric once")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
     calibrate.check_targets(wanted)  # bad input: one line, before any work
-    case = _load(case_path, overrides)
-    with _campaign(jobs, scheduler, [engine]) as campaign:
-        result = calibrate.calibrate(case, engine, wanted, dt=dt, confirm=not no_confirm, campaign=campaign)
+    _check_jobs(jobs, scheduler)
+    result = api.calibrate(case_path, engine, wanted, dt, not no_confirm, list(overrides), jobs=jobs,
+                           scheduler=scheduler, keys=SET_KEYS, base=True)
     if as_json:
         emit_json(result)
     else:

@@ -13,6 +13,64 @@ def show(v) -> str:
     return as_text(v, ".10g")
 
 
+# ----------------------------------------------------------------------------- cases, sweep
+
+
+def cases_listing(root, rows: list[dict]) -> list[str]:
+    """``demcheck cases``: the shipped case files (resources.case_rows) by folder, a line each."""
+    lines = [f"shipped case files ({len(rows)}), in {root}:"]
+    for folder in dict.fromkeys(r["folder"] for r in rows):
+        group = [r for r in rows if r["folder"] == folder]
+        what = "in the default suite" if group[0]["in_default_suite"] else "run by naming them"
+        lines.append(f"\n{folder or '.'}/ ({len(group)}, {what})")
+        for r in group:
+            law = r["kind"] if r["kind"] == "packing" else f"{r['normal']} + {r['tangential']}"
+            lines.append(f"  {r['name']:44s} {law}")
+    lines.append("\nrun one by its name (demcheck collide glass-pair); copy one: demcheck cases NAME > my-case.toml")
+    return lines
+
+
+def sweep_table(table):
+    """``demcheck sweep``: its DataFrame (api.sweep) as a rich Table, a row a point."""
+    from rich.table import Table
+
+    t = Table()
+    for c in table.columns:
+        t.add_column(c, justify="right")
+    for _, row in table.iterrows():
+        t.add_row(*[show(v) if not isinstance(v, float) else f"{v:.6g}" for v in row])
+    return t
+
+
+def validation(val: dict) -> list[str]:
+    """``demcheck validate``: the checks counted by kind and verdict, the reference's misses, and the laws' own
+    misses (reported, not failed: the model's finding, which the reference computes faithfully)."""
+    counts: dict = {}
+    for c in val["checks"]:
+        counts[(c["kind"], c["verdict"])] = counts.get((c["kind"], c["verdict"]), 0) + 1
+    lines = ["validation: " + ", ".join(f"{k} {v}: {n}" for (k, v), n in sorted(counts.items()))]
+    for c in val["failed"]:
+        lines.append(f"reference misses {c['expected']} in {c['file']}: {c['deviation']:.3g} > {c['tolerance']:.3g}")
+    for c in val["checks"]:
+        if c.get("law") and c["source"] == "reference":
+            lines.append(f"the law's own miss (not a failure) of {c['expected']} in {c['file']}: "
+                         f"{c['deviation']:.3g} > {c['tolerance']:.3g} (its force pushes along the slip at contact "
+                         "onset; the report says why)")
+    return lines
+
+
+def packing(out: dict) -> list[str]:
+    """``demcheck pack``: the source, the particles and each packing metric (the fabric tensor a row a line)."""
+    lines = [f"{out['case']} in {out['source']}: {out['particles']} particles"]
+    for k, v in out["metrics"].items():
+        if k == "fabric":  # the 3 × 3 tensor, a row a line
+            for label, row in zip(("fabric (x)", "       (y)", "       (z)"), v):
+                lines.append(f"  {label:22s} {' '.join(f'{show(c):>16s}' for c in row)}")
+        else:
+            lines.append(f"  {k:22s} {show(v)}")
+    return lines
+
+
 # ----------------------------------------------------------------------------- models
 
 

@@ -46,6 +46,24 @@ def shipped_cases() -> dict[str, Path]:
     return {f.stem: f for f in sorted(root.rglob("*.toml"), key=order)}
 
 
+def case_rows() -> list[dict]:
+    """The shipped case files (``demcheck cases``) as rows: name, folder, kind, normal and tangential model, whether
+    the default suite runs it, path."""
+    import tomllib
+
+    root = cases_dir()
+    rows = []
+    for stem, path in shipped_cases().items():
+        raw = tomllib.loads(path.read_text())
+        contact = raw.get("contact") or {}
+        folder = path.parent.relative_to(root).as_posix()
+        rows.append({"name": stem, "folder": "" if folder == "." else folder, "kind": raw.get("kind", "collision"),
+                     "normal": contact.get("normal"), "tangential": contact.get("tangential", "none"),
+                     "in_default_suite": not NAMED_ONLY & set(path.relative_to(root).parts),
+                     "path": str(path)})
+    return rows
+
+
 def case_path(text: str | Path, key: str = "CASE", what: str = "case file") -> Path:
     """A CASE argument as a file: an existing path as given, else a shipped case by its file's name
     (``glass-pair``), by the ``name`` the file gives (``suite-hertz-wall``) or by its path below the shipped cases (``packing/poured``, ``cases/packing/poured.toml``; ``.toml`` optional). Else ConfigError naming the
