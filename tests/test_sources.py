@@ -121,8 +121,6 @@ RUNNERS = re.compile(
 KNOWN = {
     "comparisons/audit.py": "next step (issue 29): the audit's twin, refined twin, engine and seed runs",
     "comparisons/audit_beyond.py": "next step (issue 29): a scenario's engine run and twin (engines/scenario.py)",
-    "comparisons/sweep.py": "an unused import of the reference's collide (the sweep's runs are Source.run's and "
-                            "reference/batch.py's batch of reference runs)",
     "comparisons/warmup.py": "compiles the reference's kernels: it runs no source for a result",
 }
 

@@ -17,7 +17,6 @@ import pandas as pd
 
 from ..case import _read, apply_overrides, from_dict, parse_value
 from ..errors import ConfigError, DemcheckError
-from ..reference.collision import collide
 
 
 FORM = "must be KEY=START:STOP:N (N values, ends included) or KEY=a,b,c"
