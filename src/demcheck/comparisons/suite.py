@@ -389,6 +389,7 @@ def _print(console: Console, summary: Summary) -> None:
     from rich.markup import escape
     from rich.table import Table
 
+    summary = Summary.of(summary)  # a run's record, or results.json's dict (as the report's renderers take)
     counts: dict[str, int] = {}
     for c in summary.cases:
         for k in c.comparisons:
