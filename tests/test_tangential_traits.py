@@ -110,14 +110,20 @@ print(json.dumps(out))
 '''
 
 
-def test_a_plugin_law_with_a_history_runs_as_the_builtin_it_copies(tmp_path):
+def _with_the_copy(tmp_path, script: str) -> dict:
+    """``script``'s JSON, run in a fresh process with the spring's copy (COPY) registered as a plug-in law, on an
+    empty kernel cache."""
     (tmp_path / "copy_spring_law.py").write_text(COPY)
     env = dict(os.environ, DEMCHECK_LAW_PLUGINS="copy_spring_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
                PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
     env.pop("NUMBA_CACHE_DIR", None)
-    p = subprocess.run([sys.executable, "-c", RUN], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
+    p = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
     assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def test_a_plugin_law_with_a_history_runs_as_the_builtin_it_copies(tmp_path):
+    out = _with_the_copy(tmp_path, RUN)
     assert len(out) == 4
     for key, (same, rows, family, slips) in out.items():
         assert family == 41.0 and rows > 10, (key, rows, family)
@@ -160,13 +166,7 @@ def test_the_packing_loop_runs_a_plugin_spring_as_the_builtin(tmp_path):
     law's own discrete slip and its slip state) gives the bits of its named fast path for the spring: a copy of the
     spring under family 41 runs the pour (150 spheres, 20 000 steps, with one μ and with μk < μs, whose slip state
     is then used) to the same positions, velocities, spins and histories as the built-in spring."""
-    (tmp_path / "copy_spring_law.py").write_text(COPY)
-    env = dict(os.environ, DEMCHECK_LAW_PLUGINS="copy_spring_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)
-    p = subprocess.run([sys.executable, "-c", PACK], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
-    assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    out = _with_the_copy(tmp_path, PACK)
     assert len(out) == 2
     for key, (same, contacts, width, slip_state) in out.items():
         assert contacts > 10, (key, contacts)  # the pour has landed: contacts exercised (26 with one μ)
