@@ -100,3 +100,39 @@ def test_the_renderers_read_a_record_and_its_json_alike(tmp_path):
                                "tolerances", "cases", "failed", "planned", "wall_time"]
     assert report.render_markdown(s) == report.render_markdown(data)
     assert report.render_junit(s) == report.render_junit(data)
+
+
+def _stored_packing() -> dict:
+    """A packing entry as results.json stores it (the suite's keys, in their order; panels as packing_suite wrote
+    them before the records), with a key a later release might add to a panel."""
+    prof = {"z": [1e-3, 2e-3], "solid_fraction": [0.55, 0.6]}
+    forces = {"x": [0.5, 1.5], "p": [0.6, 0.4], "n": 120}
+    return {"case": "pack", "file": "pack.toml", "kind": "packing", "case_hash": "h",
+            "sources": {"reference": {"status": "ok", "metrics": {"solid_fraction": 0.6}}},
+            "comparisons": [], "curves": {}, "series": [],
+            "packing": {"reference": {"ke": [[0.0, 1e-3], [0.1, 1e-6]], "forces": forces, "profile": prof},
+                        "lammps": {"ke": [[0.0, 1e-3]], "forces": forces, "profile": None, "later": 1}},
+            "model": {"normal": "lsd", "tangential": "none", "limit_force": False},
+            "status": "ok", "verdict": "agree"}
+
+
+def test_a_packing_entry_holds_its_panels_as_records_and_writes_them_back_as_stored():
+    from demcheck.comparisons.records import PackingPanel
+
+    d = _stored_packing()
+    entry = CaseResult.from_json(json.loads(json.dumps(d)))
+    ref = entry.packing["reference"]
+    assert isinstance(ref, PackingPanel)
+    assert ref.ke == [[0.0, 1e-3], [0.1, 1e-6]] and ref.forces["n"] == 120 and ref.profile["z"] == [1e-3, 2e-3]
+    assert entry.packing["lammps"].profile is None and entry.packing["lammps"].extra == {"later": 1}
+    assert entry.to_json() == d and list(entry.to_json()["packing"]["lammps"]) == ["ke", "forces", "profile", "later"]
+
+
+def test_a_stored_panel_missing_its_data_reads_as_empty_not_as_an_error():
+    from demcheck.comparisons.records import PackingPanel
+
+    d = _stored_packing()
+    d["packing"]["lammps"] = {"profile": None}  # a results.json from a release that wrote no ke or forces
+    p = CaseResult.from_json(d).packing["lammps"]
+    assert p == PackingPanel([], {}, None) and p.to_json() == {"ke": [], "forces": {}, "profile": None}
+    assert CaseResult.from_json({**d, "packing": None}).packing is None

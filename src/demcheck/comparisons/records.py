@@ -103,6 +103,31 @@ class SourceResult:
                    extra={k: v for k, v in d.items() if k not in known})
 
 
+@dataclass
+class PackingPanel:
+    """One source's packing panels' data (report/figures.py draws them): its kinetic energy against time
+    (``ke``: (t, E) pairs), its contact-force distribution (``forces``: packing_metrics.force_distribution, with
+    its count ``n``) and its solid fraction against height (``profile``; None without a periodic box). A stored
+    panel may lack any of them (an older results.json): each is then empty, and a key this release does not know is
+    kept (``extra``)."""
+
+    ke: list = field(default_factory=list)
+    forces: dict = field(default_factory=dict)
+    profile: dict | None = None
+    extra: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {"ke": self.ke, "forces": self.forces, "profile": self.profile} | self.extra
+
+    @classmethod
+    def from_json(cls, d) -> "PackingPanel":
+        if isinstance(d, PackingPanel):
+            return d
+        d = d if isinstance(d, dict) else {}
+        return cls(_copy(d.get("ke"), list), _copy(d.get("forces"), dict), d.get("profile"),
+                   {k: v for k, v in d.items() if k not in ("ke", "forces", "profile")})
+
+
 # a case's keys in JSON, in the order each kind of entry always had them (a key whose value is None is left out)
 _COLLISION = ("case", "file", "case_hash", "kind", "sources", "comparisons", "curves", "series", "walls", "variant",
               "scenario", "model", "params", "impact", "scales", "settings", "status", "verdict")
@@ -138,7 +163,7 @@ class CaseResult:
     status: str = OK
     verdict: str = verdicts.AGREE
     message: str | None = None
-    packing: dict | None = None
+    packing: dict | None = None  # source label -> PackingPanel
     extra: dict = field(default_factory=dict)  # keys of a stored entry this release does not know
 
     def judged(self) -> "CaseResult":
@@ -179,6 +204,8 @@ class CaseResult:
                 v = {name: s.to_json() for name, s in v.items()}
             elif k == "comparisons":
                 v = [c.as_dict() for c in v]
+            elif k == "packing" and v is not None:
+                v = {name: PackingPanel.from_json(p).to_json() for name, p in v.items()}
             elif k == "series" and not series:
                 continue
             if v is not None:
@@ -195,6 +222,8 @@ class CaseResult:
         values["comparisons"] = [_comparison(c) for c in d.get("comparisons") or []]
         values["curves"] = _copy(d.get("curves"), dict)
         values["series"] = _copy(d.get("series"), list)
+        if isinstance(d.get("packing"), dict):
+            values["packing"] = {name: PackingPanel.from_json(p) for name, p in d["packing"].items()}
         case = cls(**{"case": "", **values}, extra={k: v for k, v in d.items() if k not in known})
         # an entry without its status or verdict (a hand-built dict) is judged from its comparisons, never
         # read as "ok"/"agree" by default
