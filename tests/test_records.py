@@ -136,3 +136,28 @@ def test_a_stored_panel_missing_its_data_reads_as_empty_not_as_an_error():
     p = CaseResult.from_json(d).packing["lammps"]
     assert p == PackingPanel([], {}, None) and p.to_json() == {"ke": [], "forces": {}, "profile": None}
     assert CaseResult.from_json({**d, "packing": None}).packing is None
+
+
+def test_validation_checks_are_records_written_back_as_results_json_held_them():
+    """A validation's checks, series and failures read from results.json into records (Validation, Check) and
+    written back key for key, order included: a limit with its law flag, a curve with its regime."""
+    from demcheck.comparisons.records import Check, Validation
+
+    limit = {"benchmark": "b", "file": "f", "source": "reference", "kind": "limit", "quantity": "e",
+             "expected": "Hertz", "deviation": 0.2, "at": 30.0, "tolerance": 1e-6, "why": "w", "verdict": "misses",
+             "points": 2, "law": True}
+    curve = {"benchmark": "b", "file": "f", "source": "lammps", "kind": "curve", "quantity": "et",
+             "expected": "x.dat [k]", "regime": "", "tolerance": 0.05, "why": "w", "deviation": None, "at": None,
+             "verdict": "no data", "points": 0}
+    stored = {"benchmarks": [{"name": "b", "title": "t", "files": ["f.toml"]}], "checks": [limit, curve],
+              "series": [{"benchmark": "b", "file": "f", "sources": {}}], "failed": [curve]}
+    s = Summary.from_json({"cases": [], "validation": json.loads(json.dumps(stored))})
+    val = s.validation
+    assert isinstance(val, Validation) and all(isinstance(c, Check) for c in val.checks + val.failed)
+    assert val.checks[0].law is True and val.checks[1].regime == "" and val.checks[1].deviation is None
+    assert val.to_json() == stored and [list(c) for c in val.to_json()["checks"]] == [list(limit), list(curve)]
+    assert s.to_json()["validation"] == stored
+    # a check built by validate carries the keys validate always wrote, in their order
+    assert list(Check("b", "f", "reference", "limit", "e", "Hertz").to_json()) == list(limit)[:-1]
+    assert list(Check("b", "f", "reference", "limit", "e", "Hertz", law=True).to_json()) == list(limit)
+    assert list(Check("b", "f", "lammps", "curve", "et", "x", regime="").to_json()) == list(curve)

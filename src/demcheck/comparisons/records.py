@@ -231,6 +231,79 @@ class CaseResult:
 
 
 @dataclass
+class Check:
+    """One verdict of ``demcheck validate`` (comparisons/validate.py): a source against a benchmark's exact limit
+    (``kind`` "limit") or a paper's curve ("curve") over one case file's variants — the largest deviation, where
+    (``at``, on the benchmark's x axis), the tolerance there, what the tolerance stands for (``why``), the verdict,
+    how many variants or paper points it judged; a curve's regime (gross sliding or partial slip), a limit the law
+    itself misses (``law``). ``keys``: the fields it carries in JSON, in their order."""
+
+    benchmark: str
+    file: str
+    source: str
+    kind: str
+    quantity: str
+    expected: str
+    deviation: float | None = None
+    at: float | None = None
+    tolerance: float | None = None
+    why: str = ""
+    verdict: str = ""
+    points: int = 0
+    regime: str | None = None
+    law: bool = False
+    keys: tuple = ()
+    extra: dict = field(default_factory=dict)
+
+    LIMIT = ("benchmark", "file", "source", "kind", "quantity", "expected", "deviation", "at", "tolerance", "why",
+             "verdict", "points")
+    CURVE = ("benchmark", "file", "source", "kind", "quantity", "expected", "regime", "tolerance", "why",
+             "deviation", "at", "verdict", "points")
+
+    def __post_init__(self):
+        if not self.keys:
+            self.keys = (self.LIMIT + (("law",) if self.law else ())) if self.kind == "limit" else self.CURVE
+
+    def to_json(self) -> dict:
+        return {k: (self.extra[k] if k in self.extra else getattr(self, k)) for k in self.keys}
+
+    @classmethod
+    def from_json(cls, d) -> "Check":
+        if isinstance(d, Check):
+            return d
+        known = {f.name for f in fields(cls)} - {"keys", "extra"}
+        values = {"benchmark": "", "file": "", "source": "", "kind": "", "quantity": "", "expected": "",
+                  **{k: v for k, v in d.items() if k in known}}
+        return cls(**values, keys=tuple(d), extra={k: v for k, v in d.items() if k not in known})
+
+
+@dataclass
+class Validation:
+    """What ``demcheck validate`` adds to a run: the benchmarks judged (name, title, case files), every
+    :class:`Check`, the plot series (one per case file and quantity: each source's x and y, the paper's points) and
+    the checks that fail the run (the reference missing an exact limit that is not the law's own miss)."""
+
+    benchmarks: list = field(default_factory=list)
+    checks: list = field(default_factory=list)  # Check
+    series: list = field(default_factory=list)
+    failed: list = field(default_factory=list)  # Check
+    extra: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {"benchmarks": self.benchmarks, "checks": [c.to_json() for c in self.checks], "series": self.series,
+                "failed": [c.to_json() for c in self.failed]} | self.extra
+
+    @classmethod
+    def from_json(cls, d) -> "Validation | None":
+        if d is None or isinstance(d, Validation):
+            return d
+        known = ("benchmarks", "checks", "series", "failed")
+        return cls(_copy(d.get("benchmarks"), list), [Check.from_json(c) for c in d.get("checks") or []],
+                   _copy(d.get("series"), list), [Check.from_json(c) for c in d.get("failed") or []],
+                   {k: v for k, v in d.items() if k not in known})
+
+
+@dataclass
 class Summary:
     """A run: demcheck's version, its id, report folder, start, command line, the engines found (discovery's
     record by name), the tolerances, every finished case (:class:`CaseResult`), how many fail, how many were
@@ -252,7 +325,7 @@ class Summary:
     cache: dict | None = None
     baseline: dict | None = None
     baseline_error: str | None = None
-    validation: dict | None = None
+    validation: Validation | None = None
     extra: dict = field(default_factory=dict)
 
     OPTIONAL = ("cache", "baseline", "baseline_error", "validation")  # in JSON only where there are
@@ -269,6 +342,8 @@ class Summary:
             v = getattr(self, f.name)
             if f.name == "cases":
                 v = [c.to_json(series) for c in v]
+            elif f.name == "validation" and v is not None:
+                v = Validation.from_json(v).to_json()
             if v is not None or f.name not in self.OPTIONAL:
                 out[f.name] = v
         return out | self.extra
@@ -279,6 +354,8 @@ class Summary:
         values = {k: v for k, v in d.items() if k in known}
         values["cases"] = [CaseResult.from_json(c) for c in d.get("cases") or []]
         values["engines"] = _copy(d.get("engines"), dict)
+        if isinstance(d.get("validation"), dict):
+            values["validation"] = Validation.from_json(d["validation"])
         return cls(**values, extra={k: v for k, v in d.items() if k not in known})
 
     @classmethod

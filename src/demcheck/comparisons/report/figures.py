@@ -28,7 +28,8 @@ def validation_plots(summary: Summary) -> list[tuple[str, str]]:
     from .. import plots
 
     out = []
-    for line in (Summary.of(summary).validation or {}).get("series", []):
+    val = Summary.of(summary).validation
+    for line in val.series if val else []:
         if not line["x_label"]:
             continue
         fig, ax = plt.subplots(figsize=(5.2, 3.6), layout="constrained")
