@@ -100,3 +100,64 @@ def test_the_renderers_read_a_record_and_its_json_alike(tmp_path):
                                "tolerances", "cases", "failed", "planned", "wall_time"]
     assert report.render_markdown(s) == report.render_markdown(data)
     assert report.render_junit(s) == report.render_junit(data)
+
+
+def _stored_packing() -> dict:
+    """A packing entry as results.json stores it (the suite's keys, in their order; panels as packing_suite wrote
+    them before the records), with a key a later release might add to a panel."""
+    prof = {"z": [1e-3, 2e-3], "solid_fraction": [0.55, 0.6]}
+    forces = {"x": [0.5, 1.5], "p": [0.6, 0.4], "n": 120}
+    return {"case": "pack", "file": "pack.toml", "kind": "packing", "case_hash": "h",
+            "sources": {"reference": {"status": "ok", "metrics": {"solid_fraction": 0.6}}},
+            "comparisons": [], "curves": {}, "series": [],
+            "packing": {"reference": {"ke": [[0.0, 1e-3], [0.1, 1e-6]], "forces": forces, "profile": prof},
+                        "lammps": {"ke": [[0.0, 1e-3]], "forces": forces, "profile": None, "later": 1}},
+            "model": {"normal": "lsd", "tangential": "none", "limit_force": False},
+            "status": "ok", "verdict": "agree"}
+
+
+def test_a_packing_entry_holds_its_panels_as_records_and_writes_them_back_as_stored():
+    from demcheck.comparisons.records import PackingPanel
+
+    d = _stored_packing()
+    entry = CaseResult.from_json(json.loads(json.dumps(d)))
+    ref = entry.packing["reference"]
+    assert isinstance(ref, PackingPanel)
+    assert ref.ke == [[0.0, 1e-3], [0.1, 1e-6]] and ref.forces["n"] == 120 and ref.profile["z"] == [1e-3, 2e-3]
+    assert entry.packing["lammps"].profile is None and entry.packing["lammps"].extra == {"later": 1}
+    assert entry.to_json() == d and list(entry.to_json()["packing"]["lammps"]) == ["ke", "forces", "profile", "later"]
+
+
+def test_a_stored_panel_missing_its_data_reads_as_empty_not_as_an_error():
+    from demcheck.comparisons.records import PackingPanel
+
+    d = _stored_packing()
+    d["packing"]["lammps"] = {"profile": None}  # a results.json from a release that wrote no ke or forces
+    p = CaseResult.from_json(d).packing["lammps"]
+    assert p == PackingPanel([], {}, None) and p.to_json() == {"ke": [], "forces": {}, "profile": None}
+    assert CaseResult.from_json({**d, "packing": None}).packing is None
+
+
+def test_validation_checks_are_records_written_back_as_results_json_held_them():
+    """A validation's checks, series and failures read from results.json into records (Validation, Check) and
+    written back key for key, order included: a limit with its law flag, a curve with its regime."""
+    from demcheck.comparisons.records import Check, Validation
+
+    limit = {"benchmark": "b", "file": "f", "source": "reference", "kind": "limit", "quantity": "e",
+             "expected": "Hertz", "deviation": 0.2, "at": 30.0, "tolerance": 1e-6, "why": "w", "verdict": "misses",
+             "points": 2, "law": True}
+    curve = {"benchmark": "b", "file": "f", "source": "lammps", "kind": "curve", "quantity": "et",
+             "expected": "x.dat [k]", "regime": "", "tolerance": 0.05, "why": "w", "deviation": None, "at": None,
+             "verdict": "no data", "points": 0}
+    stored = {"benchmarks": [{"name": "b", "title": "t", "files": ["f.toml"]}], "checks": [limit, curve],
+              "series": [{"benchmark": "b", "file": "f", "sources": {}}], "failed": [curve]}
+    s = Summary.from_json({"cases": [], "validation": json.loads(json.dumps(stored))})
+    val = s.validation
+    assert isinstance(val, Validation) and all(isinstance(c, Check) for c in val.checks + val.failed)
+    assert val.checks[0].law is True and val.checks[1].regime == "" and val.checks[1].deviation is None
+    assert val.to_json() == stored and [list(c) for c in val.to_json()["checks"]] == [list(limit), list(curve)]
+    assert s.to_json()["validation"] == stored
+    # a check built by validate carries the keys validate always wrote, in their order
+    assert list(Check("b", "f", "reference", "limit", "e", "Hertz").to_json()) == list(limit)[:-1]
+    assert list(Check("b", "f", "reference", "limit", "e", "Hertz", law=True).to_json()) == list(limit)
+    assert list(Check("b", "f", "lammps", "curve", "et", "x", regime="").to_json()) == list(curve)

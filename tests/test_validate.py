@@ -62,10 +62,10 @@ def test_gross_sliding_limit_by_hand():
 def test_reference_meets_exact_limits(file, bench):
     b = VA.by_name(bench)[0]
     checks, _ = VA.judge(b, _reference(ROOT / file, b))
-    limits = [c for c in checks if c["kind"] == "limit" and c["points"] > 0]  # the limits that apply here
-    assert {c["quantity"] for c in limits} == set(b.quantities) & {lim.quantity for lim in b.limits}
+    limits = [c for c in checks if c.kind == "limit" and c.points > 0]  # the limits that apply here
+    assert {c.quantity for c in limits} == set(b.quantities) & {lim.quantity for lim in b.limits}
     for c in limits:
-        assert c["verdict"] == VA.MEETS, c
+        assert c.verdict == VA.MEETS, c
 
 
 def _lsd_contact(n: int, mu: float, ramp: float):
@@ -191,7 +191,7 @@ def _test6(beta: float, restitution: float, pull: float, stick: float = 0.0, src
          "rebound_angular_velocity": (beta - 0.4) * 10.0 / 1.4}
     assert VA._beta(m, imp) == pytest.approx(beta, abs=1e-14)
     b = VA.by_name("chung-ooi-6")[0]
-    (check,) = [c for c in VA.judge(b, {"f": [(imp, {src: m})]})[0] if c["kind"] == "limit"]
+    (check,) = [c for c in VA.judge(b, {"f": [(imp, {src: m})]})[0] if c.kind == "limit"]
     return check
 
 
@@ -202,11 +202,11 @@ def test_the_gross_sliding_limit_takes_the_normal_impulse_magnitude():
     (what the reference, LAMMPS and LIGGGHTS missed Tests 6 and 8 by). A source that holds F_n ≥ 0 (no pull, a
     higher e' = 0.55: Yade) meets at its own J = 1.55: β = 0.42·1.55/1.5 − 1 = −0.566."""
     ok = _test6(-0.552, 0.5, 0.05)
-    assert ok["verdict"] == VA.MEETS and ok["deviation"] < 1e-12 and ok["tolerance"] == 1e-4
-    assert _test6(-0.552, 0.5, 0.05, src="lammps")["tolerance"] == 1e-2  # an engine's time step
+    assert ok.verdict == VA.MEETS and ok.deviation < 1e-12 and ok.tolerance == 1e-4
+    assert _test6(-0.552, 0.5, 0.05, src="lammps").tolerance == 1e-2  # an engine's time step
     wrong = _test6(-0.552, 0.5, 0.0)
-    assert wrong["verdict"] == VA.MISSES and wrong["deviation"] == pytest.approx(0.028, rel=1e-12)
-    assert _test6(-0.566, 0.55, 0.0)["deviation"] < 1e-12
+    assert wrong.verdict == VA.MISSES and wrong.deviation == pytest.approx(0.028, rel=1e-12)
+    assert _test6(-0.566, 0.55, 0.0).deviation < 1e-12
 
 
 def test_a_force_short_of_its_cap_widens_the_limit_on_its_own_side_only():
@@ -218,25 +218,25 @@ def test_a_force_short_of_its_cap_widens_the_limit_on_its_own_side_only():
     SHORTFALL_MAX (Impact.law_short, the law's answer) is not judged, and up to it widens the limit the same way."""
     low = 0.42 * 1.6 * 0.99 / 1.5 - 1
     inside = _test6(low, 0.5, 0.05, stick=0.01)
-    assert inside["verdict"] == VA.MEETS and inside["deviation"] == pytest.approx(0.42 * 1.6 * 0.01 / 1.5)
+    assert inside.verdict == VA.MEETS and inside.deviation == pytest.approx(0.42 * 1.6 * 0.01 / 1.5)
     beyond = _test6(-0.552 + (-0.552 - low), 0.5, 0.05, stick=0.01)
-    assert beyond["verdict"] == VA.MISSES
+    assert beyond.verdict == VA.MISSES
     below = _test6(low, 0.5, 0.05, below_cap=0.01)  # the same β from a force below its cap after reaching it
-    assert below["verdict"] == VA.MISSES and "below cap 0.01" in below["why"]
+    assert below.verdict == VA.MISSES and "below cap 0.01" in below.why
     long = 0.42 * 1.6 * 0.8 / 1.5 - 1  # a stick of 0.2: allowed up to 0.05
-    assert _test6(long, 0.5, 0.05, stick=0.2)["verdict"] == VA.MISSES
-    assert _test6(0.42 * 1.6 * 0.95 / 1.5 - 1, 0.5, 0.05, stick=0.2)["verdict"] == VA.MEETS
+    assert _test6(long, 0.5, 0.05, stick=0.2).verdict == VA.MISSES
+    assert _test6(0.42 * 1.6 * 0.95 / 1.5 - 1, 0.5, 0.05, stick=0.2).verdict == VA.MEETS
     stuck = _test6(-0.552, 0.5, 0.05, law_short=VA.SHORTFALL_MAX * 1.01)
-    assert stuck["verdict"] == VA.NO_DATA and stuck["points"] == 0 and "not judged" in stuck["why"]
-    assert _test6(-0.552, 0.5, 0.05, below_cap=0.5)["points"] == 1  # a source's own shortfall is judged
-    assert _test6(low, 0.5, 0.05, law_short=0.01)["verdict"] == VA.MEETS
+    assert stuck.verdict == VA.NO_DATA and stuck.points == 0 and "not judged" in stuck.why
+    assert _test6(-0.552, 0.5, 0.05, below_cap=0.5).points == 1  # a source's own shortfall is judged
+    assert _test6(low, 0.5, 0.05, law_short=0.01).verdict == VA.MEETS
     missing = _test6(-0.552, 0.5, 0.05)
-    assert missing["verdict"] == VA.MEETS
+    assert missing.verdict == VA.MEETS
     imp = VA.Impact("al_alloy", 0.1, 0.5, 0.4, 0.2, 0.0, 10.0, 0.0, "lsd", "spring_sliding")
     no_history = {"restitution": 0.5, "max_overlap": 0.0, "rebound_angular_velocity": (-0.552 - 0.4) * 10 / 1.4}
     (c,) = [c for c in VA.judge(VA.by_name("chung-ooi-6")[0], {"f": [(imp, {"reference": no_history})]})[0]
-            if c["kind"] == "limit"]
-    assert c["verdict"] == VA.MISSES and c["deviation"] == math.inf  # a source without its force history is never met
+            if c.kind == "limit"]
+    assert c.verdict == VA.MISSES and c.deviation == math.inf  # a source without its force history is never met
 
 
 def _low_cap(case, factor: float):
@@ -268,12 +268,12 @@ def test_a_coulomb_cap_below_mu_misses_the_sliding_limit(file, k, bench):
         for method, src in (("adaptive", "reference"), ("verlet", "lammps")):
             res = collide(_low_cap(case, factor), method)
             m = {**res.metrics(), **VA.force_history(res.table("contact"), res.table("events"), imp.mu)}
-            (check,) = [c for c in VA.judge(b, {"f": [(imp, {src: m})]})[0] if c["kind"] == "limit"]
+            (check,) = [c for c in VA.judge(b, {"f": [(imp, {src: m})]})[0] if c.kind == "limit"]
             if factor == 1.0 and not (src == "lammps" and "tti" in file):  # LAMMPS-like TTIt: Finding 6
-                assert check["verdict"] == VA.MEETS, (factor, src, check)
+                assert check.verdict == VA.MEETS, (factor, src, check)
             elif factor < 1.0:
-                assert check["verdict"] == VA.MISSES and check["points"] == 1, (factor, src, check)
-                assert m["below_cap"] > 0.9 * (1 - factor) and "below cap" in check["why"]
+                assert check.verdict == VA.MISSES and check.points == 1, (factor, src, check)
+                assert m["below_cap"] > 0.9 * (1 - factor) and "below cap" in check.why
 
 
 def test_a_reference_with_a_low_cap_fails_validate(monkeypatch):
@@ -286,8 +286,8 @@ def test_a_reference_with_a_low_cap_fails_validate(monkeypatch):
     summary = {"cases": [{"case": case.name, "sources": {"reference": {"status": "ok", "metrics": bug.metrics()}}}]}
     b = VA.by_name("chung-ooi-6")[0]
     val = VA.validate(summary, [b], {b.name: [path]}, opts=None)
-    (check,) = [c for c in val["checks"] if c["kind"] == "limit"]
-    assert check["verdict"] == VA.MISSES and val["failed"] == [check]
+    (check,) = [c for c in val.checks if c.kind == "limit"]
+    assert check.verdict == VA.MISSES and val.failed == [check]
 
 
 def test_impact_mu_is_the_pairs_kinetic_friction():
@@ -306,11 +306,11 @@ def test_impact_mu_is_the_pairs_kinetic_friction():
     assert (VA.impact_of(kinetic).mu, VA.impact_of(static).mu, VA.impact_of(case).mu) == (0.3, 0.35, 0.4)
     b = VA.by_name("chung-ooi-6")[0]
     rows = _reference(path, b, cases=[kinetic])
-    (check,) = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit"]
-    assert check["verdict"] == VA.MEETS
+    (check,) = [c for c in VA.judge(b, rows)[0] if c.kind == "limit"]
+    assert check.verdict == VA.MEETS
     imp, ms = rows[path.stem][0]
-    (was,) = [c for c in VA.judge(b, {"f": [(dataclasses.replace(imp, mu=0.4), ms)]})[0] if c["kind"] == "limit"]
-    assert was["verdict"] == VA.MISSES and was["deviation"] > 0.05
+    (was,) = [c for c in VA.judge(b, {"f": [(dataclasses.replace(imp, mu=0.4), ms)]})[0] if c.kind == "limit"]
+    assert was.verdict == VA.MISSES and was.deviation > 0.05
 
 
 @pytest.mark.parametrize("file,bench,variant,quantity", [
@@ -326,9 +326,9 @@ def test_a_law_that_pushes_along_the_slip_at_onset_misses_by_itself(file, bench,
     (case,) = [c for c in expand(path) if c.name.endswith(variant)]
     b = VA.by_name(bench)[0]
     rows = _reference(path, b, cases=[case])
-    (check,) = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit" and c["quantity"] == quantity]
+    (check,) = [c for c in VA.judge(b, rows)[0] if c.kind == "limit" and c.quantity == quantity]
     assert rows[path.stem][0][0].pushes_at_onset
-    assert check["verdict"] == VA.MISSES and check.get("law") and "the law's own miss" in check["why"]
+    assert check.verdict == VA.MISSES and check.law and "the law's own miss" in check.why
 
 
 def test_impact_e_is_the_pairs_restitution():
@@ -358,16 +358,16 @@ def test_finding_attraction_spin_is_the_pull_and_the_first_stick():
     m = rows[path.stem][0][1]["reference"]
     assert m["pull"] == pytest.approx((ev["contact_end"] - ev["force_end"]) / ev["contact_start"], rel=1e-9)
     assert 0.004 < m["stick"] < 0.01 and abs(m["below_cap"]) < 1e-9
-    (check,) = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit"]
-    assert check["verdict"] == VA.MEETS and check["deviation"] == pytest.approx(0.0029, abs=1e-4)
+    (check,) = [c for c in VA.judge(b, rows)[0] if c.kind == "limit"]
+    assert check.verdict == VA.MEETS and check.deviation == pytest.approx(0.0029, abs=1e-4)
     old = {**m, "pull": 0.0, "stick": 0.0}
-    (was,) = [c for c in VA.judge(b, {"f": [(rows[path.stem][0][0], {"reference": old})]})[0] if c["kind"] == "limit"]
-    assert was["verdict"] == VA.MISSES and was["deviation"] == pytest.approx(0.025, abs=1e-3)
+    (was,) = [c for c in VA.judge(b, {"f": [(rows[path.stem][0][0], {"reference": old})]})[0] if c.kind == "limit"]
+    assert was.verdict == VA.MISSES and was.deviation == pytest.approx(0.025, abs=1e-3)
     held = dataclasses.replace(case, contact=dataclasses.replace(case.contact, limit_force=True))
     rows = _reference(path, cases=[held])
     assert rows[path.stem][0][1]["reference"]["pull"] == 0.0
-    (check,) = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit"]
-    assert check["verdict"] == VA.MEETS
+    (check,) = [c for c in VA.judge(b, rows)[0] if c.kind == "limit"]
+    assert check.verdict == VA.MEETS
 
 
 def test_viscous_sliding_slides_where_the_law_says():
@@ -381,15 +381,15 @@ def test_viscous_sliding_slides_where_the_law_says():
     rows = _reference(path, b, cases=cases)
     shorts = {round(imp.angle): imp.law_short for imp, _ in rows[path.stem]}
     assert sorted(a for a, s in shorts.items() if s > VA.SHORTFALL_MAX) == [40, 50, 60, 70], shorts
-    checks = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit"]
-    assert {(c["verdict"], c["points"]) for c in checks} == {(VA.MEETS, 2)}
-    assert all("4 variants" in c["why"] for c in checks)
+    checks = [c for c in VA.judge(b, rows)[0] if c.kind == "limit"]
+    assert {(c.verdict, c.points) for c in checks} == {(VA.MEETS, 2)}
+    assert all("4 variants" in c.why for c in checks)
     for imp, ms in rows[path.stem]:
         m = ms["reference"]
         ms["lammps"] = {**m, "tangential_restitution": 1.0, "rebound_angular_velocity": 0.0, "stick": 0.0,
                         "below_cap": 1.0}
-    checks = [c for c in VA.judge(b, rows)[0] if c["kind"] == "limit" and c["source"] == "lammps"]
-    assert {(c["verdict"], c["points"]) for c in checks} == {(VA.MISSES, 2)}
+    checks = [c for c in VA.judge(b, rows)[0] if c.kind == "limit" and c.source == "lammps"]
+    assert {(c.verdict, c.points) for c in checks} == {(VA.MISSES, 2)}
 
 
 def test_no_gross_sliding_limit_for_a_law_without_coulomb_friction():
@@ -430,12 +430,12 @@ def test_a_planted_wrong_paper_value_fails(tmp_path):
     for name in ("chung-ooi-4-spin.dat", "chung-ooi-4-angle.dat"):
         (tmp_path / name).write_text("# nothing\n")
     checks, _ = VA.judge(b, rows, root=tmp_path)
-    et = [c for c in checks if c["kind"] == "curve" and c["quantity"] == "et"][0]
-    assert et["verdict"] == VA.MEETS and et["deviation"] == pytest.approx(0.01)
+    et = [c for c in checks if c.kind == "curve" and c.quantity == "et"][0]
+    assert et.verdict == VA.MEETS and et.deviation == pytest.approx(0.01)
     (tmp_path / "chung-ooi-4-et.dat").write_text(good.replace("20 0.61", "20 0.71"))  # planted: 0.09 off
     checks, _ = VA.judge(b, rows, root=tmp_path)
-    et = [c for c in checks if c["kind"] == "curve" and c["quantity"] == "et"][0]
-    assert et["verdict"] == VA.MISSES and et["deviation"] == pytest.approx(0.09) and et["at"] == 20.0
+    et = [c for c in checks if c.kind == "curve" and c.quantity == "et"][0]
+    assert et.verdict == VA.MISSES and et.deviation == pytest.approx(0.09) and et.at == 20.0
 
 
 def _rigid_sliding(imp, x: float, axis: str):
@@ -498,13 +498,13 @@ def test_the_curves_are_judged_apart_past_and_below_the_sliding_threshold(tmp_pa
             m["rebound_angular_velocity"] = (0.4 - 0.4) * imp.spin / 1.4
         rows.append((imp, {"reference": m}))
     (tmp_path / "chung-ooi-6-beta.dat").write_text("# block: al_alloy\n0.35 -0.65\n0.55 -0.45\n2.0 -0.3\n6.0 -0.3\n")
-    checks = [c for c in VA.judge(b, {"f": rows}, root=tmp_path)[0] if c["kind"] == "curve"]
-    by = {c["regime"]: c for c in checks}
+    checks = [c for c in VA.judge(b, {"f": rows}, root=tmp_path)[0] if c.kind == "curve"]
+    by = {c.regime: c for c in checks}
     assert set(by) == {VA.SLIDING_REGIME, VA.PARTIAL_REGIME}
-    assert by[VA.SLIDING_REGIME]["verdict"] == VA.MEETS and by[VA.SLIDING_REGIME]["points"] == 2
-    assert by[VA.SLIDING_REGIME]["deviation"] < 1e-12  # linear between 0.42 and 0.7: interpolation is exact
-    assert by[VA.PARTIAL_REGIME]["verdict"] == VA.MISSES and by[VA.PARTIAL_REGIME]["points"] == 2
-    assert by[VA.PARTIAL_REGIME]["deviation"] == pytest.approx(0.7)
+    assert by[VA.SLIDING_REGIME].verdict == VA.MEETS and by[VA.SLIDING_REGIME].points == 2
+    assert by[VA.SLIDING_REGIME].deviation < 1e-12  # linear between 0.42 and 0.7: interpolation is exact
+    assert by[VA.PARTIAL_REGIME].verdict == VA.MISSES and by[VA.PARTIAL_REGIME].points == 2
+    assert by[VA.PARTIAL_REGIME].deviation == pytest.approx(0.7)
 
 
 def test_a_nan_is_never_a_match():
@@ -513,7 +513,7 @@ def test_a_nan_is_never_a_match():
     rows = {"f": [(imp, {"reference": {"tangential_restitution": math.nan, "rebound_angular_velocity": 0.0,
                                        "restitution": 0.98}})]}
     checks, _ = VA.judge(b, rows)
-    assert all(c["verdict"] != VA.MEETS for c in checks if c["quantity"] == "et")
+    assert all(c.verdict != VA.MEETS for c in checks if c.quantity == "et")
 
 
 def test_an_engine_that_cannot_express_the_model_is_no_source_but_a_failed_run_misses():
@@ -528,9 +528,9 @@ def test_an_engine_that_cannot_express_the_model_is_no_source_but_a_failed_run_m
         "kratos": {"status": "not expressible", "message": "no such law"},
         "yade": {"status": "engine missing", "message": "not installed"}}}]}
     val = VA.validate(summary, [b], {b.name: [path]}, opts=None)
-    assert {c["source"] for c in val["checks"]} == {"reference", "lammps"}
-    assert {(c["verdict"], c["deviation"]) for c in val["checks"] if c["source"] == "lammps"} == {(VA.MISSES, math.inf)}
-    assert {c["verdict"] for c in val["checks"] if c["source"] == "reference"} == {VA.MEETS}
+    assert {c.source for c in val.checks} == {"reference", "lammps"}
+    assert {(c.verdict, c.deviation) for c in val.checks if c.source == "lammps"} == {(VA.MISSES, math.inf)}
+    assert {c.verdict for c in val.checks if c.source == "reference"} == {VA.MEETS}
 
 
 def test_every_data_file_names_its_source_and_reads():
@@ -734,12 +734,13 @@ def test_the_cli_names_the_law_s_own_misses_and_exits_0_for_them(monkeypatch, tm
 
     from demcheck import cli
     from demcheck.comparisons import validate as V
-    from demcheck.comparisons.records import Summary
+    from demcheck.comparisons.records import Summary, Validation
 
     law = {"kind": "limit", "source": "reference", "verdict": VA.MISSES, "law": True, "expected": "psi2 = 0.5",
            "file": "thornton-e090-tti-overlap.toml", "deviation": 0.032, "tolerance": 0.024}
     meets = {**law, "verdict": VA.MEETS, "law": None, "file": "thornton-e090.toml"}
-    summary = Summary(report=str(tmp_path), validation={"checks": [law, meets], "failed": [], "series": []})
+    summary = Summary(report=str(tmp_path),
+                      validation=Validation.from_json({"checks": [law, meets], "failed": [], "series": []}))
     monkeypatch.setattr(V, "run", lambda *a, **k: summary)
     out = CliRunner().invoke(cli.cli, ["validate", "thornton", "--engines", "none", "--jobs", "1", "--report",
                                        str(tmp_path)])

@@ -619,7 +619,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
     val = summary.validation
     if as_json:
         emit_json({"report": summary.report, "engines": summary.engines, "failed": summary.failed,
-                   "validation": {k: v for k, v in val.items() if k != "series"}})
+                   "validation": {k: v for k, v in val.to_json().items() if k != "series"}})
     else:
         click.echo("\n".join(cli_text.validation(val)), err=True)
     sys.exit(0 if summary.failed == 0 else 1)

@@ -42,19 +42,20 @@ def sweep_table(table):
     return t
 
 
-def validation(val: dict) -> list[str]:
-    """``demcheck validate``: the checks counted by kind and verdict, the reference's misses, and the laws' own
-    misses (reported, not failed: the model's finding, which the reference computes faithfully)."""
+def validation(val) -> list[str]:
+    """``demcheck validate`` (its records.Validation): the checks counted by kind and verdict, the reference's
+    misses, and the laws' own misses (reported, not failed: the model's finding, which the reference computes
+    faithfully)."""
     counts: dict = {}
-    for c in val["checks"]:
-        counts[(c["kind"], c["verdict"])] = counts.get((c["kind"], c["verdict"]), 0) + 1
+    for c in val.checks:
+        counts[(c.kind, c.verdict)] = counts.get((c.kind, c.verdict), 0) + 1
     lines = ["validation: " + ", ".join(f"{k} {v}: {n}" for (k, v), n in sorted(counts.items()))]
-    for c in val["failed"]:
-        lines.append(f"reference misses {c['expected']} in {c['file']}: {c['deviation']:.3g} > {c['tolerance']:.3g}")
-    for c in val["checks"]:
-        if c.get("law") and c["source"] == "reference":
-            lines.append(f"the law's own miss (not a failure) of {c['expected']} in {c['file']}: "
-                         f"{c['deviation']:.3g} > {c['tolerance']:.3g} (its force pushes along the slip at contact "
+    for c in val.failed:
+        lines.append(f"reference misses {c.expected} in {c.file}: {c.deviation:.3g} > {c.tolerance:.3g}")
+    for c in val.checks:
+        if c.law and c.source == "reference":
+            lines.append(f"the law's own miss (not a failure) of {c.expected} in {c.file}: "
+                         f"{c.deviation:.3g} > {c.tolerance:.3g} (its force pushes along the slip at contact "
                          "onset; the report says why)")
     return lines
 

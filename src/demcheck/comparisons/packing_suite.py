@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import EngineInterrupted, UnsupportedByEngine
 from . import packing_metrics, sources, verdicts
-from .records import CaseResult, SourceResult
+from .records import CaseResult, PackingPanel, SourceResult
 
 # statistical tolerances between sources (absolute for solid fraction and coordination, relative else)
 TOLERANCES = {"solid_fraction": 0.02, "coordination_number": 0.5, "bed_height": 0.02, "mean_contact_force": 0.1}
@@ -152,8 +152,8 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
                        ke=[e for _, e in ke])
     entry.sources["reference"] = SourceResult("ok", metrics=ref_m, time=t_end, wall_time=seconds,
                                               keys=("status", "metrics", "time", "wall_time"))
-    entry.packing["reference"] = {"ke": ke, "forces": packing_metrics.force_distribution(ref_forces),
-                                     "profile": packing_metrics.profile(x, rad, box) if box else None}
+    entry.packing["reference"] = PackingPanel(ke, packing_metrics.force_distribution(ref_forces),
+                                              packing_metrics.profile(x, rad, box) if box else None)
 
     for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
         if not entry.note_plan(planned):
@@ -180,9 +180,9 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
         entry.sources[engine] = SourceResult("ok", metrics=m, engine_version=run.version,
                                              keys=("status", "metrics", "engine_version"))
         dt = packing.packing_dt(case)
-        entry.packing[engine] = {"ke": [(step * dt, e) for step, e in run.ke],
-                                    "forces": packing_metrics.force_distribution(fn),
-                                    "profile": packing_metrics.profile(x, rad, box) if box else None}
+        entry.packing[engine] = PackingPanel([(step * dt, e) for step, e in run.ke],
+                                             packing_metrics.force_distribution(fn),
+                                             packing_metrics.profile(x, rad, box) if box else None)
         _judge_engine(case, engine, m, ref_m, fn, ref_forces, x, rad, states, box, comps)
     _judge_settled(case, entry, states, comps)
     return entry.judged()

@@ -103,6 +103,31 @@ class SourceResult:
                    extra={k: v for k, v in d.items() if k not in known})
 
 
+@dataclass
+class PackingPanel:
+    """One source's packing panels' data (report/figures.py draws them): its kinetic energy against time
+    (``ke``: (t, E) pairs), its contact-force distribution (``forces``: packing_metrics.force_distribution, with
+    its count ``n``) and its solid fraction against height (``profile``; None without a periodic box). A stored
+    panel may lack any of them (an older results.json): each is then empty, and a key this release does not know is
+    kept (``extra``)."""
+
+    ke: list = field(default_factory=list)
+    forces: dict = field(default_factory=dict)
+    profile: dict | None = None
+    extra: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {"ke": self.ke, "forces": self.forces, "profile": self.profile} | self.extra
+
+    @classmethod
+    def from_json(cls, d) -> "PackingPanel":
+        if isinstance(d, PackingPanel):
+            return d
+        d = d if isinstance(d, dict) else {}
+        return cls(_copy(d.get("ke"), list), _copy(d.get("forces"), dict), d.get("profile"),
+                   {k: v for k, v in d.items() if k not in ("ke", "forces", "profile")})
+
+
 # a case's keys in JSON, in the order each kind of entry always had them (a key whose value is None is left out)
 _COLLISION = ("case", "file", "case_hash", "kind", "sources", "comparisons", "curves", "series", "walls", "variant",
               "scenario", "model", "params", "impact", "scales", "settings", "status", "verdict")
@@ -138,7 +163,7 @@ class CaseResult:
     status: str = OK
     verdict: str = verdicts.AGREE
     message: str | None = None
-    packing: dict | None = None
+    packing: dict | None = None  # source label -> PackingPanel
     extra: dict = field(default_factory=dict)  # keys of a stored entry this release does not know
 
     def judged(self) -> "CaseResult":
@@ -179,6 +204,8 @@ class CaseResult:
                 v = {name: s.to_json() for name, s in v.items()}
             elif k == "comparisons":
                 v = [c.as_dict() for c in v]
+            elif k == "packing" and v is not None:
+                v = {name: PackingPanel.from_json(p).to_json() for name, p in v.items()}
             elif k == "series" and not series:
                 continue
             if v is not None:
@@ -195,10 +222,85 @@ class CaseResult:
         values["comparisons"] = [_comparison(c) for c in d.get("comparisons") or []]
         values["curves"] = _copy(d.get("curves"), dict)
         values["series"] = _copy(d.get("series"), list)
+        if isinstance(d.get("packing"), dict):
+            values["packing"] = {name: PackingPanel.from_json(p) for name, p in d["packing"].items()}
         case = cls(**{"case": "", **values}, extra={k: v for k, v in d.items() if k not in known})
         # an entry without its status or verdict (a hand-built dict) is judged from its comparisons, never
         # read as "ok"/"agree" by default
         return case if "status" in d and "verdict" in d else case.judged()
+
+
+@dataclass
+class Check:
+    """One verdict of ``demcheck validate`` (comparisons/validate.py): a source against a benchmark's exact limit
+    (``kind`` "limit") or a paper's curve ("curve") over one case file's variants — the largest deviation, where
+    (``at``, on the benchmark's x axis), the tolerance there, what the tolerance stands for (``why``), the verdict,
+    how many variants or paper points it judged; a curve's regime (gross sliding or partial slip), a limit the law
+    itself misses (``law``). ``keys``: the fields it carries in JSON, in their order."""
+
+    benchmark: str
+    file: str
+    source: str
+    kind: str
+    quantity: str
+    expected: str
+    deviation: float | None = None
+    at: float | None = None
+    tolerance: float | None = None
+    why: str = ""
+    verdict: str = ""
+    points: int = 0
+    regime: str | None = None
+    law: bool = False
+    keys: tuple = ()
+    extra: dict = field(default_factory=dict)
+
+    LIMIT = ("benchmark", "file", "source", "kind", "quantity", "expected", "deviation", "at", "tolerance", "why",
+             "verdict", "points")
+    CURVE = ("benchmark", "file", "source", "kind", "quantity", "expected", "regime", "tolerance", "why",
+             "deviation", "at", "verdict", "points")
+
+    def __post_init__(self):
+        if not self.keys:
+            self.keys = (self.LIMIT + (("law",) if self.law else ())) if self.kind == "limit" else self.CURVE
+
+    def to_json(self) -> dict:
+        return {k: (self.extra[k] if k in self.extra else getattr(self, k)) for k in self.keys}
+
+    @classmethod
+    def from_json(cls, d) -> "Check":
+        if isinstance(d, Check):
+            return d
+        known = {f.name for f in fields(cls)} - {"keys", "extra"}
+        values = {"benchmark": "", "file": "", "source": "", "kind": "", "quantity": "", "expected": "",
+                  **{k: v for k, v in d.items() if k in known}}
+        return cls(**values, keys=tuple(d), extra={k: v for k, v in d.items() if k not in known})
+
+
+@dataclass
+class Validation:
+    """What ``demcheck validate`` adds to a run: the benchmarks judged (name, title, case files), every
+    :class:`Check`, the plot series (one per case file and quantity: each source's x and y, the paper's points) and
+    the checks that fail the run (the reference missing an exact limit that is not the law's own miss)."""
+
+    benchmarks: list = field(default_factory=list)
+    checks: list = field(default_factory=list)  # Check
+    series: list = field(default_factory=list)
+    failed: list = field(default_factory=list)  # Check
+    extra: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        return {"benchmarks": self.benchmarks, "checks": [c.to_json() for c in self.checks], "series": self.series,
+                "failed": [c.to_json() for c in self.failed]} | self.extra
+
+    @classmethod
+    def from_json(cls, d) -> "Validation | None":
+        if d is None or isinstance(d, Validation):
+            return d
+        known = ("benchmarks", "checks", "series", "failed")
+        return cls(_copy(d.get("benchmarks"), list), [Check.from_json(c) for c in d.get("checks") or []],
+                   _copy(d.get("series"), list), [Check.from_json(c) for c in d.get("failed") or []],
+                   {k: v for k, v in d.items() if k not in known})
 
 
 @dataclass
@@ -223,7 +325,7 @@ class Summary:
     cache: dict | None = None
     baseline: dict | None = None
     baseline_error: str | None = None
-    validation: dict | None = None
+    validation: Validation | None = None
     extra: dict = field(default_factory=dict)
 
     OPTIONAL = ("cache", "baseline", "baseline_error", "validation")  # in JSON only where there are
@@ -240,6 +342,8 @@ class Summary:
             v = getattr(self, f.name)
             if f.name == "cases":
                 v = [c.to_json(series) for c in v]
+            elif f.name == "validation" and v is not None:
+                v = Validation.from_json(v).to_json()
             if v is not None or f.name not in self.OPTIONAL:
                 out[f.name] = v
         return out | self.extra
@@ -250,6 +354,8 @@ class Summary:
         values = {k: v for k, v in d.items() if k in known}
         values["cases"] = [CaseResult.from_json(c) for c in d.get("cases") or []]
         values["engines"] = _copy(d.get("engines"), dict)
+        if isinstance(d.get("validation"), dict):
+            values["validation"] = Validation.from_json(d["validation"])
         return cls(**values, extra={k: v for k, v in d.items() if k not in known})
 
     @classmethod

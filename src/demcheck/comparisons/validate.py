@@ -34,7 +34,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .. import resources
-from .records import CaseResult, Summary
+from .records import CaseResult, Check, Summary, Validation
 
 DATA = resources.data_dir() / "benchmarks"
 LINK = "latest-validate"  # <report>/latest is verify's
@@ -612,7 +612,7 @@ def _allowance(imp: Impact, m: dict) -> float:
 _BREACHES = ("below_cap", "above_cap", "along_slip")  # shares of a force off its cap that no law excuses
 
 
-def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
+def _judge_limit(bench, file, src, lim: Limit, rows) -> Check:
     fn = QUANTITIES[lim.quantity][1]
     tol = lim.tol_reference if src == "reference" else lim.tol_engine
     worst, at, n, tol_at, stuck, breach = None, None, 0, tol, 0, {}
@@ -660,9 +660,8 @@ def _judge_limit(bench, file, src, lim: Limit, rows) -> dict:
     if stuck:
         why += (f" ({stuck} variant{'s' if stuck > 1 else ''} past the rigid-body threshold where the law holds its "
                 f"force short of the cap by more than {SHORTFALL_MAX:g}: not judged)")
-    return {"benchmark": bench.name, "file": file, "source": src, "kind": "limit", "quantity": lim.quantity,
-            "expected": lim.name, "deviation": worst, "at": at, "tolerance": tol_at, "why": why,
-            "verdict": verdict, "points": n, **({"law": True} if law_miss else {})}
+    return Check(bench.name, file, src, "limit", lim.quantity, lim.name, worst, at, tol_at, why, verdict, n,
+                 law=law_miss)
 
 
 # A paper's curve is two things. Where the rigid body slides throughout (past the gross-sliding threshold with
@@ -696,23 +695,23 @@ def regimes(bench: Benchmark, paper: np.ndarray | None, imp: Impact) -> list[tup
     return [(r, paper[k]) for r, k in ((SLIDING_REGIME, mask), (PARTIAL_REGIME, ~mask)) if k.any()]
 
 
-def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys, regime: str = "") -> dict:
+def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys, regime: str = "") -> Check:
     why = cur.why + _REGIME_WHY.get(regime, "")
-    out = {"benchmark": bench.name, "file": file, "source": src, "kind": "curve", "quantity": cur.quantity,
-           "expected": f"{cur.file} [{key}]" + (f", {regime}" if regime else ""), "regime": regime,
-           "tolerance": cur.tolerance, "why": why, "deviation": None, "at": None, "verdict": NO_DATA, "points": 0}
+    out = Check(bench.name, file, src, "curve", cur.quantity, f"{cur.file} [{key}]" + (f", {regime}" if regime else ""),
+                tolerance=cur.tolerance, why=why, verdict=NO_DATA, regime=regime)
     if paper is None:
         return out
     if any(y is None for y in ys):
-        out.update(deviation=math.inf, verdict=MISSES, why=why + " (a variant gave no value)")
+        out.deviation, out.verdict, out.why = math.inf, MISSES, why + " (a variant gave no value)"
         return out
     d = deviation(xs, ys, paper)
     if d is None:
         return out
     # the points compared are those inside the source's range: a source that covers part of a curve says so
-    out.update(deviation=d[0], at=d[1], points=d[2], verdict=MEETS if d[0] <= cur.tolerance else MISSES)
+    out.deviation, out.at, out.points = d
+    out.verdict = MEETS if d[0] <= cur.tolerance else MISSES
     if d[2] < len(paper):
-        out["why"] = why + f" ({d[2]} of the paper's {len(paper)} points here lie in the source's range)"
+        out.why = why + f" ({d[2]} of the paper's {len(paper)} points here lie in the source's range)"
     return out
 
 
@@ -763,13 +762,13 @@ def _law_short(case, run_of) -> float:
 
 
 def validate(summary: Summary, benches: list[Benchmark], files: dict[str, list[Path]], opts,
-             root: Path = DATA) -> dict:
+             root: Path = DATA) -> Validation:
     """The validation of a finished suite run (its records.Summary: its cases' entries): checks and series per
     benchmark."""
     from ..case import expand
 
     entries = {c.case: c for c in Summary.of(summary).cases}
-    out = {"benchmarks": [], "checks": [], "series": []}
+    out = Validation()
     for bench in benches:
         groups: dict[str, list] = {}
         for f in files[bench.name]:
@@ -805,11 +804,11 @@ def validate(summary: Summary, benches: list[Benchmark], files: dict[str, list[P
                     ms[src] = m
                 groups.setdefault(Path(f).stem, []).append((imp, ms))
         checks, series = judge(bench, groups, root)
-        out["benchmarks"].append({"name": bench.name, "title": bench.title, "files": [str(f) for f in files[bench.name]]})
-        out["checks"] += checks
-        out["series"] += series
-    out["failed"] = [c for c in out["checks"] if c["kind"] == "limit" and c["source"] == "reference"
-                     and c["verdict"] == MISSES and not c.get("law")]
+        out.benchmarks.append({"name": bench.name, "title": bench.title, "files": [str(f) for f in files[bench.name]]})
+        out.checks += checks
+        out.series += series
+    out.failed = [c for c in out.checks if c.kind == "limit" and c.source == "reference" and c.verdict == MISSES
+                  and not c.law]
     return out
 
 
@@ -861,7 +860,7 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
     with _titled("demcheck validate"):
         summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv, link=LINK)
     summary.validation = validate(summary, benches, files, opts)
-    summary.failed += len(summary.validation["failed"])
+    summary.failed += len(summary.validation.failed)
     report.write_all(summary, Path(summary.report), report_root, junit=junit, link=LINK)
     return summary
 

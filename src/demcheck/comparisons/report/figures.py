@@ -28,7 +28,8 @@ def validation_plots(summary: Summary) -> list[tuple[str, str]]:
     from .. import plots
 
     out = []
-    for line in (Summary.of(summary).validation or {}).get("series", []):
+    val = Summary.of(summary).validation
+    for line in val.series if val else []:
         if not line["x_label"]:
             continue
         fig, ax = plt.subplots(figsize=(5.2, 3.6), layout="constrained")
@@ -330,7 +331,8 @@ def packing_plots(entry: CaseResult) -> str:
     """The packing's panels, from the plot cache when the same data was drawn before (its three panels took
     2–3 s a packing to lay out and draw: most of a warm suite's report)."""
     entry = CaseResult.from_json(entry)
-    key = {"packing": entry.packing, "case": entry.case, "v": PLOT_VERSION,
+    panels = {src: p.to_json() for src, p in (entry.packing or {}).items()}
+    key = {"packing": panels, "case": entry.case, "v": PLOT_VERSION,
            "sources": {src: v.status for src, v in entry.sources.items()}}
     return _cached(key, lambda: _png(packing_figure(entry)), _png_ok)
 
@@ -355,7 +357,7 @@ def packing_figure(entry: CaseResult):
     from .. import plots
 
     entry = CaseResult.from_json(entry)
-    data = entry.packing
+    data = entry.packing or {}
     order = sorted(data, key=plots.source_order)
     absent = [f"{src} ({v.status if 'status' in v.keys else 'no output'})" for src, v in entry.sources.items()
               if src not in data]
@@ -363,17 +365,17 @@ def packing_figure(entry: CaseResult):
     notes: dict = {a1: [], a2: [], a3: []}
     for src in order:
         d = data[src]
-        prof = d.get("profile") or {}
+        prof = d.profile or {}
         if prof.get("z"):
             plots.source_line(a1, prof["solid_fraction"], [z * 1e3 for z in prof["z"]], src, markers=False)
         else:
             notes[a1].append(src)
-        ke = [k for k in d.get("ke") or [] if k[1] > 0]  # log axis: the start at rest left out
+        ke = [k for k in d.ke if k[1] > 0]  # log axis: the start at rest left out
         if ke:
             plots.source_line(a3, [k[0] for k in ke], [k[1] for k in ke], src, markers=False)
         else:
             notes[a3].append(src)
-        forces = d.get("forces") or {}
+        forces = d.forces
         n = force_count(forces)
         if n is not None and n >= MIN_CONTACTS:
             pts = [(x, p) for x, p in zip(forces["x"], forces["p"]) if p > 0]  # log axis: the empty bins left out

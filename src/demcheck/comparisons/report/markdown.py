@@ -170,11 +170,11 @@ def validation_markdown(summary: Summary) -> list[str]:
     lines = ["", "## Validation against published benchmarks", "",
              "| case file | source | quantity | expected | largest deviation | at | tolerance | verdict |",
              "|---|---|---|---|---|---|---|---|"]
-    for c in val["checks"]:
-        lines.append(f"| {_cell(c['file'])} | {_cell(c['source'])} | {_cell(c['quantity'])} | "
-                     f"{_cell(c['kind'])}: {_cell(c['expected'])} | "
-                     f"{number(c['deviation'], '.3g')} | {number(c['at'], '.3g')} | {number(c['tolerance'], '.3g')} | "
-                     f"{_cell(c['verdict'])} |")
-    lines += ["", "Tolerances:", ""] + sorted({f"* {_md(c['quantity'])} ({_md(c['kind'])}): {_md(c['why'])}"
-                                                for c in val["checks"]})
+    for c in val.checks:
+        lines.append(f"| {_cell(c.file)} | {_cell(c.source)} | {_cell(c.quantity)} | "
+                     f"{_cell(c.kind)}: {_cell(c.expected)} | {number(c.deviation, '.3g')} | "
+                     f"{number(c.at, '.3g')} | {number(c.tolerance, '.3g')} | "
+                     f"{_cell(c.verdict)} |")
+    lines += ["", "Tolerances:", ""] + sorted({f"* {_md(c.quantity)} ({_md(c.kind)}): {_md(c.why)}"
+                                                for c in val.checks})
     return lines
