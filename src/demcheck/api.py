@@ -511,22 +511,25 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
     ``tangential_restitution``) for the case's contact at ``dt``: root finding on the engine's twin, confirmed
     by one engine run (``confirm``). Returns a dict with the input, the line to paste, and the realised
     values (twin and engine). ``jobs``/``scheduler``: where the confirming run goes (``demcheck calibrate``'s
-    --jobs and --scheduler: comparisons/dispatch.py); ``keys`` and ``base`` as :func:`load` takes them."""
-    from .comparisons.calibrate import calibrate as run, check_targets
+    --jobs and --scheduler: comparisons/dispatch.py); ``keys``: the names the errors give the arguments
+    (``engine``, ``targets``, ``dt``, ``overrides``: the command line's options); ``base`` as :func:`load` takes
+    it."""
+    from .comparisons.calibrate import KEYS, calibrate as run, check_targets
     from .comparisons.dispatch import Campaign
 
-    _text("engine", engine, "must be an engine's name (text)")
+    key = {**KEYS, "overrides": "overrides", **(keys or {})}
+    _text(key["engine"], engine, "must be an engine's name (text)")
     if not isinstance(targets, Mapping):
-        raise ConfigError("targets", _shown(targets), "must be a dict of metric names to values, e.g. "
-                                                      "{'restitution': 0.6}")
-    check_targets(dict(targets))
-    _positive("dt", dt, "s")
+        raise ConfigError(key["targets"], _shown(targets), "must be a dict of metric names to values, e.g. "
+                                                           "{'restitution': 0.6}")
+    check_targets(dict(targets), key["targets"])
+    _positive(key["dt"], dt, "s")
     _flag("confirm", confirm)
     if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
         raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
     c = load(case, overrides, keys=keys, base=base, **keyword)
     with Campaign(jobs, scheduler, sources=[engine]) as campaign:
-        return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign)
+        return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign, keys=key)
 
 
 def packing_universe(path, dt: float = 1.0):

@@ -958,10 +958,11 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
         if key.strip() in wanted:
             raise ConfigError("--target", item, f"{key.strip()} is given twice: give each metric once")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
-    calibrate.check_targets(wanted)  # bad input: one line, before any work
+    calibrate.check_targets(wanted, "--target")  # bad input: one line, before any work
     _check_jobs(jobs, scheduler)
     result = api.calibrate(case_path, engine, wanted, dt, not no_confirm, list(overrides), jobs=jobs,
-                           scheduler=scheduler, keys=SET_KEYS, base=True)
+                           scheduler=scheduler, base=True,
+                           keys={**SET_KEYS, "engine": "--engine", "targets": "--target", "dt": "--dt"})
     if as_json:
         emit_json(result)
     else:
