@@ -21,7 +21,7 @@ from ..errors import ConfigError, DemcheckError
 from ..engines import registry
 from ..engines.collide import setting
 from ..engines.mapping import contact_mapping, native_summary
-from .sources import Source
+from .sources import Source, collision_only
 
 TARGETS = {"restitution": (0.0, 1.0), "tangential_restitution": (-1.0, 1.0)}
 ROOT_TOL = 1e-6  # |realised − target| the root is found to, in the metric's own (dimensionless) units
@@ -63,9 +63,7 @@ def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, c
     if engine not in registry.names():
         raise ConfigError(keys["engine"], engine, f"must be one of {', '.join(registry.names())}")
     eng = registry.get(engine)
-    if case.run.scenario != "collision":
-        raise ConfigError("run.scenario", case.run.scenario, "must be \"collision\": a target metric (restitution) "
-                                                            "is an impact's")
+    collision_only(case, "a target metric (restitution) is an impact's")
     if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
         raise ConfigError(keys["dt"], dt, "must be a number > 0 (s)")
     # the step `demcheck collide --engine` runs the case at (a native setting at its own step): the input found
