@@ -103,6 +103,8 @@ def test_the_reference_solves_a_model_given_by_the_two_body_kernel():
     seed = S.ADAPTIVE.run(case, model=resolve(case))
     assert seed.metrics() == collision3d.collide(case, resolve(case), "adaptive").metrics()
     assert seed.metrics()["restitution"] != got.metrics()["restitution"]  # another law: another answer
+    with pytest.raises(TypeError, match="model= is the reference's"):  # never silently ignored
+        S.Source.parse("lammps-twin").run(case, model=twin)
     head_on = load(CASES / "hertz-wall.toml")  # a 1-D case: the case's own solve is the 1-D kernel's
     assert S.ADAPTIVE.run(head_on, model=resolve(head_on)).metrics() == \
         collision3d.collide(head_on, resolve(head_on), "adaptive").metrics()

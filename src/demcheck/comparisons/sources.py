@@ -127,6 +127,8 @@ class Source:
         computing the engine's formula with its scheme at the engine's dt; ``converged``: its converged answer
         (:func:`_converged_twin`). ``native``: the engine's setting (default the case's own, at its own step when
         ``dt`` is None; None: the engine's mapping of the seed model)."""
+        if model is not None and self.kind != REFERENCE:
+            raise TypeError(f"{self.label}: model= is the reference's (an engine and its twin run their own setting)")
         if case.run.scenario != "collision":
             return self._scenario(case, timeout, options.get("cache"))
         if self.kind == REFERENCE:
