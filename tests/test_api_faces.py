@@ -112,3 +112,85 @@ def test_sweep_refuses_a_key_varied_twice():
     p = CliRunner().invoke(cli, ["sweep", "glass-pair", "--vary", "impact.speed=1:2:2", "--vary",
                                  "impact.speed=3,4"])
     assert isinstance(p.exception, ConfigError) and p.exception.key == "--vary" and "varied twice" in p.exception.rule
+
+
+def test_cases_and_the_api_give_the_same_listing_and_file():
+    """`demcheck cases` is api.cases: the listing and one file, the same from both faces; an unknown name names
+    the argument of each."""
+    p = CliRunner().invoke(cli, ["cases", "--json"])
+    assert p.exit_code == 0, p.output
+    listing = demcheck.cases()
+    assert json.loads(p.output) == json.loads(json.dumps(plain(listing))) and listing["cases"]
+    p = CliRunner().invoke(cli, ["cases", "glass-pair", "--json"])
+    one = demcheck.cases("glass-pair")
+    assert json.loads(p.output) == one and one["text"].startswith(("#", "name", "["))
+    p = CliRunner().invoke(cli, ["cases", "glass-pair"])
+    assert p.output == one["text"]
+    p = CliRunner().invoke(cli, ["cases", "no-such-case"])
+    assert isinstance(p.exception, ConfigError) and p.exception.key == "NAME"
+    with pytest.raises(ConfigError) as err:
+        demcheck.cases("no-such-case")
+    assert err.value.key == "name"
+
+
+def test_pack_and_the_api_give_the_same_packing_and_files(tmp_path):
+    """`demcheck pack` is api.pack: the same summary and the same settled state written, from the same file."""
+    from .test_pack_output import SMALL
+
+    case = tmp_path / "small.toml"
+    case.write_text(SMALL)
+    p = CliRunner().invoke(cli, ["pack", str(case), "--json", "--csv", str(tmp_path / "cli")])
+    assert p.exit_code == 0, p.output
+    wrote = []
+    got = demcheck.pack(case, csv=tmp_path / "api", wrote=wrote.append)
+    assert json.loads(p.stdout) == json.loads(json.dumps(plain(got))) and got["metrics"]
+    assert p.stderr.splitlines() == [f"wrote {tmp_path / 'cli' / n}" for n in ("particles.csv", "contacts.csv")]
+    assert wrote == [tmp_path / "api" / "particles.csv", tmp_path / "api" / "contacts.csv"]
+    for name in ("particles.csv", "contacts.csv"):
+        assert (tmp_path / "cli" / name).read_text() == (tmp_path / "api" / name).read_text()
+
+
+@pytest.mark.parametrize("kwargs, key", [
+    ({"mpi": 2}, "mpi"), ({"engine": "lammps", "threads": 2}, "threads"), ({"threads": 0}, "threads"),
+    ({"engine": "nosuch"}, "engine"), ({"duration": 1e-300}, "duration"), ({"csv": 3}, "csv"),
+])
+def test_pack_names_the_apis_arguments_before_any_work(tmp_path, kwargs, key):
+    from .test_pack_output import SMALL
+
+    case = tmp_path / "small.toml"
+    case.write_text(SMALL)
+    with pytest.raises(ConfigError) as err:
+        demcheck.pack(case, **kwargs)
+    assert err.value.key == key, str(err.value)
+    with pytest.raises(ConfigError) as err:
+        demcheck.pack("glass-pair")
+    assert err.value.key == "kind"
+
+
+def test_stress_and_bench_load_their_cases_through_the_api(monkeypatch, tmp_path):
+    """One loader: `demcheck stress` and `demcheck bench` build each case with api.load (its [engine.NAME]
+    settings read by their engines), never a loader of their own."""
+    from demcheck.comparisons import bench, stress
+
+    def work(*args, **kwargs):
+        raise AssertionError("a case's work started before its case was loaded by api.load")
+
+    monkeypatch.setattr(stress, "largest_stable", work)
+    monkeypatch.setattr(bench, "bench_case", work)
+    for argv in (["stress", "glass-pair", "--only", "speed"], ["bench", "glass-pair", "--steps", "10"]):
+        calls = _reached(monkeypatch, "load")
+        p = CliRunner().invoke(cli, [*argv, "--engines", "none", "--report", str(tmp_path / "r")])
+        assert isinstance(p.exception, ConfigError) and p.exception.key.endswith("reached"), (argv, p.exception)
+        assert len(calls) == 1
+
+
+def test_a_sweeps_grid_is_built_in_one_place():
+    """api.sweep builds and checks a sweep's grid (api._sweep_points); comparisons/sweep.py solves it and builds
+    no case of its own (its unused sweep_points, a second loader with --vary texts, is gone)."""
+    from pathlib import Path
+
+    from demcheck.comparisons import sweep
+
+    text = Path(sweep.__file__).read_text()
+    assert not hasattr(sweep, "sweep_points")
+    assert "from_dict" not in text and "apply_overrides" not in text and "_read(" not in text

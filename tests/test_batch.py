@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 import demcheck
+from demcheck import api
 from demcheck.errors import ConfigError
 from demcheck.comparisons import sweep
 from demcheck.metrics import stepped
@@ -77,7 +78,8 @@ def test_the_api_returns_a_frame_and_checks_its_arguments():
 
 
 def test_a_sweep_in_this_process_is_the_per_point_one():
-    points = sweep.sweep_points("cases/hertz-wall.toml", [], ["impact.speed=0.5:2:5", "run.dt=1e-7,4e-6"])
+    vary = dict(sweep.parse_vary(v) for v in ["impact.speed=0.5:2:5", "run.dt=1e-7,4e-6"])
+    points = api._sweep_points("cases/hertz-wall.toml", vary, [])  # api.sweep's grid
     batched = sweep.run_sweep(points, "verlet")
     each = [sweep.point_task(values, case, "reference", "verlet", None) for values, case in points]
     assert batched.equals(pd.DataFrame(each))

@@ -7,7 +7,9 @@ import sys
 
 import pytest
 
+import demcheck
 from demcheck.comparisons import bench as B, stress as S
+from demcheck.errors import ConfigError
 from demcheck.reference.collision import auto_dt, collide
 
 from .conftest import CASES
@@ -90,7 +92,8 @@ def test_verlet_stability_limit_of_an_undamped_linear_spring():
 @pytest.mark.engine("lammps")
 @pytest.mark.engine("liggghts")
 def test_engines_and_reference_agree_about_stability(tmp_path):
-    s = S.stress_file(CASES / "suite" / "normal-lsd-wall.toml", only=["restitution"]).summary()
+    raw = S.read_table(CASES / "suite" / "normal-lsd-wall.toml")
+    s = S.stress_case(raw, demcheck.load(raw), only=["restitution"]).summary()
     assert {"reference-verlet", "lammps", "liggghts"} <= {l["source"] for l in s["limits"]}  # and the other engines
     assert s["disagreements"] == []
     assert all(l["dt_max_over_tc"] for l in s["limits"])
@@ -262,3 +265,24 @@ def test_bench_times_engines_that_hold_one_collision_per_deck(tmp_path):
     assert p.returncode in (0, 1), p.stderr
     rows = [r for c in json.loads(p.stdout)["cases"] for r in c["points"] if r["source"] in ("kratos", "yade")]
     assert {r["source"] for r in rows} == {"kratos", "yade"} and all(r["status"] == "ok" for r in rows)
+
+
+@pytest.mark.parametrize("command, what", [(["stress", "--only", "speed"], "stress searches"),
+                                           (["bench", "--steps", "10"], "bench times")])
+def test_a_scenario_case_is_refused_as_it_is_loaded_before_any_work(command, what, tmp_path):
+    """A scenario beyond sliding has no impact to time or to search a stable step of: one line naming the file,
+    run.scenario, its value and the rule, exit 2 — as calibrate refuses it — before the work of any case."""
+    scenario = CASES / "suite" / "beyond-incline.toml"
+    p = subprocess.run([sys.executable, "-c", _NO_WORK, command[0], str(CASES / "glass-pair.toml"), str(scenario),
+                        *command[1:], "--engines", "none", "--report", str(tmp_path / "reports")],
+                       capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1, p.stderr[-2000:]
+    assert lines[0].startswith(f"demcheck: error: {scenario}: run.scenario = 'incline': must be \"collision\": "
+                               f"{what}"), lines
+    assert not (tmp_path / "reports").exists()
+    case = demcheck.load(scenario, base=True)  # and called as functions
+    for run in (lambda: S.stress_case(S.read_table(scenario), case, engines=()),
+                lambda: B.bench_case(case, engines=())):
+        with pytest.raises(ConfigError, match="^run.scenario = 'incline': must be \"collision\""):
+            run()

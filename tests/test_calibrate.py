@@ -57,17 +57,34 @@ def test_liggghts_limitforce_calibration_lowers_the_input():
 
 
 @pytest.mark.parametrize("engine, targets, key", [
-    ("lammps", {"restitution": 1.5}, "--target restitution"),
-    ("lammps", {"restitution": "0.6"}, "--target restitution"),
-    ("lammps", {"restitutio": 0.6}, "--target"),
-    ("lammps", {}, "--target"),
-    ("lammpz", {"restitution": 0.6}, "--engine"),
-    ("lammps", {"tangential_restitution": 0.3}, "--target tangential_restitution"),
+    ("lammps", {"restitution": 1.5}, "targets.restitution"),
+    ("lammps", {"restitution": "0.6"}, "targets.restitution"),
+    ("lammps", {"restitutio": 0.6}, "targets"),
+    ("lammps", {}, "targets"),
+    ("lammpz", {"restitution": 0.6}, "engine"),
+    ("lammps", {"tangential_restitution": 0.3}, "targets.tangential_restitution"),
 ])
-def test_bad_calibration_input_is_one_config_error(engine, targets, key):
+def test_bad_calibration_input_is_one_config_error_naming_the_apis_argument(engine, targets, key):
+    """An API caller sees the API's argument names (``targets``, ``engine``), never the command line's options."""
     with pytest.raises(ConfigError) as err:
         demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), engine, targets, confirm=False)
     assert err.value.key == key, str(err.value)
+    assert "--" not in str(err.value).split(" = ")[0]
+
+
+def test_an_unreachable_target_names_the_apis_argument_and_the_commands_option(tmp_path):
+    """The same refusal from the API (``targets.restitution``) and the command line (``--target restitution``)."""
+    with pytest.raises(ConfigError) as err:
+        demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), "lammps", {"restitution": 0.05}, confirm=False)
+    assert err.value.key == "targets.restitution" and "out of reach" in err.value.rule
+    with pytest.raises(ConfigError, match=r"^dt = -1\.0"):
+        demcheck.calibrate(_case({"lammps": {"pair_coeff": TSUJI}}), "lammps", {"restitution": 0.6}, dt=-1.0)
+    f = tmp_path / "c.toml"
+    f.write_text(to_toml(_case({"lammps": {"pair_coeff": TSUJI}})))
+    p = subprocess.run([sys.executable, "-m", "demcheck", "calibrate", str(f), "--engine", "lammps", "--target",
+                        "restitution=0.05", "--no-confirm"], capture_output=True, text=True, cwd=ROOT)
+    assert p.returncode == 2 and p.stderr.strip().count("\n") == 0, p.stderr
+    assert "--target restitution = 0.05: out of reach" in p.stderr, p.stderr
 
 
 def test_an_unreachable_target_says_so():

@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 import demcheck as demcheck_api
+from demcheck import api
 from demcheck.comparisons import bench, calibrate, stress, suite, sweep
 from demcheck.comparisons.dispatch import Campaign
 from demcheck.engines import discovery
@@ -159,11 +160,12 @@ def local():
 
 
 def test_sweep_stress_and_bench_on_a_local_cluster_give_what_one_process_gives(local):
-    points = sweep.sweep_points(CASES / "glass-pair.toml", [], ["impact.speed=0.5,1,2"])
+    points = api._sweep_points(CASES / "glass-pair.toml", {"impact.speed": [0.5, 1, 2]}, [])  # api.sweep's grid
     table = sweep.run_sweep(points, campaign=local)
     assert table.equals(sweep.run_sweep(points)) and list(table["impact.speed"]) == [0.5, 1.0, 2.0]
 
-    raw, case = stress.read_stress(CASES / "suite" / "normal-hertz-wall.toml")
+    raw = stress.read_table(CASES / "suite" / "normal-hertz-wall.toml")
+    case = api.load(raw)
     got = stress.stress_case(raw, case, engines=(), only=["speed"], campaign=local).summary()
     assert got == stress.stress_case(raw, case, engines=(), only=["speed"]).summary() and len(got["limits"]) == 3
 
@@ -285,7 +287,8 @@ def test_a_sweep_point_on_a_worker_without_the_engine_names_it(cluster, fake_lig
 
 
 def test_stress_bench_and_calibrate_on_a_worker_without_the_engine_say_so(cluster, fake_liggghts):
-    raw, case = stress.read_stress(CASES / "suite" / "normal-hertz-wall.toml")
+    raw = stress.read_table(CASES / "suite" / "normal-hertz-wall.toml")
+    case = api.load(raw)
     with Campaign(scheduler=cluster["address"], sources=["liggghts"]) as there:
         s = stress.stress_case(raw, case, engines=("liggghts",), only=["speed"], campaign=there)
         b = bench.bench_case(case, engines=("liggghts",), steps=(10,), rtols=(), campaign=there)

@@ -78,6 +78,38 @@ def test_the_seed_model_at_an_engines_step_is_read_off_its_states_as_an_engines_
     assert got.metrics() == want.metrics()
 
 
+def test_the_reference_solves_a_model_given_by_the_two_body_kernel():
+    """``model``: the audit's seed run and its converged answer of a deck's law — the reference solving that model
+    (the seed's, or an engine's twin model) by the two-body kernel with the seed's rules, not restated, not the
+    case's own (1-D) solve and not the case's seed model."""
+    from pandas.testing import assert_frame_equal
+
+    from demcheck.engines.mapping import contact_mapping, twin_model
+    from demcheck.laws.model import resolve
+    from demcheck.reference import collision3d
+
+    import demcheck
+
+    from .test_native import TSUJI, _case
+
+    case = demcheck.load(_case({"lammps": {"pair_coeff": TSUJI}}, angle=30.0))  # tsuji damping: not the seed's e
+    native = S.Source.parse("lammps").native(case)
+    twin = twin_model(resolve(case), contact_mapping(case, "lammps", native).require())
+    got = S.ADAPTIVE.run(case, model=twin)
+    want = collision3d.collide(case, twin, "adaptive")
+    assert got.ok and got.method == "adaptive"
+    assert_frame_equal(got.contact, want.contact)
+    assert got.metrics() == want.metrics()
+    seed = S.ADAPTIVE.run(case, model=resolve(case))
+    assert seed.metrics() == collision3d.collide(case, resolve(case), "adaptive").metrics()
+    assert seed.metrics()["restitution"] != got.metrics()["restitution"]  # another law: another answer
+    with pytest.raises(TypeError, match="model= is the reference's"):  # never silently ignored
+        S.Source.parse("lammps-twin").run(case, model=twin)
+    head_on = load(CASES / "hertz-wall.toml")  # a 1-D case: the case's own solve is the 1-D kernel's
+    assert S.ADAPTIVE.run(head_on, model=resolve(head_on)).metrics() == \
+        collision3d.collide(head_on, resolve(head_on), "adaptive").metrics()
+
+
 def test_a_twins_converged_answer_is_its_adaptive_solve_with_the_engines_rules():
     """``converged``: the twin solved by the adaptive method with the engine's kinematic rules (bench's and the
     native commands' "converged" answer); a twin with a force history has none and runs its scheme at ``dt``,
@@ -119,8 +151,6 @@ RUNNERS = re.compile(
     r"|\bimport scenario as \w+")
 # modules that still run a source by hand, and why (each one a known exception, not a place the check skips)
 KNOWN = {
-    "comparisons/audit.py": "next step (issue 29): the audit's twin, refined twin, engine and seed runs",
-    "comparisons/audit_beyond.py": "next step (issue 29): a scenario's engine run and twin (engines/scenario.py)",
     "comparisons/warmup.py": "compiles the reference's kernels: it runs no source for a result",
 }
 

@@ -74,8 +74,8 @@ KERNEL_CACHE = _numba_cache_dir()
 
 
 # the Python API (docs/api.md), looked up on first use: ``import demcheck`` loads no solver, engine or pandas
-_API = ("load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "sources", "packing_universe",
-        "models")
+_API = ("load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "cases", "sources",
+        "packing_universe", "models")
 
 
 def __getattr__(name: str):

@@ -10,7 +10,10 @@
 * :func:`sweep` — metrics over a grid of case keys → a pandas DataFrame;
 * :func:`verify` — the verification suite over case files → its results dict (what ``results.json`` holds);
 * :func:`audit` — a user's own LAMMPS or LIGGGHTS deck, Kratos DEM project or Yade script → the audit as a dict;
-* :func:`calibrate` — the native input that realises a target metric in an engine at a time step.
+* :func:`calibrate` — the native input that realises a target metric in an engine at a time step;
+* :func:`pack` — a packing case settled in the reference or an engine → its packing metrics (and its settled
+  state written where asked);
+* :func:`cases` — the shipped case files, or one file's text.
 
 Bad input raises :class:`~demcheck.errors.ConfigError` (key, value, rule) before any work; docs/api.md has
 examples.
@@ -28,8 +31,8 @@ from . import case as _case
 from .errors import ConfigError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "packing_universe", "models",
-           "Result", "ConfigError"]
+__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "cases",
+           "packing_universe", "models", "Result", "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
 MAX_TIMEOUT = 1e6  # s, as the command line's --timeout (the pipes' poll() takes at most ~2.1e6 s)
@@ -511,22 +514,159 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
     ``tangential_restitution``) for the case's contact at ``dt``: root finding on the engine's twin, confirmed
     by one engine run (``confirm``). Returns a dict with the input, the line to paste, and the realised
     values (twin and engine). ``jobs``/``scheduler``: where the confirming run goes (``demcheck calibrate``'s
-    --jobs and --scheduler: comparisons/dispatch.py); ``keys`` and ``base`` as :func:`load` takes them."""
-    from .comparisons.calibrate import calibrate as run, check_targets
+    --jobs and --scheduler: comparisons/dispatch.py); ``keys``: the names the errors give the arguments
+    (``engine``, ``targets``, ``dt``, ``overrides``: the command line's options); ``base`` as :func:`load` takes
+    it."""
+    from .comparisons.calibrate import KEYS, calibrate as run, check_targets
     from .comparisons.dispatch import Campaign
 
-    _text("engine", engine, "must be an engine's name (text)")
+    key = {**KEYS, "overrides": "overrides", **(keys or {})}
+    _text(key["engine"], engine, "must be an engine's name (text)")
     if not isinstance(targets, Mapping):
-        raise ConfigError("targets", _shown(targets), "must be a dict of metric names to values, e.g. "
-                                                      "{'restitution': 0.6}")
-    check_targets(dict(targets))
-    _positive("dt", dt, "s")
+        raise ConfigError(key["targets"], _shown(targets), "must be a dict of metric names to values, e.g. "
+                                                           "{'restitution': 0.6}")
+    check_targets(dict(targets), key["targets"])
+    _positive(key["dt"], dt, "s")
     _flag("confirm", confirm)
     if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
         raise ConfigError("jobs", _shown(jobs), f"must be a whole number from 1 to {MAX_JOBS}")
     c = load(case, overrides, keys=keys, base=base, **keyword)
     with Campaign(jobs, scheduler, sources=[engine]) as campaign:
-        return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign)
+        return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign, keys=key)
+
+
+def cases(name: str | None = None, key: str = "name") -> dict:
+    """The case files shipped with demcheck (``demcheck cases``): ``{"root", "cases"}``, a row per file (name,
+    folder, kind, normal and tangential model, whether the default suite runs it, path); with ``name`` (a shipped
+    case's name or a file's path, as every command takes it) that file: ``{"name", "path", "text"}``. An unknown
+    name is a ConfigError naming ``key``."""
+    from . import resources
+
+    if name is not None:
+        path = resources.case_path(_text(key, name, "must be a shipped case's name or a case file's path (text)"),
+                                   key)
+        return {"name": path.stem, "path": str(path), "text": path.read_text()}
+    return {"root": str(resources.cases_dir()), "cases": resources.case_rows()}
+
+
+PACK_FILES = {"csv": ("particles.csv", "contacts.csv"), "vtk": ("particles.vtu", "contacts.vtu")}  # as the
+# command line's --csv and --vtk check them (comparisons/packing_output.VTK_FILES)
+
+
+def pack(case, engine: str = "reference", duration: float | None = None, mpi: int = 1, threads: int = 1,
+         timeout: float = 3600.0, overrides: Iterable[str] | Mapping[str, Any] | None = (), *, csv=None, vtk=None,
+         xyz=None, wrote=None, keys: Mapping[str, str] | None = None, base: bool = False, **keyword) -> dict:
+    """Settle a packing case (``demcheck pack``) in the N-body reference solver (``threads``: numba's, the same
+    physics summed in another order) or in an engine (``mpi`` ranks) from the same initial state → its summary:
+    case, source, particles, dt, contacts and the packing metrics (comparisons/packing_metrics.py, with the
+    contact network's fabric tensor). ``duration``: the simulated time (default the case's packing.duration).
+    ``csv``, ``vtk`` (directories) and ``xyz`` (a file) write the settled state there (checked before any work);
+    ``wrote(path)`` is called for each file written. ``keys``: the names the errors give the arguments (the
+    command line's options); ``base`` as :func:`load` takes it."""
+    from .engines import registry
+    from .io import check_output
+
+    k = {n: n for n in ("engine", "duration", "mpi", "threads", "timeout", "csv", "vtk", "xyz", "overrides")}
+    k.update(keys or {})
+    names = [n for n in registry.names() if "@" not in n]
+    if engine not in ("reference", *names):
+        raise ConfigError(k["engine"], _shown(engine), f"must be reference or an engine ({', '.join(names)})")
+    _positive(k["duration"], duration, "s")
+    _positive(k["timeout"], timeout, "s", MAX_TIMEOUT, optional=False)
+    if isinstance(mpi, bool) or not isinstance(mpi, int) or not 1 <= mpi <= MAX_JOBS:
+        raise ConfigError(k["mpi"], _shown(mpi), f"must be a whole number from 1 to {MAX_JOBS} (MPI ranks)")
+    for what, where in (("csv", csv), ("vtk", vtk), ("xyz", xyz)):
+        if where is not None:
+            check_output(k[what], _path(k[what], where), directory=what != "xyz", files=PACK_FILES.get(what, ()))
+    c = load(case, overrides, keys={"overrides": k["overrides"]}, base=base, **keyword)
+    threads = _pack_checks(c, engine, duration, mpi, threads, k, names)
+    from .comparisons import packing_output as po
+
+    out, settled, tables = (_pack_reference(c, duration, threads) if engine == "reference" else
+                            _pack_engine(c, engine, duration, mpi, timeout))
+    for path in _pack_write(settled, tables, csv, vtk, xyz, po):
+        if wrote is not None:
+            wrote(path)
+    return out
+
+
+def _pack_checks(case, engine: str, duration, mpi: int, threads, k: dict, names: list) -> int:
+    """pack's checks of the case and the options together, before any work; the threads to use."""
+    from .reference import packing
+
+    if case.kind != "packing":
+        raise ConfigError("kind", case.kind, "demcheck pack runs packing cases (kind = \"packing\")")
+    if mpi > 1 and engine == "reference":
+        raise ConfigError(k["mpi"], mpi, f"applies to an engine ({k['engine']} {'|'.join(names)}); the reference "
+                          f"runs on threads ({k['threads']})")
+    if engine != "reference" and isinstance(threads, int) and not isinstance(threads, bool) and threads > 1:
+        raise ConfigError(k["threads"], _shown(threads), f"applies to the reference ({k['engine']} reference); an "
+                          f"engine runs on MPI ranks ({k['mpi']})")
+    try:
+        threads = packing.check_threads(threads)  # no more than numba may start here
+    except ConfigError as exc:
+        raise ConfigError(k["threads"], exc.value, exc.rule) from None
+    key, value = (k["duration"], duration) if duration else ("packing.duration", case.packing.duration)
+    fall = packing.fall_time(case)  # a shorter run reports the starting lattice, not a packing
+    if value is not None and value < fall:
+        raise ConfigError(key, value, f"must be at least the fall of the lowest body to the floor, √(2h/g) = "
+                          f"{fall:.3g} s: a shorter run ends before any body touches it (no packing forms)")
+    return threads
+
+
+def _pack_reference(case, duration, threads: int) -> tuple:
+    """(summary, settled state, (particles, contacts) tables) of the reference's packing."""
+    import pandas as pd
+
+    from .comparisons import packing_metrics, packing_output
+    from .inputs.packing_decks import CONTACT_COLUMNS
+    from .reference import packing
+
+    st = packing.simulate(case, duration=duration, threads=threads)
+    nc = min(st.n_contacts, len(st.contacts))
+    box = case.packing.box if case.packing else None
+    m = packing_metrics.compute(st.x, st.rad, box=box, forces=st.contacts[:nc, 3], overlaps=st.contacts[:nc, 2],
+                                ke=[e for _, e in st.ke])
+    out = {"case": case.name, "source": "reference", "threads": threads, "particles": len(case.particles),
+           "time": st.time, "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
+    contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
+    return out, packing_output.from_reference(case, st), (_particle_table(st.x, st.rad), contacts)
+
+
+def _pack_engine(case, engine: str, duration, mpi: int, timeout: float) -> tuple:
+    """(summary, settled state, (particles, contacts) tables) of an engine's packing."""
+    from .comparisons import packing_metrics, packing_output
+    from .engines.packing import run_engine
+    from .reference import packing
+
+    run = run_engine(case, engine, duration=duration, mpi=mpi, timeout=timeout)
+    box = case.packing.box if case.packing else None
+    x, rad = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy()
+    m = packing_metrics.compute(x, rad, box=box, forces=run.contacts["fn"].to_numpy(),
+                                overlaps=run.contacts["overlap"].to_numpy(), ke=[e for _, e in run.ke])
+    out = {"case": case.name, "source": engine, "engine_version": run.version, "mpi": mpi,
+           "particles": len(run.table), "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
+    return out, packing_output.from_engine(case, run), (_particle_table(x, rad), run.contacts)
+
+
+def _particle_table(x, rad):
+    import pandas as pd
+
+    return pd.DataFrame({"id": range(len(x)), "x": x[:, 0], "y": x[:, 1], "z": x[:, 2], "radius": rad})
+
+
+def _pack_write(settled, tables, csv, vtk, xyz, po):
+    """Write the settled state where asked (csv, vtk directories; xyz file), yielding each path written."""
+    if csv:
+        from .io import write_text
+
+        for name, table in zip(PACK_FILES["csv"], tables):
+            write_text(Path(csv) / name, table.to_csv(index=False, float_format="%.17g"))
+            yield Path(csv) / name
+    if vtk:
+        yield from po.write_vtk(settled, vtk)
+    if xyz:
+        yield po.write_xyz(settled, xyz)
 
 
 def packing_universe(path, dt: float = 1.0):

@@ -472,18 +472,15 @@ def cases_command(name, as_json):
     packing/, benchmarks/ (`demcheck validate`) and optin/ (long cases, run by naming them). Every command takes a
     shipped case by its name (`demcheck collide glass-pair`). With NAME: that file's text, to copy and edit
     (`demcheck cases glass-pair > my-case.toml`)."""
-    if name is not None:
-        path = resources.case_path(name, "NAME")
-        if as_json:
-            emit_json({"name": path.stem, "path": str(path), "text": path.read_text()})
-        else:
-            click.echo(path.read_text(), nl=False)
-        return
-    root, rows = resources.cases_dir(), resources.case_rows()
+    from . import api
+
+    found = api.cases(name, "NAME")
     if as_json:
-        emit_json({"root": str(root), "cases": rows})
-        return
-    click.echo("\n".join(cli_text.cases_listing(root, rows)))
+        emit_json(found)
+    elif name is not None:
+        click.echo(found["text"], nl=False)
+    else:
+        click.echo("\n".join(cli_text.cases_listing(Path(found["root"]), found["cases"])))
 
 
 # ----------------------------------------------------------------------------- verify
@@ -659,75 +656,17 @@ def pack(case_path, engine, duration, mpi, threads, timeout, csv_dir, vtk_dir, x
     """Settle a packing case in the N-body reference solver, or in an engine from the same initial state
     (a LAMMPS data file both engines read), and print its packing metrics (with the contact network's fabric
     tensor); --csv, --vtk and --xyz write the settled state."""
-    from .comparisons import packing_output
-    from .comparisons import packing_metrics
-    from .reference import packing
+    from . import api
 
-    case = _load(case_path, overrides)
-    if case.kind != "packing":
-        raise ConfigError("kind", case.kind, "demcheck pack runs packing cases (kind = \"packing\")")
-    if mpi > 1 and engine == "reference":
-        raise ConfigError("--mpi", mpi, f"applies to an engine (--engine {'|'.join(ENGINE_NAMES)}); the reference "
-                          "runs on threads (--threads)")
-    if threads > 1 and engine != "reference":
-        raise ConfigError("--threads", threads, "applies to the reference (--engine reference); an engine runs on MPI "
-                          "ranks (--mpi)")
-    threads = packing.check_threads(threads)  # no more than numba may start here
-    _check_pack_duration(case, duration)
-    box = case.packing.box if case.packing else None
-    import pandas as pd
-
-    from .inputs.packing_decks import CONTACT_COLUMNS
-
-    if engine == "reference":
-        st = packing.simulate(case, duration=duration, threads=threads)
-        nc = min(st.n_contacts, len(st.contacts))
-        m = packing_metrics.compute(st.x, st.rad, box=box, forces=st.contacts[:nc, 3], overlaps=st.contacts[:nc, 2],
-                       ke=[e for _, e in st.ke])
-        out = {"case": case.name, "source": "reference", "threads": threads, "particles": len(case.particles),
-               "time": st.time, "dt": packing.packing_dt(case), "contacts": st.n_contacts, "metrics": m}
-        x, rad = st.x, st.rad
-        contacts = pd.DataFrame(st.contacts[:nc], columns=list(CONTACT_COLUMNS)).astype({"i": int, "j": int})
-        settled = packing_output.from_reference(case, st)
-    else:
-        from .engines.packing import run_engine
-
-        run = run_engine(case, engine, duration=duration, mpi=mpi, timeout=timeout)
-        m = packing_metrics.compute(run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), box=box,
-                       forces=run.contacts["fn"].to_numpy(), overlaps=run.contacts["overlap"].to_numpy(),
-                       ke=[e for _, e in run.ke])
-        out = {"case": case.name, "source": engine, "engine_version": run.version, "mpi": mpi,
-               "particles": len(run.table), "dt": packing.packing_dt(case), "contacts": len(run.contacts), "metrics": m}
-        x, rad, contacts = run.table[["x", "y", "z"]].to_numpy(), run.table["radius"].to_numpy(), run.contacts
-        settled = packing_output.from_engine(case, run)
-    if csv_dir:
-        from .io import write_text
-
-        parts = pd.DataFrame({"id": range(len(x)), "x": x[:, 0], "y": x[:, 1], "z": x[:, 2], "radius": rad})
-        for name, table in zip(PACK_CSV_DIR.files, (parts, contacts)):  # both checked up front
-            write_text(Path(csv_dir) / name, table.to_csv(index=False, float_format="%.17g"))
-            click.echo(f"wrote {Path(csv_dir) / name}", err=True)
-    if vtk_dir:
-        for path in packing_output.write_vtk(settled, vtk_dir):
-            click.echo(f"wrote {path}", err=True)
-    if xyz_file:
-        click.echo(f"wrote {packing_output.write_xyz(settled, xyz_file)}", err=True)
+    out = api.pack(case_path, engine, duration, mpi, threads, timeout, list(overrides), csv=csv_dir, vtk=vtk_dir,
+                   xyz=xyz_file, wrote=lambda path: click.echo(f"wrote {path}", err=True), base=True,
+                   keys={**SET_KEYS, "engine": "--engine", "duration": "--duration", "mpi": "--mpi",
+                         "threads": "--threads", "timeout": "--timeout", "csv": "--csv", "vtk": "--vtk",
+                         "xyz": "--xyz"})
     if as_json:
         emit_json(out)
         return
     click.echo("\n".join(cli_text.packing(out)))
-
-
-def _check_pack_duration(case, duration) -> None:
-    """A packing run shorter than the fall of its lowest body to the floor reports the starting lattice, not a
-    packing: refused before any work, naming the key that set the duration."""
-    from .reference import packing
-
-    key, value = ("--duration", duration) if duration else ("packing.duration", case.packing.duration)
-    fall = packing.fall_time(case)
-    if value is not None and value < fall:
-        raise ConfigError(key, value, f"must be at least the fall of the lowest body to the floor, √(2h/g) = "
-                          f"{fall:.3g} s: a shorter run ends before any body touches it (no packing forms)")
 
 
 def _show_report(data: dict, out_dir: Path, as_json: bool) -> None:
@@ -786,7 +725,7 @@ def bench(paths, engines, steps, batch, report_dir, as_json, overrides, jobs, sc
     cases = []
     for f in _case_files(paths):  # every file read and checked before any work; an error names the file
         with naming_file(f):
-            cases.append(_load(f, overrides))
+            cases.append(bench.check_case(_load(f, overrides)))
     root = Path(report_dir)
     out_dir = new_run_dir(root, "bench")
     results = []
@@ -824,19 +763,16 @@ def stress(paths, engines, only, report_dir, as_json, jobs, scheduler):
     reference disagree."""
     from rich.progress import Progress
 
-    from .comparisons.perf_report import new_run_dir, write_stress
-    from .comparisons.stress import read_stress, stress_case
-
     from .case import naming_file
-    from .engines import registry
-    from .engines.base import case_natives
+    from .comparisons.perf_report import new_run_dir, write_stress
+    from .comparisons.stress import check_case, read_table, stress_case
 
     names = _engine_list(engines)
-    files = _case_files(paths)
-    cases = [read_stress(f) for f in files]  # every file read and checked before any work
-    for f, (_, case) in zip(files, cases):
+    cases = []
+    for f in _case_files(paths):  # every file read and checked before any work; an error names the file
+        raw = read_table(f)
         with naming_file(f):
-            case_natives(case, registry.all_engines())  # [engine.NAME] settings read before any work
+            cases.append((raw, check_case(_load(raw, ()))))  # api.load: its [engine.NAME] settings read too
     root = Path(report_dir)
     out_dir = new_run_dir(root, "stress")
     results = []
@@ -958,10 +894,11 @@ def calibrate(case_path, engine, targets, dt, overrides, no_confirm, as_json, jo
         if key.strip() in wanted:
             raise ConfigError("--target", item, f"{key.strip()} is given twice: give each metric once")
         wanted[key.strip()] = number(f"--target {key.strip()}", value)
-    calibrate.check_targets(wanted)  # bad input: one line, before any work
+    calibrate.check_targets(wanted, "--target")  # bad input: one line, before any work
     _check_jobs(jobs, scheduler)
     result = api.calibrate(case_path, engine, wanted, dt, not no_confirm, list(overrides), jobs=jobs,
-                           scheduler=scheduler, keys=SET_KEYS, base=True)
+                           scheduler=scheduler, base=True,
+                           keys={**SET_KEYS, "engine": "--engine", "targets": "--target", "dt": "--dt"})
     if as_json:
         emit_json(result)
     else:

@@ -25,15 +25,14 @@ from ..case import Case, from_dict
 from ..errors import ConfigError, DemcheckError
 from ..io import number
 from ..inputs import script as deck_script
-from ..reference import collision3d
 from ..laws.model import resolve
 from ..laws.damping import ConstantDamping, NoDamping, QuarterDamping, SqrtDamping
 from ..laws.normal import HertzNormal, HookeNormal, HysteresisNormal
 from ..laws.tangential import NoTangential, SpringTangential, SqrtSpringTangential, ViscousSlidingTangential
 from ..engines import registry
-from ..engines.collide import collide, twin_states
 from ..engines.mapping import native_summary, twin_model
 from . import audit_beyond
+from .sources import ADAPTIVE, Source
 from .verdicts import Tolerances, scaled
 
 ANGLES = (0.0, 30.0, 60.0)
@@ -455,18 +454,18 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: T
     out = {"angle": angle, "speed": speed, "dt": dt, "dt_note": dt_note,
            "seed": {"normal": seed[0], "tangential": seed[1], "reasons": seed[3]}}
     scales = {"impact_energy": 0.5 * m_eff * speed ** 2, "spin": speed / case.particles[0].radius}
-    twin = twin_states(case, setup.engine, dt, native=ps.native)
+    twin = Source.of(eng, twin=True).run(case, dt, native=ps.native)
     out["twin"] = {"status": twin.status, "message": twin.message, **_metrics(twin)}
     try:
-        conv = _converged(case, setup.engine, eng, ps.native, dt)
+        conv = _converged(case, eng, ps.native, dt)
         out["converged"] = {"status": conv.status, **_metrics(conv), "by": conv.meta.get("converged_by", "")}
     except ConfigError as exc:
         conv = None
         out["converged"] = {"status": "not run", "message": str(exc)}
-    ref = collision3d.collide(case, resolve(case), "adaptive")
+    ref = ADAPTIVE.run(case, model=resolve(case))  # the seed model by the two-body kernel
     out["seed"].update(status=ref.status, **_metrics(ref))
     if run_engine:
-        res = collide(case, setup.engine, dt=dt, native=ps.native)
+        res = Source.of(eng).run(case, dt, native=ps.native)
         out["engine"] = {"status": res.status, "message": res.message, "version": res.engine_version,
                          **_metrics(res)}
         fn = res.contact["fn"].to_numpy() if res.contact is not None and len(res.contact) else np.array([0.0])
@@ -479,7 +478,7 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: T
     if conv is not None and conv.ok and twin.ok:
         out["dt_error"] = _worst(out["twin"], out["converged"], [k for k in METRICS if k != "peak_force"], scales)
         if out["dt_error"] > tol.verlet_rtol:  # is it the step's? the error must shrink with dt
-            half = twin_states(case, setup.engine, dt / 2.0, native=ps.native)
+            half = Source.of(eng, twin=True).run(case, dt / 2.0, native=ps.native)
             out["dt_error_half"] = (_worst({**_metrics(half)}, out["converged"],
                                            [k for k in METRICS if k != "peak_force"], scales) if half.ok else math.nan)
     t_c = main["contact_time"]
@@ -495,15 +494,15 @@ def probe(setup, ps, speed: float, angle: float, run_engine: bool = True, tol: T
 OWN_LAW_REFINE = 16  # an engine's own twin kernel has no adaptive form: its converged answer is dt / 16 (error / 256)
 
 
-def _converged(case, name: str, eng, native, dt: float):
+def _converged(case, eng, native, dt: float):
     """The probe's converged answer: the twin's law by the adaptive solver, or, where the engine's twin steps a law
     of its own (Engine.own_twin: Kratos' tangential force, Yade's Luding law), that kernel at dt / 16 — the
     adaptive solver would solve the description of the law, not the law."""
     if eng.own_twin(native):
-        conv = twin_states(case, name, dt / OWN_LAW_REFINE, native=native)
+        conv = Source.of(eng, twin=True).run(case, dt / OWN_LAW_REFINE, native=native)
         conv.meta["converged_by"] = f"the engine's own law stepped at dt/{OWN_LAW_REFINE}"
         return conv
-    conv = collision3d.collide(case, twin_model(resolve(case), native), "adaptive")
+    conv = ADAPTIVE.run(case, model=twin_model(resolve(case), native))  # the twin's law, the seed's rules
     conv.meta["converged_by"] = "the adaptive solver"
     return conv
 
@@ -943,7 +942,7 @@ def reverse(engine: str, line: str, radius: float = 1e-3, density: float = 2500.
         try:
             case = probe_case(setup, ps, speed, angle, nl, tl, seed_of(nl, tl, ps.asked))
             twin = native_law(case, engine, ps.native)
-            seed = collision3d.collide(case, resolve(case), "adaptive")
+            seed = ADAPTIVE.run(case, model=resolve(case))
         except (ValueError, ArithmeticError) as exc:
             raise ConfigError("SETTING", line, f"the {angle:g}° probe cannot be computed: {exc}") from None
         g = _worst(_metrics_of(twin.converged), _metrics(seed), [k for k in METRICS if k != "peak_force"], scales)
@@ -975,5 +974,5 @@ def _rerun(setup, ps, native, p: dict) -> dict:
     """The engine's metrics of probe ``p`` run again with another Native (an engine reader's measured trap)."""
     nl, tl = registry.get(setup.engine).twin(native, *_effective(setup, ps))
     case = probe_case(setup, ps, p["speed"], p["angle"], nl, tl, seed_of(nl, tl, ps.asked), p["dt"])
-    res = collide(case, setup.engine, dt=p["dt"], native=native)
+    res = Source.of(setup.engine).run(case, p["dt"], native=native)
     return {"status": res.status, "message": res.message, **_metrics(res)}

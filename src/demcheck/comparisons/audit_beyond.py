@@ -19,10 +19,11 @@ probes run:
 * heat — LAMMPS ``heat radius/area``, LIGGGHTS ``fix heat/gran/conduction``: two like spheres held at the head-on
   probe's largest overlap (``conduction``: heat_time_constant, Batchelor & O'Brien 1977 for LIGGGHTS).
 
-Each runs three times: the engine (engines/scenario.run: the deck its package writes), its twin
-(engines/scenario.twin) and the closed form (reference/scenarios.scenario_metrics, closed=True). A probe whose run
-fails or gives a metric that is not finite is a failure, never clean; a sub-model the engine's scenario mapping
-refuses, or one a probe cannot be built for, is listed with its reason.
+Each runs three times: the engine and its twin through Source.run (comparisons/sources.py; a scenario case:
+engines/scenario.run, the deck its package writes, and engines/scenario.twin) and the closed form
+(reference/scenarios.scenario_metrics, closed=True). A probe whose run fails or gives a metric that is not finite
+is a failure, never clean; a sub-model the engine's scenario mapping refuses, or one a probe cannot be built for,
+is listed with its reason.
 """
 
 from __future__ import annotations
@@ -451,8 +452,9 @@ def run_probe(setup, raw: dict, run_engine: bool) -> dict:
     """The scenario case run in the engine, its twin and the closed form: {status, scenario, fidelity, reasons,
     metrics: {name: {engine, twin, reference}}, engine_vs_twin, engine_vs_reference, twin_vs_reference}."""
     from ..engines import registry
-    from ..engines import scenario as sc
+    from ..engines.scenario import mapping as scenario_mapping
     from ..reference.scenarios import scenario_metrics
+    from .sources import Source
 
     try:
         case = from_dict({**raw, "name": _name(raw["name"])})
@@ -460,14 +462,14 @@ def run_probe(setup, raw: dict, run_engine: bool) -> dict:
         return {"status": "not probed", "why": f"the deck's values make no scenario case: {exc}"}
     eng = registry.get(setup.engine)
     out = {"scenario": case.run.scenario}
-    mp = sc.mapping(case, eng)
+    mp = scenario_mapping(case, eng)
     out.update(fidelity=mp.fidelity, reasons=list(mp.reasons))
     if mp.native is None:
         return {**out, "status": "not probed", "why": "; ".join(mp.reasons)}
     try:
         ref = scenario_metrics(case, closed=True)
-        twin = sc.twin(case, eng)
-        res = sc.run(case, eng) if run_engine else None
+        twin = Source.of(eng, twin=True).run(case)  # a scenario case: engines/scenario.py's twin and run
+        res = Source.of(eng).run(case) if run_engine else None
     except EngineInterrupted:
         raise
     except UnsupportedByEngine as exc:

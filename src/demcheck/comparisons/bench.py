@@ -283,6 +283,13 @@ class Basis:
     batch: int
 
 
+def check_case(case: Case) -> Case:
+    """A case bench can time: a collision (``demcheck bench`` checks every file so as it loads it)."""
+    from .sources import collision_only
+
+    return collision_only(case, "bench times the steps of an impact; a scenario beyond sliding is solved by the adaptive reference alone (`demcheck verify` runs it)")
+
+
 def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE_RTOLS,
                batch: int = BATCH, cache=None, progress=None, campaign=None) -> BenchResult:
     """The work–precision of each source for one collision case (module docstring). ``engines``: the engines
@@ -293,6 +300,7 @@ def bench_case(case: Case, engines=None, steps=STEPS_PER_CONTACT, rtols=ADAPTIVE
     from . import sources
     from .dispatch import Campaign
 
+    check_case(case)
     model = resolve(case)
     t_c = characteristic_time(model)
     ref = sources.ADAPTIVE.run(case).metrics()

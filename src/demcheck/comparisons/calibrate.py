@@ -21,101 +21,112 @@ from ..errors import ConfigError, DemcheckError
 from ..engines import registry
 from ..engines.collide import setting
 from ..engines.mapping import contact_mapping, native_summary
-from .sources import Source
+from .sources import Source, collision_only
 
 TARGETS = {"restitution": (0.0, 1.0), "tangential_restitution": (-1.0, 1.0)}
 ROOT_TOL = 1e-6  # |realised − target| the root is found to, in the metric's own (dimensionless) units
 MAX_DOUBLINGS = 60
+# the names the errors give the arguments: the API's (a command line passes its options: --target, --engine, --dt)
+KEYS = {"targets": "targets", "engine": "engine", "dt": "dt"}
 
 
-def check_targets(targets: dict) -> dict:
+def _under(key: str, metric: str) -> str:
+    """One target's key in an error: ``--target restitution`` (the option's), ``targets.restitution``."""
+    return key + (" " if key.startswith("--") else ".") + metric
+
+
+def check_targets(targets: dict, key: str = KEYS["targets"]) -> dict:
+    """``targets`` (metric → value) checked; else a ConfigError naming ``key`` (the API's ``targets``, the
+    command line's ``--target``)."""
     out = {}
     for k, v in targets.items():
         if k not in TARGETS:
-            raise ConfigError("--target", k, f"must be one of {', '.join(TARGETS)}")
+            raise ConfigError(key, k, f"must be one of {', '.join(TARGETS)}")
         lo, hi = TARGETS[k]
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not (lo < v <= hi):
-            raise ConfigError(f"--target {k}", v, f"must be a number in ({lo:g}, {hi:g}]")
+            raise ConfigError(_under(key, k), v, f"must be a number in ({lo:g}, {hi:g}]")
         out[k] = float(v)
     if not out:
-        raise ConfigError("--target", None, "give at least one METRIC=VALUE (restitution, tangential_restitution)")
+        raise ConfigError(key, None, "give at least one " + ("METRIC=VALUE" if key.startswith("--") else "metric")
+                          + " (restitution, tangential_restitution)")
     return out
 
 
 def calibrate(case: Case, engine: str, targets: dict, dt: float | None = None, confirm: bool = True,
-              campaign=None) -> dict:
+              campaign=None, keys: dict | None = None) -> dict:
     """The calibration as a dict: per target the input found (name, from, to), the twin's realised value, and
     the engine's on confirmation; the native configuration and the lines to paste. The root finding runs here (each
     twin run needs the one before); the confirming engine run is a task of ``campaign`` (dispatch.Campaign; default
-    this process)."""
-    from scipy.optimize import brentq
-
-    targets = check_targets(targets)
+    this process). ``keys``: the names the errors give the arguments (KEYS; the command line's options)."""
+    keys = {**KEYS, **(keys or {})}
+    targets = check_targets(targets, keys["targets"])
     if engine not in registry.names():
-        raise ConfigError("--engine", engine, f"must be one of {', '.join(registry.names())}")
+        raise ConfigError(keys["engine"], engine, f"must be one of {', '.join(registry.names())}")
     eng = registry.get(engine)
-    if case.run.scenario != "collision":
-        raise ConfigError("run.scenario", case.run.scenario, "must be \"collision\": a target metric (restitution) "
-                                                            "is an impact's")
+    collision_only(case, "a target metric (restitution) is an impact's")
     if dt is not None and not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-        raise ConfigError("--dt", dt, "must be a number > 0 (s)")
+        raise ConfigError(keys["dt"], dt, "must be a number > 0 (s)")
     # the step `demcheck collide --engine` runs the case at (a native setting at its own step): the input found
     # realises the target in the run of the line pasted back into the case
     native, step = setting(case, engine, dt)
     step = step or run_length(case)[0]
     native = native or contact_mapping(case, engine).require()
     if "tangential_restitution" in targets and not _oblique(case):
-        raise ConfigError("--target tangential_restitution", targets["tangential_restitution"],
+        raise ConfigError(_under(keys["targets"], "tangential_restitution"), targets["tangential_restitution"],
                           "needs an oblique impact (impact.angle > 0): a head-on one has no tangential motion")
     twin = Source.of(eng, twin=True)
-    knobs = {}
     for metric in targets:  # every input named before any run
         if eng.knob(native, metric) is None:
-            raise ConfigError("--target", metric, f"{eng.title}'s {native_summary(native)} has no input that "
-                                                  "sets it")
-        knobs[metric] = True
+            raise ConfigError(keys["targets"], metric, f"{eng.title}'s {native_summary(native)} has no input that "
+                                                       "sets it")
     out = {"case": case.name, "engine": engine, "dt": step, "from": native_summary(native), "inputs": {}}
     for metric in sorted(targets, key=list(TARGETS).index):
-        target = targets[metric]
-        knob = eng.knob(native, metric)
-        calls = []
-
-        def gap(x, knob=knob, metric=metric, target=target):
-            v = twin.run(case, step, native=knob.set(x)).metrics()[metric]
-            calls.append((x, v))
-            if not math.isfinite(v):
-                raise DemcheckError(f"the twin's {metric} is not finite at {knob.name} = {x:g}")
-            return v - target
-
-        lo, hi = knob.lo, knob.hi
-        f_lo = gap(lo)
-        if hi is None:
-            hi = max(knob.start, 1e-300)
-            for _ in range(MAX_DOUBLINGS):
-                if (gap(hi) > 0) != (f_lo > 0):
-                    break
-                hi *= 2.0
-        f_hi = gap(hi)
-        if (f_lo > 0) == (f_hi > 0):
-            a, b = calls[0][1], calls[-1][1]
-            raise ConfigError(f"--target {metric}", target, f"out of reach: {knob.name} in [{lo:g}, {hi:g}] "
-                                                            f"realises {min(a, b):.6g} to {max(a, b):.6g} at dt = {step:g} s")
-        x = brentq(gap, lo, hi, xtol=1e-14, rtol=1e-12, maxiter=200)
-        realised = gap(x) + target
-        if abs(realised - target) > ROOT_TOL:
-            raise DemcheckError(f"{metric}: Brent's method stopped at {knob.name} = {x:.10g} with {realised:.10g}, "
-                                f"not within {ROOT_TOL:g} of {target:g} (the metric jumps there)")
-        before = knob.start
-        native = knob.set(x)
-        out["inputs"][metric] = {"input": knob.name, "from": before, "to": x, "target": target,
-                                 "twin": realised, "twin_runs": len(calls)}
+        native, out["inputs"][metric] = _find(case, eng.knob(native, metric), twin, step, metric, targets[metric],
+                                              keys["targets"])
     out["native"] = native_summary(native)
     out["lines"] = eng.native_lines(native)
     out["confirmed"] = None
-    eng.check_native(native, "--target")  # an input the engine would refuse: stopped before its run
+    eng.check_native(native, keys["targets"])  # an input the engine would refuse: stopped before its run
     if confirm:
         _confirm(out, case, engine, step, native, campaign)
     return out
+
+
+def _find(case: Case, knob, twin: Source, step: float, metric: str, target: float, key: str) -> tuple:
+    """(the native configuration with ``knob`` set, its entry in the result): the input that realises ``target``
+    in ``twin`` at ``step``, by Brent's method over the knob's range (doubled up to MAX_DOUBLINGS times when it
+    has no upper end); a target out of the range's reach is a ConfigError naming ``key``."""
+    from scipy.optimize import brentq
+
+    calls = []
+
+    def gap(x):
+        v = twin.run(case, step, native=knob.set(x)).metrics()[metric]
+        calls.append((x, v))
+        if not math.isfinite(v):
+            raise DemcheckError(f"the twin's {metric} is not finite at {knob.name} = {x:g}")
+        return v - target
+
+    lo, hi = knob.lo, knob.hi
+    f_lo = gap(lo)
+    if hi is None:
+        hi = max(knob.start, 1e-300)
+        for _ in range(MAX_DOUBLINGS):
+            if (gap(hi) > 0) != (f_lo > 0):
+                break
+            hi *= 2.0
+    f_hi = gap(hi)
+    if (f_lo > 0) == (f_hi > 0):
+        a, b = calls[0][1], calls[-1][1]
+        raise ConfigError(_under(key, metric), target, f"out of reach: {knob.name} in [{lo:g}, {hi:g}] realises "
+                                                       f"{min(a, b):.6g} to {max(a, b):.6g} at dt = {step:g} s")
+    x = brentq(gap, lo, hi, xtol=1e-14, rtol=1e-12, maxiter=200)
+    realised = gap(x) + target
+    if abs(realised - target) > ROOT_TOL:
+        raise DemcheckError(f"{metric}: Brent's method stopped at {knob.name} = {x:.10g} with {realised:.10g}, "
+                            f"not within {ROOT_TOL:g} of {target:g} (the metric jumps there)")
+    return knob.set(x), {"input": knob.name, "from": knob.start, "to": x, "target": target, "twin": realised,
+                         "twin_runs": len(calls)}
 
 
 def _confirm(out: dict, case: Case, engine: str, step: float, native, campaign) -> None:

@@ -115,19 +115,25 @@ class Source:
         return setting(case, self.engine, dt)
 
     def run(self, case: Case, dt: float | None = None, *, rtol: float | None = None, native=_SETTING,
-            timeout: float | None = None, restated: bool = False, converged: bool = False, **options) -> Result:
+            timeout: float | None = None, restated: bool = False, converged: bool = False, model=None,
+            **options) -> Result:
         """The source's Result for ``case`` at ``dt``. The reference: its method at ``dt`` (verlet) or ``rtol``
-        (adaptive); ``restated``: by the two-body kernel, read off its states as an engine's run is
+        (adaptive); ``model``: the contact it solves by the two-body kernel (reference/collision3d.py, the seed's
+        kinematic rules) instead of the case's own solve — the seed model (laws.model.resolve) or an engine's law
+        (engines.mapping.twin_model: the audit's converged answer of a deck's setting); ``restated``: by the
+        two-body kernel (the seed model unless ``model``), read off its states as an engine's run is
         (engines.states.restate) — the seed model at an engine's step. An engine: its deck run for real
         (``timeout``; ``options`` — cache, worker, copies — go to engines.collide.collide). A twin: the reference
         computing the engine's formula with its scheme at the engine's dt; ``converged``: its converged answer
         (:func:`_converged_twin`). ``native``: the engine's setting (default the case's own, at its own step when
         ``dt`` is None; None: the engine's mapping of the seed model)."""
+        if model is not None and self.kind != REFERENCE:
+            raise TypeError(f"{self.label}: model= is the reference's (an engine and its twin run their own setting)")
         if case.run.scenario != "collision":
             return self._scenario(case, timeout, options.get("cache"))
         if self.kind == REFERENCE:
-            if restated:
-                return _restated(case, self.method, dt, rtol)
+            if restated or model is not None:
+                return _two_body(case, model, self.method, dt, rtol, restated)
             from ..reference.collision import collide
 
             return collide(case, method=self.method, dt=dt, rtol=rtol)
@@ -170,14 +176,17 @@ class Source:
         return solve(case)
 
 
-def _restated(case: Case, method: str | None, dt: float | None, rtol: float | None) -> Result:
-    """The seed model's run by the two-body kernel, its contact table read off its states as an engine's is."""
+def _two_body(case: Case, model, method: str | None, dt: float | None, rtol: float | None,
+              restated: bool) -> Result:
+    """``model`` (None: the seed model) solved by the two-body kernel; ``restated``: its contact table read off its
+    states as an engine's is."""
     from ..engines import states
     from ..laws.model import resolve
     from ..reference import collision3d
 
-    return states.restate(collision3d.collide(case, resolve(case), method or case.run.method, dt=dt, rtol=rtol),
-                          case)
+    res = collision3d.collide(case, resolve(case) if model is None else model, method or case.run.method, dt=dt,
+                              rtol=rtol)
+    return states.restate(res, case) if restated else res
 
 
 def _converged_twin(case: Case, engine, native, dt: float) -> Result:
@@ -202,6 +211,15 @@ def _converged_twin(case: Case, engine, native, dt: float) -> Result:
 
 
 ADAPTIVE, VERLET = Source.reference("adaptive"), Source.reference("verlet")
+
+
+def collision_only(case: Case, why: str) -> Case:
+    """``case`` when it is a collision (run.scenario "collision"); a scenario beyond sliding is a ConfigError naming
+    run.scenario, its value and ``why`` — what the command measures is an impact's (calibrate, bench, stress: each
+    refuses it as it loads the case, before any work)."""
+    if case.run.scenario != "collision":
+        raise ConfigError("run.scenario", case.run.scenario, f"must be \"collision\": {why}")
+    return case
 
 
 @dataclass(frozen=True)

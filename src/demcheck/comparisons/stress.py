@@ -219,18 +219,21 @@ def largest_stable(check) -> tuple[float | None, str]:
     return GRID[hi], failure
 
 
-def read_stress(path: Path) -> tuple[dict, Case]:
-    """A stress case file, read and checked (its variants dropped: stress pushes parameters of its own): its
-    raw table and its Case. A bad file is a ConfigError naming the file (case.naming_file)."""
+def read_table(path: Path) -> dict:
+    """A stress case file's table (its variants dropped: stress pushes parameters of its own), which ``stress_case``
+    varies; its Case is api.load's of this table (the one loader). A file that cannot be read is a ConfigError
+    naming the file (case.naming_file)."""
     with naming_file(path):
-        raw0 = _read(path)
-        raw0.pop("variants", None)
-        return raw0, from_dict(copy.deepcopy(raw0))
+        raw = _read(path)
+        raw.pop("variants", None)
+        return raw
 
 
-def stress_file(path: Path, engines=None, only: list[str] | None = None,
-                progress=None, campaign=None) -> StressResult:
-    return stress_case(*read_stress(path), engines=engines, only=only, progress=progress, campaign=campaign)
+def check_case(case: Case) -> Case:
+    """A case stress can search: a collision (``demcheck stress`` checks every file so as it loads it)."""
+    from .sources import collision_only
+
+    return collision_only(case, "stress searches the largest stable step of an impact; a scenario beyond sliding is solved by the adaptive reference alone (`demcheck verify` runs it)")
 
 
 def limit_task(parameter: str, value, source: str, case: Case, t_c: float, cache=None) -> Limit | str:
@@ -255,11 +258,12 @@ def limit_task(parameter: str, value, source: str, case: Case, t_c: float, cache
 
 def stress_case(raw0: dict, base: Case, engines=None, only: list[str] | None = None,
                 progress=None, campaign=None) -> StressResult:
-    """Stress one case (``read_stress``'s raw table and Case) over its parameters, each source's search at each
+    """Stress one case (``read_table``'s raw table and its Case) over its parameters, each source's search at each
     value a task of ``campaign`` (dispatch.Campaign; default this process); the limits in the order planned."""
     from .dispatch import Campaign
     from .sources import engines_of
 
+    check_case(base)
     res = StressResult(base.name, resolve(base).describe())
     params = parameters(raw0)
     if only:

@@ -9,13 +9,12 @@ and restitution): such a sweep is refused before any work, rather than a table o
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
 import pandas as pd
 
-from ..case import _read, apply_overrides, from_dict, parse_value
+from ..case import parse_value
 from ..errors import ConfigError, DemcheckError
 
 
@@ -59,28 +58,6 @@ class Points(list):
         self.overrides = list(overrides)
 
 
-def sweep_points(case_path, overrides, varies: list[str]) -> Points:
-    """Every point of the grid as (its values by key, its Case), all loaded and validated before any is
-    solved: a bad key or value is one ConfigError (exit 2), not a row of errors."""
-    axes = [parse_vary(v) for v in varies]
-    keys = [k for k, _ in axes]
-    total = math.prod(len(vals) for _, vals in axes)
-    if total > MAX_POINTS:
-        raise ConfigError("--vary", " ".join(varies), f"makes a grid of {total} points; at most {MAX_POINTS}")
-    from ..engines import registry
-    from ..engines.base import case_natives
-
-    raw = _read(case_path)  # the file is read once
-    case_natives(from_dict(apply_overrides(raw, list(overrides))), registry.all_engines())  # valid on its own
-    points = []
-    for point in itertools.product(*[vals for _, vals in axes]):
-        sets = list(overrides) + [f"{k}={_text(v)}" for k, v in zip(keys, point)]
-        case = from_dict(apply_overrides(raw, sets))
-        case_natives(case, registry.all_engines())  # [engine.NAME] settings read by their engines
-        points.append((dict(zip(keys, point)), case))
-    return Points(points, overrides)
-
-
 def check_source(source: str, method=None, keys: tuple[str, str, str] = ("--engine", "--method", "--dt")) -> str:
     """``source`` as a sweep runs it: reference, a registered engine (or build), or ``NAME-twin``; ``method``
     is the reference's. Else ConfigError naming the option, before any work: ``keys`` are the names of the
@@ -121,7 +98,7 @@ def native_vary_rule(points: list[tuple[dict, object]], source: str, where: str 
                      set_where: str = "--set ") -> None:
     """Refuse, before any work, a key that cannot move what ``source`` runs: with the case's own setting for the
     source's engine (``[engine.NAME]``), a ``contact.*`` key (the seed model's, not the native law's) varied or
-    set (``points.overrides``, sweep_points' Points), or a ``materials.*`` key that leaves what the native run
+    set (``points.overrides``: api.sweep's Points), or a ``materials.*`` key that leaves what the native run
     sees (bench.native_seen: its law, the masses, …) unchanged at every point. The error's key is ``where`` +
     the case key (``--vary contact.kn``; the API's ``vary.contact.kn``), or ``set_where`` + it for an override
     (``--set contact.kn``; the API's ``overrides.contact.kn``)."""
@@ -199,7 +176,7 @@ BATCH = 256  # points a compiled call of the reference solves (the progress bar 
 
 def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=None,
               source: str = "reference", campaign=None) -> pd.DataFrame:
-    """Solve each point (``sweep_points``) from ``source`` (``check_source``), in ``campaign``
+    """Solve each point (api.sweep's grid: its values by key and its Case) from ``source`` (``check_source``), in ``campaign``
     (dispatch.Campaign; default this process), the rows in the points' order. The reference's points in this
     process are solved BATCH at a time (reference/batch.py: the 1-D verlet ones in one compiled call)."""
     from .dispatch import Campaign
@@ -224,14 +201,6 @@ def run_sweep(points: list[tuple[dict, object]], method=None, dt=None, progress=
         if progress:
             progress()
     return pd.DataFrame([rows[i] for i in sorted(rows)])
-
-
-def _text(v) -> str:
-    if isinstance(v, str):
-        return f'"{v}"'
-    if isinstance(v, bool):
-        return str(v).lower()
-    return repr(float(v)) if isinstance(v, (float, np.floating)) else repr(v)
 
 
 def plot_sweep(table: pd.DataFrame, key: str, path) -> None:
