@@ -5,6 +5,7 @@ what can run the case, and every command loads its case through api.load."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -115,21 +116,21 @@ def test_sweep_refuses_a_key_varied_twice():
 
 
 def test_cases_and_the_api_give_the_same_listing_and_file():
-    """`demcheck cases` is api.cases: the listing and one file, the same from both faces; an unknown name names
+    """`demcheck cases` is api.case_files: the listing and one file, the same from both faces; an unknown name names
     the argument of each."""
     p = CliRunner().invoke(cli, ["cases", "--json"])
     assert p.exit_code == 0, p.output
-    listing = demcheck.cases()
+    listing = demcheck.case_files()
     assert json.loads(p.output) == json.loads(json.dumps(plain(listing))) and listing["cases"]
     p = CliRunner().invoke(cli, ["cases", "glass-pair", "--json"])
-    one = demcheck.cases("glass-pair")
+    one = demcheck.case_files("glass-pair")
     assert json.loads(p.output) == one and one["text"].startswith(("#", "name", "["))
     p = CliRunner().invoke(cli, ["cases", "glass-pair"])
     assert p.output == one["text"]
     p = CliRunner().invoke(cli, ["cases", "no-such-case"])
     assert isinstance(p.exception, ConfigError) and p.exception.key == "NAME"
     with pytest.raises(ConfigError) as err:
-        demcheck.cases("no-such-case")
+        demcheck.case_files("no-such-case")
     assert err.value.key == "name"
 
 
@@ -194,3 +195,15 @@ def test_a_sweeps_grid_is_built_in_one_place():
     text = Path(sweep.__file__).read_text()
     assert not hasattr(sweep, "sweep_points")
     assert "from_dict" not in text and "apply_overrides" not in text and "_read(" not in text
+
+
+def test_no_api_name_is_a_module_or_folder_of_the_package():
+    """`demcheck.NAME` is an API function looked up by the package's __getattr__; an import of a submodule or a
+    folder of the same name (`import demcheck.cases`: the shipped case files' folder) would set the attribute to
+    that module, in its place, for the whole process."""
+    import demcheck
+
+    root = Path(demcheck.__file__).parent
+    taken = {p.stem for p in root.iterdir() if p.suffix == ".py" or p.is_dir()}
+    assert not taken & set(demcheck._API)
+    assert callable(demcheck.case_files) and demcheck.case_files()["cases"]

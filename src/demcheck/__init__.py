@@ -74,7 +74,7 @@ KERNEL_CACHE = _numba_cache_dir()
 
 
 # the Python API (docs/api.md), looked up on first use: ``import demcheck`` loads no solver, engine or pandas
-_API = ("load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "cases", "sources",
+_API = ("load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "case_files", "sources",
         "packing_universe", "models")
 
 

@@ -31,7 +31,7 @@ from . import case as _case
 from .errors import ConfigError
 from .result import Result as _Result
 
-__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "cases",
+__all__ = ["load", "collide", "collide_many", "sweep", "verify", "audit", "calibrate", "pack", "case_files",
            "packing_universe", "models", "Result", "ConfigError"]
 
 MAX_POINTS = 10_000  # a sweep's grid, as the command line's
@@ -535,11 +535,12 @@ def calibrate(case, engine: str, targets: Mapping[str, float], dt: float | None 
         return run(c, engine, dict(targets), dt=dt, confirm=confirm, campaign=campaign, keys=key)
 
 
-def cases(name: str | None = None, key: str = "name") -> dict:
-    """The case files shipped with demcheck (``demcheck cases``): ``{"root", "cases"}``, a row per file (name,
-    folder, kind, normal and tangential model, whether the default suite runs it, path); with ``name`` (a shipped
-    case's name or a file's path, as every command takes it) that file: ``{"name", "path", "text"}``. An unknown
-    name is a ConfigError naming ``key``."""
+def case_files(name: str | None = None, key: str = "name") -> dict:
+    """The case files shipped with demcheck (``demcheck cases``; not ``demcheck.cases``, the name of the folder
+    that ships them, which an ``import demcheck.cases`` would put in its place): ``{"root", "cases"}``, a row per
+    file (name, folder, kind, normal and tangential model, whether the default suite runs it, path); with
+    ``name`` (a shipped case's name or a file's path, as every command takes it) that file: ``{"name", "path",
+    "text"}``. An unknown name is a ConfigError naming ``key``."""
     from . import resources
 
     if name is not None:

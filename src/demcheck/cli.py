@@ -474,7 +474,7 @@ def cases_command(name, as_json):
     (`demcheck cases glass-pair > my-case.toml`)."""
     from . import api
 
-    found = api.cases(name, "NAME")
+    found = api.case_files(name, "NAME")
     if as_json:
         emit_json(found)
     elif name is not None:
