@@ -11,7 +11,8 @@ run.rtol = 1e-13 (the default), 1e-12, 1e-11, 1e-10, 1e-9 and 1e-8: the compiled
 REPEAT; one run for a solve over 0.3 s), the output points, whether it completed, and the largest scaled
 difference of its metrics (restitution, tangential restitution, contact time, rebound angle, rebound spin, peak
 forces, energy dissipated: every metric both runs report) from the same variant at 1e-13 and from the verlet
-method at 20 000 steps per contact (an independent path; first order in dt, so ~1e-5 to 1e-8 itself). Printed: per
+method at 20 000 steps per contact (an independent path, but first order in dt for the damped laws: up to ~1e-3
+itself, shrinking with its step — it bounds the adaptive answer only loosely). Printed: per
 variant and rtol, then per rtol the worst difference over all variants and the median and total kernel time.
 
 Run: .venv/bin/python benchmarks/bench_adaptive_rtol.py [REPEAT] > benchmarks/results/bench_adaptive_rtol.txt

@@ -155,9 +155,17 @@ def test_pack_and_the_api_give_the_same_packing_and_files(tmp_path):
     ({"mpi": 2}, "mpi"), ({"engine": "lammps", "threads": 2}, "threads"), ({"threads": 0}, "threads"),
     ({"engine": "nosuch"}, "engine"), ({"duration": 1e-300}, "duration"), ({"csv": 3}, "csv"),
 ])
-def test_pack_names_the_apis_arguments_before_any_work(tmp_path, kwargs, key):
+def test_pack_names_the_apis_arguments_before_any_work(tmp_path, kwargs, key, monkeypatch):
+    from demcheck.engines import packing as engine_packing
+    from demcheck.reference import packing
+
     from .test_pack_output import SMALL
 
+    def work(*args, **kwargs):
+        raise AssertionError("a packing was started before its arguments were checked")
+
+    monkeypatch.setattr(packing, "simulate", work)
+    monkeypatch.setattr(engine_packing, "run_engine", work)
     case = tmp_path / "small.toml"
     case.write_text(SMALL)
     with pytest.raises(ConfigError) as err:
@@ -207,3 +215,15 @@ def test_no_api_name_is_a_module_or_folder_of_the_package():
     taken = {p.stem for p in root.iterdir() if p.suffix == ".py" or p.is_dir()}
     assert not taken & set(demcheck._API)
     assert callable(demcheck.case_files) and demcheck.case_files()["cases"]
+
+
+def test_a_case_file_that_is_not_text_is_bad_input_naming_it(tmp_path):
+    """`demcheck cases FILE` / demcheck.case_files(FILE) of a binary file: one line naming the argument and the
+    file, exit 2 — it was a UnicodeDecodeError traceback, exit 1."""
+    f = tmp_path / "binary.toml"
+    f.write_bytes(b"\xff\xfe\x00binary")
+    with pytest.raises(ConfigError) as err:
+        demcheck.case_files(str(f))
+    assert err.value.key == "name" and "UTF-8" in err.value.rule
+    p = CliRunner().invoke(cli, ["cases", str(f)])
+    assert isinstance(p.exception, ConfigError) and p.exception.key == "NAME"

@@ -315,3 +315,30 @@ def test_liggghts_deck_numbers_out_of_range_name_the_property_line(tmp_path):
                  "pair_style gran model hertz/stiffness tangential history\npair_coeff * *\n")
     r = A.audit(deck, run_engine=False)  # gammat > 0 with gamman = 0: no twin; listed, not probed
     assert r["pairs"][0]["probes"] == [] and "no twin" in " ".join(r["pairs"][0]["notes"])
+
+
+@pytest.mark.engine("lammps")
+def test_the_converged_answer_is_the_limit_of_the_twin_with_the_engine_s_rules(tmp_path):
+    """The probe's converged answer is the twin's law solved by the adaptive method with LAMMPS's own kinematic rules
+    (slip arm at the radius, the history rescaled when significant): the twin stepped at dt/16 lands on it (a first-order
+    scheme: ~dt/16 of the twin's own error), where the seed's rules left a floor of 2.4e-4 that no step removed — and
+    the audit's time-step error carried it."""
+    from demcheck.comparisons.sources import ADAPTIVE, Source
+    from demcheck.engines import registry
+    from demcheck.engines.mapping import twin_model
+    from demcheck.laws.model import resolve
+
+    deck = _deck(tmp_path, HEAD.format(n=1) + "pair_style granular\npair_coeff * * hertz/material 63e9 0.6 0.24 "
+                 "damping tsuji tangential mindlin NULL 1.0 0.5\n")
+    setup = A.read(deck)
+    ps = setup.pairs[0]
+    eng = registry.get("lammps")
+    nl, tl = eng.twin(ps.native, *A._effective(setup, ps))
+    case, dt, _ = A.case_at_step(setup, ps, 1.0, 60.0, nl, tl, A.seed_of(nl, tl, ps.asked))
+    conv = A._converged(case, eng, ps.native, dt)
+    assert conv.meta["converged_by"] == "the adaptive solver, with the engine's kinematic rules"
+    fine = Source.of(eng, twin=True).run(case, dt / 16, native=ps.native).metrics()
+    seed_rules = ADAPTIVE.run(case, model=twin_model(resolve(case), ps.native)).metrics()
+    for k in ("tangential_restitution", "rebound_angular_velocity"):
+        assert abs(fine[k] / conv.metrics()[k] - 1) < 1e-4, k
+        assert abs(fine[k] / seed_rules[k] - 1) > 2e-4, k  # what the seed's rules answered (the old converged answer)

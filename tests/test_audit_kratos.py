@@ -180,7 +180,7 @@ def test_a_law_the_twin_steps_its_own_way_is_converged_by_its_own_kernel(tmp_pat
     setup = A.read(_project(tmp_path, dt=5e-9))
     pair = setup.pairs[0]
     w = A.probe(setup, pair, 1.0, 0.0, run_engine=False)
-    assert w["converged"]["by"] == "the adaptive solver"
+    assert w["converged"]["by"].startswith("the adaptive solver")
     pair.native = copy.deepcopy(pair.native)
     pair.native.tangential = FRICTION
     pair.native.props.update(poisson=NU_GLASS, mu_s=0.4, mu_d=0.3, decay=500.0)

@@ -238,4 +238,4 @@ def test_sweep_solves_a_scenario_at_each_point_and_dt_refuses_one():
         t, _ = b.rolling_stop_closed(row["contact.mu_r"], 1.59e-3, 1.59e-3, 0.02, 9.81)
         assert row["status"] == "ok" and abs(row["rolling_stop_time"] - t) < 1e-9 * t
     d = subprocess.run([sys.executable, "-m", "demcheck", "dt", "beyond-twist"], capture_output=True, text=True)
-    assert d.returncode == 2 and "run.scenario = 'twist': has no time step to recommend" in d.stderr
+    assert d.returncode == 2 and "run.scenario = 'twist': must be \"collision\": a time step is recommended" in d.stderr

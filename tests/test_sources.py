@@ -227,3 +227,19 @@ def test_a_native_step_too_fine_names_what_set_it_not_dt():
         assert "--dt" not in str(exc.value).split(":")[0]
     with pytest.raises(ConfigError, match="^--dt = 9e-12"):  # a step given is named as given
         S.Source.parse("lammps").run(case, 9e-12)
+
+
+def test_a_model_given_for_a_scenario_case_is_refused_not_ignored():
+    """Source.run(model=…) solves a collision of that model; a scenario case runs its own laws, so a model given for
+    one is an error (it was silently ignored)."""
+    from demcheck.case import expand, load
+    from demcheck.comparisons.sources import ADAPTIVE
+    from demcheck.laws.model import resolve
+    from demcheck.resources import case_path
+
+    glass = resolve(load(case_path("glass-pair")))
+    (first,) = sorted((Path(case_path("glass-pair")).parent / "suite").glob("beyond-*.toml"))[:1]
+    scenario = next(iter(expand(first)))
+    assert scenario is not None and scenario.run.scenario != "collision"
+    with pytest.raises(TypeError, match="model= solves a collision"):
+        ADAPTIVE.run(scenario, model=glass)

@@ -13,7 +13,7 @@
 * :func:`calibrate` — the native input that realises a target metric in an engine at a time step;
 * :func:`pack` — a packing case settled in the reference or an engine → its packing metrics (and its settled
   state written where asked);
-* :func:`cases` — the shipped case files, or one file's text.
+* :func:`case_files` — the shipped case files, or one file's text.
 
 Bad input raises :class:`~demcheck.errors.ConfigError` (key, value, rule) before any work; docs/api.md has
 examples.
@@ -546,7 +546,11 @@ def case_files(name: str | None = None, key: str = "name") -> dict:
     if name is not None:
         path = resources.case_path(_text(key, name, "must be a shipped case's name or a case file's path (text)"),
                                    key)
-        return {"name": path.stem, "path": str(path), "text": path.read_text()}
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (UnicodeDecodeError, OSError) as exc:
+            raise ConfigError(key, name, f"must be a case file (TOML, UTF-8 text): {type(exc).__name__}") from None
+        return {"name": path.stem, "path": str(path), "text": text}
     return {"root": str(resources.cases_dir()), "cases": resources.case_rows()}
 
 

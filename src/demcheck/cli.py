@@ -803,10 +803,10 @@ def dt(case_path, target, overrides, as_json):
     work–precision of the engines' scheme, with the error to expect."""
     from .comparisons.bench import recommend
 
-    case = _load(case_path, overrides)
-    if case.run.scenario != "collision":
-        raise ConfigError("run.scenario", case.run.scenario, "has no time step to recommend: the scenarios beyond "
-                                                             "sliding are solved by the adaptive reference only")
+    from .comparisons.sources import collision_only
+
+    case = collision_only(_load(case_path, overrides), "a time step is recommended for an impact; the scenarios "
+                                                       "beyond sliding are solved by the adaptive reference only")
     rec = recommend(case, target)
     if as_json:
         emit_json(rec)

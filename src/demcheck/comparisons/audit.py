@@ -495,15 +495,23 @@ OWN_LAW_REFINE = 16  # an engine's own twin kernel has no adaptive form: its con
 
 
 def _converged(case, eng, native, dt: float):
-    """The probe's converged answer: the twin's law by the adaptive solver, or, where the engine's twin steps a law
-    of its own (Engine.own_twin: Kratos' tangential force, Yade's Luding law), that kernel at dt / 16 — the
-    adaptive solver would solve the description of the law, not the law."""
+    """The probe's converged answer: the twin's law by the adaptive solver with the engine's kinematic rules (its
+    slip arm, torque arms and history rotation: what the twin steps at dt, so that the difference is the time
+    step's alone), or, where the engine's twin steps a law of its own (Engine.own_twin: Kratos' tangential force,
+    Yade's Luding law), that kernel at dt / 16 — the adaptive solver would solve the description of the law, not
+    the law. A law whose history the adaptive solver does not keep (a force history, a rescaled history) is solved
+    with the seed's rules, and the result says so."""
     if eng.own_twin(native):
         conv = Source.of(eng, twin=True).run(case, dt / OWN_LAW_REFINE, native=native)
         conv.meta["converged_by"] = f"the engine's own law stepped at dt/{OWN_LAW_REFINE}"
         return conv
-    conv = ADAPTIVE.run(case, model=twin_model(resolve(case), native))  # the twin's law, the seed's rules
-    conv.meta["converged_by"] = "the adaptive solver"
+    model = twin_model(resolve(case), native)
+    if not (model.tangential_law.force_history or model.tangential_law.rescale_history):
+        conv = Source.of(eng, twin=True).run(case, dt, native=native, converged=True)
+        conv.meta["converged_by"] = "the adaptive solver, with the engine's kinematic rules"
+        return conv
+    conv = ADAPTIVE.run(case, model=model)  # the twin's law, the seed's rules
+    conv.meta["converged_by"] = "the adaptive solver, with the seed's kinematic rules (its history is not the law's)"
     return conv
 
 

@@ -129,6 +129,8 @@ class Source:
         ``dt`` is None; None: the engine's mapping of the seed model)."""
         if model is not None and self.kind != REFERENCE:
             raise TypeError(f"{self.label}: model= is the reference's (an engine and its twin run their own setting)")
+        if model is not None and case.run.scenario != "collision":
+            raise TypeError(f"{self.label}: model= solves a collision; a scenario's laws are its case's")
         if case.run.scenario != "collision":
             return self._scenario(case, timeout, options.get("cache"))
         if self.kind == REFERENCE:
