@@ -206,7 +206,8 @@ def test_generated_packing_decks_match_the_golden_files(engine):
 def test_golden_packing_decks_run_by_hand(engine, tmp_path):
     """A person runs the golden deck (lmp -in / liggghts -in) beside its data file: it runs to the end, every
     particle's mass is the case's to the last bit, no particle is below the floor, and the contact dump reads."""
-    from demcheck.engines.packing import read_contacts
+    from demcheck.engines import registry
+    from demcheck.engines.family import read_contact_dump
 
     case = small_case()
     table = _run_by_hand(engine, GOLDEN / f"packing-small.{engine}.in",
@@ -214,7 +215,7 @@ def test_golden_packing_decks_run_by_hand(engine, tmp_path):
     assert len(table) == len(case.particles)
     assert [m == case.mass(k) for k, m in enumerate(table["mass"])] == [True] * len(case.particles)
     assert (table["z"] > 0).all() and np.isfinite(table.drop(columns="step").to_numpy(float)).all()
-    contacts = read_contacts(engine, tmp_path / PD.CONTACT_DUMP, table["radius"].to_numpy(),
+    contacts = read_contact_dump(registry.get(engine), tmp_path / PD.CONTACT_DUMP, table["radius"].to_numpy(),
                              table[["x", "y", "z"]].to_numpy(), case.packing.box)
     assert list(contacts.columns) == list(PD.CONTACT_COLUMNS)
 

@@ -58,11 +58,23 @@ class Toy(Engine):
     def check_deck(self, text: str, files: dict | None = None) -> None:
         check_toy_deck(text, files)
 
-    def read_collision(self, workdir):
-        """runner.py's dump: the LAMMPS family's columns (engines/family.py reads them)."""
-        from demcheck.engines.family import read_state_dump
+    log_files = ("log.txt", "screen.txt")
 
-        return read_state_dump(workdir)
+    def errors(self, log: str) -> list[str]:
+        """runner.py's errors: a Python exception."""
+        from demcheck.engines.base import traceback_errors
+
+        return traceback_errors(log)
+
+    def read_collision(self, workdir, log: str = ""):
+        """runner.py's dump (its own states in the dump custom layout) as the collision record."""
+        from pathlib import Path
+
+        from demcheck.engines.dumps import read_dump
+        from demcheck.engines.output import STATE_COLUMNS, CollisionOutput
+        from demcheck.inputs.common import DUMP_FILE
+
+        return CollisionOutput(read_dump(Path(workdir) / DUMP_FILE, columns=STATE_COLUMNS), log)
 
     def map(self, model, contact_params: dict) -> Mapping:
         native = Native("toy", normal=model.normal.id, tangential=model.tangential.id, limit=model.limit_force,

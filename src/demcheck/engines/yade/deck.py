@@ -239,3 +239,14 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
               "x[s][2], a[0], a[1], a[2], b[0], b[1], b[2], f[0], f[1], f[2], t[0], t[1], t[2]))",
               "out.close()", ""]
     return common.Deck("yade", "\n".join(lines), {}, dt=sc.dt, check=check_script)
+
+
+def read_states(workdir):
+    """The collision script's state table (HEAD, ROW: a block per step in the ``dump custom`` text layout, one
+    parser for every file in it, engines/dumps.py) with the record's columns (engines.output.STATE_COLUMNS)."""
+    from pathlib import Path
+
+    from ..dumps import read_dump
+    from ..output import STATE_COLUMNS
+
+    return read_dump(Path(workdir) / common.DUMP_FILE, columns=STATE_COLUMNS)
