@@ -116,3 +116,25 @@ def test_the_records_refuse_a_table_without_their_columns():
         CollisionOutput(_states().drop(columns="tqz"))
     with pytest.raises(ParseError, match="fn"):
         PackingOutput(_states().drop(columns=["tqx", "tqy", "tqz"]), pd.DataFrame({"i": [], "j": []}))
+
+
+def test_yade_writes_and_reads_its_own_state_table_not_a_lammps_dump(tmp_path):
+    """Yade's collision script writes its own table (a header of the record's columns, a row per body per step), and
+    Yade's reader turns it into the record with every double as written; a cut row is a ParseError."""
+    from demcheck.api import load
+    from demcheck.engines.yade import deck as yade_deck
+    from demcheck.errors import ParseError
+
+    case = load(str(Path(__file__).resolve().parents[1] / "src" / "demcheck" / "cases" / "oblique-lsd-wall.toml"))
+    text = registry.get("yade").collision_deck(case).text
+    assert "ITEM:" not in text and "dump.txt" in text
+    states = _states()
+    states["x"] += 0.1  # doubles with 17 significant digits
+    rows = [yade_deck.ROW % tuple(r) for r in states[["step", *STATE_COLUMNS]].itertuples(index=False)]
+    (tmp_path / "dump.txt").write_text(yade_deck.HEAD + "".join(rows))
+    got = registry.get("yade").read_collision(tmp_path, "its log")
+    assert got.log == "its log" and got.states.dtypes["id"] == np.int64
+    assert np.array_equal(got.states.to_numpy(float), states[["step", *STATE_COLUMNS]].to_numpy(float))
+    (tmp_path / "dump.txt").write_text(yade_deck.HEAD + "".join(rows)[:-40])
+    with pytest.raises(ParseError, match="cut short"):
+        registry.get("yade").read_collision(tmp_path)

@@ -3,8 +3,8 @@
 A collision deck is a Python script generated from a fixed template with only numbers substituted
 (:mod:`.deck`), checked before every run by :func:`.deck.check_script` (parsed with ``ast``: only the
 template's names, attributes, calls and numeric constants). It steps Yade's leap-frog NewtonIntegrator one
-step at a time and writes the bodies' states as a LAMMPS-style ``dump custom`` (float64, %.17g), so the rest
-of demcheck reads Yade as it reads the other engines. A packing script (:mod:`.packing`) comes from a second fixed
+step at a time and writes the bodies' states as a plain table (float64, %.17g), which :meth:`Yade.read_collision`
+reads into the collision record (engines/output.py), as every engine's reader does. A packing script (:mod:`.packing`) comes from a second fixed
 template with its own guard; :meth:`Yade.check_deck` picks the guard by the script's first line.
 """
 
