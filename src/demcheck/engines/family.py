@@ -16,6 +16,8 @@ from .base import PackageEngine
 from .output import FINAL_COLUMNS, STATE_COLUMNS, CollisionOutput, PackingOutput, touching
 
 LOG, SCREEN = "log.txt", "screen.txt"
+# the collision decks' ``dump custom`` columns: the record's (engines/output.py), named as LAMMPS names them
+DUMP_COLUMNS = STATE_COLUMNS
 _WARNING = re.compile(r"^WARNING:?\s*(.*)$", re.M)
 _ERROR = re.compile(r"^(?:ERROR|ERROR on proc \d+):?\s*(.*)$", re.M)
 _LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on", re.M)
@@ -50,7 +52,7 @@ class LammpsFamily(PackageEngine):
         return sum(float(x) for x in found) if found else None
 
     def read_collision(self, workdir: Path, log: str = "") -> CollisionOutput:
-        """The collision deck's ``dump custom`` (inputs/common.py DUMP_FILE, DUMP_COLUMNS)."""
+        """The collision deck's ``dump custom`` (inputs/common.py DUMP_FILE, :data:`DUMP_COLUMNS`)."""
         from ..inputs import common
         from .dumps import read_dump
 
