@@ -47,7 +47,8 @@ class Toy(Engine):
         """A wrapper script that runs runner.py with this Python (written once per process)."""
         path = Path(tempfile.gettempdir()) / f"demcheck-toy-engine-{os.getuid()}-{os.getpid()}"
         if not path.exists():
-            path.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT}${{PYTHONPATH:+:$PYTHONPATH}} exec {sys.executable} "
+            # the demcheck of this source tree (the engines' environment may not carry PYTHONPATH)
+            path.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT}:{ROOT / 'src'}${{PYTHONPATH:+:$PYTHONPATH}} exec {sys.executable} "
                             f"-m tests.toy_engine.runner \"$@\"\n")
             path.chmod(path.stat().st_mode | stat.S_IXUSR)
         return [str(path)]
