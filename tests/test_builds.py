@@ -69,7 +69,8 @@ def test_an_executable_that_is_not_the_engine_is_refused(tmp_path):
 
 
 def _demcheck(*args, tmp_path):
-    env = dict(os.environ, DEMCHECK_ENGINE_PLUGINS="tests.toy_engine", PYTHONPATH=str(ROOT),
+    # this source tree's demcheck (src) and its tests' toy engine (the root), not an installed demcheck
+    env = dict(os.environ, DEMCHECK_ENGINE_PLUGINS="tests.toy_engine", PYTHONPATH=f"{ROOT}:{ROOT / 'src'}",
                DEMCHECK_CACHE=str(tmp_path / "cache"))
     return subprocess.run([sys.executable, "-m", "demcheck", *map(str, args)], capture_output=True, text=True,
                           env=env, cwd=tmp_path, timeout=600)
@@ -79,7 +80,7 @@ def test_two_builds_of_the_toy_engine_side_by_side(tmp_path):
     """A second toy build (version 2.0, the same runner) beside the first: its own column with its version in
     collide and verify, its own cache entries, and diff finds nothing moved between the two builds."""
     toy2 = script(tmp_path / "toy2", "toy engine 2.0",
-                  f"PYTHONPATH={ROOT} exec {sys.executable} -m tests.toy_engine.runner \"$@\"")
+                  f"PYTHONPATH={ROOT}:{ROOT / 'src'} exec {sys.executable} -m tests.toy_engine.runner \"$@\"")
     p = _demcheck("collide", CASES / "hertz-wall.toml", "--engine", f"toy,toy@v2={toy2}", "--json", tmp_path=tmp_path)
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)

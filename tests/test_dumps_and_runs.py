@@ -55,9 +55,11 @@ def test_engine_contact_dumps_parse(engine):
     """Each engine's per-contact dump (dump local) of the settled five-sphere column (recorded by the
     packing decks): the four pairs, each carrying the weight of the spheres above it (closed form), with
     the overlap δ = F/kn of the case's LSDn (kn = 2000 N/m)."""
-    from demcheck.engines.packing import CONTACT_COLUMNS, read_contacts
+    from demcheck.engines import registry
+    from demcheck.engines.family import read_contact_dump
+    from demcheck.engines.packing import CONTACT_COLUMNS
 
-    c = read_contacts(engine, DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3))
+    c = read_contact_dump(registry.get(engine), DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3))
     assert tuple(c.columns) == CONTACT_COLUMNS
     weight = 2500.0 * 4.0 / 3.0 * np.pi * 1e-9 * 9.81
     assert [tuple(p) for p in c[["i", "j"]].to_numpy()] == [(0, 1), (1, 2), (2, 3), (3, 4)]
@@ -66,7 +68,7 @@ def test_engine_contact_dumps_parse(engine):
     assert np.all(c["ft"] == 0.0)
     # with the positions (a vertical column), Fn is signed: repulsive > 0 in both engines' readings
     column = np.array([[0.0, 0.0, (2 * k + 1) * 1e-3] for k in range(5)])
-    signed = read_contacts(engine, DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3), column)
+    signed = read_contact_dump(registry.get(engine), DATA / f"{engine}_column_contacts.txt", np.full(5, 1e-3), column)
     np.testing.assert_allclose(signed["fn"], c["fn"], rtol=1e-15)
 
 

@@ -1,5 +1,5 @@
 """The engine contract has no engine's conventions (issue 29 item 6): an engine of another family must say how it
-is run, how its decks are guarded and how its collision output is read; LAMMPS and LIGGGHTS share theirs in
+is run, how its decks are guarded, how its errors are found and how its collision output is read; LAMMPS and LIGGGHTS share theirs in
 engines/family.LammpsFamily, and no other engine inherits them."""
 
 from __future__ import annotations
@@ -21,12 +21,15 @@ def _bare(**methods):
     return type("Bare", (Engine,), body)
 
 
-@pytest.mark.parametrize("missing", ["argv", "check_deck", "read_collision"])
-def test_an_engine_must_give_its_own_command_line_guard_and_reader(missing):
-    given = {m: (lambda self, *a, **k: None) for m in ("argv", "check_deck", "read_collision") if m != missing}
+OWN = ("argv", "check_deck", "errors", "read_collision")
+
+
+@pytest.mark.parametrize("missing", OWN)
+def test_an_engine_must_give_its_own_command_line_guard_errors_and_reader(missing):
+    given = {m: (lambda self, *a, **k: None) for m in OWN if m != missing}
     with pytest.raises(TypeError, match=missing):
         _bare(**given)()
-    _bare(**{m: (lambda self, *a, **k: None) for m in ("argv", "check_deck", "read_collision")})()
+    _bare(**{m: (lambda self, *a, **k: None) for m in OWN})()
 
 
 def test_only_lammps_and_liggghts_are_of_the_lammps_family():

@@ -102,10 +102,11 @@ def test_the_worker_reports_its_loop_time():
     """RunOutput.loop_time: the log's ``Loop time of`` where the engine prints it, else the worker's own measure
     (Yade: the script; Kratos: the stage's solution loop); a process of Yade or Kratos has none."""
     log = "Loop time of 0.25 on 1 procs for 10 steps\nLoop time of 0.5 on 1 procs for 10 steps\n"
-    assert runner.loop_time(log) == 0.75
-    assert runner.loop_time(log, 9.0) == 0.75
-    assert runner.loop_time("no loop here", 0.125) == 0.125
-    assert runner.loop_time("no loop here") is None
+    assert runner.loop_time("lammps", log) == 0.75
+    assert runner.loop_time("liggghts", log, 9.0) == 0.75
+    assert runner.loop_time("lammps", "no loop here", 0.125) == 0.125
+    assert runner.loop_time("lammps", "no loop here") is None
+    assert runner.loop_time("yade", log, 0.125) == 0.125  # the LAMMPS family's log line is no Yade's
 
 
 @pytest.mark.parametrize("engine", _engines())

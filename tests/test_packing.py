@@ -424,7 +424,8 @@ def test_packing_decks_run_by_hand(engine, tmp_path):
     import sys
 
     from demcheck.engines import discovery, dumps
-    from demcheck.engines.packing import read_contacts
+    from demcheck.engines import registry
+    from demcheck.engines.family import read_contact_dump
     from demcheck.inputs.packing_decks import CONTACT_DUMP, FINAL_COLUMNS, FINAL_DUMP
 
     from .conftest import CASES
@@ -437,7 +438,7 @@ def test_packing_decks_run_by_hand(engine, tmp_path):
     subprocess.run([discovery.find(engine).executable, "-in", "in.column"], cwd=tmp_path, check=True,
                    capture_output=True, timeout=300)
     table = dumps.read_dump(tmp_path / FINAL_DUMP, columns=FINAL_COLUMNS)
-    c = read_contacts(engine, tmp_path / CONTACT_DUMP, table["radius"].to_numpy())
+    c = read_contact_dump(registry.get(engine), tmp_path / CONTACT_DUMP, table["radius"].to_numpy())
     weight = C.load(CASES / "packing" / "column-lsd.toml").mass(0) * 9.81
     np.testing.assert_allclose(c["fn"], [4 * weight, 3 * weight, 2 * weight, weight], rtol=1e-6)
 

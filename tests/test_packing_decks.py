@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from demcheck import case as C
-from demcheck.engines import discovery, dumps, registry
+from demcheck.engines import discovery, dumps, family_packing as FP, registry
 from demcheck.errors import DemcheckError
 from demcheck.inputs import common, packing_decks as PD
 
@@ -108,7 +108,7 @@ def test_a_packing_deck_is_short_and_says_what_each_block_is(name, engine):
     for start in must:
         assert any(line.startswith(start) for line in lines), start
     assert any(line.startswith(("# every species pair", "# species 1 with 1:")) for line in lines)
-    data = dk.files[PD.DATA_FILE].splitlines()
+    data = dk.files[FP.DATA_FILE].splitlines()
     header = data[:data.index("Atoms")]
     assert header[0].startswith("# demcheck packing: case ") and sum(h.startswith("#") for h in header) > 3
     assert f"{len(case.particles)} atoms" in header
@@ -120,7 +120,7 @@ def test_the_data_file_carries_every_mass(engine):
     """poured-poly: each particle's data-file density gives the case's mass under the engines' product; the
     1.2 mm species needs a density one ulp above 2500 (2500 itself gives one ulp less)."""
     case = C.load(CASES / "packing" / "poured-poly.toml")
-    data = deck_of(case, engine).files[PD.DATA_FILE].splitlines()
+    data = deck_of(case, engine).files[FP.DATA_FILE].splitlines()
     atoms = data[data.index("Atoms") + 2:data.index("Velocities") - 1]
     assert len(atoms) == len(case.particles)
     for k, line in enumerate(atoms):
@@ -206,15 +206,16 @@ def test_generated_packing_decks_match_the_golden_files(engine):
 def test_golden_packing_decks_run_by_hand(engine, tmp_path):
     """A person runs the golden deck (lmp -in / liggghts -in) beside its data file: it runs to the end, every
     particle's mass is the case's to the last bit, no particle is below the floor, and the contact dump reads."""
-    from demcheck.engines.packing import read_contacts
+    from demcheck.engines import registry
+    from demcheck.engines.family import read_contact_dump
 
     case = small_case()
     table = _run_by_hand(engine, GOLDEN / f"packing-small.{engine}.in",
-                         {PD.DATA_FILE: GOLDEN / f"packing-small.{engine}.{PD.DATA_FILE}"}, tmp_path)
+                         {FP.DATA_FILE: GOLDEN / f"packing-small.{engine}.{FP.DATA_FILE}"}, tmp_path)
     assert len(table) == len(case.particles)
     assert [m == case.mass(k) for k, m in enumerate(table["mass"])] == [True] * len(case.particles)
     assert (table["z"] > 0).all() and np.isfinite(table.drop(columns="step").to_numpy(float)).all()
-    contacts = read_contacts(engine, tmp_path / PD.CONTACT_DUMP, table["radius"].to_numpy(),
+    contacts = read_contact_dump(registry.get(engine), tmp_path / PD.CONTACT_DUMP, table["radius"].to_numpy(),
                              table[["x", "y", "z"]].to_numpy(), case.packing.box)
     assert list(contacts.columns) == list(PD.CONTACT_COLUMNS)
 
@@ -226,4 +227,4 @@ def test_demcheck_deck_writes_the_golden_packing_deck(tmp_path):
                         str(tmp_path / "in.small")], capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "in.small").read_text() == (GOLDEN / "packing-small.lammps.in").read_text()
-    assert (tmp_path / PD.DATA_FILE).read_text() == (GOLDEN / f"packing-small.lammps.{PD.DATA_FILE}").read_text()
+    assert (tmp_path / FP.DATA_FILE).read_text() == (GOLDEN / f"packing-small.lammps.{FP.DATA_FILE}").read_text()

@@ -12,7 +12,7 @@ from demcheck.engines import run
 
 def test_a_runs_log_is_read_without_escape_sequences(tmp_path):
     (tmp_path / "log.txt").write_text("LAMMPS (22 Jul 2025)\n\x1b[31mERROR: Lost atoms\x1b[0m\n\x1b]0;title\x07done\n")
-    text = run._read_log(tmp_path, None)
+    text = run._read_log(tmp_path, None, "lammps")
     assert "\x1b" not in text and "\x07" not in text
     assert "ERROR: Lost atoms" in text and "done" in text
 

@@ -14,7 +14,8 @@ from .conftest import CASES, ROOT
 
 
 def _demcheck(*args, tmp_path):
-    env = dict(os.environ, DEMCHECK_ENGINE_PLUGINS="tests.toy_engine", PYTHONPATH=str(ROOT),
+    # this source tree's demcheck (src) and its tests' toy engine (the root), not an installed demcheck
+    env = dict(os.environ, DEMCHECK_ENGINE_PLUGINS="tests.toy_engine", PYTHONPATH=f"{ROOT}:{ROOT / 'src'}",
                DEMCHECK_CACHE=str(tmp_path / "cache"))
     return subprocess.run([sys.executable, "-m", "demcheck", *args], capture_output=True, text=True, env=env,
                           cwd=tmp_path, timeout=600)

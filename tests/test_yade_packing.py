@@ -210,7 +210,7 @@ def test_golden_yade_script_runs_by_hand(tmp_path):
     radius and mass as the case's (its own state, dumped), every sphere stays above the floor of its species,
     and the kinetic energy lines and the contact dump read."""
     from demcheck.engines import discovery
-    from demcheck.engines.packing import read_contacts
+    from demcheck.engines.yade.packing import contacts as read_contacts
 
     case = small_case()
     exe = discovery.find("yade").executable
@@ -235,8 +235,7 @@ def test_golden_yade_script_runs_by_hand(tmp_path):
     for t, group in table.groupby("type"):
         ratio = (group["radius"] - group["z"]) * kn_wall[t - 1][1] / (group["mass"] * 9.81)
         assert np.median(ratio) == pytest.approx(1.0, rel=1e-6), t
-    contacts = read_contacts("yade", tmp_path / PD.CONTACT_DUMP, table["radius"].to_numpy(),
-                             table[["x", "y", "z"]].to_numpy(), case.packing.box)
+    contacts = read_contacts(tmp_path / PD.CONTACT_DUMP)
     assert list(contacts.columns) == list(PD.CONTACT_COLUMNS)
 
 

@@ -47,7 +47,8 @@ class Toy(Engine):
         """A wrapper script that runs runner.py with this Python (written once per process)."""
         path = Path(tempfile.gettempdir()) / f"demcheck-toy-engine-{os.getuid()}-{os.getpid()}"
         if not path.exists():
-            path.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT}${{PYTHONPATH:+:$PYTHONPATH}} exec {sys.executable} "
+            # the demcheck of this source tree (the engines' environment may not carry PYTHONPATH)
+            path.write_text(f"#!/bin/sh\nPYTHONPATH={ROOT}:{ROOT / 'src'}${{PYTHONPATH:+:$PYTHONPATH}} exec {sys.executable} "
                             f"-m tests.toy_engine.runner \"$@\"\n")
             path.chmod(path.stat().st_mode | stat.S_IXUSR)
         return [str(path)]
@@ -58,11 +59,23 @@ class Toy(Engine):
     def check_deck(self, text: str, files: dict | None = None) -> None:
         check_toy_deck(text, files)
 
-    def read_collision(self, workdir):
-        """runner.py's dump: the LAMMPS family's columns (engines/family.py reads them)."""
-        from demcheck.engines.family import read_state_dump
+    log_files = ("log.txt", "screen.txt")
 
-        return read_state_dump(workdir)
+    def errors(self, log: str) -> list[str]:
+        """runner.py's errors: a Python exception."""
+        from demcheck.engines.base import traceback_errors
+
+        return traceback_errors(log)
+
+    def read_collision(self, workdir, log: str = ""):
+        """runner.py's dump (its own states in the dump custom layout) as the collision record."""
+        from pathlib import Path
+
+        from demcheck.engines.dumps import read_dump
+        from demcheck.engines.output import STATE_COLUMNS, CollisionOutput
+        from demcheck.inputs.common import DUMP_FILE
+
+        return CollisionOutput(read_dump(Path(workdir) / DUMP_FILE, columns=STATE_COLUMNS), log)
 
     def map(self, model, contact_params: dict) -> Mapping:
         native = Native("toy", normal=model.normal.id, tangential=model.tangential.id, limit=model.limit_force,

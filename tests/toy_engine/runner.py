@@ -16,7 +16,8 @@ def main(argv: list[str]) -> int:
     deck = argv[argv.index("-in") + 1]
     d = json.loads(open(deck).read())
     from demcheck import case as C
-    from demcheck.inputs.common import DUMP_COLUMNS, DUMP_FILE
+    from demcheck.engines.output import STATE_COLUMNS as DUMP_COLUMNS
+    from demcheck.inputs.common import DUMP_FILE
     from demcheck.reference import collision3d
     from demcheck.laws.model import resolve
 

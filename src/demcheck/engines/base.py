@@ -12,7 +12,9 @@ over the registry. What an engine owns:
   its scheme uses (:attr:`Engine.rules`: slip arm, torque arms, rotation of the tangential history);
 * deck writers for every scenario (:meth:`Engine.collision_deck`, :meth:`Engine.packing_deck`);
 * how it is launched (:meth:`Engine.argv`, :meth:`Engine.mpi_launcher`, and :meth:`Engine.worker_argv`, a
-  long-lived worker where it has one) and how its per-contact output is read (:meth:`Engine.read_contacts`);
+  long-lived worker where it has one), what its log is and says (:attr:`Engine.log_files`, :meth:`Engine.errors`,
+  :meth:`Engine.warnings`, :meth:`Engine.loop_time`) and how its output is read into one record per scenario
+  (:meth:`Engine.read_collision`, :meth:`Engine.read_packing`: engines/output.py);
 * how a report draws it (:attr:`Engine.style`).
 
 Its expected differences live in ``data/expected_differences.toml``, keyed by the engine's name and version.
@@ -99,6 +101,21 @@ def refused(engine: str, reason: str) -> Mapping:
     return Mapping(engine, NONE_, [reason], None)
 
 
+TRACEBACK = "Traceback (most recent call last):"
+
+
+def traceback_errors(log: str) -> list[str]:
+    """The exception line of every Python traceback in ``log`` (an engine driven by a Python script: its deck's
+    error, as a LAMMPS ERROR line is), first first."""
+    lines = log.splitlines()
+    out = []
+    for k, line in enumerate(lines):
+        if TRACEBACK in line:
+            end = next((ln.strip() for ln in lines[k + 1:] if ln.strip() and not ln[0].isspace()), "")
+            out.append(end or "a Python exception (its traceback cut short)")
+    return out
+
+
 def worst(*fidelities: str) -> str:
     order = {EXACT: 0, APPROXIMATE: 1, NONE_: 2}
     return max(fidelities, key=order.__getitem__)
@@ -147,8 +164,28 @@ class Engine(ABC):
 
     @abstractmethod
     def argv(self, executable: str, deck: str) -> list[str]:
-        """The command that runs ``deck`` (a file name in the work directory), its log and screen written there
-        (``log.txt``, ``screen.txt``: engines/run.py reads them) or its output printed."""
+        """The command that runs ``deck`` (a file name in the work directory), its log written there (into
+        :attr:`log_files`) or printed (engines/run.py keeps what a process prints)."""
+
+    # ------------------------------------------------------------------ what a run leaves (engines/run.py asks)
+
+    # the files in a run's work directory the engine writes its log into (the longest is the log), besides what its
+    # process prints and a worker's screen (engines/run.py and engines/serve.py own those)
+    log_files: tuple[str, ...] = ()
+
+    @abstractmethod
+    def errors(self, log: str) -> list[str]:
+        """The engine's own error messages in a run's log, first first: a run with one failed by its deck (a
+        run without one that fails is a fault of the process, made once more: engines/run.py)."""
+
+    def warnings(self, log: str) -> list[str]:
+        """The engine's own warnings in a run's log (a Result carries them); the default: none."""
+        return []
+
+    def loop_time(self, log: str) -> float | None:
+        """The seconds of the engine's own stepping loop, where its log says; None (the default): it does not
+        (a worker's own measure is taken instead)."""
+        return None
 
     def worker_argv(self, executable: str) -> list[str] | None:
         """The command of a long-lived worker that runs this engine's decks case after case in one process
@@ -164,9 +201,10 @@ class Engine(ABC):
         otherwise)."""
 
     @abstractmethod
-    def read_collision(self, workdir):
-        """A collision deck's output in ``workdir``: the bodies' states, one row per body per step (a DataFrame
-        of inputs.common.DUMP_COLUMNS, every value as the engine wrote it)."""
+    def read_collision(self, workdir, log: str = ""):
+        """A collision deck's output in ``workdir`` and its run's ``log``, read into one record
+        (engines.output.CollisionOutput: the bodies' states step by step, every value as the engine computed it,
+        the log, the loop's time): the collision driver reads nothing else."""
 
     def mpi_launcher(self, executable: str, ranks: int) -> list[str]:
         from ..errors import EngineNotFound
@@ -259,9 +297,10 @@ class Engine(ABC):
 
         raise UnsupportedByEngine(f"{self.name} decks are not written for packings")
 
-    def read_packing(self, workdir, log: str):
-        """A packing deck's output: (the final per-particle table of inputs.packing_decks.FINAL_COLUMNS, sorted by
-        id, one row per particle; the kinetic energy series [(step, ke)] read from ``log``)."""
+    def read_packing(self, workdir, log: str, box=None):
+        """A packing deck's output in ``workdir`` and its run's ``log``, read into one record
+        (engines.output.PackingOutput: the settled particles sorted by id, their contacts, the kinetic energy
+        series); ``box`` the packing's periodic [lx, ly] (None: none)."""
         from ..errors import UnsupportedByEngine
 
         raise UnsupportedByEngine(f"{self.name} writes no packing output")
@@ -287,13 +326,6 @@ class Engine(ABC):
         from ..errors import UnsupportedByEngine
         raise UnsupportedByEngine(f"{self.name} writes no scenario output")
 
-    def read_contacts(self, values, i, j, radius, x=None, box=None):
-        """(overlap, fn, ft) of the engine's per-contact dump: ``values`` its columns as an array (one row per
-        listed pair), ``i``, ``j`` the 0-based particle indices of the first two columns, ``radius`` and ``x``
-        per particle, ``box`` the periodic [lx, ly]; fn repulsive > 0."""
-        from ..errors import UnsupportedByEngine
-
-        raise UnsupportedByEngine(f"{self.name} writes no per-contact output")
 
 
 class PackageEngine(Engine):

@@ -1,4 +1,5 @@
-"""One collision case in an engine: deck → run → dump → Result (with the engine's version)."""
+"""One collision case in an engine: deck → run → the engine's record of it (engines.output.CollisionOutput, read by
+the engine itself) → Result (with the engine's version)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from ..inputs import common
 from ..reference import health
 from ..result import Result
 from . import cache as cache_checks, dumps, run as runner, states
+from .output import STATE_COLUMNS
 from .mapping import as_engine, contact_mapping, native_summary, twin_model
 
 
@@ -89,7 +91,7 @@ META_KEYS = {"version": cache_checks.text, "workdir": cache_checks.text, "wall_t
 
 
 def _every_body(bodies: int):
-    """The check of a cached dump: every body's rows, as many for each (at every step the run wrote)."""
+    """The check of a cached run's states: every body's rows, as many for each (at every step the run wrote)."""
     def check(table: pd.DataFrame, meta: dict) -> str | None:
         counts = table["id"].value_counts()
         if set(counts.index) != set(range(1, bodies + 1)) or counts.nunique() != 1:
@@ -142,7 +144,7 @@ def collide(case: Case, engine, dt: float | None = None, workdir: str | Path | N
                                    meta["warnings"])
         else:
             out = runner.run(engine, dk.text, workdir=workdir, timeout=timeout, files=dk.files, worker=worker)
-            table = eng.read_collision(out.workdir)
+            table = eng.read_collision(out.workdir, out.log).states
             non_finite = dumps.non_finite(table)
             if cache is not None and not non_finite:
                 fresh.append((k, table, {"version": out.version, "workdir": str(out.workdir),
@@ -203,7 +205,7 @@ def _cached(cache, engine: str, dk: common.Deck, bodies: int):
 
         raise EngineNotFound(discovery.missing(engine))
     k = cache_key(engine, info.version, dk.text, dk.files)
-    return k, cache.get(k, columns=("step",) + common.DUMP_COLUMNS, meta_keys=META_KEYS, min_rows=1,
+    return k, cache.get(k, columns=("step",) + STATE_COLUMNS, meta_keys=META_KEYS, min_rows=1,
                         check=_every_body(bodies))
 
 

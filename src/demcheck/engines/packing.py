@@ -1,6 +1,6 @@
 """A packing in an engine: its deck (the engine's package writes it from the shared layout of
-inputs/packing_decks), the run, the final state and the engine's own per-contact output, read back into the
-tables every source yields."""
+inputs/packing_decks), the run, and the engine's record of it (engines.output.PackingOutput: the final state, the
+contacts, the kinetic energy, read by the engine itself), as the tables every source yields."""
 
 from __future__ import annotations
 
@@ -11,11 +11,12 @@ import numpy as np
 import pandas as pd
 
 from ..case import Case
-from ..inputs.packing_decks import CONTACT_COLUMNS, CONTACT_DUMP, CONTACT_READER, FINAL_COLUMNS, FINAL_DUMP
+from ..inputs.packing_decks import CONTACT_READER, FINAL_DUMP
 from . import dumps, registry
 from .cache import ke_series, text
+from .output import CONTACT_COLUMNS, FINAL_COLUMNS
 
-__all__ = ["PackingRun", "read_contacts", "run_engine", "universe", "CONTACT_COLUMNS"]
+__all__ = ["PackingRun", "run_engine", "universe", "CONTACT_COLUMNS"]
 
 
 @dataclass
@@ -27,21 +28,6 @@ class PackingRun:
     contacts: pd.DataFrame
     ke: list
     version: str
-
-
-def read_contacts(engine: str, path, radius: np.ndarray, x: np.ndarray | None = None, box=None) -> pd.DataFrame:
-    """The engine's per-contact dump (its last block) as CONTACT_COLUMNS: touching pairs only (overlap > 0),
-    each once (with newton off a pair across a periodic or processor boundary may be listed from both
-    sides). ``radius`` (and ``x``): per particle, indexed by id − 1; ``box``: the periodic [lx, ly]. The
-    engine's package turns its own columns into (i, j, overlap, fn, ft) (:meth:`Engine.read_contacts`)."""
-    raw = dumps.read_dump(path)
-    raw = raw[raw["step"] == raw["step"].max()] if len(raw) else raw
-    v = raw.drop(columns="step").to_numpy(float)
-    i, j = v[:, 0].astype(np.int64) - 1, v[:, 1].astype(np.int64) - 1
-    overlap, fn, ft = registry.get(engine).read_contacts(v, i, j, radius, x, box)
-    out = pd.DataFrame({"i": np.minimum(i, j), "j": np.maximum(i, j), "overlap": overlap, "fn": fn, "ft": ft})
-    out = out[out["overlap"] > 0].drop_duplicates(subset=["i", "j"]).sort_values(["i", "j"])
-    return out.reset_index(drop=True)
 
 
 def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
@@ -65,10 +51,8 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
             contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
             return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
     out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi, workdir=workdir)
-    table, ke = registry.get(engine).read_packing(out.workdir, out.log)
-    # the data file numbers the particles 1…N and the table is sorted by id: row k is particle id k + 1
-    contacts = read_contacts(engine, out.workdir / CONTACT_DUMP, table["radius"].to_numpy(),
-                             table[["x", "y", "z"]].to_numpy(), case.packing.box if case.packing else None)
+    record = registry.get(engine).read_packing(out.workdir, out.log, case.packing.box if case.packing else None)
+    table, contacts, ke = record.final, record.contacts, record.ke
     from ..errors import EngineFailed
 
     bad = dumps.non_finite(table) or dumps.non_finite(contacts)

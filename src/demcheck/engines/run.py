@@ -6,11 +6,14 @@ directory: a helper it leaves behind may hold a pipe open long after it ended); 
 session is killed when it ends. Every engine process and worker starts with ``discovery.ENGINE_ENV`` (one thread;
 Open MPI's singleton start without its helper daemon, whose start fails on a loaded machine).
 
+The engine says which files its log is in, what in it is an error or a warning and how long its loop took
+(``Engine.log_files``, ``errors``, ``warnings``, ``loop_time``): this module knows no engine's log.
+
 A failed run keeps its work directory — the deck and its files, the log, the screen, what the process printed,
 the dump's last frames, each within ``keep_for_diagnosis``'s bound — and its error names the directory and its
 files and quotes the log's tail, or says plainly that the engine wrote nothing and what demcheck saw (an exit
-code, a signal, what a worker answered). A failure without an error of the engine's (no ERROR line, no Python
-traceback: a crash, a silent exit, a worker that died or did not start) is a fault of the process, not of the
+code, a signal, what a worker answered). A failure without an error of the engine's (``Engine.errors`` finds none in
+its log: a crash, a silent exit, a worker that died or did not start) is a fault of the process, not of the
 deck: the run is made once more on a fresh process or worker, and fails only if that fails too (both reasons
 given). A run past its timeout is killed and reported as such (not run again).
 
@@ -27,7 +30,7 @@ work directory as above, with the same timeout, interrupt and failure rules and 
 its timeout or stopped by an interrupt kills the worker's process group (the next run starts a new worker; its
 start is not counted in the run's timeout), an engine error is EngineFailed with the log's tail and leaves the
 worker usable, a worker that died is replaced — also one an engine error ends (LIGGGHTS's library exits): that
-run fails with its log's ERROR line and tail, as a process's does. Each worker serves one run at a
+run fails with its log's error and tail, as a process's does. Each worker serves one run at a
 time: concurrent jobs take one each (a pool per engine and command). A worker runs in a session of its own,
 as a run's process does, and dies with the thread that started it (a job's, or the main thread); an
 interrupt kills the workers that are running, ``shutdown_workers`` (also run at exit) ends the idle ones.
@@ -53,10 +56,6 @@ from . import discovery, registry
 from .serve import plain_text
 
 DEFAULT_TIMEOUT = 600.0
-# the engines' own warnings, as they print them
-_WARNING = re.compile(r"^WARNING:?\s*(.*)$", re.M)
-_ERROR = re.compile(r"^(?:ERROR|ERROR on proc \d+):?\s*(.*)$", re.M)
-_LOOP = re.compile(r"^Loop time of ([0-9.eE+-]+) on", re.M)
 
 
 class EngineTimeout(EngineFailed):
@@ -148,18 +147,20 @@ def log_tail(text: str, lines: int = 15) -> str:
     return "\n".join(text.rstrip().splitlines()[-lines:])
 
 
-def warnings_of(log: str) -> list[str]:
-    return [w.strip() for w in _WARNING.findall(log)]
-
-
-def loop_time(log: str, measured: float | None = None) -> float | None:
-    """The seconds of the engine's own stepping loop in a run: the sum of its log's ``Loop time of`` lines
-    (LAMMPS, LIGGGHTS: the loop and its dump output), else what its worker measured (``measured``: Yade the
-    script, Kratos its RunSolutionLoop), else None."""
-    found = _LOOP.findall(log)
-    if found:
-        return sum(float(x) for x in found)
+def loop_time(engine: str, log: str, measured: float | None = None) -> float | None:
+    """The seconds of the engine's own stepping loop in a run: what its log says (``Engine.loop_time``: LAMMPS,
+    LIGGGHTS), else what its worker measured (``measured``: Yade the script, Kratos its RunSolutionLoop), else
+    None."""
+    said = registry.get(engine).loop_time(log)
+    if said is not None:
+        return said
     return None if measured is None else float(measured)
+
+
+def _output(engine: str, info, wd: Path, log: str, wall: float, measured: float | None = None) -> RunOutput:
+    """A run's RunOutput: the engine's own warnings and loop time read off its log."""
+    return RunOutput(engine, info.version, wd, log, wall, registry.get(engine).warnings(log),
+                     loop_time(engine, log, measured))
 
 
 def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
@@ -167,7 +168,7 @@ def mpi_launcher(engine: str, executable: str, ranks: int) -> list[str]:
     return registry.get(engine).mpi_launcher(executable, ranks)
 
 
-SCREEN = "screen.txt"  # an engine's screen in its work directory (``-screen``; a worker's stdout and stderr)
+SCREEN = "screen.txt"  # a worker's stdout and stderr in a run's work directory (engines/serve.py)
 OUTPUT = "output.txt"  # what a run's process printed on stdout and stderr (its screen, or what came before one)
 
 
@@ -176,8 +177,8 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     """Write ``deck`` (and ``files``) into a work directory and run ``engine`` on it (``mpi`` ranks: the
     engine's own domain decomposition); ``worker``: in the engine's long-lived worker where it has one (see
     the module's notes), else as a process of its own. A run that fails without an error of the engine's (a
-    crash, an exit with no ERROR line, a worker that died or did not start: a fault of the process, not of the
-    deck) is run once more on a fresh process or worker before it is called failed."""
+    crash, an exit with none in its log, Engine.errors; a worker that died or did not start: a fault of the
+    process, not of the deck) is run once more on a fresh process or worker before it is called failed."""
     info = discovery.require(engine)  # named by the caller: tried twice, EngineNotFound with the reason
     if _STOP.is_set():
         raise EngineInterrupted(f"{engine}: not started: demcheck was interrupted")
@@ -187,7 +188,7 @@ def run(engine: str, deck: str, *, workdir: str | Path | None = None, timeout: f
     for name, text in {"in.deck": deck, **(files or {})}.items():
         (wd / name).write_text(text)
     argv = registry.get(engine).worker_argv(info.executable) if worker and mpi == 1 else None
-    before = {p.name for p in wd.iterdir()} - {"log.txt", SCREEN, OUTPUT}  # the caller's: never removed
+    before = {p.name for p in wd.iterdir()} - {*_logs(engine), OUTPUT}  # the caller's: never removed
 
     def in_process() -> RunOutput:
         return _run_process(engine, info, wd, workdir, timeout, mpi)
@@ -289,11 +290,11 @@ def _run_process(engine: str, info, wd: Path, workdir, timeout: float, mpi: int)
     if proc in _KILLED:  # stopped by an interrupt handled elsewhere (another thread's kill_all)
         raise _interrupted(engine, wd, workdir, interrupt_exit_code(None))
     wall = time.perf_counter() - started
-    log = _read_log(wd, None)
-    errors = _ERROR.findall(log)
+    log = _read_log(wd, None, engine)
+    errors = registry.get(engine).errors(log)
     if proc.returncode != 0 or errors:
-        raise _failed(engine, wd, log, _exit_words(proc.returncode), deck_error=bool(errors) or _raised(log))
-    return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log))
+        raise _failed(engine, wd, log, _exit_words(proc.returncode), deck_error=bool(errors))
+    return _output(engine, info, wd, log, wall)
 
 
 def _exit_words(code: int | None) -> str:
@@ -306,19 +307,15 @@ def _exit_words(code: int | None) -> str:
     return f"exit code {code}"
 
 
-def _raised(log: str) -> bool:
-    """A Python deck's exception (Yade, Kratos): the deck's error, as an engine's ERROR line is."""
-    return "Traceback (most recent call last)" in log
-
-
 _MPI_START = re.compile(r"MPI_INIT failed|error occurred in MPI_Init|Returned \"([^\"]+)\"")
 
 
 def _failed(engine: str, wd: Path, log: str, seen: str, deck_error: bool) -> EngineFailed:
-    """The error of a failed run: the engine's ERROR line (else what the process or worker showed: ``seen``), the
+    """The error of a failed run: the engine's first error (Engine.errors; else what the process or worker showed:
+    ``seen``), the
     work directory kept for a diagnosis (its files named, each within its bound: keep_for_diagnosis) and the log's
     tail, or a plain sentence that the engine wrote none. ``fault``: not the deck's error (run.py retries once)."""
-    errors = _ERROR.findall(log)
+    errors = registry.get(engine).errors(log)
     what = errors[0].strip() if errors else seen
     mpi = _MPI_START.findall(log)
     if not errors and mpi:
@@ -335,7 +332,7 @@ def _failed(engine: str, wd: Path, log: str, seen: str, deck_error: bool) -> Eng
 
 
 def _timed_out(engine: str, wd: Path, timeout: float, pid: int | None) -> EngineTimeout:
-    log = _read_log(wd, None)
+    log = _read_log(wd, None, engine)
     kept = keep_for_diagnosis(wd)
     tail = log_tail(log) if log.strip() else f"({engine} wrote no log and printed nothing)"
     return EngineTimeout(f"{engine} ran past its timeout of {timeout:g} s and was stopped; work directory kept: "
@@ -420,15 +417,22 @@ def _interrupted(engine: str, wd: Path, workdir, code: int, what: str = "was sto
     return exc
 
 
-def _read_log(wd: Path, out: str | None) -> str:
-    """What a run wrote: the longer of its log and its screen (they carry the same lines), after what its process
-    printed besides (``output.txt``: MPI's messages, a crash's; a Python engine's whole output) and ``out``."""
+def _logs(engine: str | None) -> tuple[str, ...]:
+    """The files a run's log may be in: the engine's own (Engine.log_files), then a worker's screen."""
+    own = registry.get(engine).log_files if engine else ()
+    return (*own, *((SCREEN,) if SCREEN not in own else ()))
+
+
+def _read_log(wd: Path, out: str | None, engine: str | None = None) -> str:
+    """What a run wrote: the longest of its log files (``engine``'s own and a worker's screen: they carry the same
+    lines), after what its process printed besides (``output.txt``: MPI's messages, a crash's; a Python engine's
+    whole output) and ``out``."""
     texts = {}
-    for name in ("log.txt", SCREEN, OUTPUT):
+    for name in (*_logs(engine), OUTPUT):
         p = wd / name
         if p.exists():
             texts[name] = p.read_text(errors="replace")
-    log = max((texts.get("log.txt", ""), texts.get(SCREEN, "")), key=len)
+    log = max((texts.get(name, "") for name in _logs(engine)), key=len)
     extra = [t for t in (texts.get(OUTPUT, ""), out or "") if t.strip() and t.strip() not in log]
     return plain_text("\n".join([*extra, log] if log else extra))  # an engine's colours never reach a report
 
@@ -673,9 +677,9 @@ def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeo
             w.end(kill=True)
             raise _interrupted(engine, wd, workdir, interrupt_exit_code(None))
         wall = time.perf_counter() - started
-        log = _read_log(wd, None)
-        errors = _ERROR.findall(log)
-        if answer is None and not any((wd / name).exists() for name in ("log.txt", SCREEN)):
+        log = _read_log(wd, None, engine)
+        errors = registry.get(engine).errors(log)
+        if answer is None and not any((wd / name).exists() for name in _logs(engine)):
             code = w.end(kill=True)
             raise _NotTaken(f"its worker process ended: {_exit_words(code)}")
         if answer is None:  # the worker died during the run: the next run starts a new one
@@ -685,6 +689,6 @@ def _worker_attempt(engine: str, info, argv: list[str], wd: Path, workdir, timeo
             message = str(answer.get("error") or "").strip()
             seen = f"its worker answered: {message.splitlines()[0]}" if message else "its worker answered no message"
             raise _failed(engine, wd, log or message, seen, deck_error=True)
-        return RunOutput(engine, info.version, wd, log, wall, warnings_of(log), loop_time(log, answer.get("loop")))
+        return _output(engine, info, wd, log, wall, answer.get("loop"))
     finally:
         _checkin(w, argv)

@@ -12,9 +12,7 @@ from ..case import Case, run_length
 from ..errors import DemcheckError, UnsupportedByEngine
 from ..laws.model import ResolvedModel, resolve
 
-DUMP_COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
-                "fx", "fy", "fz", "tqx", "tqy", "tqz")
-DUMP_FILE = "dump.txt"
+DUMP_FILE = "dump.txt"  # a collision deck's output of the bodies' states (each engine writes it in its own way)
 
 
 @dataclass

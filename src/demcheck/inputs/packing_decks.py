@@ -1,9 +1,9 @@
-"""What every engine's packing deck shares: the same initial state as the reference (a LAMMPS data file, one atom type per
-particle species, carrying each particle's exact mass through its density), the species pairs' coefficients from the
-mapping, plane walls, gravity, periodic x and y where the packing has a box, a final dump of every particle in full
-precision, and a final dump of every particle-particle contact (the engine's own per-contact output: LAMMPS ``compute
-pair/local`` with ``property/local``, LIGGGHTS ``compute pair/gran/local``) for the contact-force distribution. Every
-block of a deck opens with a comment saying what it is."""
+"""What every engine's packing deck shares: the same initial state as the reference (the layout: one species per
+material and radius, each with the case's exact mass, the box, periodic in x and y where the packing has one, the
+step and the run's length), the comments on walls and laws, and the names of the final state's and the contacts'
+files. The LAMMPS family's data file, opening block, gravity and integration lines are engines/family_packing.py's;
+the masses' rule below (a density that gives the case's mass through the engines' 4π/3·r·r·r·ρ) is what a data file
+must carry, and the layout's species hold it."""
 
 from __future__ import annotations
 
@@ -20,7 +20,6 @@ from .common import fmt
 
 FINAL_DUMP = "final.txt"
 CONTACT_DUMP = "contacts.txt"
-DATA_FILE = "data.lmp"
 # the contact table every source yields: particle indices (0-based), overlap, normal force, |tangential force|
 CONTACT_COLUMNS = ("i", "j", "overlap", "fn", "ft")
 CONTACT_READER = 2  # in the engine-run cache key: cached contact tables are parsed ones (2: LIGGGHTS Fn signed)
@@ -92,7 +91,7 @@ def species_table(case: Case, rep) -> list[Species]:
     return out
 
 
-# ----------------------------------------------------------------------------- the layout and the data file
+# ----------------------------------------------------------------------------- the layout
 
 
 @dataclass
@@ -127,71 +126,7 @@ def layout(case: Case, duration, dt) -> Layout:
     return Layout(species, species_table(case, rep), rad, lo, hi, periodic, dt, steps, duration)
 
 
-def data_file(case: Case, lay: Layout, n_types: int | None = None) -> str:
-    """The initial state both engines read (read_data): the box, every particle (id, type, diameter, density,
-    position) and its velocities; the header says what each column is and why a density may not be the
-    material's."""
-    n_types = n_types or len(lay.table)
-    title = common.comment(f"demcheck packing: case {case.name} (hash {case.hash})")
-    about = ["the box (m), then per particle: id, atom type (its species), diameter (m), density (kg/m^3) and",
-             "x y z (m); then its velocity (m/s) and angular velocity (rad/s). The engines make a mass",
-             "4*pi/3 * r * r * r * density in doubles: a species' density is its material's, or the double",
-             "nearest it that makes that mass the case's 4/3 pi r^3 rho bit for bit (the deck sets the mass",
-             "of a species no density reaches)"]
-    lines = [title, *[common.comment(a) for a in about], "", f"{len(case.particles)} atoms", f"{n_types} atom types",
-             "", *(f"{fmt(lay.lo[k])} {fmt(lay.hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")), "", "Atoms", ""]
-    for k, p in enumerate(case.particles):
-        s = lay.table[lay.species[k]]
-        lines.append(f"{k + 1} {s.type} {fmt(2 * p.radius)} {fmt(s.file_density)} "
-                     f"{' '.join(fmt(x) for x in p.position)}")
-    lines += ["", "Velocities", ""]
-    for k, p in enumerate(case.particles):
-        lines.append(f"{k + 1} {' '.join(fmt(x) for x in p.velocity)} {' '.join(fmt(x) for x in p.angular_velocity)}")
-    return "\n".join(lines) + "\n"
-
-
-# ----------------------------------------------------------------------------- the deck's blocks
-
-
-def head(case: Case, engine: str, note: str, hand: str, lay: Layout, mappings, atom_style: str, comm: str) -> list[str]:
-    """The opening comments (what the deck is, the case, the model and its mapping, the run, how to run it by
-    hand), units, the atoms and the box, the data file and the masses no density carries."""
-    fidelities = sorted({mp.fidelity for mp in mappings})
-    reasons = list(dict.fromkeys(r for mp in mappings for r in mp.reasons))
-    periodic = "".join("xy"[k] for k in range(2) if lay.periodic[k])
-    box = {"xy": "periodic in x and y, not in z", "x": "periodic in x only", "y": "periodic in y only",
-           "": "not periodic"}[periodic]
-    lines = [common.comment(f"demcheck packing deck for {engine} ({note})"),
-             common.comment(f"case: {case.name} (hash {case.hash})"),
-             common.comment(f"model: normal = {case.contact.normal}, tangential = {case.contact.tangential}; "
-                            f"mapping fidelity: {', '.join(fidelities)}"),
-             *common.notes(reasons),
-             common.comment(f"{len(case.particles)} particles of {len(lay.table)} species; {lay.steps} steps of dt = "
-                            f"{fmt(lay.dt)} s ({fmt(lay.duration)} s); final state: {FINAL_DUMP} (every particle), "
-                            f"{CONTACT_DUMP} (every contact)"),
-             common.comment(f"run by hand: {hand} <this file> (it reads {DATA_FILE}, written beside it)"), "",
-             common.comment("SI units (m, kg, s)"), "units si",
-             common.comment("spheres with their own radius, mass and spin; one atom type per species (material, "
-                            "radius)"),
-             f"atom_style {atom_style}", "atom_modify map array",
-             common.comment(f"the box: {box} (its extent is in {DATA_FILE})"),
-             "boundary " + " ".join("p" if lay.periodic[k] else "f" for k in range(2)) + " f",
-             common.comment("a pair across a periodic or process boundary is computed on both sides, and ghost "
-                            "particles carry their velocities (the dashpots use them)"),
-             "newton off", comm,
-             common.comment("on several MPI ranks (mpirun -np N), cut the box across x and y only: the bed gathers at "
-                            "the bottom, and ranks cut along the height would leave it to one rank"),
-             "processors * * 1",
-             common.comment("the initial state: every particle's type, diameter, density, position and velocity"),
-             f"read_data {DATA_FILE}"]
-    for s in lay.table:
-        how = (f"its density in {DATA_FILE}, {fmt(s.file_density)}, gives it exactly" if s.data_density is not None
-               else "set here: no density gives it exactly in doubles")
-        lines.append(common.comment(f"species {s.type}: {s.material}, radius {fmt(s.radius)} m, mass {fmt(s.mass)} kg "
-                                    f"({how})"))
-        if s.data_density is None:
-            lines.append(f"set type {s.type} mass {fmt(s.mass)}")
-    return lines
+# ----------------------------------------------------------------------------- comments
 
 
 def wall_comment(w, k: int) -> str:
@@ -209,23 +144,3 @@ def law_comments(laws) -> list[str]:
         walls = " and the walls" if any(w.endswith("the walls") for w, _ in texts) else ""
         return [common.comment(f"every species pair{walls}: {texts[0][1]}")]
     return [common.comment(f"{who}: {t}") for who, t in texts]
-
-
-def gravity(case: Case) -> list[str]:
-    g = np.asarray(case.run.gravity, float)
-    gn = float(np.linalg.norm(g))
-    if gn == 0:
-        return []
-    return [common.comment(f"gravity: {fmt(gn)} m/s^2 along ({', '.join(fmt(c / gn) for c in g)})"),
-            f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(c / gn) for c in g)}"]
-
-
-def integration(lay: Layout) -> list[str]:
-    """Velocity Verlet (positions and spins) at dt, the kinetic energy printed 50 times, and the run."""
-    every = max(1, lay.steps // 50)
-    return ["", common.comment(f"time integration: velocity Verlet for positions and spins, dt = {fmt(lay.dt)} s; "
-                               f"the total translational kinetic energy every {every} steps"),
-            "fix integrate all nve/sphere", f"timestep {fmt(lay.dt)}", "thermo_style custom step ke atoms",
-            "thermo_modify norm no", f"thermo {every}",
-            common.comment(f"the run: {lay.steps} steps, the {fmt(lay.duration)} s of the case in whole steps"),
-            f"run {lay.steps}"]

@@ -8,7 +8,7 @@ import re
 import sys
 
 from .. import registry
-from ..base import Native, PackageEngine, Style
+from ..base import Native, PackageEngine, Style, traceback_errors
 
 # what the engine's Python answers for its installed distributions (no Kratos import: that takes a second)
 VERSION_QUERY = ("from importlib.metadata import version; "
@@ -74,12 +74,16 @@ class Kratos(PackageEngine):
 
         check(text, files)
 
-    def read_collision(self, workdir):
-        """The collision project's dump (deck.py's script writes the LAMMPS family's columns,
-        engines/family.py)."""
-        from ..family import read_state_dump
+    def errors(self, log: str) -> list[str]:
+        """The runner script's Python exception (Kratos's own errors are raised into it)."""
+        return traceback_errors(log)
 
-        return read_state_dump(workdir)
+    def read_collision(self, workdir, log: str = ""):
+        """The runner script's state table (deck.py, :func:`.deck.read_states`)."""
+        from ..output import CollisionOutput
+        from .deck import read_states
+
+        return CollisionOutput(read_states(workdir), log)
 
     def own_twin(self, native: Native) -> bool:
         from .mapping import FRICTION

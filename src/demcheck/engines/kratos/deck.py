@@ -463,3 +463,15 @@ def _check_mdpa(text: str, name: str) -> None:
     for no, line in enumerate(text.split("\n"), start=1):
         if line and not MDPA_LINE.fullmatch(line):
             _refuse(f"{name}:{no}", f"is not a line demcheck writes: {line[:60]!r}")
+
+
+def read_states(workdir):
+    """The runner's state table (TEMPLATE's ``demcheck_write``: a block per step in the ``dump custom`` text layout,
+    which the scenarios' reader reads too; one parser for every file in it, engines/dumps.py) with the record's
+    columns (engines.output.STATE_COLUMNS)."""
+    from pathlib import Path
+
+    from ..dumps import read_dump
+    from ..output import STATE_COLUMNS
+
+    return read_dump(Path(workdir) / common.DUMP_FILE, columns=STATE_COLUMNS)

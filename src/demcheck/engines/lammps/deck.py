@@ -15,6 +15,7 @@ from ...inputs import common
 from ...inputs.common import fmt
 from ..mapping import contact_mapping, pair_mapping
 from ..base import Engine, Native
+from ..family import DUMP_COLUMNS
 
 VERSION_NOTE = "written for LAMMPS 22 Jul 2025 (pair_style granular)"
 
@@ -95,7 +96,7 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
     if gn > 0:
         lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(x / gn) for x in g)}")
     lines += ["", "fix integrate all nve/sphere", f"timestep {fmt(sc.dt)}",
-              f"dump state all custom 1 {common.DUMP_FILE} {' '.join(common.DUMP_COLUMNS)}",
+              f"dump state all custom 1 {common.DUMP_FILE} {' '.join(DUMP_COLUMNS)}",
               "dump_modify state format float %.17g sort id",
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]

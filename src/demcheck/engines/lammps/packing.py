@@ -1,4 +1,5 @@
-"""LAMMPS decks for packing cases, from the layout every engine shares (inputs/packing_decks)."""
+"""LAMMPS decks for packing cases: the layout every engine shares (inputs/packing_decks), written in the LAMMPS
+family's packing blocks (engines/family_packing.py)."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
+from .. import family_packing as FP
 from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import VERSION_NOTE, coeff_args
@@ -29,7 +31,7 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
             if mp.native != walls[0].native:
                 raise UnsupportedByEngine("fix wall/gran takes one set of coefficients for every species: species "
                                           "whose wall contacts differ are not expressible")
-    lines = PD.head(case, "lammps", VERSION_NOTE, "lmp -in", lay, [*pairs.values(), *walls], "sphere",
+    lines = FP.head(case, "lammps", VERSION_NOTE, "lmp -in", lay, [*pairs.values(), *walls], "sphere",
                     "comm_modify vel yes")
     lines += ["", common.comment("neighbour lists: a skin of half the largest radius, checked every step"),
               f"neighbor {fmt(0.5 * float(lay.rad.max()))} bin", "neigh_modify delay 0 every 1 check yes",
@@ -44,8 +46,8 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
         where = f"{fmt(w.point[ax])} NULL" if side == "lo" else f"NULL {fmt(w.point[ax])}"
         lines += [common.comment(f"{PD.wall_comment(w, k)}, with the walls' law"),
                   f"fix wall{k} all wall/gran granular {coeff_args(walls[0].native)} {'xyz'[ax]}plane {where}"]
-    lines += PD.gravity(case)
-    lines += PD.integration(lay)
+    lines += FP.gravity(case)
+    lines += FP.integration(lay)
     lines += ["", common.comment("the final state's contacts, re-evaluated by a run of no steps: for every pair within "
                                  "the cutoff the two ids, the centre distance,"),
               common.comment("the normal force (repulsive > 0) and the tangential force's magnitude (pair granular's "
@@ -56,4 +58,4 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
               common.comment("the final state: every particle, at full precision (%.17g), sorted by id"),
               f"write_dump all custom {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)} modify format float %.17g sort id",
               ""]
-    return common.Deck("lammps", "\n".join(lines), {PD.DATA_FILE: PD.data_file(case, lay)}, dt=lay.dt)
+    return common.Deck("lammps", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay)}, dt=lay.dt)

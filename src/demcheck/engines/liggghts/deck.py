@@ -15,6 +15,7 @@ from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ...inputs.common import fmt
 from ..base import Engine
+from ..family import DUMP_COLUMNS
 from ..mapping import contact_mapping, pair_mapping
 
 VERSION_NOTE = "written for LIGGGHTS-PUBLIC 3.8.0 (pair_style gran)"
@@ -128,9 +129,9 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
     gn = sum(x * x for x in g) ** 0.5
     if gn > 0:
         lines.append(f"fix gravity all gravity {fmt(gn)} vector {' '.join(fmt(x / gn) for x in g)}")
-    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(common.DUMP_COLUMNS) - 2))
+    fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(DUMP_COLUMNS) - 2))
     lines += ["", "fix integrate all nve/sphere", f"timestep {fmt(sc.dt)}",
-              f"dump state all custom 1 {common.DUMP_FILE} {' '.join(common.DUMP_COLUMNS)}",
+              f"dump state all custom 1 {common.DUMP_FILE} {' '.join(DUMP_COLUMNS)}",
               f'dump_modify state format "{fmt_line}" sort id',
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]

@@ -6,6 +6,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
+from .. import family_packing as FP
 from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
@@ -49,7 +50,7 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
             moduli.append(RIGID_WALL_MODULUS)
             ratios.append(ratios[0])
     model_lines, style, flags = model_setup(nat, matrices, moduli, ratios)
-    lines = PD.head(case, "liggghts", VERSION_NOTE, "liggghts -in", lay, list(natives.values()), "granular",
+    lines = FP.head(case, "liggghts", VERSION_NOTE, "liggghts -in", lay, list(natives.values()), "granular",
                     "communicate single vel yes")
     walls = f", {ntypes} the walls" if case.walls else ""
     lines += ["", common.comment("neighbour lists: a skin of half the largest radius, checked every step"),
@@ -64,18 +65,18 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
         lines += [common.comment(f"{PD.wall_comment(w, k)}; a primitive of atom type {ntypes}"),
                   f"fix wall{k} all wall/gran {style} primitive type {ntypes} {'xyz'[ax]}plane "
                   f"{fmt(w.point[ax])} {' '.join(flags)}"]
-    lines += PD.gravity(case)
+    lines += FP.gravity(case)
     fmt_line = " ".join(["%d", "%d"] + ["%.17g"] * (len(PD.FINAL_COLUMNS) - 2))
     local_fmt = " ".join(["%.17g"] * 10)  # compute values are doubles, the ids too
     lines += ["", common.comment("per contact: the two ids, a periodic flag, the force on the first and its normal "
                                  "part, the overlap"),
               common.comment("(defined before the first run, as LIGGGHTS requires; dumped at the final state only)"),
               "compute pairs all pair/gran/local id force force_normal delta"]
-    lines += PD.integration(lay)
+    lines += FP.integration(lay)
     lines += ["", common.comment("the final state: every particle and every contact at full precision (%.17g), "
                                  "written by a run of no steps"),
               f"dump final all custom 1 {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)}",
               f'dump_modify final format "{fmt_line}" sort id',
               f"dump contacts all local 1 {PD.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
               f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
-    return common.Deck("liggghts", "\n".join(lines), {PD.DATA_FILE: PD.data_file(case, lay, ntypes)}, dt=lay.dt)
+    return common.Deck("liggghts", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay, ntypes)}, dt=lay.dt)

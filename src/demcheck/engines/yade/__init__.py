@@ -3,8 +3,8 @@
 A collision deck is a Python script generated from a fixed template with only numbers substituted
 (:mod:`.deck`), checked before every run by :func:`.deck.check_script` (parsed with ``ast``: only the
 template's names, attributes, calls and numeric constants). It steps Yade's leap-frog NewtonIntegrator one
-step at a time and writes the bodies' states as a LAMMPS-style ``dump custom`` (float64, %.17g), so the rest
-of demcheck reads Yade as it reads the other engines. A packing script (:mod:`.packing`) comes from a second fixed
+step at a time and writes the bodies' states as a plain table (float64, %.17g), which :meth:`Yade.read_collision`
+reads into the collision record (engines/output.py), as every engine's reader does. A packing script (:mod:`.packing`) comes from a second fixed
 template with its own guard; :meth:`Yade.check_deck` picks the guard by the script's first line.
 """
 
@@ -21,9 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import registry
-from ..base import Native, PackageEngine, Style
+from ..base import Native, PackageEngine, Style, traceback_errors
 
 LAUNCHER = Path(__file__).with_name("launch.py")
+# a line of Yade's logger (its colours taken off by engines/serve.plain_text): ``<WARNING> file:line function: text``
+_LOGGED = re.compile(r"^<(WARNING|ERROR|FATAL ERROR)> (.*)$", re.M)
 WORKER = Path(__file__).with_name("worker.py")
 
 
@@ -133,27 +135,27 @@ class Yade(PackageEngine):
             return scenario.check_script(text, files)
         (packing.check_script if packing.is_packing_script(text) else deck.check_script)(text, files)
 
-    def read_collision(self, workdir):
-        """The collision script's dump (deck.py writes the LAMMPS family's columns, engines/family.py)."""
-        from ..family import read_state_dump
+    def errors(self, log: str) -> list[str]:
+        """The script's Python exception (Yade prints its traceback and ends)."""
+        return traceback_errors(log)
 
-        return read_state_dump(workdir)
+    def warnings(self, log: str) -> list[str]:
+        """The lines of Yade's logger at WARNING, ERROR or FATAL ERROR level (``<WARNING> file:line function:
+        message``): a run they appear in is judged by its output, as Yade goes on past them."""
+        return [f"{level}: {text.strip()}" for level, text in _LOGGED.findall(log)]
 
-    def read_packing(self, workdir, log: str):
-        """The packing script's final dump and thermo lines (packing.py writes the LAMMPS family's)."""
-        from ..family import read_packing_output
+    def read_collision(self, workdir, log: str = ""):
+        """The collision script's state table (deck.py, :func:`.deck.read_states`)."""
+        from ..output import CollisionOutput
+        from .deck import read_states
 
-        return read_packing_output(workdir, log)
+        return CollisionOutput(read_states(workdir), log)
 
-    def read_contacts(self, v, i, j, radius, x=None, box=None):
-        """A packing script's contact dump (packing.CONTACT_COLUMNS): id1 id2, penetrationDepth, the normal
-        force on the second body (3), the stored shear force (3), the contact normal from the first to the
-        second (3). Fn = normalForce · normal (repulsive > 0), |Ft| = |shearForce|; the overlap is Yade's
-        penetrationDepth (across a periodic boundary too: Yade computes it with the cell shift)."""
-        overlap = v[:, 2]
-        fn = np.einsum("ij,ij->i", v[:, 3:6], v[:, 9:12])
-        ft = np.linalg.norm(v[:, 6:9], axis=1)
-        return overlap, fn, ft
+    def read_packing(self, workdir, log: str, box=None):
+        """The packing script's final state, contacts and kinetic energy lines (:func:`.packing.read`)."""
+        from .packing import read
+
+        return read(self, workdir, log, box)
 
     def summary(self, native: Native) -> str:
         return f"{native.normal} + {native.tangential}"

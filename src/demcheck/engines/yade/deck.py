@@ -5,7 +5,8 @@ The script builds the two bodies (spheres, or a sphere and an axis-aligned ``Wal
 the engines (``NewtonIntegrator(damping=0, gravity=…)``: Yade's default Cundall damping is 0.2 in many
 examples), then steps one step at a time. Yade's NewtonIntegrator is a leap-frog: a step computes the forces
 F_k at the positions x_k with the velocities v_{k−½}, then v_{k+½} = v_{k−½} + dt F_k/m and x_{k+1} = x_k +
-dt v_{k+½}. The dump's row of step k holds x_k, F_k (the weight included, as the LAMMPS-family engines write a
+dt v_{k+½}. The state table's row of step k (``dump.txt``: a header of the record's columns, a row per body
+per step; :func:`read_states`) holds x_k, F_k (the weight included, as the LAMMPS-family engines write a
 body's force) and the full-step velocity v_k = v_{k−½} + ½dt F_k/m: exactly the rows velocity Verlet writes,
 whose force at step k reads the same x_k and v_{k−½}. The script starts from v_{−½} = v_0 − ½dt g (no contact
 at the start, so the weight is F_0), so that its first row's velocity is the case's.
@@ -20,15 +21,16 @@ from ...case import Case
 from ...errors import DemcheckError, UnsupportedByEngine
 from ...inputs import common
 from ..base import Engine
+from ..output import STATE_COLUMNS
 from ..mapping import contact_mapping
 from .mapping import CUNDALL, LUDING, MINDLIN, VISCEL
 
 VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
 # a ViscElPhys Native whose props name CUNDALL (mapping.py) runs as FrictMat + FrictPhys + CundallStrack: a linear
 # spring and an incremental shear force capped at μFn, without dashpots (cn = cs = 0), as Yade's FrictPhys computes
-HEAD = "ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\nITEM: BOX BOUNDS ff ff ff\n-1 1\n-1 1\n-1 1\nITEM: ATOMS " \
-       + " ".join(common.DUMP_COLUMNS) + "\n"
-ROW = "%d %d" + " %.17g" * (len(common.DUMP_COLUMNS) - 2) + "\n"
+# the states' table (:func:`read_states`): a header line of the record's column names, then a row per body per step
+HEAD = "step " + " ".join(STATE_COLUMNS) + "\n"
+ROW = "%d %d %d" + " %.17g" * (len(STATE_COLUMNS) - 2) + "\n"
 STRINGS = frozenset({HEAD, ROW, common.DUMP_FILE, "w"})
 NAMES = frozenset({
     "O", "Vector3", "utils", "FrictMat", "ViscElMat", "ForceResetter", "InsertionSortCollider", "Bo1_Sphere_Aabb",
@@ -221,6 +223,7 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
               f"              NewtonIntegrator(damping={_num(float(p.get('newton_damping', 0.0)))}, gravity=G)]",
               "O.dt = DT",
               f"out = open({common.DUMP_FILE!r}, 'w')",
+              f"out.write({HEAD!r})",
               "n = len(ids)",
               # step k: F_k (the weight m g included: NewtonIntegrator adds it, O.forces holds the contacts') at x_k
               # with v_{k-1/2}; the row holds x_k, v_k = v_{k-1/2} + dt F_k/(2m), F_k
@@ -229,13 +232,39 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
               "    v = [Vector3(O.bodies[i].state.vel) for i in ids]",
               "    w = [Vector3(O.bodies[i].state.angVel) for i in ids]",
               "    O.step()",
-              f"    out.write({HEAD!r} % (k, n))",
               "    for s in range(n):",
               "        f = O.forces.f(ids[s]) + G * mass[s]",
               "        t = O.forces.t(ids[s])",
               "        a = v[s] + f * (0.5 * DT / mass[s])",
               "        b = w[s] + t * (0.5 * DT / inertia[s])",
-              f"        out.write({ROW!r} % (s + 1, s + 1, radius[s], mass[s], x[s][0], x[s][1], "
+              f"        out.write({ROW!r} % (k, s + 1, s + 1, radius[s], mass[s], x[s][0], x[s][1], "
               "x[s][2], a[0], a[1], a[2], b[0], b[1], b[2], f[0], f[1], f[2], t[0], t[1], t[2]))",
               "out.close()", ""]
     return common.Deck("yade", "\n".join(lines), {}, dt=sc.dt, check=check_script)
+
+
+def read_states(workdir):
+    """The collision script's state table (HEAD, then ROW: a row per body per step, float64 as ``%.17g``) with the
+    record's columns (engines.output.STATE_COLUMNS): ``step``, ``id`` and ``type`` as integers."""
+    from pathlib import Path
+
+    import numpy as np
+    import pandas as pd
+
+    from ...errors import ParseError
+
+    path = Path(workdir) / common.DUMP_FILE
+    if not path.exists():
+        raise ParseError(f"{path}: no such state table (the Yade script wrote none)")
+    head, _, body = path.read_text().partition("\n")
+    names = head.split()
+    if names != ["step", *STATE_COLUMNS]:
+        raise ParseError(f"{path}:1: not the collision script's header ({head[:80]!r})")
+    try:
+        values = np.array(body.split(), dtype=np.float64)
+    except ValueError:
+        raise ParseError(f"{path}: a value that is not a number") from None
+    if values.size % len(names):
+        raise ParseError(f"{path}: its last row is cut short ({values.size % len(names)} of {len(names)} values)")
+    table = pd.DataFrame(values.reshape(-1, len(names)), columns=names)
+    return table.astype({"step": np.int64, "id": np.int64, "type": np.int64})

@@ -28,14 +28,18 @@ What the script does, and why:
   ``step ke atoms`` lines, which engines/packing.run_engine reads from the log), then FINAL_DUMP (every
   particle at step N: x_N, v_N, ω_N and F_N + m g, positions wrapped into the periodic box, float64 %.17g,
   LAMMPS ``dump custom`` layout) and CONTACT_DUMP (every particle pair Yade holds at step N: the two ids,
-  penetrationDepth, the normal force vector, the shear force vector and the contact normal), read by
-  ``Yade.read_contacts``.
+  penetrationDepth, the normal force vector, the shear force vector and the contact normal), both in the ``dump
+  custom`` / ``dump local`` text layout (one parser, engines/dumps.py, for every file in it; ``demcheck pack``'s
+  ``universe`` opens FINAL_DUMP as a LAMMPS dump), read by :func:`read` into the packing's record
+  (engines.output.PackingOutput).
 """
 
 from __future__ import annotations
 
 import ast
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 
@@ -49,7 +53,8 @@ from .deck import VERSION_NOTE, ascii_comment, guard
 from .mapping import MINDLIN, VISCEL
 
 MARKER = "# demcheck: a Yade packing script (Python), generated from a fixed template"
-KE = "%d %.17g %d"  # a thermo line as the LAMMPS-family decks print it: step, ke, atoms
+KE = "%d %.17g %d"  # a kinetic energy line: step, ke, atoms (the LAMMPS-family decks' thermo columns)
+_KE_LINE = re.compile(r"^(\d+) (\S+) \d+$", re.M)
 BOX = {True: "pp pp ff", False: "ff ff ff"}
 _BOUNDS = "ITEM: BOX BOUNDS {}\n%.17g %.17g\n%.17g %.17g\n%.17g %.17g\n"
 FINAL_HEAD = {p: "ITEM: TIMESTEP\n%d\nITEM: NUMBER OF ATOMS\n%d\n" + _BOUNDS.format(BOX[p]) + "ITEM: ATOMS "
@@ -501,3 +506,32 @@ def _outputs(periodic: bool, bounds: list) -> list[str]:
             f"    out.write({CONTACT_ROW!r} % (c.id1 + 1, c.id2 + 1, c.geom.penetrationDepth, f[0], f[1], f[2], "
             "t[0], t[1], t[2], a[0], a[1], a[2]))",
             "out.close()", ""]
+
+
+def read(engine, workdir, log: str, box=None):
+    """A packing script's output as its record (engines.output.PackingOutput): the final state (the last block of
+    FINAL_DUMP, sorted by id), the contacts (:func:`contacts`) and the kinetic energy lines of ``log``."""
+    from ..output import PackingOutput
+
+    final = _last_block(Path(workdir) / PD.FINAL_DUMP, PD.FINAL_COLUMNS).sort_values("id").reset_index(drop=True)
+    ke = [(int(m.group(1)), float(m.group(2))) for m in _KE_LINE.finditer(log)]
+    return PackingOutput(final, contacts(Path(workdir) / PD.CONTACT_DUMP), ke, log)
+
+
+def contacts(path):
+    """CONTACT_DUMP (the last block: every pair Yade holds) as engines.output.CONTACT_COLUMNS: Fn = normalForce ·
+    normal (repulsive > 0), |Ft| = |shearForce|; the overlap is Yade's penetrationDepth (across a periodic
+    boundary too: Yade computes it with the cell shift)."""
+    from ..output import touching
+
+    v = _last_block(path, CONTACT_COLUMNS)[list(CONTACT_COLUMNS)].to_numpy(float)
+    i, j = v[:, 0].astype(np.int64) - 1, v[:, 1].astype(np.int64) - 1
+    fn = np.einsum("ij,ij->i", v[:, 3:6], v[:, 9:12])
+    return touching(i, j, v[:, 2], fn, np.linalg.norm(v[:, 6:9], axis=1))
+
+
+def _last_block(path, columns):
+    from ..dumps import read_dump
+
+    table = read_dump(path, columns=columns)
+    return table[table["step"] == table["step"].max()] if len(table) else table
