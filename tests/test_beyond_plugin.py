@@ -5,15 +5,9 @@ case keys, resolves to its record as a case's [contact] does, torques through th
 solve (against its closed form) and in the engines' stepped wall scheme, has its docs row, and is refused by every
 engine's scenario mapping with a reason — with no other file edited."""
 
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .helpers import with_plugin_law
 
 TOY = '''
 """A toy rolling law: a torque of constant magnitude M0 against the rolling, whatever the load."""
@@ -90,13 +84,7 @@ print(json.dumps(out))
 
 
 def test_a_rolling_law_in_one_module_runs_in_the_reference_and_is_refused_by_every_engine(tmp_path):
-    (tmp_path / "toy_rolling_law.py").write_text(TOY)
-    env = dict(os.environ, DEMCHECK_LAW_PLUGINS="toy_rolling_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)
-    p = subprocess.run([sys.executable, "-c", RUN], cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
-    assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    out = with_plugin_law(tmp_path, "toy_rolling_law", TOY, RUN, timeout=900)
     assert "fixed_torque" in out["ids"] and out["keys"] == ["m0"] and out["record"] == "FixedTorqueRolling"
     assert out["docs"] == ["M = −M0 ŵt", "tests/test_beyond_plugin.py"] and out["m0"] == 2e-7
     assert out["torque"] == pytest.approx([0.0, -2e-7, 0.0], rel=1e-15)

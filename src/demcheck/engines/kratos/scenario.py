@@ -51,8 +51,11 @@ JKR_LAW, DMT_LAW = "DEM_D_Hertz_viscous_Coulomb_JKR", "DEM_D_Hertz_viscous_Coulo
 # the adhesion records Kratos' cohesive laws express: the law, and its force as reference/beyond_kratos computes it
 COHESIVE = {JkrAdhesion: JKR_LAW, DmtAdhesion: DMT_LAW}
 COHESIVE_FORCE = {JKR_LAW: _bk.kratos_jkr_force, DMT_LAW: _bk.kratos_dmt_force}
-ROLLING_MODELS = {ConstantTorqueRolling: "DEMRollingFrictionModelConstantTorque",
-                  ViscousRolling: "DEMRollingFrictionModelViscousTorque"}
+# the rolling records Kratos' rolling friction models express
+ROLLING_BY_RECORD = {ConstantTorqueRolling: "DEMRollingFrictionModelConstantTorque",
+                     ViscousRolling: "DEMRollingFrictionModelViscousTorque"}
+# the same by the law's id: what engines/kratos/audit.py reads a project's model name back to
+ROLLING_MODELS = {record.id: name for record, name in ROLLING_BY_RECORD.items()}
 WHY_NOT = {
     "twist": ("Kratos DEM 10.4.4 has no twisting torque model: its discontinuum laws give a force, and its only "
               "torque models are the rolling friction models (ConstantTorque, ViscousTorque, Bounded)"),
@@ -121,7 +124,7 @@ def _rolling(engine: Engine, case: Case, model) -> Mapping:
     from .mapping import FRICTION
 
     rec = model.slot("rolling")
-    if type(rec) not in ROLLING_MODELS:
+    if type(rec) not in ROLLING_BY_RECORD:
         return refused("kratos", NO_SPRING if isinstance(rec, EpsdRolling) else
                        f"no Kratos rolling friction model for '{rec.id}'")
     base = engine.map(model, case.contact.params)
@@ -140,7 +143,7 @@ def _rolling(engine: Engine, case: Case, model) -> Mapping:
     else:
         mu = rec.c_r / (weight * radius * radius)
         reason = VISCOUS_REASON.format(weight=weight, dr2=1.0 - (1.0 - delta / radius) ** 2)
-    name = ROLLING_MODELS[type(rec)]
+    name = ROLLING_BY_RECORD[type(rec)]
     nat.props = {**nat.props, "rolling": (name, mu)}
     nat.comments = [*nat.comments, f"RollingFrictionOption = true, {name}, ROLLING_FRICTION = "
                                    f"ROLLING_FRICTION_WITH_WALLS = {mu:.10g}"]
@@ -189,7 +192,7 @@ def _rolling_laws(engine: Engine, case: Case, nat: Native) -> dict:
 
 def _roll(nl, kp, rolling, case: Case, laws: dict, lay) -> dict:
     w = case.walls[0]
-    model = _bk.VISCOUS_TORQUE if rolling[0] == ROLLING_MODELS[ViscousRolling] else _bk.CONSTANT_TORQUE
+    model = _bk.VISCOUS_TORQUE if rolling[0] == ROLLING_BY_RECORD[ViscousRolling] else _bk.CONSTANT_TORQUE
     return _bk.wall_roll(nl, kp, model, rolling[1], case.particles[0].radius, case.mass(0), lay.positions[0],
                          lay.velocities[0], lay.omegas[0], case.run.gravity, w.point, w.normal, lay.dt, lay.steps,
                          lay.every)

@@ -11,6 +11,7 @@ from typing import ClassVar
 from numba import njit
 
 from ... import KERNEL_CACHE
+from ..adhesion_laws.sjkr import lens_area  # the circle sjkr's lens area is: one function for both laws
 from ..registry import Key, positive
 from .slot import KERNELS, HeatSubModel
 
@@ -27,16 +28,6 @@ class LensHeat(HeatSubModel):
     r0: float = 0.0
     r1: float = 0.0
     wall: bool = False
-
-
-@njit(cache=KERNEL_CACHE)
-def lens_area(r0, r1, delta, wall):
-    """The circle where two undeformed spheres (or a sphere and a plane) intersect. (adhesion_laws/sjkr.py has the
-    same function: numba's cache keys a kernel by its own file only, so a kernel here does not call one there.)"""
-    if wall:
-        return math.pi * (2.0 * r0 * delta - delta * delta)
-    d = r0 + r1 - delta
-    return -0.25 * math.pi * (d - r0 - r1) * (d + r0 - r1) * (d - r0 + r1) * (d + r0 + r1) / (d * d)
 
 
 @njit(cache=KERNEL_CACHE)
