@@ -129,3 +129,23 @@ def group_alive(pgid: int) -> list[int]:
 def children_alive(pid: int) -> list[int]:
     """The live (not zombie) children of a process."""
     return _alive_where(1, pid)
+
+
+def with_plugin_law(tmp_path, module: str, source: str, script: str, timeout: float = 1500) -> dict:
+    """``script``'s JSON (its last line), run in a fresh process with ``source`` written as the plug-in law module
+    ``module`` named in $DEMCHECK_LAW_PLUGINS, on an empty kernel cache (the plug-in's source in its fingerprint)."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    (tmp_path / f"{module}.py").write_text(source)
+    env = dict(os.environ, DEMCHECK_LAW_PLUGINS=module, XDG_CACHE_HOME=str(tmp_path / "cache"),
+               PYTHONPATH=os.pathsep.join([str(tmp_path), str(root / "src"), str(root)]))
+    env.pop("NUMBA_CACHE_DIR", None)
+    p = subprocess.run([sys.executable, "-c", script], cwd=root, env=env, capture_output=True, text=True,
+                       timeout=timeout)
+    assert p.returncode == 0, p.stderr[-3000:]
+    return json.loads(p.stdout.strip().splitlines()[-1])

@@ -5,12 +5,11 @@ exactly as the built-in spring does, with no solver edited."""
 
 import ast
 import io
-import json
-import os
-import subprocess
 import sys
 import tokenize
 from pathlib import Path
+
+from .helpers import with_plugin_law
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "src" / "demcheck" / "reference"
@@ -113,13 +112,7 @@ print(json.dumps(out))
 def _with_the_copy(tmp_path, script: str) -> dict:
     """``script``'s JSON, run in a fresh process with the spring's copy (COPY) registered as a plug-in law, on an
     empty kernel cache."""
-    (tmp_path / "copy_spring_law.py").write_text(COPY)
-    env = dict(os.environ, DEMCHECK_LAW_PLUGINS="copy_spring_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)
-    p = subprocess.run([sys.executable, "-c", script], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
-    assert p.returncode == 0, p.stderr[-3000:]
-    return json.loads(p.stdout.strip().splitlines()[-1])
+    return with_plugin_law(tmp_path, "copy_spring_law", COPY, script)
 
 
 def test_a_plugin_law_with_a_history_runs_as_the_builtin_it_copies(tmp_path):

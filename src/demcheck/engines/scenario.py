@@ -26,6 +26,9 @@ from ..errors import DemcheckError, UnsupportedByEngine
 from ..laws.adhesion import adhesive_force
 from ..laws.heat import heat_flow
 from ..laws.model import resolve
+from ..laws.rolling import ViscousRolling
+from ..laws.tangential_laws.none import NoTangential
+from ..laws.tangential_laws.spring import SpringTangential
 from ..reference import beyond as _b
 from ..reference.expected import scenario_closed_forms
 from ..reference.scenarios import _on_wall, _twisting_law, metric_names, stepped_metrics
@@ -90,25 +93,23 @@ def _rolling_viscous_example(case: Case) -> dict:
     return {"c_r": math.floor(half / unit) * unit}
 
 
-# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it);
-# a function of the case where the value must fit it (type B's Cr: the sphere must roll without slip)
-EXAMPLE_PARAMS = {("rolling", "constant_torque"): {"mu_r": 0.1}, ("rolling", "viscous"): _rolling_viscous_example,
-                  ("rolling", "epsd"): {"mu_r": 0.1, "k_r": 1e-3}, ("twisting", "sds"): {"k_tw": 1e-3, "mu_tw": 1e-4},
-                  ("twisting", "marshall"): {"kt": 1e5}, ("adhesion", "jkr"): {"w": 0.1}, ("adhesion", "dmt"): {"w": 0.1},
-                  ("adhesion", "sjkr"): {"k_c": 1e5}, ("heat", "radius"): {"k": 45.0}, ("heat", "area"): {"k": 1e6},
-                  ("heat", "lens"): {"k": 45.0}}
+# a law's parameters where a suite case of its slot runs another law of the slot (its own where the case runs it)
+# are its record's ``example``; a function of the case where the value must fit it (type B's Cr: the sphere must
+# roll without slip)
+EXAMPLE_FITS = {ViscousRolling: _rolling_viscous_example}
 KEPT_KEYS = ("kt",)  # also the tangential spring's: never taken out with another law's keys
 RANK = {"exact": 0, "approximate": 1}
 
 
 def law_cases(slot: str, law_id: str) -> tuple[list[Case], list[str]]:
     """The suite's cases of ``slot``'s scenarios with its law set to ``law_id`` (the case's own parameters where it
-    runs that law, else EXAMPLE_PARAMS), and the rules that left the others out (a scenario that does not run the
-    law: its ConfigError's text)."""
+    runs that law, else its record's ``example`` or EXAMPLE_FITS), and the rules that left the others out (a
+    scenario that does not run the law: its ConfigError's text)."""
     import tomllib
 
     from ..case import from_dict
     from ..errors import ConfigError
+    from ..laws.base import sub_model
     from ..laws.slots import KEYS
     from ..resources import case_path
 
@@ -119,9 +120,10 @@ def law_cases(slot: str, law_id: str) -> tuple[list[Case], list[str]]:
         contact = raw["contact"]
         try:
             if contact.get(slot, "none") != law_id:
-                example = EXAMPLE_PARAMS[(slot, law_id)]
-                if callable(example):  # of the suite case as it is: its sphere, wall, friction and speed
-                    example = example(from_dict(tomllib.loads(text)))
+                record = sub_model(slot, law_id)
+                example = dict(record.example)
+                if record in EXAMPLE_FITS:  # of the suite case as it is: its sphere, wall, friction and speed
+                    example = EXAMPLE_FITS[record](from_dict(tomllib.loads(text)))
                 for key in KEYS.get((slot, contact.get(slot, "none")), ()):
                     if key.name not in KEPT_KEYS:
                         contact.pop(key.name, None)
@@ -214,7 +216,7 @@ def overlap_scale(case: Case) -> float:
     pull-off force, sjkr's 4 × the Hertz overlap under its largest tension."""
     model = resolve(case)
     law = model.slot("adhesion")
-    return _adhesion_scale(law) if law.id != "sjkr" else _cohesion_scale(case, model)
+    return _adhesion_scale(law) if law.replaces_normal else _cohesion_scale(case, model)
 
 
 def _cohesion_scale(case: Case, model) -> float:
@@ -224,8 +226,8 @@ def _cohesion_scale(case: Case, model) -> float:
 
 
 def _adhesion_scale(law) -> float:
-    """The overlap scale of a pull: JKR's |δ_f|, DMT's Hertz overlap under its pull-off force."""
-    if law.id == "jkr":
+    """The overlap scale of a pull: JKR's |δ_f| (a law that necks), DMT's Hertz overlap under its pull-off force."""
+    if law.necks:
         return abs(law.separation_at_pull_off("displacement"))
     return (law.pull_off_force("load") / (4.0 / 3.0 * law.e_eff * math.sqrt(law.r_eff))) ** (2.0 / 3.0)
 
@@ -260,7 +262,7 @@ def _wall_duration(case: Case, mass: float, radius: float, g: float, theta: floa
     if case.run.scenario == "rolling":
         law, p, n = model.slot("rolling"), case.particles[0], np.asarray(case.walls[0].normal, dtype=float)
         v = np.asarray(p.velocity, dtype=float)
-        if law.id == "viscous":  # type B never stops: 1.5 × its time constant (the e-fold time is measured)
+        if law.decays:  # type B never stops: 1.5 × its time constant (the e-fold time is measured)
             return 1.5 * _b.rolling_viscous_closed(law.c_r, mass, radius, 1.0)[0]
         return 1.25 * _b.rolling_stop_closed(law.mu_r, law.r_roll, radius, float(np.linalg.norm(v - (v @ n) * n)),
                                             g)[0]
@@ -343,9 +345,9 @@ def seed_laws(case: Case) -> dict:
         return nl.k * d ** nl.a + nl.eta * d ** nl.b * rate
 
     tangential = None
-    if tl.id == "spring":
+    if type(tl) is SpringTangential:  # the constant-kt spring (not sqrt_spring, its subclass)
         tangential = (tl.kt, tl.eta, model.pair.friction)
-    elif tl.id != "none":
+    elif not isinstance(tl, NoTangential):
         raise UnsupportedByEngine(f"the scenario's seed run steps a tangential spring or none, not '{tl.id}'")
     laws = {"normal": normal, "tangential": tangential}
     laws.update({s: model.slot(s) for s in ("rolling", "twisting", "adhesion", "heat")})
@@ -372,7 +374,7 @@ def _why_not_finite(case: Case, lay: Layout) -> str:
     """The cause of a metric that is not finite, where demcheck knows it: a viscous rolling torque (type B) whose
     speed did not fall to v0/e within the run (1.5 T). (A Cr past the no-slip bound, where the sphere slides, is
     refused when the case loads: case.rolling_grip.)"""
-    if case.run.scenario != "rolling" or resolve(case).slot("rolling").id != "viscous":
+    if case.run.scenario != "rolling" or not resolve(case).slot("rolling").decays:
         return ""
     return f"the speed did not fall to v0/e within the run ({lay.steps * lay.dt:.3g} s)"
 
@@ -398,22 +400,22 @@ def seed(case: Case, engine) -> Result:
     return _result(case, "reference-verlet", "verlet", _metrics(case, step(case, seed_laws(case), lay)), lay, started)
 
 
-def cached_metrics(kind: str, case: Case, engine, cache=None) -> dict:
-    """The metrics of the engine's ``twin`` or of the ``seed`` run (``kind``), from ``cache`` (engines.cache.Cache)
-    when an entry is there: keyed by the kind, the engine, the case's hash and the fingerprint of demcheck's own
-    source and of numpy's, numba's and scipy's versions (:func:`code_fingerprint`), so a changed law, scheme,
+def cached_metrics(which: str, case: Case, engine, cache=None) -> dict:
+    """The metrics of the engine's ``twin`` or of the ``seed`` run (``which``), from ``cache``
+    (engines.cache.Cache) when an entry is there: keyed by which run it is, the engine, the case's hash and the
+    fingerprint of demcheck's own source and of numpy's, numba's and scipy's versions (:func:`code_fingerprint`), so a changed law, scheme,
     mapping or layout never serves an old result. A metric that is not finite is stored as such (its flag
     column), never as a number."""
     import json
 
     from .cache import key
 
-    run_it = twin if kind == "twin" else seed
+    run_it = twin if which == "twin" else seed
     if cache is None:
         return run_it(case, engine).metrics()
     name = _engine(engine).name
     names = metric_names(case)
-    k = key(f"scenario-{kind}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
+    k = key(f"scenario-{which}", code_fingerprint(), json.dumps({"case": case.hash, "engine": name}), {})
     hit = get_metrics(cache, k, names)
     if hit is not None:
         return hit[0]

@@ -123,16 +123,16 @@ def rolling_on_plane(law, mass: float, radius: float, v0: float, g: float, theta
         m, _ = rolling_torque(law, np.array([0.0, v / radius, 0.0]), N_DOWN, fn, dt, np.array([0.0, mk, 0.0]))
         return m[1]
 
-    def rhs_free(t, y):  # y = x, v, Mk (Mk only for type C)
+    def rhs_free(t, y):  # y = x, v, Mk (Mk only for a law with a spring torque: type C)
         v, mk = y[1], y[2]
-        if law.id == "epsd":
+        if law.spring:
             mk_rate = -law.k_r * v / radius if abs(mk) < cap or mk * v > 0.0 else 0.0
             m_tot = np.clip(mk, -cap, cap) + (-law.c_r * v / radius if abs(mk) < cap else 0.0)
             return [v, (drive + m_tot / radius) / m_eff, mk_rate]
         return [v, (drive + torque_y(v, 0.0) / radius) / m_eff, 0.0]
 
     stopped = _stop_event()
-    stops = law.id == "constant_torque"  # type A stops in finite time; B decays; C rocks
+    stops = law.stops  # type A stops in finite time; B decays; C rocks
     sol = solve_ivp(rhs_free, (0.0, t_end), [0.0, v0, 0.0], method="DOP853", rtol=RTOL, atol=1e-14,
                     events=[stopped] if stops else None, dense_output=False)
     out = {"t": sol.t, "x": sol.y[0], "v": sol.y[1]}
@@ -206,7 +206,7 @@ def pull_off(law, delta0: float | None = None) -> dict:
     def f(d):
         return adhesive_force(law, d, 1.0)[0]
 
-    if law.id == "jkr":
+    if law.necks:  # JKR: the largest tension is past δ = 0, the break at a negative overlap
         lo, hi = law.separation_at_pull_off("displacement") * (1 - 1e-9), delta0
         r = minimize_scalar(f, bounds=(lo * 0.999999, hi), method="bounded", options={"xatol": 1e-18})
         tension = -r.fun
@@ -284,9 +284,10 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
     engines' ``fix nve/sphere`` does (half kick, drift, forces at full-step positions and half-step velocities,
     half kick; histories updated from the first step on, not at set-up; temperatures by explicit Euler after the
     step). The normal force is a linear spring kn·δ (plus a cohesion record's force), or the adhesion record's
-    when it replaces the normal law; the limit of the rolling and twisting torques is |Fn| (|Fn + 2·(3/2)πwR̄|
-    for jkr: the engine's critical force; the elastic kn·δ alone with ``elastic_limit``); a linear dashpot
-    eta_n·δ̇ (δ̇ > 0 approaching) joins the linear spring; the twisting law sees the contact radius √(R̄δ).
+    when it replaces the normal law; the limit of the rolling and twisting torques is the adhesion record's
+    ``limit_force`` (|Fn|; |Fn + 2·(3/2)πwR̄| for jkr: the engine's critical force; the elastic kn·δ alone with
+    ``elastic_limit``); a linear dashpot eta_n·δ̇ (δ̇ > 0 approaching) joins the linear spring; the twisting law
+    sees the contact radius √(R̄δ).
     ``setup_increment``: the set-up force call already adds one step's spring increment to the torques it applies
     (and forgets it: the history still starts at step 1), as LIGGGHTS's rolling models do.
     Returns per step (after it): x, v, ω, f, τ (steps×2×3 each), T (steps×2) and the heat flow Q into body 0."""
@@ -303,8 +304,7 @@ def verlet_pair(radius: float, density: float, x1: float, v1: float, omega0, ome
     def normal(delta, rate):
         if adhesion is not None and adhesion.replaces_normal:
             fn, touch = adhesive_force(adhesion, delta, state["touch"])
-            crit = abs(fn + 2.0 * adhesion.pull_off_force("load")) if adhesion.id == "jkr" else abs(fn)
-            return fn, crit, touch
+            return fn, adhesion.limit_force(fn), touch
         fn, touch = kn * delta + eta_n * rate, float(delta > 0.0)
         if adhesion is not None and touch:  # a cohesion added to the normal force (and to its limit)
             fn += adhesive_force(adhesion, delta, 1.0)[0]
@@ -431,18 +431,20 @@ def _norm(a) -> float:
 def _rolling_kernel(law):
     """``rolling_torque`` of ``law`` with its coefficients laid out once: (w, n, |Fn|, dt, history) → (torque,
     history), the compiled force function called as rolling_torque calls it."""
-    if law is None or law.id not in _rolling.FORCES:
+    force = _rolling.KERNELS.of(law)
+    if force is None:
         return lambda w, n, fn_abs, dt, history: (np.zeros(3), np.asarray(history, dtype=np.float64))
-    force, c = _rolling.FORCES[law.id], law.array()
+    c = law.array()
     return lambda w, n, fn_abs, dt, history: force(c, np.asarray(w, dtype=np.float64), n, float(fn_abs), float(dt),
                                                    np.asarray(history, dtype=np.float64))
 
 
 def _twisting_kernel(law):
     """``twisting_torque`` of ``law`` with its coefficients laid out once: (w, n, |Fn|, a, dt, φ) → (torque, φ)."""
-    if law is None or law.id not in _twisting.FORCES:
+    force = _twisting.KERNELS.of(law)
+    if force is None:
         return lambda w, n, fn_abs, a, dt, phi: (np.zeros(3), phi)
-    force, c = _twisting.FORCES[law.id], law.array()
+    c = law.array()
     return lambda w, n, fn_abs, a, dt, phi: force(c, np.asarray(w, dtype=np.float64), n, float(fn_abs), float(a),
                                                   float(dt), float(phi))
 

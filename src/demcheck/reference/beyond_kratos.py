@@ -28,19 +28,25 @@ from ..laws.normal_force import normal_force
 from ..laws.tangential_force import _cross, _dot
 from .twins_kratos import kratos_arm_turn, tangential
 
-JKR, DMT = "jkr", "dmt"
-
-
-def kratos_adhesive_force(kind: str, r_eff: float, e_eff: float, w: float, delta: float) -> float:
-    """The normal force (> 0 repulsive) of Kratos' Hertz_viscous_Coulomb_JKR/_DMT without damping at overlap δ:
-    0 unless δ > 0."""
+def kratos_jkr_force(r_eff: float, e_eff: float, w: float, delta: float) -> float:
+    """The normal force (> 0 repulsive) of Kratos' Hertz_viscous_Coulomb_JKR without damping at overlap δ: the
+    Hertz force less √(8πwE*a³) at the Hertz radius a = √(R̄δ); 0 unless δ > 0."""
     if not delta > 0.0:
         return 0.0
-    elastic = 4.0 / 3.0 * e_eff * math.sqrt(r_eff) * delta ** 1.5
-    if kind == JKR:
-        a = math.sqrt(r_eff * delta)
-        return elastic - math.sqrt(8.0 * w * math.pi * a * a * a * e_eff)
-    return elastic - 2.0 * math.pi * w * r_eff
+    a = math.sqrt(r_eff * delta)
+    return _hertz(r_eff, e_eff, delta) - math.sqrt(8.0 * w * math.pi * a * a * a * e_eff)
+
+
+def kratos_dmt_force(r_eff: float, e_eff: float, w: float, delta: float) -> float:
+    """The normal force (> 0 repulsive) of Kratos' Hertz_viscous_Coulomb_DMT without damping at overlap δ: the
+    Hertz force less 2πwR̄; 0 unless δ > 0."""
+    if not delta > 0.0:
+        return 0.0
+    return _hertz(r_eff, e_eff, delta) - 2.0 * math.pi * w * r_eff
+
+
+def _hertz(r_eff: float, e_eff: float, delta: float) -> float:
+    return 4.0 / 3.0 * e_eff * math.sqrt(r_eff) * delta ** 1.5
 
 
 def pair_impact(force, radius: float, mass: float, x1: float, v1: float, dt: float, steps: int) -> dict:
@@ -80,7 +86,7 @@ def jkr_hertz_radius_pull_off(r_eff: float, e_eff: float, w: float) -> tuple[flo
     """(largest tension, overlap where it acts) of the JKR law with the Hertz radius, by dF/dδ = 0:
     2E*√R̄ δ^{1/2} = (3/4)√(8πwE*) R̄^{3/4} δ^{−1/4} ⇒ δ* = ((3/8)√(8πw/E*) R̄^{1/4})^{4/3}."""
     d = (0.375 * math.sqrt(8.0 * math.pi * w / e_eff) * r_eff ** 0.25) ** (4.0 / 3.0)
-    return -kratos_adhesive_force(JKR, r_eff, e_eff, w, d), d
+    return -kratos_jkr_force(r_eff, e_eff, w, d), d
 
 
 # ----------------------------------------------------------------------------- a sphere rolling on a wall

@@ -27,7 +27,6 @@ import numpy as np
 
 from ..laws.heat import conductance
 from ..laws.model import resolve
-from ..laws.twisting import MarshallTwisting
 from ..result import Result
 from . import beyond as _b
 
@@ -39,17 +38,19 @@ SCENARIO_METRICS = {
     "adhesive_impact": ("restitution", "capture_velocity"),
     "conduction": ("heat_time_constant",),
 }
-# a law whose scenario measures something else: type B never stops (v = v0 e^{−t/T}): its time constant and the
-# distance to rest v0·T
-LAW_METRICS = {("rolling", "viscous"): ("rolling_time_constant", "rolling_distance")}
+# the rolling scenario of a law that never stops (its record's trait ``decays``: type B, v = v0 e^{−t/T}): its time
+# constant and the distance to rest v0·T
+DECAY_METRICS = ("rolling_time_constant", "rolling_distance")
+
+
+def _decays(case) -> bool:
+    """Whether the case rolls under a law that never stops (the rolling record's trait ``decays``)."""
+    return case.run.scenario == "rolling" and resolve(case).slot("rolling").decays
 
 
 def metric_names(case) -> tuple:
-    """The metrics of a case's scenario: SCENARIO_METRICS, or LAW_METRICS for the law the scenario runs."""
-    scenario = case.run.scenario
-    if scenario == "rolling" and case.contact.rolling == "viscous":
-        return LAW_METRICS[("rolling", "viscous")]
-    return SCENARIO_METRICS[scenario]
+    """The metrics of a case's scenario: SCENARIO_METRICS, or DECAY_METRICS for a rolling law that never stops."""
+    return DECAY_METRICS if _decays(case) else SCENARIO_METRICS[case.run.scenario]
 
 
 def _on_wall(case):
@@ -62,8 +63,8 @@ def _on_wall(case):
 
 
 def _twisting_law(case, law):
-    """The sds law the twist runs (Marshall's at the Hertz contact radius under the weight)."""
-    if not isinstance(law, MarshallTwisting):
+    """The law the twist runs at the Hertz contact radius under the weight (Marshall's: the sds law there)."""
+    if not law.from_contact_radius:
         return law
     mass, radius, g, theta, _ = _on_wall(case)
     a = (3.0 * mass * g * math.cos(theta) * radius / (4.0 * resolve(case).pair.e_eff)) ** (1.0 / 3.0)
@@ -75,7 +76,7 @@ def _rolling(case, model, closed):
     mass, radius, g, theta, n = _on_wall(case)
     v = np.asarray(case.particles[0].velocity, dtype=float)
     v0 = float(np.linalg.norm(v - (v @ n) * n))
-    if law.id == "viscous":
+    if law.decays:
         return _rolling_viscous(law, mass, radius, v0, g, closed)
     t_stop, s_stop = _b.rolling_stop_closed(law.mu_r, law.r_roll, radius, v0, g)
     if closed:
@@ -115,7 +116,7 @@ def _twist(case, model, closed):
 
 def _pull_off(case, model, closed):
     law = model.slot("adhesion")
-    if law.id == "sjkr":  # a cohesion added to the elastic Hertz law (case.py: like spheres, elastic hertz)
+    if not law.replaces_normal:  # a cohesion added to the elastic Hertz law (case.py: like spheres, elastic hertz)
         nl, radius = model.normal_law, case.particles[0].radius
         if closed:
             return {"pull_off_force": _b.sjkr_pull_off_closed(nl.k, law.k_c, law.area, radius, model.pair.r_eff),
@@ -130,8 +131,7 @@ def _adhesive_impact(case, model, closed):
     law, pair = model.slot("adhesion"), model.pair
     v = pair.impact_speed
     if closed:
-        rule = "load" if law.break_at == 1 else "displacement"
-        vs = _b.capture_velocity_closed(law.r_eff, law.e_eff, law.w, pair.m_eff, rule)
+        vs = _b.capture_velocity_closed(law.r_eff, law.e_eff, law.w, pair.m_eff, law.control)
         return {"restitution": _b.adhesive_restitution_closed(v, vs), "capture_velocity": vs}
     out = _b.adhesive_impact(law, pair.m_eff, v)
     e = out["restitution"]
@@ -166,7 +166,7 @@ def stepped_metrics(case, run: dict) -> dict:
             v0 = np.asarray(case.particles[0].velocity, dtype=float)
             u = v0 - (v0 @ n) * n
             u /= np.linalg.norm(u)
-            if case.contact.rolling == "viscous":  # the e-fold time; the distance at the end plus v·T still to go
+            if _decays(case):  # the e-fold time; the distance at the end plus v·T still to go
                 tau = _b.efold_time(t, v @ u)
                 return {"rolling_time_constant": tau,
                         "rolling_distance": float((x[-1] - x[0]) @ u + (v[-1] @ u) * tau)}

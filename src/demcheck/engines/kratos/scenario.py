@@ -37,14 +37,25 @@ import numpy as np
 from ...case import Case
 from ...errors import DemcheckError
 from ...inputs import common
+from ...laws.adhesion import DmtAdhesion, JkrAdhesion
+from ...laws.damping import NoDamping
 from ...laws.model import resolve
+from ...laws.normal import HertzNormal
+from ...laws.rolling import ConstantTorqueRolling, EpsdRolling, ViscousRolling
+from ...laws.tangential_laws.none import NoTangential
 from ...reference import beyond_kratos as _bk
 from ...reference.scenarios import _on_wall
 from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused
 
 JKR_LAW, DMT_LAW = "DEM_D_Hertz_viscous_Coulomb_JKR", "DEM_D_Hertz_viscous_Coulomb_DMT"
-ROLLING_MODELS = {"constant_torque": "DEMRollingFrictionModelConstantTorque",
-                  "viscous": "DEMRollingFrictionModelViscousTorque"}
+# the adhesion records Kratos' cohesive laws express: the law, and its force as reference/beyond_kratos computes it
+COHESIVE = {JkrAdhesion: JKR_LAW, DmtAdhesion: DMT_LAW}
+COHESIVE_FORCE = {JKR_LAW: _bk.kratos_jkr_force, DMT_LAW: _bk.kratos_dmt_force}
+# the rolling records Kratos' rolling friction models express
+ROLLING_BY_RECORD = {ConstantTorqueRolling: "DEMRollingFrictionModelConstantTorque",
+                     ViscousRolling: "DEMRollingFrictionModelViscousTorque"}
+# the same by the law's id: what engines/kratos/audit.py reads a project's model name back to
+ROLLING_MODELS = {record.id: name for record, name in ROLLING_BY_RECORD.items()}
 WHY_NOT = {
     "twist": ("Kratos DEM 10.4.4 has no twisting torque model: its discontinuum laws give a force, and its only "
               "torque models are the rolling friction models (ConstantTorque, ViscousTorque, Bounded)"),
@@ -87,20 +98,20 @@ def mapping(engine: Engine, case: Case) -> Mapping:
     if s in ("rolling", "incline"):
         return _rolling(engine, case, model)
     rec = model.slot("adhesion")
-    if rec.id not in ("jkr", "dmt"):
+    if type(rec) not in COHESIVE:
         return refused("kratos", f"Kratos DEM 10.4.4 has no adhesion law like '{rec.id}' (its cohesive laws are "
                                  "DEM_D_*_JKR and DEM_D_*_DMT)")
-    if model.contact.damping.id != "none" or model.contact.tangential.id != "none":
+    if not isinstance(model.contact.damping, NoDamping) or not isinstance(model.contact.tangential, NoTangential):
         return refused("kratos", "the adhesive scenarios are written without a normal dashpot and without a "
                                  "tangential law (DAMPING_GAMMA = 0, no friction)")
-    law = JKR_LAW if rec.id == "jkr" else DMT_LAW
+    law = COHESIVE[type(rec)]
     nat = Native("kratos", normal=law, normal_args=(rec.e_eff,), damping="gamma", damping_coeff=0.0,
                  tangential="none", limit=True,
                  props={"young_eff": rec.e_eff, "gamma": 0.0, "wall": False, "cohesion": rec.w,
-                        "r_eff": rec.r_eff, "kind": rec.id})
+                        "r_eff": rec.r_eff})
     nat.comments = [f"{law}: E* = {rec.e_eff:.10g} Pa, PARTICLE_COHESION w = {rec.w:g} J/m² (the relation's), "
                     "DAMPING_GAMMA = 0, no friction"]
-    if rec.id == "dmt":
+    if law == DMT_LAW:  # the seed's DMT law itself
         return Mapping("kratos", EXACT, [], nat, {})
     tension, d_star = _bk.jkr_hertz_radius_pull_off(rec.r_eff, rec.e_eff, rec.w)
     reason = JKR_REASON.format(tension=tension, d_star=d_star)
@@ -113,8 +124,9 @@ def _rolling(engine: Engine, case: Case, model) -> Mapping:
     from .mapping import FRICTION
 
     rec = model.slot("rolling")
-    if rec.id not in ROLLING_MODELS:
-        return refused("kratos", NO_SPRING if rec.id == "epsd" else f"no Kratos rolling friction model for '{rec.id}'")
+    if type(rec) not in ROLLING_BY_RECORD:
+        return refused("kratos", NO_SPRING if isinstance(rec, EpsdRolling) else
+                       f"no Kratos rolling friction model for '{rec.id}'")
     base = engine.map(model, case.contact.params)
     if base.native is None:
         return refused("kratos", f"the sphere's contact with the wall: {'; '.join(base.reasons)}")
@@ -125,13 +137,13 @@ def _rolling(engine: Engine, case: Case, model) -> Mapping:
     mass, radius, g, theta, _ = _on_wall(case)
     weight = mass * g * math.cos(theta)
     delta = _static_overlap(nat, mass, radius, weight)
-    if rec.id == "constant_torque":
+    if isinstance(rec, ConstantTorqueRolling):
         mu = rec.mu_r * rec.r_roll / radius
         reason = CONSTANT_REASON.format(dr=delta / radius, direction="" if rec.full_direction else WHOLE_SPIN)
     else:
         mu = rec.c_r / (weight * radius * radius)
         reason = VISCOUS_REASON.format(weight=weight, dr2=1.0 - (1.0 - delta / radius) ** 2)
-    name = ROLLING_MODELS[rec.id]
+    name = ROLLING_BY_RECORD[type(rec)]
     nat.props = {**nat.props, "rolling": (name, mu)}
     nat.comments = [*nat.comments, f"RollingFrictionOption = true, {name}, ROLLING_FRICTION = "
                                    f"ROLLING_FRICTION_WITH_WALLS = {mu:.10g}"]
@@ -140,11 +152,11 @@ def _rolling(engine: Engine, case: Case, model) -> Mapping:
 
 
 def _static_overlap(nat: Native, mass: float, radius: float, weight: float) -> float:
-    """The overlap at which Kratos' elastic normal force carries ``weight``."""
+    """The overlap at which Kratos' elastic normal force (its spring record, k δ^exponent) carries ``weight``."""
     from .mapping import law_numbers
 
-    ln = law_numbers(nat, mass, radius)
-    return (weight / ln["k_el"]) ** (1.0 / ln["a"])
+    spring = law_numbers(nat, mass, radius)["spring"]
+    return (weight / spring.k) ** (1.0 / spring.exponent)
 
 
 def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
@@ -153,9 +165,9 @@ def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     if "rolling" in nat.props:
         return _rolling_laws(engine, case, nat)
     p = nat.props
-    force = functools.partial(_bk.kratos_adhesive_force, p["kind"], p["r_eff"], nat.normal_args[0], p["cohesion"])
+    force = functools.partial(COHESIVE_FORCE[nat.normal], p["r_eff"], nat.normal_args[0], p["cohesion"])
     laws = {"stepper": functools.partial(_step, force)}
-    if p["kind"] == "jkr":  # start the pull at twice the overlap of Kratos' largest tension (past it)
+    if nat.normal == JKR_LAW:  # start the pull at twice the overlap of Kratos' largest tension (past it)
         laws["pull_scale"] = 2.0 * _bk.jkr_hertz_radius_pull_off(p["r_eff"], nat.normal_args[0], p["cohesion"])[1]
     return laws
 
@@ -167,18 +179,20 @@ def _rolling_laws(engine: Engine, case: Case, nat: Native) -> dict:
 
     m, r, g, theta, _ = _on_wall(case)
     ln = law_numbers(nat, m, r)
+    spring, dashpot = ln["spring"], ln["damping"]  # the normal records: k δ^exponent and η δ^exponent
+    c = getattr(dashpot, "eta", 0.0)
     nl, _ = engine.twin(nat, m, r)
     kt = (ln["rho"] or tangential_ratio(nat)) * ln["kn"]  # × √δ for Hertz: at the static overlap
-    if ln["hertz"]:
+    if isinstance(spring, HertzNormal):
         kt *= math.sqrt(_static_overlap(nat, m, r, m * g * math.cos(theta)))
     return {"stepper": functools.partial(_roll, nl.array(), twin_law_array(nat, m, r), nat.props["rolling"]),
-            "normal": lambda d, rate: ln["k_el"] * d ** ln["a"] + ln["c"] * d ** ln["b"] * rate,
+            "normal": lambda d, rate: spring.k * d ** spring.exponent + c * d ** dashpot.exponent * rate,
             "tangential": (kt, 0.0, 0.0)}
 
 
 def _roll(nl, kp, rolling, case: Case, laws: dict, lay) -> dict:
     w = case.walls[0]
-    model = _bk.VISCOUS_TORQUE if rolling[0] == ROLLING_MODELS["viscous"] else _bk.CONSTANT_TORQUE
+    model = _bk.VISCOUS_TORQUE if rolling[0] == ROLLING_BY_RECORD[ViscousRolling] else _bk.CONSTANT_TORQUE
     return _bk.wall_roll(nl, kp, model, rolling[1], case.particles[0].radius, case.mass(0), lay.positions[0],
                          lay.velocities[0], lay.omegas[0], case.run.gravity, w.point, w.normal, lay.dt, lay.steps,
                          lay.every)

@@ -19,15 +19,20 @@ import numpy as np
 from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
-from ...laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion
+from ...laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion, SjkrAdhesion
+from ...laws.damping import ConstantDamping, NoDamping
+from ...laws.heat import AreaHeat, LensHeat, RadiusHeat
 from ...laws.model import resolve
-from ...laws.rolling import CAP_TOTAL, EpsdRolling
+from ...laws.rolling import CAP_TOTAL, ConstantTorqueRolling, EpsdRolling
+from ...laws.tangential_laws.none import NoTangential
 from ...laws.twisting import MarshallTwisting, SdsTwisting
 from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused, worst
 from ..damping import damping
 
 SLOT = {"rolling": "rolling", "incline": "rolling", "twist": "twisting", "pull_off": "adhesion",
         "adhesive_impact": "adhesion", "conduction": "heat"}
+HEAT = {RadiusHeat: "radius", AreaHeat: "area"}  # LAMMPS's heat sub-models by the record they compute
+NORMAL = {JkrAdhesion: "jkr", DmtAdhesion: "dmt"}  # its adhesive normal sub-models by the record
 COLUMNS = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz", "fx", "fy", "fz")
 
 
@@ -58,7 +63,7 @@ def mapping(engine: Engine, case: Case) -> Mapping:
 
 def _rolling(model, rec, nat: Native):
     r = model.pair.r_eff
-    if rec.id == "constant_torque" and not rec.full_direction:
+    if isinstance(rec, ConstantTorqueRolling) and not rec.full_direction:
         k = nat.tangential_args[0]
         mu = rec.mu_r * rec.r_roll / r
         reason = (f"type A (constant torque) as rolling sds with k_roll = kt = {k:.6g} N/m and no damping: the "
@@ -66,7 +71,7 @@ def _rolling(model, rec, nat: Native):
                   "back at the stop")
         return (f"rolling sds {fmt(k)} 0 {fmt(mu)}", EpsdRolling(mu, r, k * r * r, 0.0, CAP_TOTAL, slack_zero=True),
                 APPROXIMATE, [reason])
-    if rec.id == "epsd":
+    if isinstance(rec, EpsdRolling):
         k, gamma, mu = rec.k_r / (r * r), rec.c_r / (r * r), rec.mu_r * rec.r_roll / r
         twin_rec = EpsdRolling(mu, r, k * r * r, gamma * r * r, CAP_TOTAL, slack_zero=True)
         exact = rec.c_r == 0.0 or (rec.cap == CAP_TOTAL and rec.slack_zero)
@@ -74,13 +79,13 @@ def _rolling(model, rec, nat: Native):
                                     "no torque from an unstretched spring whose dashpot alone passes it); the case "
                                     "caps the spring and drops the dashpot at the limit (Ai et al.)"]
         return (f"rolling sds {fmt(k)} {fmt(gamma)} {fmt(mu)}", twin_rec, EXACT if exact else APPROXIMATE, reasons)
-    what = "the direction from the whole relative spin (LIGGGHTS cdt)" if rec.id == "constant_torque" else \
+    what = "the direction from the whole relative spin (LIGGGHTS cdt)" if isinstance(rec, ConstantTorqueRolling) else \
         "a viscous rolling torque (type B)"
     return refused("lammps", f"LAMMPS 22Jul2025 has no rolling model with {what}: its only one is rolling sds")
 
 
 def _twisting(model, rec, nat: Native):
-    if rec.id == "sds":
+    if isinstance(rec, SdsTwisting):
         return (f"twisting sds {fmt(rec.k_tw)} {fmt(rec.gamma_tw)} {fmt(rec.mu_tw)}",
                 SdsTwisting(rec.k_tw, rec.gamma_tw, rec.mu_tw), EXACT, [])
     if nat.tangential != "linear_history":  # linear_nohistory takes (x_t, μ) only: no spring to build it from
@@ -94,32 +99,39 @@ def _twisting(model, rec, nat: Native):
 
 
 def _heat(model, rec, nat: Native):
-    if rec.id == "lens":
+    if isinstance(rec, LensHeat):
         return refused("lammps", "LAMMPS heat radius conducts through a = √(R̄δ), not the spheres' intersection "
                                  "circle (LIGGGHTS's rule)")
-    return f"heat {rec.id} {fmt(rec.k)}", rec, EXACT, []
+    if type(rec) not in HEAT:
+        return refused("lammps", f"LAMMPS 22Jul2025 has no heat model like '{rec.id}' (LAMMPS's are heat "
+                                 "radius and heat area)")
+    return f"heat {HEAT[type(rec)]} {fmt(rec.k)}", rec, EXACT, []
 
 
 def _adhesion(case: Case, model, rec) -> Mapping:
     """jkr and dmt replace LAMMPS's normal model: ``jkr E 0 ν γ`` with γ = w/2 (LAMMPS's surface energy)."""
     pair = model.pair
-    if rec.id == "sjkr":
+    if isinstance(rec, SjkrAdhesion):
         return refused("lammps", "LAMMPS 22Jul2025 has no simplified JKR cohesion (LIGGGHTS sjkr/sjkr2)")
-    if len({p.material for p in case.particles}) != 1 or model.contact.damping.id != "none":
+    if type(rec) not in NORMAL:
+        return refused("lammps", f"LAMMPS 22Jul2025 has no adhesive normal model like '{rec.id}' (LAMMPS's are jkr "
+                                 "and dmt)")
+    if len({p.material for p in case.particles}) != 1 or not isinstance(model.contact.damping, NoDamping):
         return refused("lammps", "the adhesive scenarios are written for like bodies without a normal dashpot")
-    if model.contact.tangential.id != "none":
+    if not isinstance(model.contact.tangential, NoTangential):
         return refused("lammps", "the adhesive scenarios are written without a tangential law")
     e_mod, nu = pair.youngs_modulus, pair.poisson_ratio
-    nat = Native("lammps", normal=rec.id, normal_args=(e_mod, nu, 0.5 * rec.w), damping="velocity",
+    word = NORMAL[type(rec)]
+    nat = Native("lammps", normal=word, normal_args=(e_mod, nu, 0.5 * rec.w), damping="velocity",
                  damping_coeff=0.0, tangential="linear_nohistory", tangential_args=(0.0, 0.0))
     e_star = e_mod / (2.0 * (1.0 - nu * nu))
-    words = f"{rec.id} {fmt(e_mod)} 0 {fmt(nu)} {fmt(0.5 * rec.w)}"
-    twin_rec = JkrAdhesion(pair.r_eff, e_star, rec.w, BREAK_LOAD) if rec.id == "jkr" else \
+    words = f"{word} {fmt(e_mod)} 0 {fmt(nu)} {fmt(0.5 * rec.w)}"
+    twin_rec = JkrAdhesion(pair.r_eff, e_star, rec.w, BREAK_LOAD) if rec.necks else \
         DmtAdhesion(pair.r_eff, e_star, rec.w)
     nat.props = {"words": words, "slots": {"adhesion": twin_rec}}
     nat.comments = [f"{words}: E* = E/(2(1−ν²)) = {e_star:.10g} Pa, w = 2γ = {rec.w:g} J/m²"]
     reasons = []
-    if rec.id == "jkr" and rec.break_at != BREAK_LOAD:
+    if rec.necks and rec.break_at != BREAK_LOAD:
         reasons = ["LAMMPS jkr ends the contact at the load-controlled pull-off δ_c = −a_c²/(3R̄) "
                    "(F = −(3/2)πwR̄), not at the displacement-controlled δ_f = −3a_f²/R̄ the case asks for"]
     return Mapping("lammps", APPROXIMATE if reasons else EXACT, reasons, nat, {r: words for r in reasons})
@@ -133,16 +145,17 @@ def twin_laws(engine: Engine, case: Case, nat: Native) -> dict:
     model = resolve(case)
     m, r = model.pair.m_eff, model.pair.r_eff
     nl, _ = engine.twin(nat, m, r)
-    dashpot = damping(nat.damping, nat.damping_coeff, nl.slots()[0], m, r)  # a damping record: η δ^b
+    spring = nl.slots()[0]  # the elastic record: k δ^exponent
+    dashpot = damping(nat.damping, nat.damping_coeff, spring, m, r)  # the damping record: η δ^exponent
     c, b = dashpot.eta, dashpot.exponent
 
     def normal(d, rate):
-        return nl.k * d ** nl.a + c * d ** b * rate
+        return spring.k * d ** spring.exponent + c * d ** b * rate
 
     laws = {"normal": normal, **slots}
     if nat.tangential == "linear_history":
         kt, x_t, mu = nat.tangential_args
-        if x_t and b:
+        if x_t and not isinstance(dashpot, (NoDamping, ConstantDamping)):
             from ...errors import UnsupportedByEngine
             raise UnsupportedByEngine(f"the wall twin steps a constant tangential dashpot, not x_t × damping "
                                       f"{nat.damping} (δ^{b:g})")

@@ -17,9 +17,9 @@ import numpy as np
 from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
-from ...laws.adhesion import AREA_LENS
-from ...laws.heat import LensHeat
-from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling
+from ...laws.adhesion import AREA_LENS, SjkrAdhesion
+from ...laws.heat import AreaHeat, LensHeat, RadiusHeat
+from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling, ViscousRolling
 from ...laws.model import resolve
 from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused
 from .deck import VERSION_NOTE, model_setup, property_matrices
@@ -41,7 +41,7 @@ def mapping(engine: Engine, case: Case) -> Mapping:
     s = case.run.scenario
     model = resolve(case)
     if s in ("rolling", "incline"):  # the contact itself first: the case's own reason where LIGGGHTS has none
-        if model.slot("rolling").id == "viscous":
+        if isinstance(model.slot("rolling"), ViscousRolling):
             return refused("liggghts", "LIGGGHTS-PUBLIC 3.8.0 has no viscous rolling torque (type B): its rolling "
                                        "models are cdt, epsd, epsd2 and epsd3")
         base = engine.map(model, case.contact.params)
@@ -49,14 +49,14 @@ def mapping(engine: Engine, case: Case) -> Mapping:
             return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")
         if s == "rolling":
             return _rolling(model, base)
-        if model.slot("rolling").id == "epsd":
+        if isinstance(model.slot("rolling"), EpsdRolling):
             return _incline(model, base)
-    if s == "pull_off" and model.slot("adhesion").id == "sjkr":
+    if s == "pull_off" and isinstance(model.slot("adhesion"), SjkrAdhesion):
         return _cohesion(model, engine.map(model, case.contact.params))
     if s in WHY_NOT:
         return refused("liggghts", WHY_NOT[s])
     rec = model.slot("heat")
-    if rec.id == "area":
+    if isinstance(rec, AreaHeat):
         return refused("liggghts", "LIGGGHTS fix heat/gran/conduction has no conductance per contact area")
     base = engine.map(model, case.contact.params)
     if base.native is None:
@@ -68,7 +68,7 @@ def mapping(engine: Engine, case: Case) -> Mapping:
     nat.comments = [*nat.comments, f"fix heat/gran/conduction, thermalConductivity {rec.k:g} W/(m·K): 2ks√A over "
                                    "the spheres' intersection circle"]
     reasons = []
-    if rec.id == "radius":
+    if isinstance(rec, RadiusHeat):
         reasons = ["LIGGGHTS fix heat/gran/conduction conducts through the spheres' intersection circle, "
                    "H = 2ks√A (√(2π) × Batchelor & O'Brien's 2ks√(R̄δ) between like spheres at small overlap)"]
     mp = Mapping("liggghts", APPROXIMATE if reasons else EXACT, [*base.reasons, *reasons], nat,

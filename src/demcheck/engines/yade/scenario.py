@@ -26,6 +26,11 @@ from ...case import Case
 from ...errors import DemcheckError
 from ...inputs import common
 from ...laws.model import resolve
+from ...laws.normal import HertzNormal, HookeNormal
+from ...laws.rolling import ConstantTorqueRolling, EpsdRolling
+from ...laws.tangential_laws.none import NoTangential
+from ...laws.tangential_laws.spring import SpringTangential
+from ...laws.twisting import SdsTwisting
 from ...reference import beyond_yade
 from ...reference.scenarios import _on_wall
 from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused, worst
@@ -105,9 +110,9 @@ def _contact(case, model, radius):
     mass, _, g, theta, _ = _on_wall(case)
     weight = mass * g * math.cos(theta)
     normal = contact.normal
-    if normal.id == "hooke":
+    if isinstance(normal, HookeNormal):
         kn = normal.k
-    elif normal.id == "hertz":
+    elif isinstance(normal, HertzNormal):
         kn = weight ** (1.0 / 3.0) * normal.k ** (2.0 / 3.0)  # the linear spring with Hertz's overlap under m g
         fid = APPROXIMATE
         reasons.append("CohFrictPhys's normal spring is linear: kn = m g / δ_Hertz(m g), the same static overlap "
@@ -120,12 +125,12 @@ def _contact(case, model, radius):
                        "dashpot only damps the rocking)")
     tl = contact.tangential
     mu = model.pair.friction or 0.0
-    if tl.id == "spring":
+    if type(tl) is SpringTangential:  # the constant-kt spring (not sqrt_spring, its subclass)
         ks = tl.kt
         if tl.eta > 0.0:
             fid = APPROXIMATE
             reasons.append("CohFrictPhys's shear spring has no dashpot")
-    elif tl.id == "none" and case.run.scenario == "twist":
+    elif isinstance(tl, NoTangential) and case.run.scenario == "twist":
         ks, mu = TWIST_POISSON * kn, 0.0
     else:
         return refused("yade", "a sphere rolling on a wall in Yade needs the case's linear tangential spring "
@@ -138,13 +143,13 @@ def _contact(case, model, radius):
 
 def _rolling(law, props, radius):
     r2ks = radius * radius * props["ks"]
-    if law.id == "epsd":
+    if isinstance(law, EpsdRolling):
         props.update(kr=law.k_r, max_roll=law.mu_r * law.r_roll, etaRoll=law.mu_r * law.r_roll / radius,
                      alphaKr=law.k_r / r2ks)
         if law.c_r > 0.0:
             return APPROXIMATE, ["CohesionMoment's bending moment has no dashpot (type C without its viscous part)"]
         return EXACT, []
-    if law.id == "constant_torque":
+    if isinstance(law, ConstantTorqueRolling):
         props.update(kr=r2ks, max_roll=law.mu_r * law.r_roll, etaRoll=law.mu_r * law.r_roll / radius, alphaKr=1.0)
         return APPROXIMATE, ["type A (constant torque) as CohesionMoment's bending spring (kr = R² ks, alphaKr = 1) "
                              "at its limit etaRoll·R·|Fn|: it winds up first and springs back at the stop"]
@@ -153,7 +158,7 @@ def _rolling(law, props, radius):
 
 
 def _twisting(law, props, radius):
-    if law.id != "sds":
+    if not isinstance(law, SdsTwisting):
         return refused("yade", "Yade's twisting moment has a constant ktw (CohFrictMat alphaKtw): Marshall's "
                                "stiffness from the contact radius is not expressible")
     props.update(ktw=law.k_tw, max_twist=law.mu_tw, etaTwist=law.mu_tw / radius,
