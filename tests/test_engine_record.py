@@ -189,3 +189,22 @@ def test_the_familys_writers_pass_the_familys_guard():
                  scenario.deck(beyond, eng)]
         assert all(dk.check is FD.check_deck for dk in decks), name
     assert LAMMPS_COMMANDS <= FD.COMMANDS  # the static check above names commands the family's guard admits
+
+
+def test_kratos_writes_and_reads_its_own_state_table(tmp_path):
+    """Kratos' runner writes the record's state table (engines/output.py: a header, a row per body per step, %.17g),
+    not the LAMMPS dump layout, and its collisions and scenarios read it through kratos/deck.read_states."""
+    for name in ("kratos/deck.py", "kratos/scenario.py"):
+        found = sorted({w[:40] for w in _code_words(ENGINES / name) if re.search(r"^read_dump$|ITEM: ", w)})
+        assert not found, f"engines/{name} names {found}: the LAMMPS family's dump layout and its reader"
+    from demcheck.engines.kratos import deck as KD
+    from demcheck.engines.output import STATE_HEAD, STATE_ROW
+
+    assert repr(STATE_HEAD) in KD.TEMPLATE and repr(STATE_ROW) in KD.TEMPLATE
+    states = _states()
+    rows = [STATE_ROW % (r.step, r.id, r.type, *(getattr(r, c) for c in STATE_COLUMNS[2:])) for r in
+            states.itertuples()]
+    (tmp_path / "dump.txt").write_text(STATE_HEAD + "".join(rows))
+    got = registry.get("kratos").read_collision(tmp_path).states
+    assert np.array_equal(got.to_numpy(), states[["step", *STATE_COLUMNS]].to_numpy())
+    assert got["id"].dtype == np.int64
