@@ -138,3 +138,73 @@ def test_yade_writes_and_reads_its_own_state_table_not_a_lammps_dump(tmp_path):
     (tmp_path / "dump.txt").write_text(yade_deck.HEAD + "".join(rows)[:-40])
     with pytest.raises(ParseError, match="cut short"):
         registry.get("yade").read_collision(tmp_path)
+
+
+INPUTS = ENGINES.parent / "inputs"
+# the LAMMPS input language's pieces (engines/family_deck.py): its guard, its command and style lists, its data file
+FAMILY_DECK = frozenset({"check_deck", "check_data", "COMMANDS", "STYLES", "FILE_ARGUMENT", "SAFE_FILE", "DATA_WORDS",
+                         "data_file", "batch_layout", "offset"})
+# commands of the LAMMPS input language that the family's decks write (and no other engine's script has)
+LAMMPS_COMMANDS = frozenset({"units", "atom_style", "atom_modify", "create_box", "read_data", "pair_style", "pair_coeff",
+                             "neigh_modify", "fix", "compute", "dump", "dump_modify", "write_dump", "timestep",
+                             "thermo_style"})
+
+
+@pytest.mark.parametrize("name", ("common.py", "packing_decks.py"))
+def test_inputs_holds_what_every_engine_uses_and_no_lammps_command(name):
+    """inputs/ (below engines/ in the layers) holds what every engine's deck writer uses: no piece of the LAMMPS
+    family's language, no command of it (inputs/script.py, the reader of a user's LAMMPS-family deck, aside)."""
+    tree = ast.parse((INPUTS / name).read_text())
+    defined = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    defined |= {t.id for n in tree.body if isinstance(n, (ast.Assign, ast.AnnAssign))
+                for t in (n.targets if isinstance(n, ast.Assign) else [n.target]) if isinstance(t, ast.Name)}
+    assert not defined & FAMILY_DECK, f"inputs/{name} defines {sorted(defined & FAMILY_DECK)}: engines/family_deck.py's"
+    strings = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+    assert not strings & LAMMPS_COMMANDS, f"inputs/{name} names the LAMMPS commands {sorted(strings & LAMMPS_COMMANDS)}"
+
+
+def test_a_deck_has_no_default_guard():
+    """Deck.check is each engine's own: a deck without it is refused, not checked as a LAMMPS deck."""
+    import dataclasses
+
+    from demcheck.inputs.common import Deck
+
+    check = next(f for f in dataclasses.fields(Deck) if f.name == "check")
+    assert check.default is dataclasses.MISSING and check.default_factory is dataclasses.MISSING
+    with pytest.raises(TypeError):
+        Deck("lammps", "units si\n", {})
+
+
+def test_the_familys_writers_pass_the_familys_guard():
+    """Each deck the LAMMPS family writes (collision, batch, scenario, packing) carries engines/family_deck's guard."""
+    from demcheck.api import load
+    from demcheck.engines import family_deck as FD, scenario
+
+    root = Path(__file__).resolve().parents[1] / "cases"
+    pair, packing = load(str(root / "glass-pair.toml")), load(str(root / "packing" / "poured.toml"))
+    beyond = load(str(root / "suite" / "beyond-conduction.toml"))
+    for name in ("lammps", "liggghts"):
+        eng = registry.get(name)
+        decks = [eng.collision_deck(pair), eng.collision_deck(pair, copies=2), eng.packing_deck(packing),
+                 scenario.deck(beyond, eng)]
+        assert all(dk.check is FD.check_deck for dk in decks), name
+    assert LAMMPS_COMMANDS <= FD.COMMANDS  # the static check above names commands the family's guard admits
+
+
+def test_kratos_writes_and_reads_its_own_state_table(tmp_path):
+    """Kratos' runner writes the record's state table (engines/output.py: a header, a row per body per step, %.17g),
+    not the LAMMPS dump layout, and its collisions and scenarios read it through kratos/deck.read_states."""
+    for name in ("kratos/deck.py", "kratos/scenario.py"):
+        found = sorted({w[:40] for w in _code_words(ENGINES / name) if re.search(r"^read_dump$|ITEM: ", w)})
+        assert not found, f"engines/{name} names {found}: the LAMMPS family's dump layout and its reader"
+    from demcheck.engines.kratos import deck as KD
+    from demcheck.engines.output import STATE_HEAD, STATE_ROW
+
+    assert repr(STATE_HEAD) in KD.TEMPLATE and repr(STATE_ROW) in KD.TEMPLATE
+    states = _states()
+    rows = [STATE_ROW % (r.step, r.id, r.type, *(getattr(r, c) for c in STATE_COLUMNS[2:])) for r in
+            states.itertuples()]
+    (tmp_path / "dump.txt").write_text(STATE_HEAD + "".join(rows))
+    got = registry.get("kratos").read_collision(tmp_path).states
+    assert np.array_equal(got.to_numpy(), states[["step", *STATE_COLUMNS]].to_numpy())
+    assert got["id"].dtype == np.int64

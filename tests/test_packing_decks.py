@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from demcheck import case as C
-from demcheck.engines import discovery, dumps, family_packing as FP, registry
+from demcheck.engines import discovery, dumps, family_deck as FD, family_packing as FP, registry
 from demcheck.errors import DemcheckError
 from demcheck.inputs import common, packing_decks as PD
 
@@ -146,9 +146,9 @@ def test_a_species_no_density_reaches_has_its_mass_set_in_the_deck():
 
 def test_data_file_comments_are_allowed_in_the_header_only():
     ok = "# title\n# what the columns are\n\n1 atoms\n1 atom types\n\nAtoms\n\n1 1 0.002 2500 0 0 0\n"
-    common.check_data(ok)
+    FD.check_data(ok)
     with pytest.raises(DemcheckError, match="line 10 is not a number"):
-        common.check_data(ok + "# a comment among the atoms\n")
+        FD.check_data(ok + "# a comment among the atoms\n")
 
 
 # ----------------------------------------------------------------------------- the engines' masses

@@ -20,7 +20,7 @@ import pytest
 
 from demcheck import case as C
 from demcheck.errors import ConfigError, DemcheckError
-from demcheck.engines import mapping, registry
+from demcheck.engines import family_deck as FD, mapping, registry
 from demcheck.inputs import common, packing_decks
 
 from .conftest import CASES, ROOT
@@ -322,16 +322,17 @@ def test_the_guard_refuses_any_line_demcheck_does_not_write(engine, line):
     at = lines.index(next(x for x in lines if x.startswith("units")))
     text = "\n".join(lines[:at] + [line] + lines[at:])
     with pytest.raises(DemcheckError):
-        common.check_deck(text)
+        FD.check_deck(text)
     with pytest.raises(DemcheckError):
-        common.Deck(engine, text, base.files)
+        common.Deck(engine, text, base.files, check=FD.check_deck)
 
 
 def test_the_guard_refuses_a_data_file_with_more_than_its_title():
     base = WRITERS["liggghts"](_collision_case(False))
     name, data = next(iter(base.files.items()))
     with pytest.raises(DemcheckError):
-        common.Deck("liggghts", base.text, {name: "# title\nshell touch F\n" + data.split("\n", 1)[1]})
+        common.Deck("liggghts", base.text, {name: "# title\nshell touch F\n" + data.split("\n", 1)[1]},
+                    check=FD.check_deck)
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -342,10 +343,10 @@ def test_every_deck_demcheck_writes_passes_the_guard(engine):
                 dk = WRITERS[engine](case)
             except DemcheckError:  # a model the engine cannot express
                 continue
-            common.check_deck(dk.text)
+            FD.check_deck(dk.text)
     for path in sorted((CASES / "packing").glob("*.toml")):
         case = C.load(path)
-        common.check_deck(PACKING_WRITERS[engine](case).text)
+        FD.check_deck(PACKING_WRITERS[engine](case).text)
 
 
 # ----------------------------------------------------------------------------- end to end
@@ -494,14 +495,14 @@ def test_the_runner_refuses_a_deck_with_a_command_demcheck_does_not_write(tmp_pa
 ])
 def test_the_guard_refuses_hidden_comments_variables_and_paths(line):
     with pytest.raises(DemcheckError):
-        common.check_deck(f"units si\n{line}\n")
+        FD.check_deck(f"units si\n{line}\n")
 
 
 def test_a_comment_never_carries_a_triple_quote():
     for text in ['"""', '""""" tail', 'a"b""c"""d']:
         line = common.comment(text)
         assert '"""' not in line and line.startswith("# ")
-        common.check_deck(line + "\nunits si\n")
+        FD.check_deck(line + "\nunits si\n")
 
 
 @pytest.mark.parametrize("engine", ["yade", "kratos"])

@@ -1,5 +1,5 @@
-"""What LAMMPS and LIGGGHTS share, and no other engine: one input language (inputs/common.py writes it and its guard
-checks it), one command line (``-in DECK -log log.txt -screen screen.txt``), one log (``ERROR`` and ``WARNING``
+"""What LAMMPS and LIGGGHTS share, and no other engine: one input language (engines/family_deck.py: its guard and
+the data file), one command line (``-in DECK -log log.txt -screen screen.txt``), one log (``ERROR`` and ``WARNING``
 lines, ``Loop time of`` a run's loop, a packing deck's thermo lines), one output (a ``dump custom`` of every body
 every step, a ``dump local`` of the contacts, read by engines/dumps.py). Their packages subclass
 :class:`LammpsFamily`, which reads that output into the records of engines/output.py; an engine of another family
@@ -34,8 +34,8 @@ class LammpsFamily(PackageEngine):
         return [executable, "-in", deck, "-log", LOG, "-screen", SCREEN]
 
     def check_deck(self, text: str, files: dict | None = None) -> None:
-        """The LAMMPS input language's guard (inputs.common.check_deck): every line one demcheck writes."""
-        from ..inputs.common import check_deck
+        """The LAMMPS input language's guard (engines/family_deck.check_deck): every line one demcheck writes."""
+        from .family_deck import check_deck
 
         check_deck(text, files)
 

@@ -61,6 +61,36 @@ class PackingOutput:
         _require(self.contacts, CONTACT_COLUMNS, "a packing run's contacts")
 
 
+# a state table (Yade's collision script, Kratos' runner): a header line of the record's column names, then a row per body
+# per step: step, id and type as integers, the rest float64 as %.17g (the shortest text that reads back exactly)
+STATE_HEAD = "step " + " ".join(STATE_COLUMNS) + "\n"
+STATE_ROW = "%d %d %d" + " %.17g" * (len(STATE_COLUMNS) - 2) + "\n"
+
+
+def read_state_table(path, writer: str) -> pd.DataFrame:
+    """A state table (:data:`STATE_HEAD`, then :data:`STATE_ROW` rows) with the record's columns: ``step``, ``id`` and
+    ``type`` as integers; ``writer`` names the script that wrote it in the errors."""
+    from pathlib import Path
+
+    from ..errors import ParseError
+
+    path = Path(path)
+    if not path.exists():
+        raise ParseError(f"{path}: no such state table ({writer} wrote none)")
+    head, _, body = path.read_text().partition("\n")
+    names = head.split()
+    if names != ["step", *STATE_COLUMNS]:
+        raise ParseError(f"{path}:1: not {writer}'s header ({head[:80]!r})")
+    try:
+        values = np.array(body.split(), dtype=np.float64)
+    except ValueError:
+        raise ParseError(f"{path}: a value that is not a number") from None
+    if values.size % len(names):
+        raise ParseError(f"{path}: its last row is cut short ({values.size % len(names)} of {len(names)} values)")
+    table = pd.DataFrame(values.reshape(-1, len(names)), columns=names)
+    return table.astype({"step": np.int64, "id": np.int64, "type": np.int64})
+
+
 def touching(i, j, overlap, fn, ft) -> pd.DataFrame:
     """An engine's per-contact output (0-based particle indices, overlap, Fn repulsive > 0, |Ft|, one entry per
     listed pair) as CONTACT_COLUMNS: touching pairs only (overlap > 0), each once (with newton off a pair across a

@@ -8,8 +8,9 @@ gravity, no global damping, no rolling friction unless a scenario sets a model, 
 mapping's friction — none without a tangential law — and FRICTION_DECAY) and ``caseDEM.mdpa`` /
 ``caseDEM_FEM_boundary.mdpa`` (the spheres; the wall as one rigid triangle in the wall's plane covering the whole
 scene). The runner sets each pair's DAMPING_GAMMA after Kratos has initialised, the bodies' velocities and spins,
-and writes every step's states as a LAMMPS-style
-``dump custom`` (%.17g) to ``dump.txt``.
+and writes every step's states to ``dump.txt`` as
+a state table (engines/output.py: a header of the record's columns, a row per body per step, %.17g), which
+:func:`read_states` reads for the collisions and the scenarios.
 
 :func:`check` is the last guard before Kratos runs: the script must be the template line for line (comment
 lines before it allowed), its CASE a literal of known keys and numbers; the JSON files only known keys with
@@ -31,6 +32,7 @@ from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ..base import Engine
 from ..mapping import contact_mapping, pair_mapping
+from ..output import STATE_HEAD, STATE_ROW
 from .mapping import CUSTOM, LAWS, particle_young
 
 VERSION_NOTE = "written for Kratos DEM 10.4.4 (KratosMultiphysics + KratosDEMApplication from PyPI)"
@@ -70,6 +72,7 @@ class DemcheckRun(DEMAnalysisStage):
             node.SetSolutionStepValue(K.ANGULAR_VELOCITY_Z, body[2][2])
         self.demcheck_step = 0
         self.demcheck_dump = open("dump.txt", "w")
+        self.demcheck_dump.write(STATE_HEAD)
         self.demcheck_write()
 
     def KeepAdvancingSolutionLoop(self):
@@ -88,26 +91,21 @@ class DemcheckRun(DEMAnalysisStage):
         super().Finalize()
 
     def demcheck_write(self):
-        nodes = sorted(self.spheres_model_part.Nodes, key=lambda node: node.Id)
-        rows = ["ITEM: TIMESTEP", str(self.demcheck_step), "ITEM: NUMBER OF ATOMS", str(len(nodes)),
-                "ITEM: BOX BOUNDS ff ff ff", "-1 1", "-1 1", "-1 1",
-                "ITEM: ATOMS id type radius mass x y z vx vy vz omegax omegay omegaz fx fy fz tqx tqy tqz"]
-        for node in nodes:
+        for node in sorted(self.spheres_model_part.Nodes, key=lambda node: node.Id):
             v = node.GetSolutionStepValue(K.VELOCITY)
             w = node.GetSolutionStepValue(K.ANGULAR_VELOCITY)
             f = node.GetSolutionStepValue(K.TOTAL_FORCES)
             t = node.GetSolutionStepValue(D.PARTICLE_MOMENT)
             values = [node.GetSolutionStepValue(K.RADIUS), node.GetSolutionStepValue(K.NODAL_MASS),
                       node.X, node.Y, node.Z, v[0], v[1], v[2], w[0], w[1], w[2], f[0], f[1], f[2], t[0], t[1], t[2]]
-            rows.append(" ".join([str(node.Id), str(node.Id)] + ["%.17g" % x for x in values]))
-        self.demcheck_dump.write("\n".join(rows) + "\n")
+            self.demcheck_dump.write(STATE_ROW % tuple([self.demcheck_step, node.Id, node.Id] + values))
 
 
 K.Logger.GetDefaultOutput().SetSeverity(K.Logger.Severity.WARNING)
 with open("ProjectParameters.json") as stream:
     parameters = K.Parameters(json.dumps(json.load(stream)))
 DemcheckRun(K.Model(), parameters).Run()
-'''
+'''.replace("STATE_HEAD", repr(STATE_HEAD)).replace("STATE_ROW", repr(STATE_ROW))
 
 
 # the pull's runner (scenario pull_off): the template with each ``fixed`` body's velocity held by Kratos (its
@@ -466,12 +464,10 @@ def _check_mdpa(text: str, name: str) -> None:
 
 
 def read_states(workdir):
-    """The runner's state table (TEMPLATE's ``demcheck_write``: a block per step in the ``dump custom`` text layout,
-    which the scenarios' reader reads too; one parser for every file in it, engines/dumps.py) with the record's
-    columns (engines.output.STATE_COLUMNS)."""
+    """The runner's state table (TEMPLATE's ``demcheck_write``: engines/output.py's STATE_HEAD, then a STATE_ROW per
+    body per step) with the record's columns (engines.output.STATE_COLUMNS): the collisions' and the scenarios'."""
     from pathlib import Path
 
-    from ..dumps import read_dump
-    from ..output import STATE_COLUMNS
+    from ..output import read_state_table
 
-    return read_dump(Path(workdir) / common.DUMP_FILE, columns=STATE_COLUMNS)
+    return read_state_table(Path(workdir) / common.DUMP_FILE, "the Kratos runner")

@@ -30,7 +30,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -218,15 +217,12 @@ def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
                    rolling=nat.props.get("rolling"), mapping=mapping(engine, case))
 
 
-COLUMNS = ("id", "type", "radius", "mass", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz",
-           "fx", "fy", "fz", "tqx", "tqy", "tqz")
-
-
 def read(engine: Engine, case: Case, lay, workdir) -> dict:
-    """The runner's dump (every step) as reference/scenarios.stepped_metrics reads it."""
-    from ..dumps import read_dump
+    """The runner's state table (every step, engines/kratos/deck.read_states) as reference/scenarios.stepped_metrics
+    reads it."""
+    from .deck import read_states
 
-    rows = read_dump(Path(workdir) / common.DUMP_FILE, columns=COLUMNS).sort_values(["step", "id"])
+    rows = read_states(workdir).sort_values(["step", "id"])
     n = len(case.particles)
 
     def col(name, body):
@@ -235,7 +231,7 @@ def read(engine: Engine, case: Case, lay, workdir) -> dict:
     if case.run.scenario in ("rolling", "incline"):  # every step dumped: the layout's samples are every lay.every-th
         steps = rows["step"].to_numpy()
         if len(steps) != lay.steps + 1 or steps[-1] != lay.steps:
-            raise DemcheckError(f"the Kratos dump has {len(steps)} steps, not the layout's {lay.steps + 1}")
+            raise DemcheckError(f"the Kratos state table has {len(steps)} steps, not the layout's {lay.steps + 1}")
 
         def cols(*names):
             return np.column_stack([col(c, 0)[::lay.every] for c in names])

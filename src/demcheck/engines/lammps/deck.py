@@ -13,6 +13,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ...inputs.common import fmt
+from .. import family_deck as FD
 from ..mapping import contact_mapping, pair_mapping
 from ..base import Engine, Native
 from ..family import DUMP_COLUMNS
@@ -50,7 +51,7 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
     lo, hi = sc.box
     batch_axis, spacing = 0, 0.0
     if copies > 1:
-        batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
+        batch_axis, spacing, (lo, hi) = FD.batch_layout(sc, copies)
     lines = common.header("lammps", sc, mp, VERSION_NOTE, "lmp -in") + common.notes(mp.native.comments)
     lines += ["", "units si", "atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
               "comm_modify vel yes",
@@ -60,7 +61,7 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
     for c in range(copies):
         for i, p in enumerate(case.particles):
             k = c * n + i + 1
-            pos = common.offset(p.position, batch_axis, spacing, c)
+            pos = FD.offset(p.position, batch_axis, spacing, c)
             lines += [f"create_atoms {k} single {' '.join(fmt(x) for x in pos)} units box",
                       f"set atom {k} diameter {fmt(2 * p.radius)}",
                       f"set atom {k} mass {fmt(case.mass(i))}",
@@ -100,4 +101,4 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
               "dump_modify state format float %.17g sort id",
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]
-    return common.Deck("lammps", "\n".join(lines), {}, dt=sc.dt)
+    return common.Deck("lammps", "\n".join(lines), {}, dt=sc.dt, check=FD.check_deck)

@@ -7,7 +7,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
-from .. import family_packing as FP
+from .. import family_deck as FD, family_packing as FP
 from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import VERSION_NOTE, coeff_args
@@ -58,4 +58,5 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
               common.comment("the final state: every particle, at full precision (%.17g), sorted by id"),
               f"write_dump all custom {PD.FINAL_DUMP} {' '.join(PD.FINAL_COLUMNS)} modify format float %.17g sort id",
               ""]
-    return common.Deck("lammps", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay)}, dt=lay.dt)
+    return common.Deck("lammps", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay)}, dt=lay.dt,
+                       check=FD.check_deck)

@@ -19,6 +19,7 @@ import numpy as np
 from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
+from .. import family_deck as FD
 from ...laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion, SjkrAdhesion
 from ...laws.damping import ConstantDamping, NoDamping
 from ...laws.heat import AreaHeat, LensHeat, RadiusHeat
@@ -197,7 +198,7 @@ def deck(engine: Engine, case: Case, nat: Native, lay) -> common.Deck:
               + (" c_th" if heat else ""),
               "dump_modify state format float %.17g sort id", f"thermo {max(lay.steps // 10, 1)}",
               f"run {lay.steps}", ""]
-    return common.Deck("lammps", "\n".join(lines), {}, dt=lay.dt)
+    return common.Deck("lammps", "\n".join(lines), {}, dt=lay.dt, check=FD.check_deck)
 
 
 def _coeff(nat: Native) -> str:

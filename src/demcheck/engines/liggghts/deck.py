@@ -14,6 +14,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common
 from ...inputs.common import fmt
+from .. import family_deck as FD
 from ..base import Engine
 from ..family import DUMP_COLUMNS
 from ..mapping import contact_mapping, pair_mapping
@@ -98,7 +99,7 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
     lo, hi = sc.box
     batch_axis, spacing = 0, 0.0
     if copies > 1:
-        batch_axis, spacing, (lo, hi) = common.batch_layout(sc, copies)
+        batch_axis, spacing, (lo, hi) = FD.batch_layout(sc, copies)
     lines = common.header("liggghts", sc, mp, VERSION_NOTE, "liggghts -in") + common.notes(nat.comments)
     natives = _type_natives(engine, case, native, nat, n)
 
@@ -135,9 +136,9 @@ def deck(engine: Engine, case: Case, dt: float | None = None, length: float = 1.
               f'dump_modify state format "{fmt_line}" sort id',
               "thermo_style custom step atoms ke", f"thermo {max(sc.steps // 10, 1)}",
               f"run {sc.steps}", ""]
-    data = common.data_file(case, ntypes, (lo, hi), f"demcheck: case {case.name} (hash {case.hash})", copies=copies,
+    data = FD.data_file(case, ntypes, (lo, hi), f"demcheck: case {case.name} (hash {case.hash})", copies=copies,
                             axis=batch_axis, spacing=spacing)
-    return common.Deck("liggghts", "\n".join(lines), {data_name: data}, dt=sc.dt)
+    return common.Deck("liggghts", "\n".join(lines), {data_name: data}, dt=sc.dt, check=FD.check_deck)
 
 
 def _type_natives(engine: Engine, case: Case, native, nat, n: int) -> dict:

@@ -6,7 +6,7 @@ from ...case import Case
 from ...errors import UnsupportedByEngine
 from ...inputs import common, packing_decks as PD
 from ...inputs.common import fmt
-from .. import family_packing as FP
+from .. import family_deck as FD, family_packing as FP
 from ..base import Engine
 from ..mapping import pair_mapping
 from .deck import RIGID_WALL_MODULUS, VERSION_NOTE, model_setup, property_matrices
@@ -79,4 +79,5 @@ def deck(engine: Engine, case: Case, duration: float | None = None, dt: float | 
               f'dump_modify final format "{fmt_line}" sort id',
               f"dump contacts all local 1 {PD.CONTACT_DUMP} " + " ".join(f"c_pairs[{k}]" for k in range(1, 11)),
               f'dump_modify contacts format "{local_fmt}"', "run 0", ""]
-    return common.Deck("liggghts", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay, ntypes)}, dt=lay.dt)
+    return common.Deck("liggghts", "\n".join(lines), {FP.DATA_FILE: FP.data_file(case, lay, ntypes)}, dt=lay.dt,
+                       check=FD.check_deck)

@@ -17,6 +17,7 @@ import numpy as np
 from ...case import Case
 from ...inputs import common
 from ...inputs.common import fmt
+from .. import family_deck as FD
 from ...laws.adhesion import AREA_LENS, SjkrAdhesion
 from ...laws.heat import AreaHeat, LensHeat, RadiusHeat
 from ...laws.rolling import CAP_SPRING, ConstantTorqueRolling, EpsdRolling, ViscousRolling
@@ -192,8 +193,8 @@ def _pull_deck(case: Case, nat: Native, lay) -> common.Deck:
     box = (np.array(lay.positions).min(axis=0) - size, np.array(lay.positions).max(axis=0) + size)
     held = replace(case, particles=[replace(p, position=tuple(lay.positions[i]), velocity=(0.0, 0.0, 0.0),
                                             angular_velocity=(0.0, 0.0, 0.0)) for i, p in enumerate(case.particles)])
-    data = common.data_file(held, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
-    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
+    data = FD.data_file(held, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt, check=FD.check_deck)
 
 
 DUMP_WALL = ("id", "x", "y", "z", "vx", "vy", "vz", "omegax", "omegay", "omegaz")
@@ -234,8 +235,8 @@ def _wall_deck(case: Case, nat: Native, lay) -> common.Deck:
     p = case.particles[0]
     moved = replace(case, particles=[replace(p, position=tuple(lay.positions[0]), velocity=tuple(lay.velocities[0]),
                                              angular_velocity=tuple(lay.omegas[0]))])
-    data = common.data_file(moved, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
-    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
+    data = FD.data_file(moved, 2, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt, check=FD.check_deck)
 
 
 def _held_deck(case: Case, nat: Native, lay) -> common.Deck:
@@ -266,8 +267,8 @@ def _held_deck(case: Case, nat: Native, lay) -> common.Deck:
            np.array(lay.positions).max(axis=0) + 4 * max(p.radius for p in case.particles))
     held = replace(case, particles=[replace(p, position=tuple(lay.positions[i]), velocity=(0.0, 0.0, 0.0),
                                             angular_velocity=(0.0, 0.0, 0.0)) for i, p in enumerate(case.particles)])
-    data = common.data_file(held, n, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
-    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt)
+    data = FD.data_file(held, n, box, f"demcheck: scenario {case.run.scenario} of {case.name}")
+    return common.Deck("liggghts", "\n".join(lines), {"data.lmp": data}, dt=lay.dt, check=FD.check_deck)
 
 
 def read(engine: Engine, case: Case, lay, workdir) -> dict:

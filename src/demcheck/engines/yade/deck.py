@@ -21,7 +21,7 @@ from ...case import Case
 from ...errors import DemcheckError, UnsupportedByEngine
 from ...inputs import common
 from ..base import Engine
-from ..output import STATE_COLUMNS
+from ..output import STATE_HEAD, STATE_ROW
 from ..mapping import contact_mapping
 from .mapping import CUNDALL, LUDING, MINDLIN, VISCEL
 
@@ -29,8 +29,7 @@ VERSION_NOTE = "written for Yade 2023.02a (yade -x -n)"
 # a ViscElPhys Native whose props name CUNDALL (mapping.py) runs as FrictMat + FrictPhys + CundallStrack: a linear
 # spring and an incremental shear force capped at μFn, without dashpots (cn = cs = 0), as Yade's FrictPhys computes
 # the states' table (:func:`read_states`): a header line of the record's column names, then a row per body per step
-HEAD = "step " + " ".join(STATE_COLUMNS) + "\n"
-ROW = "%d %d %d" + " %.17g" * (len(STATE_COLUMNS) - 2) + "\n"
+HEAD, ROW = STATE_HEAD, STATE_ROW  # engines/output.py's layout, read by its read_state_table
 STRINGS = frozenset({HEAD, ROW, common.DUMP_FILE, "w"})
 NAMES = frozenset({
     "O", "Vector3", "utils", "FrictMat", "ViscElMat", "ForceResetter", "InsertionSortCollider", "Bo1_Sphere_Aabb",
@@ -248,23 +247,6 @@ def read_states(workdir):
     record's columns (engines.output.STATE_COLUMNS): ``step``, ``id`` and ``type`` as integers."""
     from pathlib import Path
 
-    import numpy as np
-    import pandas as pd
+    from ..output import read_state_table
 
-    from ...errors import ParseError
-
-    path = Path(workdir) / common.DUMP_FILE
-    if not path.exists():
-        raise ParseError(f"{path}: no such state table (the Yade script wrote none)")
-    head, _, body = path.read_text().partition("\n")
-    names = head.split()
-    if names != ["step", *STATE_COLUMNS]:
-        raise ParseError(f"{path}:1: not the collision script's header ({head[:80]!r})")
-    try:
-        values = np.array(body.split(), dtype=np.float64)
-    except ValueError:
-        raise ParseError(f"{path}: a value that is not a number") from None
-    if values.size % len(names):
-        raise ParseError(f"{path}: its last row is cut short ({values.size % len(names)} of {len(names)} values)")
-    table = pd.DataFrame(values.reshape(-1, len(names)), columns=names)
-    return table.astype({"step": np.int64, "id": np.int64, "type": np.int64})
+    return read_state_table(Path(workdir) / common.DUMP_FILE, "the Yade script")
