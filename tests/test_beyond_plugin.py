@@ -60,7 +60,7 @@ from demcheck.resources import case_path
 
 case = from_dict(tomllib.loads(case_path("suite/beyond-rolling.toml").read_text()))
 p = case.particles[0]
-# its record as a case's [contact] resolves it (the scenarios name their laws in case.py: none runs it yet)
+# its record as a case's [contact] resolves it (a scenario runs the laws whose records name it, `scenarios`: none here)
 rec = slots.record("rolling", slots.check_id("rolling", "Fixed_Torque"), {"m0": 2e-7}, resolve(case).pair,
                    (p.radius, 0.0))
 out = {"ids": slots.law_ids("rolling"), "keys": [k.name for k in slots.KEYS[("rolling", "fixed_torque")]],
