@@ -96,3 +96,32 @@ def test_a_rolling_law_in_one_module_runs_in_the_reference_and_is_refused_by_eve
     assert set(out["engines"]) >= {"lammps", "liggghts", "yade", "kratos"}
     for name, row in out["engines"].items():
         assert row["fidelity"] == "none" and row["reason"].strip(), (name, row)
+
+
+NAMED = TOY.replace('    stops: ClassVar[bool] = True\n',
+                    '    stops: ClassVar[bool] = True\n    scenarios: ClassVar[tuple] = ("rolling",)\n')
+
+ACCEPT = r'''
+import json, tomllib
+from demcheck.case import from_dict
+from demcheck.errors import ConfigError
+from demcheck.resources import case_path
+
+raw = tomllib.loads(case_path("suite/beyond-rolling.toml").read_text())
+raw["contact"] = {**{k: v for k, v in raw["contact"].items() if k != "mu_r"}, "rolling": "fixed_torque", "m0": 2e-7}
+out = {"rolling": from_dict(raw).contact.rolling}
+raw["run"]["scenario"] = "incline"
+try:
+    from_dict(raw)
+except ConfigError as exc:
+    out["incline"] = [exc.key, exc.rule]
+print(json.dumps(out))
+'''
+
+
+def test_a_plugin_law_is_a_cases_law_in_the_scenarios_its_record_names(tmp_path):
+    """The laws a scenario accepts are read off the records (``scenarios``): the toy law naming ``rolling`` is a
+    case's law there, and the incline, which it does not name, lists the laws whose records do."""
+    out = with_plugin_law(tmp_path, "toy_named_rolling_law", NAMED, ACCEPT, timeout=900)
+    assert "scenarios" in NAMED and out["rolling"] == "fixed_torque"
+    assert out["incline"] == ["contact.rolling", 'run.scenario = "incline" needs rolling = "constant_torque" or "epsd"']
