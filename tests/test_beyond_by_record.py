@@ -5,7 +5,14 @@ engines/scenario.py and engines/*/scenario.py and lists every comparison that na
 operand ``x.id`` or a name ``kind`` (``law.id == "epsd"``, ``rec.id in ("jkr", "dmt")``, ``kind == JKR``), a
 subscript ``…["kind"]``, or a slot of the case's contact against a string (``case.contact.rolling ==
 "viscous"``); and every read of a law's exponents by key (``ln["a"]``, ``ln["b"]``) or a bare exponent ``b`` as
-a truth value (``if x_t and b``). comparisons/audit_beyond.py is not read (another change's file)."""
+a truth value (``if x_t and b``).
+
+It also reads the deck audit's probes beyond sliding (comparisons/audit_beyond.py), Yade's pair-scenario writer
+(engines/yade/pair.py) and the case's scenario checks (case.py), and lists there a law's id against a string: a
+deck's sub-model (``sub["law"]``, a name ``law``/``law_id``) against a law id of demcheck's (``sub["law"] ==
+"sds"``; an engine's own word such as ``"cdt"`` is spared). In case.py a case's own keys are the user's words
+(``kind == "collision"``, ``case.contact.normal != "hertz"``: the closed form is written for that model id), so
+there only ``x.id``, the law-id rule and the exponent reads apply."""
 
 from __future__ import annotations
 
@@ -23,10 +30,45 @@ def files():
             *sorted((SRC / "engines").glob("*/scenario.py"))]
 
 
-def _by_id(node) -> bool:
-    """An operand that names a law by id or kind."""
+def user_key_files():
+    """Files whose comparisons of a case's own keys (its kind, the model id the user wrote) are the rule itself."""
+    return [SRC / "case.py"]
+
+
+def deck_files():
+    return [SRC / "comparisons" / "audit_beyond.py", SRC / "engines" / "yade" / "pair.py"]
+
+
+def law_ids() -> frozenset:
+    """Every id of a registered law beyond sliding (``none`` aside)."""
+    from demcheck.laws import slots
+
+    return frozenset(i for slot in slots.BEYOND_SLOTS for i in slots.law_ids(slot)) - {"none"}
+
+
+def _names_a_law(node) -> bool:
+    """A deck's sub-model or a law's name: ``sub["law"]``, ``law``, ``law_id``."""
+    if isinstance(node, ast.Subscript):
+        return isinstance(node.slice, ast.Constant) and node.slice.value == "law"
+    return isinstance(node, ast.Name) and node.id in ("law", "law_id")
+
+
+def _law_id_string(node) -> bool:
+    """A string constant (or a tuple, list or set of them) that is a law id of demcheck's."""
+    items = node.elts if isinstance(node, (ast.Tuple, ast.List, ast.Set)) else [node]
+    return any(isinstance(x, ast.Constant) and isinstance(x.value, str) and x.value in law_ids() for x in items)
+
+
+def _law_against_id(left, right) -> bool:
+    return any(_names_a_law(a) and _law_id_string(b) for a, b in ((left, right), (right, left)))
+
+
+def _by_id(node, user_keys: bool = False) -> bool:
+    """An operand that names a law by id or kind (``user_keys``: by ``x.id`` only)."""
     if isinstance(node, ast.Attribute):
-        return node.attr == "id" or node.attr == "kind"
+        return node.attr == "id" or (node.attr == "kind" and not user_keys)
+    if user_keys:
+        return False
     if isinstance(node, ast.Name):
         return node.id == "kind"
     if isinstance(node, ast.Subscript):
@@ -57,13 +99,15 @@ def _bare_exponent_test(node) -> bool:
     return any(isinstance(x, ast.Name) and x.id in ("a", "b") for x in out)
 
 
-def by_id(source: str, name: str) -> list[str]:
+def by_id(source: str, name: str, user_keys: bool = False) -> list[str]:
     out = []
     for node in ast.walk(ast.parse(source)):
         hit = False
         if isinstance(node, ast.Compare):
             ops = [node.left, *node.comparators]
-            hit = any(_by_id(x) for x in ops) or any(_slot_string(x, y) for x, y in zip(ops, ops[1:]))
+            pairs = list(zip(ops, ops[1:]))
+            hit = (any(_by_id(x, user_keys) for x in ops) or any(_law_against_id(x, y) for x, y in pairs)
+                   or (not user_keys and any(_slot_string(x, y) for x, y in pairs)))
         elif _exponent_read(node) or _bare_exponent_test(node):
             hit = True
         if hit:
@@ -75,6 +119,33 @@ def test_the_scenario_solvers_and_writers_ask_records_never_ids():
     assert len(files()) >= 9
     found = [hit for f in files() for hit in by_id(f.read_text(encoding="utf-8"), str(f.relative_to(ROOT)))]
     assert not found, "\n".join(found)
+
+
+def test_the_deck_audit_and_yades_pair_writer_ask_records_never_ids():
+    found = [hit for f in deck_files() for hit in by_id(f.read_text(encoding="utf-8"), str(f.relative_to(ROOT)))]
+    assert not found, "\n".join(found)
+
+
+def test_the_cases_scenario_checks_ask_records_beside_the_users_keys():
+    found = [hit for f in user_key_files()
+             for hit in by_id(f.read_text(encoding="utf-8"), str(f.relative_to(ROOT)), user_keys=True)]
+    assert not found, "\n".join(found)
+
+
+def test_the_law_id_rule_sees_a_decks_law_and_spares_engine_words_and_user_keys():
+    caught = ['sub["law"] == "sds"', 'ps.beyond["adhesion"]["law"] in ("jkr", "dmt")', 'law == "viscous"',
+              'law_id != "lens"', '"constant_torque" == sub["law"]']
+    for text in caught:
+        assert by_id(text, "t"), text
+        assert by_id(text, "t", user_keys=True), text
+    for text in ('law.id == "viscous"', 'normal.id != "hertz"'):
+        assert by_id(text, "t", user_keys=True), text
+    spared = ['law == "cdt"', 'law not in ("cdt", "epsd3")', 'sub["law"] == "sjkr2"', 'sub["args"] == "jkr"',
+              'law not in laws']
+    for text in spared:
+        assert not by_id(text, "t"), text
+    for text in ('kind == "collision"', 'case.contact.normal != "hertz"', *spared):
+        assert not by_id(text, "t", user_keys=True), text
 
 
 def test_the_rule_sees_each_form_and_spares_the_records():
@@ -90,3 +161,15 @@ def test_the_rule_sees_each_form_and_spares_the_records():
               'nat.props["rolling"]', "if x_t and not isinstance(dashpot, ConstantDamping):\n    pass"]
     for text in spared:
         assert not by_id(text, "t"), text
+
+
+def test_each_scenario_runs_the_laws_whose_records_name_it():
+    """case.py's scenario check reads the laws a scenario runs off the records (``scenarios``): the table it held
+    by id before (dbdcd08's SCENARIO_LAWS), law for law and in its order (the refusal lists them)."""
+    from demcheck.case import SCENARIO_SLOTS
+    from demcheck.laws.slots import scenario_laws
+
+    before = {"rolling": ("constant_torque", "viscous"), "incline": ("constant_torque", "epsd"),
+              "twist": ("sds", "marshall"), "pull_off": ("jkr", "dmt", "sjkr"), "adhesive_impact": ("jkr",),
+              "conduction": ("radius", "area", "lens")}
+    assert {s: scenario_laws(slot, s) for s, (slot, _) in SCENARIO_SLOTS.items()} == before

@@ -60,7 +60,7 @@ from demcheck.resources import case_path
 
 case = from_dict(tomllib.loads(case_path("suite/beyond-rolling.toml").read_text()))
 p = case.particles[0]
-# its record as a case's [contact] resolves it (the scenarios name their laws in case.py: none runs it yet)
+# its record as a case's [contact] resolves it (a scenario runs the laws whose records name it, `scenarios`: none here)
 rec = slots.record("rolling", slots.check_id("rolling", "Fixed_Torque"), {"m0": 2e-7}, resolve(case).pair,
                    (p.radius, 0.0))
 out = {"ids": slots.law_ids("rolling"), "keys": [k.name for k in slots.KEYS[("rolling", "fixed_torque")]],
@@ -96,3 +96,32 @@ def test_a_rolling_law_in_one_module_runs_in_the_reference_and_is_refused_by_eve
     assert set(out["engines"]) >= {"lammps", "liggghts", "yade", "kratos"}
     for name, row in out["engines"].items():
         assert row["fidelity"] == "none" and row["reason"].strip(), (name, row)
+
+
+NAMED = TOY.replace('    stops: ClassVar[bool] = True\n',
+                    '    stops: ClassVar[bool] = True\n    scenarios: ClassVar[tuple] = ("rolling",)\n')
+
+ACCEPT = r'''
+import json, tomllib
+from demcheck.case import from_dict
+from demcheck.errors import ConfigError
+from demcheck.resources import case_path
+
+raw = tomllib.loads(case_path("suite/beyond-rolling.toml").read_text())
+raw["contact"] = {**{k: v for k, v in raw["contact"].items() if k != "mu_r"}, "rolling": "fixed_torque", "m0": 2e-7}
+out = {"rolling": from_dict(raw).contact.rolling}
+raw["run"]["scenario"] = "incline"
+try:
+    from_dict(raw)
+except ConfigError as exc:
+    out["incline"] = [exc.key, exc.rule]
+print(json.dumps(out))
+'''
+
+
+def test_a_plugin_law_is_a_cases_law_in_the_scenarios_its_record_names(tmp_path):
+    """The laws a scenario accepts are read off the records (``scenarios``): the toy law naming ``rolling`` is a
+    case's law there, and the incline, which it does not name, lists the laws whose records do."""
+    out = with_plugin_law(tmp_path, "toy_named_rolling_law", NAMED, ACCEPT, timeout=900)
+    assert "scenarios" in NAMED and out["rolling"] == "fixed_torque"
+    assert out["incline"] == ["contact.rolling", 'run.scenario = "incline" needs rolling = "constant_torque" or "epsd"']

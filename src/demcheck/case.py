@@ -668,14 +668,15 @@ def _contact(contact_raw: dict) -> Contact:
                    **beyond)
 
 
-# scenario → (the slot it exercises, the laws it has a metric for, one body on a wall?)
-SCENARIO_LAWS = {
-    "rolling": ("rolling", ("constant_torque", "viscous"), True),
-    "incline": ("rolling", ("constant_torque", "epsd"), True),
-    "twist": ("twisting", ("sds", "marshall"), True),
-    "pull_off": ("adhesion", ("jkr", "dmt", "sjkr"), None),
-    "adhesive_impact": ("adhesion", ("jkr",), None),
-    "conduction": ("heat", ("radius", "area", "lens"), None),
+# scenario → (the slot it exercises, one body on a wall?); the laws it has a metric for are those whose record
+# names it (``scenarios``, in each law's module: laws/slots.scenario_laws)
+SCENARIO_SLOTS = {
+    "rolling": ("rolling", True),
+    "incline": ("rolling", True),
+    "twist": ("twisting", True),
+    "pull_off": ("adhesion", None),
+    "adhesive_impact": ("adhesion", None),
+    "conduction": ("heat", None),
 }
 
 
@@ -686,8 +687,11 @@ def _check_scenario(case: Case) -> None:
     scenario = case.run.scenario
     if scenario == "collision":
         return
-    slot, laws, on_wall = SCENARIO_LAWS[scenario]
-    law = getattr(case.contact, slot)
+    from .laws.slots import scenario_laws
+
+    slot, on_wall = SCENARIO_SLOTS[scenario]
+    laws = scenario_laws(slot, scenario)
+    law = getattr(case.contact, slot)  # the id the user wrote, checked against the records that name the scenario
     if law not in laws:
         raise ConfigError(f"contact.{slot}", law, f"run.scenario = \"{scenario}\" needs {slot} = "
                           + " or ".join(f"\"{x}\"" for x in laws))
@@ -704,7 +708,7 @@ def _check_scenario(case: Case) -> None:
             raise ConfigError("run.gravity", list(case.run.gravity),
                               "the rolling scenario is on a level wall: gravity along -normal (run.scenario = "
                               "\"incline\" for a tilt)")
-        if law == "viscous":
+        if _record(case, slot).decays:
             _viscous_roll_grips(case)
     if scenario in ("rolling", "incline"):
         _tangential_holds(case, scenario)
@@ -713,7 +717,7 @@ def _check_scenario(case: Case) -> None:
         if not abs(w @ n) > 0:
             raise ConfigError("particles.0.angular_velocity", list(case.particles[0].angular_velocity),
                               "the twist scenario needs a spin about the wall's normal")
-    if scenario == "pull_off" and law == "sjkr":
+    if scenario == "pull_off" and not _record(case, slot).replaces_normal:  # a cohesion on the elastic law
         _sjkr_pull_inputs(case)
     if scenario == "adhesive_impact":
         from .laws import model as _model
@@ -722,6 +726,13 @@ def _check_scenario(case: Case) -> None:
             raise ConfigError("particles", "(initial state)", "the bodies never meet: no impact to solve")
     if scenario == "conduction":
         _conduction_inputs(case)
+
+
+def _record(case: Case, slot: str):
+    """The case's record of a slot beyond sliding (its traits say what its scenario checks)."""
+    from .laws import model as _model
+
+    return _model.resolve(case).slot(slot)
 
 
 def rolling_grip(case: Case) -> tuple[float, float, float]:
@@ -745,7 +756,7 @@ def rolling_grip(case: Case) -> tuple[float, float, float]:
     model = _model.resolve(case)
     grip = (model.pair.friction or 0.0) * g * math.cos(theta)
     law = model.slot("rolling")
-    viscous = law is not None and law.id == "viscous"
+    viscous = law is not None and law.decays  # type B: −Cr w
     deceleration = v0 / (1.4 * mass * radius * radius / law.c_r) if viscous else 0.0
     return deceleration, grip, 1.4 * mass * radius * radius * grip / v0 if v0 > 0.0 else math.inf
 
@@ -795,8 +806,13 @@ def _sjkr_pull_inputs(case: Case) -> None:
     if len(radii) != 2 or radii[0] != radii[1]:
         raise ConfigError("particles", radii, "the pull_off scenario with adhesion = \"sjkr\" pulls two like spheres "
                           "(equal radii)")
-    normal, damping = _model.resolve(case).normal_law.slots()  # the slot records, by id (never exponents)
-    if normal.id != "hertz" or damping.id != "none" or case.contact.normal != "hertz":
+    from .laws.damping import NoDamping
+    from .laws.normal import HertzNormal
+
+    normal, damping = _model.resolve(case).normal_law.slots()  # the slot records, by class (never exponents)
+    # and the model id the user wrote: the closed form (reference/beyond.py sjkr_pull_off_closed) is written for
+    # the case's model "hertz", not for any model whose records are an undamped Hertz spring
+    if not isinstance(normal, HertzNormal) or not isinstance(damping, NoDamping) or case.contact.normal != "hertz":
         raise ConfigError("contact.normal", case.contact.normal, "the pull_off scenario with adhesion = \"sjkr\" adds "
                           "the cohesion to the elastic Hertz law: normal = \"hertz\"")
 

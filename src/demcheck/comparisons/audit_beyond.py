@@ -101,7 +101,7 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
                                 "sphere rests)"]
     if ps.j is not None and ps.j != ps.i:
         notes.append(f"the sphere is type {ps.i}'s (radius {r:g}, density {rho:g}) under the pair's law")
-    if "adhesion" in ps.beyond and ps.beyond["adhesion"]["law"] in ("jkr", "dmt"):  # its Hertz part, E and ν
+    if "adhesion" in ps.beyond and _replaces_normal(ps.beyond["adhesion"]):  # its Hertz part, E and ν
         e_mod, _, nu, _ = ps.beyond["adhesion"]["args"]
         native = dataclasses.replace(native, normal="hertz/material", normal_args=(e_mod, nu))
         notes.append(f"the Hertz part of {ps.beyond['adhesion']['law']} (E {e_mod:g}, ν {nu:g}); its adhesion is "
@@ -131,6 +131,24 @@ def _elastic(setup, ps, base: dict) -> tuple[dict, dict, list]:
             notes.append(f"the √(R̄δ) tangential spring taken at the static overlap: kt = {kt:.6g}")
         contact.update(tangential="spring_sliding", kt=kt)
     return mat, contact, notes
+
+
+def _record(slot: str, sub: dict, required: bool = True) -> type | None:
+    """The record class of the law a deck's sub-model reads back to (its reader names it by the law's id where
+    demcheck has the law); where demcheck has none of that name (an engine's own word: cdt, sjkr2), None — or,
+    ``required``, a ValueError (the probe is listed with it)."""
+    from ..laws.slots import law_class
+
+    law = law_class(slot, sub["law"])
+    if law is None and required:
+        raise ValueError(f"{slot} {sub['law']}: demcheck has no twin of this law")
+    return law
+
+
+def _replaces_normal(sub: dict) -> bool:
+    """An adhesion that is the whole elastic normal law (JKR, DMT: its args E, η, ν, γ)."""
+    law = _record("adhesion", sub, required=False)
+    return law is not None and law.replaces_normal
 
 
 def _elastic_id(nl) -> str:
@@ -194,16 +212,17 @@ def _twisting(setup, ps, sub, base, entry, speed) -> list:
         return [(label, None, "the deck sets no gravity: a spinning sphere on a plane has no load", [])]
     if not speed:
         return [(label, None, "no characteristic speed to set the spin by", [])]
+    law = _record("twisting", sub)
     mat, contact, notes = _elastic(setup, ps, base)
-    if sub["law"] == "sds":
+    if not law.from_contact_radius:  # its own coefficients (LAMMPS twisting sds k γ μ)
         k, gamma, mu = sub["args"]
         contact = {k_: v for k_, v in contact.items() if k_ not in ("tangential", "kt")}
-        contact.update(twisting="sds", k_tw=k, gamma_tw=gamma, mu_tw=mu)
+        contact.update(twisting=law.id, k_tw=k, gamma_tw=gamma, mu_tw=mu)
     else:
         if "tangential" not in contact:
-            return [(label, None, "twisting marshall is built from the tangential spring and μ: the deck's has none",
+            return [(label, None, f"twisting {law.id} is built from the tangential spring and μ: the deck's has none",
                      notes)]
-        contact.update(twisting="marshall", mu_t=mat["friction"])
+        contact.update(twisting=law.id, mu_t=mat["friction"])
         notes.append("marshall's coefficients from the probe's tangential spring (kt, μs; its dashpot left out)")
     omega = speed / base["radius"]
     notes.append(f"spun at ω0 = v/R = {omega:.6g} (the characteristic speed over the radius)")
@@ -234,7 +253,7 @@ def _jkr_dmt(setup, ps, sub, base, entry, speed) -> list:
              + (f"; the deck's normal dashpot ({eta:g}) left out (the probes are elastic)" if eta else "")]
     out = [(f"pull-off ({ps.label})", _pair_bodies(f"audit-pull-off-{ps.label}", mat, base["radius"], contact,
                                                     {"scenario": "pull_off"}), "", notes)]
-    if sub["law"] == "jkr" and speed:
+    if "adhesive_impact" in _record("adhesion", sub).scenarios and speed:
         out.append((f"adhesive impact ({ps.label})",
                     _pair_bodies(f"audit-impact-{ps.label}", mat, base["radius"], contact,
                                  {"scenario": "adhesive_impact"}, impact=speed),
@@ -246,6 +265,8 @@ def _heat(setup, ps, sub, base, entry, speed) -> list:
     """The held pair: two like spheres at the head-on probe's largest overlap, conducting by the deck's law
     (LAMMPS ``heat radius ks``/``area hs``; LIGGGHTS fix heat/gran/conduction, asked as Batchelor & O'Brien's
     2ks a with ks = 2k0k1/(k0+k1))."""
+    from ..laws.heat import LensHeat
+
     label = f"conduction ({ps.label})"
     if ps.j is None:
         return [(label, None, "the heat probe holds two spheres; a wall's conduction (a wall temperature) is not "
@@ -255,7 +276,7 @@ def _heat(setup, ps, sub, base, entry, speed) -> list:
     if None in cps:
         return [(label, None, "the deck gives no heat capacity for these types (LAMMPS fix heat/flow; LIGGGHTS "
                               "thermalCapacity)", [])]
-    if sub["law"] == "lens":
+    if issubclass(_record("heat", sub), LensHeat):  # LIGGGHTS: the types' conductivities, mixed
         ks = [heat.get("k", {}).get(t, heat.get("k_all")) for t in (ps.i, ps.j)]
         if None in ks:
             return [(label, None, "the deck gives no thermalConductivity for these types", [])]
@@ -410,7 +431,7 @@ def _kratos_rolling(setup, ps, sub, base, entry, speed) -> list:
            "youngs_modulus": 1e9, "poisson_ratio": 0.3}
     contact = {"normal": "lsd", "kn": kn, "tangential": "spring_sliding", "kt": ratio * kn}
     weight = rho * 4.0 / 3.0 * math.pi * r ** 3 * g
-    if sub["law"] == "constant_torque":
+    if _record("rolling", sub).stops:  # type A (ConstantTorque), else type B (ViscousTorque)
         contact.update(rolling="constant_torque", mu_r=coef, full_direction=True)
         what = f"type A μr = {coef:g} (Rr = R)"
         roll = f"rolling at the characteristic speed {speed:g}, ω = v/R"

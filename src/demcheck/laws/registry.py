@@ -105,6 +105,8 @@ class BeyondSubModel(SubModel):
     slot (``example``). Each slot's base (``laws/<slot>_laws/slot.py``) adds the traits its solvers ask."""
 
     keys: ClassVar[tuple] = ()
+    # the scenarios beyond sliding (run.scenario) that measure this law: case.py accepts it in those
+    scenarios: ClassVar[tuple] = ()
     formula: ClassVar[str] = ""
     source: ClassVar[str] = ""
     example: ClassVar[dict] = {}

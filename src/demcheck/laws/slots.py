@@ -49,6 +49,16 @@ def law_ids(slot: str) -> list[str]:
     return ["none", *sorted(i for s, i in KEYS if s == slot)]
 
 
+def law_class(slot: str, id_: str) -> type | None:
+    """The record class of a registered law beyond sliding, None for ``none`` or an id no law has."""
+    return _laws().get((slot, id_))
+
+
+def scenario_laws(slot: str, scenario: str) -> tuple[str, ...]:
+    """The ids of the laws of ``slot`` whose record names ``scenario`` (its ``scenarios``), in registration order."""
+    return tuple(id_ for (s, id_), cls in _laws().items() if s == slot and scenario in cls.scenarios)
+
+
 def check_id(slot: str, value) -> str:
     if not isinstance(value, str) or value.strip().lower() not in law_ids(slot):
         raise ConfigError(f"contact.{slot}", value, f"must be one of {', '.join(law_ids(slot))}")

@@ -31,8 +31,11 @@ from scipy.optimize import brentq
 from ...case import Case
 from ...errors import DemcheckError
 from ...inputs import common
+from ...laws.adhesion import DmtAdhesion
+from ...laws.damping import NoDamping
 from ...laws.heat import conductance
 from ...laws.model import resolve
+from ...laws.tangential import NoTangential
 from ...reference import beyond_yade
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 from .deck import ascii_comment, guard
@@ -86,9 +89,9 @@ def mapping(case: Case) -> Mapping:
     if s == "conduction":
         return _heat(case, model)
     rec = model.slot("adhesion")
-    if rec.id != "dmt":
-        return refused("yade", NO_JKR if rec.id == "jkr" else NO_SJKR)
-    if model.contact.damping.id != "none" or model.contact.tangential.id != "none":
+    if not isinstance(rec, DmtAdhesion):  # JKR (an adhesive elastic law too) or a cohesion on the elastic law
+        return refused("yade", NO_JKR if rec.replaces_normal else NO_SJKR)
+    if not isinstance(model.contact.damping, NoDamping) or not isinstance(model.contact.tangential, NoTangential):
         return refused("yade", "the pull is written without a normal dashpot and without a tangential law (Mindlin "
                                "betan = betas = 0, frictionAngle = 0)")
     gamma = 0.5 * rec.w
@@ -101,7 +104,7 @@ def mapping(case: Case) -> Mapping:
 
 def _heat(case: Case, model) -> Mapping:
     law = model.slot("heat")
-    if law.id == "area":
+    if not law.conductivity:
         return refused("yade", "ThermalEngine takes a conductivity (W/(m K)), not a conductance per area: no "
                                "setting of Yade 2023.02a gives hs pi a^2")
     r0, r1 = (p.radius for p in case.particles)

@@ -18,6 +18,7 @@ from .slot import KERNELS, AdhesionSubModel
 class DmtAdhesion(AdhesionSubModel):
     id: ClassVar[str] = "dmt"
     title: ClassVar[str] = "Derjaguin-Muller-Toporov adhesive elastic contact"
+    scenarios: ClassVar[tuple] = ("pull_off",)
     replaces_normal: ClassVar[bool] = True
     keys: ClassVar[tuple] = (Key("w", "work of adhesion (J/m²)", "must be > 0 (J/m²)", positive),)
     formula: ClassVar[str] = "F = (4/3)E*√R̄ δ^{3/2} − 2πwR̄ (δ ≥ 0)"

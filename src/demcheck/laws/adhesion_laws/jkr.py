@@ -25,6 +25,7 @@ class JkrAdhesion(AdhesionSubModel):
     id: ClassVar[str] = "jkr"
     history_size: ClassVar[int] = 1  # the touching flag
     title: ClassVar[str] = "Johnson-Kendall-Roberts adhesive elastic contact"
+    scenarios: ClassVar[tuple] = ("pull_off", "adhesive_impact")
     replaces_normal: ClassVar[bool] = True
     necks: ClassVar[bool] = True
     keys: ClassVar[tuple] = (

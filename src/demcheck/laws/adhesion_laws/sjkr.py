@@ -22,6 +22,7 @@ AREA_LENS, AREA_BAND = 0, 1
 class SjkrAdhesion(AdhesionSubModel):
     id: ClassVar[str] = "sjkr"
     title: ClassVar[str] = "simplified JKR cohesion (force = energy density × contact area)"
+    scenarios: ClassVar[tuple] = ("pull_off",)
     keys: ClassVar[tuple] = (
         Key("k_c", "cohesion energy density (J/m³)", "must be > 0 (J/m³)", positive),
         Key("area", "contact area: lens (sjkr) or band 2πRxδ (sjkr2)", default="lens",

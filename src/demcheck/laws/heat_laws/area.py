@@ -17,6 +17,7 @@ from .slot import KERNELS, HeatSubModel
 class AreaHeat(HeatSubModel):
     id: ClassVar[str] = "area"
     title: ClassVar[str] = "conductance hs π a²"
+    scenarios: ClassVar[tuple] = ("conduction",)
     keys: ClassVar[tuple] = (Key("k", "contact conductance per area hs (W/(m²·K))", "must be > 0", positive),)
     formula: ClassVar[str] = "Q = hs π a² (T1 − T0)"
     source: ClassVar[str] = "LAMMPS pair granular heat area"

@@ -20,6 +20,8 @@ from .slot import KERNELS, HeatSubModel
 class LensHeat(HeatSubModel):
     id: ClassVar[str] = "lens"
     title: ClassVar[str] = "conductance 2 ks √A over the spheres' intersection circle"
+    scenarios: ClassVar[tuple] = ("conduction",)
+    conductivity: ClassVar[bool] = True
     keys: ClassVar[tuple] = (Key("k", "conductivity ks = 2k0k1/(k0+k1) (W/(m·K))", "must be > 0", positive),)
     formula: ClassVar[str] = "Q = 2 ks √A (T1 − T0), A the spheres' intersection circle"
     source: ClassVar[str] = "LIGGGHTS fix heat/gran/conduction"

@@ -18,6 +18,8 @@ from .slot import KERNELS, HeatSubModel
 class RadiusHeat(HeatSubModel):
     id: ClassVar[str] = "radius"
     title: ClassVar[str] = "conductance 2 ks a (Batchelor & O'Brien 1977)"
+    scenarios: ClassVar[tuple] = ("conduction",)
+    conductivity: ClassVar[bool] = True
     keys: ClassVar[tuple] = (Key("k", "conductivity ks (W/(m·K))", "must be > 0", positive),)
     formula: ClassVar[str] = "Q = 2 ks a (T1 − T0), a = √(R̄δ)"
     source: ClassVar[str] = "Batchelor & O'Brien, Proc. R. Soc. A 355 (1977) 313"

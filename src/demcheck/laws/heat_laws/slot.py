@@ -14,6 +14,9 @@ KERNELS = Kernels("heat")
 
 @dataclass(frozen=True)
 class HeatSubModel(BeyondSubModel):
-    """A conduction law's record: its conductance H(δ) is the heat flow at dT = 1 K (laws/heat.conductance)."""
+    """A conduction law's record: its conductance H(δ) is the heat flow at dT = 1 K (laws/heat.conductance). Its
+    trait ``conductivity``: its coefficient ``k`` is a conductivity ks (W/(m·K)), as an engine that takes a
+    material's conductivity needs (without it, e.g. a conductance per contact area)."""
 
     slot: ClassVar[str] = "heat"
+    conductivity: ClassVar[bool] = False

@@ -21,6 +21,7 @@ from .slot import KERNELS, MU_R, R_ROLL, RollingSubModel, _rolling_part
 class ConstantTorqueRolling(RollingSubModel):
     id: ClassVar[str] = "constant_torque"
     title: ClassVar[str] = "constant directional torque (Ai et al. 2011 type A)"
+    scenarios: ClassVar[tuple] = ("rolling", "incline")
     stops: ClassVar[bool] = True
     keys: ClassVar[tuple] = (
         MU_R, R_ROLL,

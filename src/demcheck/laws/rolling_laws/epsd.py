@@ -27,6 +27,7 @@ class EpsdRolling(RollingSubModel):
     id: ClassVar[str] = "epsd"
     history_size: ClassVar[int] = 3  # the spring torque Mk
     title: ClassVar[str] = "elastic-plastic spring-dashpot rolling resistance (Ai et al. 2011 type C)"
+    scenarios: ClassVar[tuple] = ("incline",)
     spring: ClassVar[bool] = True
     keys: ClassVar[tuple] = (
         MU_R, R_ROLL, Key("k_r", "rolling stiffness kr (N·m/rad)", "must be > 0", positive), C_R,

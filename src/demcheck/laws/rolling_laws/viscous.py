@@ -17,6 +17,7 @@ from .slot import KERNELS, RollingSubModel, _rolling_part
 class ViscousRolling(RollingSubModel):
     id: ClassVar[str] = "viscous"
     title: ClassVar[str] = "viscous rolling resistance (Ai et al. 2011 type B)"
+    scenarios: ClassVar[tuple] = ("rolling",)
     decays: ClassVar[bool] = True
     keys: ClassVar[tuple] = (Key("c_r", "rolling damping coefficient Cr (N·m·s/rad)", "must be > 0", positive),)
     formula: ClassVar[str] = "M = −Cr wt"

@@ -18,6 +18,7 @@ from .slot import KERNELS, TwistingSubModel, _sds
 class MarshallTwisting(TwistingSubModel):
     id: ClassVar[str] = "marshall"
     title: ClassVar[str] = "Marshall's twisting (coefficients from the tangential law and the contact radius)"
+    scenarios: ClassVar[tuple] = ("twist",)
     from_contact_radius: ClassVar[bool] = True
     keys: ClassVar[tuple] = (
         Key("kt", "the tangential stiffness the twist is built from (N/m)", "must be > 0", positive),

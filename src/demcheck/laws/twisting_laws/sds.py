@@ -18,6 +18,7 @@ from .slot import KERNELS, TwistingSubModel, _sds
 class SdsTwisting(TwistingSubModel):
     id: ClassVar[str] = "sds"
     title: ClassVar[str] = "Coulomb-limited twisting spring-dashpot"
+    scenarios: ClassVar[tuple] = ("twist",)
     keys: ClassVar[tuple] = (
         Key("k_tw", "twisting stiffness (N·m/rad)", "must be > 0", positive),
         Key("gamma_tw", "twisting damping (N·m·s/rad)", default=0.0),
