@@ -115,6 +115,8 @@ try:
     from_dict(raw)
 except ConfigError as exc:
     out["incline"] = [exc.key, exc.rule]
+from demcheck.engines import scenario
+out["engines"] = scenario.law_mappings("rolling", "fixed_torque")
 print(json.dumps(out))
 '''
 
@@ -125,3 +127,8 @@ def test_a_plugin_law_is_a_cases_law_in_the_scenarios_its_record_names(tmp_path)
     out = with_plugin_law(tmp_path, "toy_named_rolling_law", NAMED, ACCEPT, timeout=900)
     assert "scenarios" in NAMED and out["rolling"] == "fixed_torque"
     assert out["incline"] == ["contact.rolling", 'run.scenario = "incline" needs rolling = "constant_torque" or "epsd"']
+    # a law the engines' writers do not know, in a scenario it names: refused with its own name, never read as
+    # one they know (LIGGGHTS's writer took it for type A and crashed; LAMMPS and Yade called it viscous)
+    for name, row in out["engines"].items():
+        assert row["fidelity"] == "none" and "type B" not in row["reason"] and "viscous" not in row["reason"], (name, row)
+    assert all("fixed_torque" in out["engines"][e]["reason"] for e in ("lammps", "liggghts", "yade")), out["engines"]

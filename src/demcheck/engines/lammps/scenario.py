@@ -24,7 +24,7 @@ from ...laws.adhesion import BREAK_LOAD, DmtAdhesion, JkrAdhesion, SjkrAdhesion
 from ...laws.damping import ConstantDamping, NoDamping
 from ...laws.heat import AreaHeat, LensHeat, RadiusHeat
 from ...laws.model import resolve
-from ...laws.rolling import CAP_TOTAL, ConstantTorqueRolling, EpsdRolling
+from ...laws.rolling import CAP_TOTAL, ConstantTorqueRolling, EpsdRolling, ViscousRolling
 from ...laws.tangential_laws.none import NoTangential
 from ...laws.twisting import MarshallTwisting, SdsTwisting
 from ..base import APPROXIMATE, EXACT, Engine, Mapping, Native, refused, worst
@@ -80,8 +80,12 @@ def _rolling(model, rec, nat: Native):
                                     "no torque from an unstretched spring whose dashpot alone passes it); the case "
                                     "caps the spring and drops the dashpot at the limit (Ai et al.)"]
         return (f"rolling sds {fmt(k)} {fmt(gamma)} {fmt(mu)}", twin_rec, EXACT if exact else APPROXIMATE, reasons)
-    what = "the direction from the whole relative spin (LIGGGHTS cdt)" if isinstance(rec, ConstantTorqueRolling) else \
-        "a viscous rolling torque (type B)"
+    if isinstance(rec, ConstantTorqueRolling):
+        what = "the direction from the whole relative spin (LIGGGHTS cdt)"
+    elif isinstance(rec, ViscousRolling):
+        what = "a viscous rolling torque (type B)"
+    else:  # a law demcheck gained after this writer (a plug-in law): never read as one it knows
+        what = f"the rolling law {rec.id!r}"
     return refused("lammps", f"LAMMPS 22Jul2025 has no rolling model with {what}: its only one is rolling sds")
 
 

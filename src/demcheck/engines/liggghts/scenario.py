@@ -45,6 +45,9 @@ def mapping(engine: Engine, case: Case) -> Mapping:
         if isinstance(model.slot("rolling"), ViscousRolling):
             return refused("liggghts", "LIGGGHTS-PUBLIC 3.8.0 has no viscous rolling torque (type B): its rolling "
                                        "models are cdt, epsd, epsd2 and epsd3")
+        if not isinstance(model.slot("rolling"), (ConstantTorqueRolling, EpsdRolling)):  # a plug-in law
+            return refused("liggghts", f"LIGGGHTS-PUBLIC 3.8.0 has no rolling law like {model.slot('rolling').id!r}: "
+                                       "its rolling models are cdt, epsd, epsd2 and epsd3")
         base = engine.map(model, case.contact.params)
         if base.native is None:
             return refused("liggghts", f"the contact of the rolling sphere: {'; '.join(base.reasons)}")

@@ -27,7 +27,7 @@ from ...errors import DemcheckError
 from ...inputs import common
 from ...laws.model import resolve
 from ...laws.normal import HertzNormal, HookeNormal
-from ...laws.rolling import ConstantTorqueRolling, EpsdRolling
+from ...laws.rolling import ConstantTorqueRolling, EpsdRolling, ViscousRolling
 from ...laws.tangential_laws.none import NoTangential
 from ...laws.tangential_laws.spring import SpringTangential
 from ...laws.twisting import SdsTwisting
@@ -153,8 +153,10 @@ def _rolling(law, props, radius):
         props.update(kr=r2ks, max_roll=law.mu_r * law.r_roll, etaRoll=law.mu_r * law.r_roll / radius, alphaKr=1.0)
         return APPROXIMATE, ["type A (constant torque) as CohesionMoment's bending spring (kr = R² ks, alphaKr = 1) "
                              "at its limit etaRoll·R·|Fn|: it winds up first and springs back at the stop"]
-    return refused("yade", "Yade's only viscous rolling torque (ViscElMat mR, mRtype 1) is −mR|Fn|·w, not −Cr w: "
-                           "not mapped")
+    if isinstance(law, ViscousRolling):
+        return refused("yade", "Yade's only viscous rolling torque (ViscElMat mR, mRtype 1) is −mR|Fn|·w, not −Cr w: "
+                               "not mapped")
+    return refused("yade", f"Yade has no rolling moment like the rolling law {law.id!r}: not mapped")
 
 
 def _twisting(law, props, radius):
