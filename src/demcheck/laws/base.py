@@ -26,28 +26,32 @@ examples, and ``rolling``, ``twisting``, ``adhesion`` and ``heat`` laws write th
   fields, and :meth:`SubModel.array` / :meth:`SubModel.from_array` are the coefficient layout — the fields in
   declaration order as float64 (a bool as 0.0/1.0, an int as its float) and back, exactly.
 
-* **The engines map records by their ids** (``contact.damping.id == "quarter"``), never by exponents or by the
-  kernels' family numbers: an engine that cannot express a record refuses the mapping with its reason.
+* **Nothing names a law by its id to decide what to compute.** The solvers ask a law's traits (the tangential
+  laws' flag word, ``has(tl, F_…)``; the normal laws' ``loads_and_unloads``; the beyond-sliding records'
+  ``stops``, ``decays``, ``spring``, ``replaces_normal``, ``scenarios``, …), and the engines map records by their
+  class (``isinstance(contact.damping, QuarterDamping)``) — never by exponents or by the kernels' family numbers:
+  an engine that cannot express a record refuses the mapping with its reason (tests/test_laws_by_record.py and
+  tests/test_beyond_by_record.py read the source to hold that).
 
-* **The compiled force function** of a new law lives in the law's module (or, where the records must import
-  without numba, in ``<family>_force.py`` beside it), ``@njit(cache=KERNEL_CACHE)``, named
-  ``<id>_<slot>_force``, and takes the record's ``array()`` first, then the contact's scalars and its history
-  slice, and returns its contribution:
+* **The compiled force function** of a law lives in the law's own module — one module per law, in its slot's
+  package (``normal_laws/``, ``damping_laws/``, ``tangential_laws/``, ``rolling_laws/``, ``twisting_laws/``,
+  ``adhesion_laws/``, ``heat_laws/``) — ``@njit(cache=KERNEL_CACHE)``, named ``<id>_<slot>_force`` (the
+  tangential laws add their slip surface and return map), and takes the law's coefficients first. Its signature
+  is its slot's, stated once in the slot's interface module, which also dispatches to it:
 
-  - normal: ``(c, delta, history) → F`` (N, + repulsive; ``history`` e.g. the largest overlap);
-  - damping: ``(c, delta) → η(δ)`` (the prefactor of δ̇; the tangential dashpots of the engines reuse it);
-  - tangential: ``(c, eta_n, fn_abs, xi, vt, delta) → Ft`` (3-vector on body 0);
-  - rolling / twisting: ``(c, fn_abs, r_eff, rate, history) → torque`` (3-vector / scalar);
-  - adhesion: ``(c, delta, r_eff) → F`` (N, negative: attractive);
-  - heat: ``(c, delta, r_eff, temperature_difference) → heat flow`` (W).
+  - normal and damping: ``normal_laws/common.py``, ``damping_laws/common.py``, composed (spring + dashpot,
+    with limit_force's clip) by ``normal_force.py`` for every solver;
+  - tangential: ``tangential_slot.py`` (the law array's ``T_*`` layout, the traits) and the generated switch of
+    ``tangential_dispatch.py`` behind ``tangential_force.py``;
+  - rolling, twisting, adhesion, heat: ``<slot>_laws/slot.py`` (its base record, traits and ``KERNELS``
+    table: record class → compiled function).
 
   Numba compiles a function once per set of argument types: pass numbers as float64 and arrays as arrays
   (docs/architecture.md, "Compiled kernels, one specialisation each").
 
-  The seed's normal, damping and tangential laws predate this convention: their compiled functions
-  (``normal_force.py``, ``tangential_force.py``) read the kernels' composed arrays, ``NormalLaw.array()``
-  (normal + damping) and ``TangentialLaw.array()``, which ``NormalLaw.from_slots`` / ``TangentialLaw.from_slot``
-  build from the records and ``slots()`` / ``slot()`` turn back into them, exactly.
+  The seed's normal, damping and tangential laws are stepped through the kernels' composed arrays,
+  ``NormalLaw.array()`` (normal + damping) and ``TangentialLaw.array()``, which ``NormalLaw.from_slots`` /
+  ``TangentialLaw.from_slot`` build from the records and ``slots()`` / ``slot()`` turn back into them, exactly.
 
 A law module registers its record classes (the subclass statement does it) and, for the users' names, its
 seed models in its slot's :class:`~demcheck.laws.registry.Registry`.
