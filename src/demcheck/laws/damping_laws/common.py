@@ -66,7 +66,8 @@ RECORDS: dict[int, type] = {}  # family → the record class
 
 @njit(cache=KERNEL_CACHE, inline="always")
 def power_dashpot_force(law, delta, rate, b):
-    """η δ^b δ̇ (δ^b sign-preserving)."""
+    """η δ^b δ̇ (δ^b sign-preserving; a law passes its own exponent, a constant numba folds into spow's switch —
+    faster in the 1-D solver than the array's exponent, docs/performance.md)."""
     return law[L_ETA] * spow(delta, b) * rate
 
 

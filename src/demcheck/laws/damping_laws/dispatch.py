@@ -44,33 +44,26 @@ def source(kernels=None) -> str:
     return "\n".join(lines + body) + "\n"
 
 
-def _write(text: str) -> Path | None:
-    """The module file of ``text`` in the kernel cache (written once, atomically), or None without a cache."""
-    if not KERNEL_CACHE or not os.environ.get("NUMBA_CACHE_DIR"):
-        return None
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    path = Path(os.environ["NUMBA_CACHE_DIR"]) / "generated" / f"damping_dispatch_{digest}.py"
-    if path.exists() and path.read_text() == text:
-        return path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.utime(tmp, (_STAMP, _STAMP))
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
-
-
-def build():
-    """The switch module of the registered laws (closing the registry)."""
-    text = source()
-    _BUILT.append(True)
-    name = "demcheck.laws._damping_dispatch"
-    path = _write(text)
+def generated_module(name: str, stem: str, text: str):
+    """The module ``name`` of the generated source ``text``: written once (atomically) to
+    ``$NUMBA_CACHE_DIR/generated/<stem>_<hash of text>.py`` and imported from there, so that ``cache=True`` holds
+    for its functions; compiled from the text where there is no kernel cache. (What laws/tangential_dispatch.py
+    does for the tangential switch; one of the two could serve both.)"""
+    path = None
+    if KERNEL_CACHE and os.environ.get("NUMBA_CACHE_DIR"):
+        digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+        path = Path(os.environ["NUMBA_CACHE_DIR"]) / "generated" / f"{stem}_{digest}.py"
+        if not (path.exists() and path.read_text() == text):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
+                try:
+                    fh.write(text)
+                    fh.close()
+                    os.utime(fh.name, (_STAMP, _STAMP))
+                    os.replace(fh.name, path)
+                finally:
+                    if os.path.exists(fh.name):
+                        os.unlink(fh.name)
     if path is None:
         module = types.ModuleType(name)
         exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # noqa: S102 - our own generated source
@@ -80,3 +73,10 @@ def build():
         spec.loader.exec_module(module)
     sys.modules[name] = module
     return module
+
+
+def build():
+    """The switch module of the registered laws (closing the registry)."""
+    text = source()
+    _BUILT.append(True)
+    return generated_module("demcheck.laws._damping_dispatch", "damping_dispatch", text)
