@@ -60,7 +60,7 @@ def test_the_kernels_compile_one_specialisation_each(tmp_path):
     p = subprocess.run([sys.executable, "-c", SPECIALISATIONS], cwd=ROOT, env=env, capture_output=True, text=True,
                        timeout=900)
     assert p.returncode == 0, p.stderr[-2000:]
-    assert json.loads(p.stdout.strip().splitlines()[-1]) == {"demcheck.laws.normal_laws.viscoelastic.viscoelastic_force": 2,
+    assert json.loads(p.stdout.strip().splitlines()[-1]) == {"demcheck.laws.normal_force.viscoelastic_force": 2,
                                                              "demcheck.laws.normal_force.normal_force": 2}
 
 

@@ -1,4 +1,6 @@
-"""The damping slot: the normal dashpot η δ^b δ̇ of a viscoelastic contact, one record per exponent family.
+"""The damping slot: the normal dashpot η δ^b δ̇ of a viscoelastic contact. Each law is one module of
+laws/damping_laws/ (its record, family id and compiled force); this module gathers the built-in records and
+names a dashpot by its exponent where the seed's laws give one.
 
 The seed's damped normal models are pairs of an elastic law and one of these (LSDn: hooke + constant; BSHPn and
 KKn: hertz + sqrt; TTIn: hertz + quarter); the engines' tangential dashpots reuse the prefactor η(δ) = η δ^b.
@@ -6,52 +8,16 @@ KKn: hertz + sqrt; TTIn: hertz + quarter); the engines' tangential dashpots reus
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import ClassVar
+from . import damping_laws  # noqa: F401  (every damping law registered)
+from .damping_laws.common import RECORDS, Damping  # noqa: F401
+from .damping_laws.constant import ConstantDamping
+from .damping_laws.none import NoDamping
+from .damping_laws.quarter import QuarterDamping
+from .damping_laws.sqrt import SqrtDamping
 
-from .base import SubModel
-
-
-@dataclass(frozen=True)
-class Damping(SubModel):
-    """η(δ) = eta · δ^exponent, the prefactor of the approach rate δ̇ in the normal force."""
-
-    slot: ClassVar[str] = "damping"
-    exponent: ClassVar[float] = 0.0
-
-
-@dataclass(frozen=True)
-class NoDamping(Damping):
-    id: ClassVar[str] = "none"
-    title: ClassVar[str] = "no normal dashpot (elastic)"
-
-
-@dataclass(frozen=True)
-class ConstantDamping(Damping):
-    id: ClassVar[str] = "constant"
-    title: ClassVar[str] = "η δ̇ (linear dashpot: LSDn)"
-    exponent: ClassVar[float] = 0.0
-    eta: float = 0.0  # N·s/m
-
-
-@dataclass(frozen=True)
-class SqrtDamping(Damping):
-    id: ClassVar[str] = "sqrt"
-    title: ClassVar[str] = "η δ^{1/2} δ̇ (BSHPn, KKn; LAMMPS viscoelastic)"
-    exponent: ClassVar[float] = 0.5
-    eta: float = 0.0  # N·s/m^1.5
-
-
-@dataclass(frozen=True)
-class QuarterDamping(Damping):
-    id: ClassVar[str] = "quarter"
-    title: ClassVar[str] = "η δ^{1/4} δ̇ (TTIn; the engines' restitution dashpot on Hertz)"
-    exponent: ClassVar[float] = 0.25
-    eta: float = 0.0  # N·s/m^1.25
-
-
-# the damped records by their exponent (the one place an exponent names a record: NormalLaw.slots)
+# the seed's damped records by their exponent (the one place an exponent names a record: NormalLaw.slots)
 BY_EXPONENT = {cls.exponent: cls for cls in (ConstantDamping, SqrtDamping, QuarterDamping)}
+SEED_FAMILIES = frozenset(cls.family for cls in (NoDamping, *BY_EXPONENT.values()))
 
 
 def damping_of(eta: float, b: float) -> Damping:

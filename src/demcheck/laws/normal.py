@@ -23,7 +23,7 @@ from ..errors import ConfigError
 from . import analytic
 from .base import SubModel
 from .contact import Pair
-from .damping import Damping, NoDamping, damping_of
+from .damping import RECORDS, SEED_FAMILIES, Damping, NoDamping, damping_of
 from .registry import Registry, contact_number
 
 from .normal_laws.hls import FAMILY as HYSTERETIC  # the law array's family ids (laws/normal_laws/)
@@ -41,16 +41,25 @@ class NormalLaw:
     ku: float = 0.0  # > 0: constant unloading stiffness; 0: K_U = K_L + s·F_max
     s: float = 0.0
     limit: bool = False
+    # the damping law's family id (laws/damping_laws/): a seed dashpot's is the one its exponent names (damping_of),
+    # whatever is given; None where no record has the exponent (then array() raises, slots() too)
+    damping: int | None = None
+
+    def __post_init__(self):
+        if self.damping is None or self.damping in SEED_FAMILIES:
+            object.__setattr__(self, "damping", _seed_damping(self))
 
     def array(self) -> np.ndarray:
         """The law as the compiled kernels read it (kernels.L_FAMILY … L_LIMIT): the only positional form."""
-        return np.array([self.family, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s,
+        if self.damping is None:
+            self.slots()  # the ValueError naming the exponent no record has
+        return np.array([self.family, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s, self.damping,
                          1.0 if self.limit else 0.0])
 
     @classmethod
     def from_array(cls, law) -> "NormalLaw":
-        family, k, a, eta, b, kl, ku, s, limit = (float(x) for x in law)
-        return cls(int(family), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0)
+        family, k, a, eta, b, kl, ku, s, damping, limit = (float(x) for x in law)
+        return cls(int(family), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0, damping=int(damping))
 
     def loading_overlap(self, force: float) -> float:
         """The overlap at which the loading branch carries ``force`` at rest: (F/k)^{1/a}, or F/K_L for HLS."""
@@ -73,6 +82,8 @@ class NormalLaw:
             return HysteresisNormal(kl=self.kl, ku=self.ku, s=self.s), NoDamping()
         if self.a not in ELASTIC_BY_EXPONENT:
             raise ValueError(f"no normal record has the δ^{self.a:g} spring (known: hooke δ^1, hertz δ^1.5)")
+        if self.damping is not None and self.damping not in SEED_FAMILIES:
+            return ELASTIC_BY_EXPONENT[self.a](k=self.k), RECORDS[self.damping](eta=self.eta)
         return ELASTIC_BY_EXPONENT[self.a](k=self.k), damping_of(self.eta, self.b)
 
     @classmethod
@@ -83,7 +94,17 @@ class NormalLaw:
                 raise ValueError(f"the hysteretic normal law takes no dashpot (damping {damping.id!r})")
             return cls(HYSTERETIC, kl=normal.kl, ku=normal.ku, s=normal.s, limit=limit)
         return cls(VISCOELASTIC, k=normal.k, a=normal.exponent, eta=getattr(damping, "eta", 0.0),
-                   b=damping.exponent, limit=limit)
+                   b=damping.exponent, limit=limit, damping=damping.family)
+
+
+def _seed_damping(law: NormalLaw) -> int | None:
+    """The family of a seed law's dashpot: none for the hysteretic spring, else the record its (η, b) name."""
+    if law.family == HYSTERETIC:
+        return NoDamping.family
+    try:
+        return damping_of(law.eta, law.b).family
+    except ValueError:
+        return None
 
 
 # ----------------------------------------------------------------------------- the normal slot's records

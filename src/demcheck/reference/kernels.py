@@ -1,8 +1,8 @@
 """Compiled (numba, cached on disk) 1-D normal-impact integrators, adaptive and verlet, and many collisions at once.
 
-The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, limit]; its force is
-laws/normal_force.py's, and the solver asks its trait (``loads_and_unloads``: the hysteretic law's loading and
-unloading modes), never its family id.
+The law array is ``NormalLaw.array()``: [family, k, a, eta, b, kl, ku, s, damping, limit]; its force (the
+spring's plus the damping law's, and their rate) is laws/normal_force.py's, and the solver asks its trait
+(``loads_and_unloads``: the hysteretic law's loading and unloading modes), never its family id.
 
 State of the 1-D problem: δ (overlap, > 0 in contact) and r = δ̇ (approach rate); m̄ δ̈ = −F + m̄ a_n.
 """
@@ -15,8 +15,8 @@ import numpy as np
 from numba import njit
 
 from .. import KERNEL_CACHE
-from ..laws.normal_force import (L_A, L_B, L_ETA, L_K, L_KL, L_LIMIT, hls_unloading, loads_and_unloads, normal_force,
-                                 spow, viscoelastic_force)
+from ..laws.normal_force import (L_ETA, L_KL, L_LIMIT, hls_unloading, loads_and_unloads, normal_force,
+                                 viscoelastic_force, viscoelastic_force_rate)
 from ..metrics import stepped
 from .health import reading
 from .integrator import (H_MIN, H_START, LOCATE_ITERATIONS, THETA_TOL, crossed, ended_with_it, error, grow,
@@ -91,15 +91,7 @@ def _event_value(law, mode, event, d, r, dmax, m, an):
     if event == 2:
         return r
     if event == 3:  # dF/dt of the viscoelastic law
-        acc = _acc(law, mode, d, r, dmax, m, an)
-        ad = abs(d)
-        a, b = law[L_A], law[L_B]
-        dfd = law[L_K] * (r if a == 1.0 else a * ad ** (a - 1.0) * r)
-        if b == 0.0:
-            dfv = law[L_ETA] * acc
-        else:
-            dfv = law[L_ETA] * (b * ad ** (b - 1.0) * r * r + spow(d, b) * acc)
-        return dfd + dfv
+        return viscoelastic_force_rate(law, d, r, _acc(law, mode, d, r, dmax, m, an))
     return d - dmax  # event 4
 
 

@@ -1,5 +1,6 @@
-"""The normal law array's layout ``NormalLaw.array()`` — [family, k, a, eta, b, kl, ku, s, limit], the L_*
-columns — and the sign-preserving power the laws (and the tangential dashpots) use."""
+"""The normal law array's layout ``NormalLaw.array()`` — [family, k, a, eta, b, kl, ku, s, damping, limit], the
+L_* columns (``damping``: the damping law's family id, laws/damping_laws/) — and the sign-preserving power the
+laws (and the tangential dashpots) use."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from numba import njit
 
 from ... import KERNEL_CACHE
 
-L_FAMILY, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_LIMIT = range(9)
+L_FAMILY, L_K, L_A, L_ETA, L_B, L_KL, L_KU, L_S, L_DAMPING, L_LIMIT = range(10)
+# (limit stays the last column: the array's length is L_LIMIT + 1 where the packing loop and the warm-up use it)
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
