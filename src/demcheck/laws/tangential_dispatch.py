@@ -11,14 +11,7 @@ Once assembled the registry is closed: a law registered later raises (it would b
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import os
-import sys
-import tempfile
-from pathlib import Path
-
-from .. import KERNEL_CACHE
+from .generated import generated_module
 from .tangential_slot import _BUILT, KERNELS, T_FAMILY
 
 # the dispatch functions: name → (arguments, the default: a law function's (module, name), or the expression
@@ -85,45 +78,8 @@ def source(kernels=None) -> str:
     return "\n".join(lines + body) + "\n"
 
 
-def _write(text: str) -> Path | None:
-    """The module file of ``text`` in the kernel cache (written once, atomically), or None without a cache."""
-    if not KERNEL_CACHE or not os.environ.get("NUMBA_CACHE_DIR"):
-        return None
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    path = Path(os.environ["NUMBA_CACHE_DIR"]) / "generated" / f"tangential_dispatch_{digest}.py"
-    if path.exists() and path.read_text() == text:
-        return path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        # numba keys its cache by the file's (mtime, size): one fixed mtime, whichever process writes it
-        os.utime(tmp, (_STAMP, _STAMP))
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
-
-
-_STAMP = 1_000_000_000  # the generated file's mtime (2001-09-09): the same bytes, the same stamp
-
-
 def build():
     """The dispatch module of the registered laws (closing the registry)."""
     text = source()
     _BUILT.append(True)
-    name = "demcheck.laws._tangential_dispatch"
-    path = _write(text)
-    if path is None:
-        import types
-
-        module = types.ModuleType(name)
-        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # noqa: S102 - our own generated source
-    else:
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    sys.modules[name] = module
-    return module
+    return generated_module("demcheck.laws._tangential_dispatch", "tangential_dispatch", text)

@@ -6,15 +6,7 @@ cache it is compiled from the text. Once assembled the registry is closed."""
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
-import os
-import sys
-import tempfile
-import types
-from pathlib import Path
-
-from ... import KERNEL_CACHE
+from ..generated import generated_module
 from .common import _BUILT, KERNELS, L_DAMPING
 
 # the switch functions: name → (the Kernels field, arguments)
@@ -22,7 +14,6 @@ SIGNATURES = {"damping_force": ("force", "law, delta, rate"), "damping_rate": ("
 DOCS = {"damping_force": "The damping law's contribution to the normal force (N, + repulsive).",
         "damping_rate": "The time derivative of damping_force (acc: the overlap's acceleration)."}
 _INLINE = 'njit(inline="always")(getattr({0}, "py_func", {0}))'
-_STAMP = 1_000_000_000  # the file's mtime: the same bytes, the same stamp (numba keys its cache by it)
 
 
 def source(kernels=None) -> str:
@@ -42,37 +33,6 @@ def source(kernels=None) -> str:
             body += [f"    if family == {family}:", f"        return {alias}({args})"]
         body.append("    return math.nan  # no damping law of this id: the run is not finite, never a verdict")
     return "\n".join(lines + body) + "\n"
-
-
-def generated_module(name: str, stem: str, text: str):
-    """The module ``name`` of the generated source ``text``: written once (atomically) to
-    ``$NUMBA_CACHE_DIR/generated/<stem>_<hash of text>.py`` and imported from there, so that ``cache=True`` holds
-    for its functions; compiled from the text where there is no kernel cache. (What laws/tangential_dispatch.py
-    does for the tangential switch; one of the two could serve both.)"""
-    path = None
-    if KERNEL_CACHE and os.environ.get("NUMBA_CACHE_DIR"):
-        digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-        path = Path(os.environ["NUMBA_CACHE_DIR"]) / "generated" / f"{stem}_{digest}.py"
-        if not (path.exists() and path.read_text() == text):
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
-                try:
-                    fh.write(text)
-                    fh.close()
-                    os.utime(fh.name, (_STAMP, _STAMP))
-                    os.replace(fh.name, path)
-                finally:
-                    if os.path.exists(fh.name):
-                        os.unlink(fh.name)
-    if path is None:
-        module = types.ModuleType(name)
-        exec(compile(text, f"<{name}>", "exec"), module.__dict__)  # noqa: S102 - our own generated source
-    else:
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-    sys.modules[name] = module
-    return module
 
 
 def build():
