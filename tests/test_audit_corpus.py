@@ -370,7 +370,9 @@ def test_an_interrupt_during_an_audit_is_an_interrupt(tmp_path, monkeypatch):
     def stopped(*a, **k):
         raise EngineInterrupted("lammps was stopped by the interrupt")
 
-    monkeypatch.setattr(A, "collide", stopped)
+    from demcheck.engines import collide as engine_collide
+
+    monkeypatch.setattr(engine_collide, "collide", stopped)  # the engine's run, as Source.run reaches it
     with pytest.raises(EngineInterrupted):
         A.audit(_deck(tmp_path, TWO_BODY))
 
