@@ -70,8 +70,8 @@ def particle_young(e_star: float, nus: list, wall: bool) -> float:
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by class (named here by their ids): normal hertz with damping none | quarter, or hooke with none |
-    constant; tangential none."""
+    """The contact's slot records, by class (named here by their ids): normal hertz with damping none | quarter, or
+    hooke with none | constant; tangential none."""
     contact, pair = model.contact, model.pair
     normal, damp = contact.normal, contact.damping
     eta = getattr(damp, "eta", 0.0)

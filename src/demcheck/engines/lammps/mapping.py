@@ -20,8 +20,8 @@ from ..mapping import HUGE_MU, SLIDING_XT, mu_of
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant | sqrt | quarter,
-    tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
+    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant |
+    sqrt | quarter, tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
     contact = model.contact
     nat = Native("lammps", normal="", limit=model.limit_force)
     comments: list[str] = []

@@ -43,8 +43,8 @@ CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashp
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant (hooke) or none |
-    quarter (hertz), tangential none | viscous | spring."""
+    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant
+    (hooke) or none | quarter (hertz), tangential none | viscous | spring."""
     contact, pair = model.contact, model.pair
     normal, damp, tl = contact.normal, contact.damping, contact.tangential
     m, r = pair.m_eff, pair.r_eff
