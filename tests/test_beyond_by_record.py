@@ -173,3 +173,15 @@ def test_each_scenario_runs_the_laws_whose_records_name_it():
               "twist": ("sds", "marshall"), "pull_off": ("jkr", "dmt", "sjkr"), "adhesive_impact": ("jkr",),
               "conduction": ("radius", "area", "lens")}
     assert {s: scenario_laws(slot, s) for s, (slot, _) in SCENARIO_SLOTS.items()} == before
+
+
+def test_the_engines_collision_vocabularies_map_records_never_ids():
+    """engines/*/mapping.py (a seed model's slots → the engine's collision settings) recognise a record by its
+    class (``type(damp) is QuarterDamping``), never by its id (``damp.id == "quarter"``). The user's preset —
+    ``model.normal`` / ``model.tangential``, the seed model's name the case wrote — is the user's word, as a case's
+    keys are: LAMMPS writes LSD calibrated by restitution as its own ``coeff_restitution``."""
+    paths = sorted((SRC / "engines").glob("*/mapping.py"))
+    assert len(paths) >= 4
+    found = [hit for f in paths for hit in by_id(f.read_text(encoding="utf-8"), str(f.relative_to(ROOT)))
+             if "model.normal.id" not in hit and "model.tangential.id" not in hit]
+    assert not found, "\n".join(found)

@@ -132,3 +132,59 @@ def test_a_plugin_law_is_a_cases_law_in_the_scenarios_its_record_names(tmp_path)
     for name, row in out["engines"].items():
         assert row["fidelity"] == "none" and "type B" not in row["reason"] and "viscous" not in row["reason"], (name, row)
     assert all("fixed_torque" in out["engines"][e]["reason"] for e in ("lammps", "liggghts", "yade")), out["engines"]
+
+
+TWIST_TOY = '''
+"""A toy twisting law with Marshall's field names but another law: a fixed torque against the twist."""
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+from numba import njit
+
+from demcheck import KERNEL_CACHE
+from demcheck.laws.registry import Key, positive
+from demcheck.laws.twisting_laws.slot import KERNELS, TwistingSubModel
+
+
+@dataclass(frozen=True)
+class FixedTwisting(TwistingSubModel):
+    id: ClassVar[str] = "fixed_twist"
+    title: ClassVar[str] = "a twisting torque of fixed magnitude"
+    scenarios: ClassVar[tuple] = ("twist",)
+    keys: ClassVar[tuple] = (Key("kt", "torque magnitude (N·m)", "must be > 0", positive),
+                             Key("mu_t", "unused", default=0.0), Key("gamma_t", "unused", default=0.0))
+    formula: ClassVar[str] = "Mt = −kt sign(φ̇)"
+    source: ClassVar[str] = "tests/test_beyond_plugin.py"
+    example: ClassVar[dict] = {"kt": 1e-6}
+    kt: float = 0.0
+    mu_t: float = 0.0
+    gamma_t: float = 0.0
+
+
+@njit(cache=KERNEL_CACHE)
+def fixed_twist_twisting_force(c, w, n, fn_abs, a, dt, phi):
+    rate = w[0] * n[0] + w[1] * n[1] + w[2] * n[2]
+    return (-c[0] * math.copysign(1.0, rate) if rate != 0.0 else 0.0), phi
+
+
+KERNELS.register(FixedTwisting, fixed_twist_twisting_force)
+'''
+
+TWIST_MAP = r'''
+import json
+from demcheck.engines import scenario
+print(json.dumps(scenario.law_mappings("twisting", "fixed_twist")))
+'''
+
+
+def test_a_twisting_law_the_engines_do_not_know_is_refused_with_its_name(tmp_path):
+    """A plug-in twisting law naming the twist scenario, with Marshall's field names: every engine refuses it
+    with its own name — LAMMPS's writer took any non-sds twisting law for Marshall (an AttributeError, or an EXACT
+    `twisting marshall` of another law when the fields matched), Yade's refused it as Marshall."""
+    rows = with_plugin_law(tmp_path, "toy_twisting_law", TWIST_TOY, TWIST_MAP, timeout=900)
+    assert set(rows) >= {"lammps", "liggghts", "yade", "kratos"}
+    for name, row in rows.items():
+        assert row["fidelity"] == "none", (name, row)
+        assert "marshall takes kt" not in row["reason"] and "Marshall's stiffness" not in row["reason"], (name, row)
+    assert all("fixed_twist" in rows[e]["reason"] for e in ("lammps", "yade")), rows

@@ -117,7 +117,7 @@ _KERNEL_ATTRIBUTES = {"normal_law", "tangential_law", "family", "kt_sqrt", "a", 
 
 
 @pytest.mark.parametrize("path", sorted((SRC / "engines").glob("*/mapping.py")), ids=lambda p: p.parent.name)
-def test_engines_map_records_by_id_never_exponents_or_families(path):
+def test_engines_map_records_never_exponents_or_families(path):
     """Every function of an engine's vocabulary but its twin (settings → kernel laws) reads the contact's slot
     records: no kernel family constant, no exponent, no law array."""
     bad = []

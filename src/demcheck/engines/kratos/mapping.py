@@ -28,8 +28,9 @@ import math
 from ...reference import twins
 from ...laws.model import ResolvedModel
 from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping
-from ...laws.normal import HertzNormal, HookeNormal, NormalLaw
-from ...laws.tangential import TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw
+from ...laws.normal import HertzNormal, HookeNormal, HysteresisNormal, NormalLaw
+from ...laws.tangential import (TRUNC_SPRING, NoTangential, SpringTangential, SqrtSpringTangential,
+                               TangentialLaw)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused
 from ..mapping import mu_of
 
@@ -69,8 +70,8 @@ def particle_young(e_star: float, nus: list, wall: bool) -> float:
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by id: normal hertz with damping none | quarter, or hooke with none |
-    constant; tangential none."""
+    """The contact's slot records, by class (named here by their ids): normal hertz with damping none | quarter, or
+    hooke with none | constant; tangential none."""
     contact, pair = model.contact, model.pair
     normal, damp = contact.normal, contact.damping
     eta = getattr(damp, "eta", 0.0)
@@ -78,21 +79,21 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nid = model.normal.id
     reasons: list[str] = []
     fid = EXACT
-    if normal.id == "hls":
+    if type(normal) is HysteresisNormal:
         return refused("kratos", "Kratos DEM 10.4.4 has no linear hysteretic (HLS) discontinuum law")
-    if normal.id not in ("hooke", "hertz"):
+    if type(normal) not in (HookeNormal, HertzNormal):
         return refused("kratos", f"no Kratos DEM discontinuum law for the normal record '{normal.id}'")
     tl = contact.tangential
-    if tl.id != "none":
-        why = _no_friction_law(normal.id, tl)
+    if type(tl) is not NoTangential:
+        why = _no_friction_law(normal, tl)
         if why:
             return refused("kratos", why)
-    if normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "quarter")):
+    if type(normal) is HertzNormal and (eta == 0.0 or type(damp) in (NoDamping, QuarterDamping)):
         law = HERTZ
         young_eff = normal.k / (4.0 / 3.0 * math.sqrt(r))  # F = (4/3)E*√R̄ δ^3/2
         gamma = eta / (2.0 * math.sqrt(2.0 * m * young_eff * math.sqrt(r))) if eta > 0 else 0.0
         kn_note = f"E* = {young_eff:.10g} Pa (Kn = 2E*√(R̄δ), F = ⅔Knδ)"
-    elif normal.id == "hooke" and damp.id in ("none", "constant"):
+    elif type(normal) is HookeNormal and type(damp) in (NoDamping, ConstantDamping):
         law = LINEAR
         young_eff = normal.k / linear_kn(1.0, r, pair.wall)
         gamma = eta / (2.0 * math.sqrt(m * normal.k)) if eta > 0 else 0.0
@@ -113,7 +114,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                  comments=[f"{law}: {kn_note}",
                            f"DAMPING_GAMMA γ = {gamma:.17g} (the seed's η = 2γ√(m̄Kn)), set on the contact's "
                            "properties after Kratos' own e → γ"])
-    if tl.id == "none":
+    if type(tl) is NoTangential:
         nat.comments.append("STATIC_FRICTION = DYNAMIC_FRICTION = 0, no rolling friction, no global damping")
         return Mapping("kratos", fid, reasons, nat, keywords)
     n_reasons = len(reasons)
@@ -130,7 +131,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     nat.comments.append(f"Kt/Kn = 4G*/E* = 2(1 − ν)/(2 − ν) = {rho:.10g}: POISSON_RATIO ν = {nu:.17g} (E set for "
                         f"E*); STATIC_FRICTION = DYNAMIC_FRICTION = {mu:.10g}, FRICTION_DECAY = 0, no rolling "
                         "friction, no global damping")
-    reasons.append(FRICTION_REASON[tl.id == "sqrt_spring"].format(
+    reasons.append(FRICTION_REASON[type(tl) is SqrtSpringTangential].format(
         ratio=math.sqrt(rho), measured=MEASURED.get((model.tangential.id, tl.truncation), "not measured for this law")))
     keywords[reasons[-1]] = law
     return Mapping("kratos", APPROXIMATE, reasons, nat, keywords)
@@ -160,14 +161,14 @@ MEASURED = {
 }
 
 
-def _no_friction_law(normal_id: str, tl) -> str:
+def _no_friction_law(normal, tl) -> str:
     """Why Kratos' own tangential law cannot stand for the seed's ('' where it can): a spring Kt = ρKn beside
     its normal law (constant with Linear_viscous_Coulomb, √δ with Hertz_viscous_Coulomb), ρ = 4G*/E* =
     2(1 − ν)/(2 − ν) in (2/3, 4/3) for ν in (−1, 0.5), its dashpot √ρ times the normal one."""
-    family = {"hooke": "spring", "hertz": "sqrt_spring"}[normal_id]
-    if tl.id != family:
+    family = {HookeNormal: SpringTangential, HertzNormal: SqrtSpringTangential}[type(normal)]
+    if type(tl) is not family:
         return (f"Kratos' tangential force is part of its normal law (an incremental spring Kt = 4G*Kn/E*, "
-                f"{'constant' if normal_id == 'hooke' else '∝ √δ'} with this normal law, a dashpot 2γ√(m̄Kt), μ "
+                f"{'constant' if type(normal) is HookeNormal else '∝ √δ'} with this normal law, a dashpot 2γ√(m̄Kt), μ "
                 f"decaying with the slip speed); the seed's tangential record '{tl.id}' is not a spring of that form")
     return ""
 

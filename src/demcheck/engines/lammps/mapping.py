@@ -9,16 +9,19 @@ from dataclasses import replace
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.normal import HertzNormal, HookeNormal, NormalLaw
-from ...laws.tangential import TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, TangentialLaw
+from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping, SqrtDamping
+from ...laws.normal import HertzNormal, HookeNormal, HysteresisNormal, NormalLaw
+from ...laws.tangential import (TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, LthTangential, NoTangential, SlidingTangential,
+                                SpringTangential, SqrtSpringTangential, TangentialLaw, ViscousSlidingTangential,
+                                ViscousTangential, WaltonTangential, ZzyTangential)
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import HUGE_MU, SLIDING_XT, mu_of
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by id: normal hooke | hertz, damping none | constant | sqrt | quarter,
-    tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
+    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant |
+    sqrt | quarter, tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
     contact = model.contact
     nat = Native("lammps", normal="", limit=model.limit_force)
     comments: list[str] = []
@@ -35,15 +38,16 @@ def _map_normal(model: ResolvedModel, contact, cp: dict, nat: Native, comments: 
     normal, damp, pair = contact.normal, contact.damping, model.pair
     m, r = pair.m_eff, pair.r_eff
     eta = getattr(damp, "eta", 0.0)
-    if normal.id == "hls":
+    if type(normal) is HysteresisNormal:
         return refused("lammps", "LAMMPS 22Jul2025 has no linear hysteretic normal model (HLS)")
-    if normal.id not in ("hooke", "hertz"):
+    if type(normal) not in (HookeNormal, HertzNormal):
         return refused("lammps", f"no LAMMPS normal model for the normal record '{normal.id}'")
-    if normal.id == "hooke" and eta > 0.0 and damp.id not in ("none", "constant"):
+    if type(normal) is HookeNormal and eta > 0.0 and type(damp) not in (NoDamping, ConstantDamping):
         return refused("lammps", f"no LAMMPS normal model has the δ^{normal.exponent:g} spring with a "
                                   f"δ^{damp.exponent:g} dashpot")
-    if normal.id == "hooke":
+    if type(normal) is HookeNormal:
         nat.normal, nat.normal_args = "hooke", (normal.k,)
+        # the user's preset (not a slot record): LSD calibrated by restitution is LAMMPS's own coeff_restitution
         if model.normal.id == "lsd" and "eta_n" not in cp and pair.restitution is not None and eta > 0:
             nat.damping, nat.damping_coeff = "coeff_restitution", pair.restitution
             comments.append(f"hooke Kn = {normal.k:.10g} N/m; damping coeff_restitution e = {pair.restitution:g} "
@@ -57,12 +61,12 @@ def _map_normal(model: ResolvedModel, contact, cp: dict, nat: Native, comments: 
     comments.append(f"hertz k = (4/3)Ē = {k_hz_coef:.10g} Pa, so that F = k√R̄ δ^3/2")
     if eta == 0.0:
         nat.damping, nat.damping_coeff = "velocity", 0.0
-    elif damp.id == "sqrt":
+    elif type(damp) is SqrtDamping:
         eta0 = eta / (m * math.sqrt(r))
         nat.damping, nat.damping_coeff = "viscoelastic", eta0
         comments.append(f"damping viscoelastic η0 = ηn/(m̄√R̄) = {eta0:.10g} 1/(s·m), per pair "
                         f"(m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
-    elif damp.id == "quarter":
+    elif type(damp) is QuarterDamping:
         e_prime = twins.restitution_for_eta(eta / math.sqrt(m * normal.k), math.sqrt(5.0))
         if not (0.0 < e_prime < 1.0):
             return refused("lammps", f"TTIn's ηn = {eta:g} is at or above what coeff_restitution "
@@ -83,17 +87,17 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
     keywords: dict[str, str] = {}  # an approximate reason → the pair_coeff keyword it is about
     fid = EXACT
     nid, tid = model.normal.id, model.tangential.id
-    eta_n_const = damp.id == "constant" and eta > 0.0
-    if tl.id == "none":
+    eta_n_const = type(damp) is ConstantDamping and eta > 0.0
+    if type(tl) is NoTangential:
         nat.tangential, nat.tangential_args = "linear_nohistory", (0.0, 0.0)
-    elif tl.id in ("lth", "zzy", "walton"):
+    elif type(tl) in (LthTangential, ZzyTangential, WaltonTangential):
         return refused("lammps", f"LAMMPS 22Jul2025 has no {model.tangential.seed_name} law "
                                   "(nearest: mindlin_rescale/force, a different law)")
     else:
         mu, f_mu = mu_of(model, reasons)
         mu_reason = reasons[-1] if f_mu == APPROXIMATE else None
         fid = worst(fid, f_mu)
-        if tl.id == "sliding":
+        if type(tl) is SlidingTangential:
             if eta == 0.0:
                 return refused("lammps", "simple sliding friction needs linear_nohistory's dashpot, which "
                                           "is x_t × the normal damping, and this normal law has none")
@@ -102,24 +106,24 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
             reasons.append(f"simple sliding friction as linear_nohistory with x_t = {SLIDING_XT:g}: "
                            "min(x_t η(δ)|v_t|, μ|Fn|) is a regularised slider near v_t = 0")
             keywords[reasons[-1]] = "tangential linear_nohistory"
-        elif tl.id in ("viscous", "viscous_sliding"):
+        elif type(tl) in (ViscousTangential, ViscousSlidingTangential):
             if tl.eta_normal or not eta_n_const:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
                                           f"x_t η(δ)); normal '{nid}' damps with δ^{damp.exponent:g}"
                                           + (" and has no damping" if eta == 0 else ""))
             x_t = tl.eta / eta
-            if tl.id == "viscous" and model.limit_force:
+            if type(tl) is ViscousTangential and model.limit_force:
                 fid = worst(fid, APPROXIMATE)
                 reasons.append("with limit_damping the Coulomb cap μ|Fn| is 0 wherever the normal force is held "
                                "at 0, so the viscous force vanishes there too")
                 keywords[reasons[-1]] = "limit_damping"
             nat.tangential = "linear_nohistory"
-            nat.tangential_args = (x_t, HUGE_MU if tl.id == "viscous" else mu)
+            nat.tangential_args = (x_t, HUGE_MU if type(tl) is ViscousTangential else mu)
             comments.append(f"linear_nohistory x_t = ηt/ηn = {x_t:.10g}"
-                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if tl.id == "viscous" else ""))
-        elif tl.id in ("spring", "sqrt_spring"):
+                            + (f", μ = {HUGE_MU:g} (no Coulomb limit)" if type(tl) is ViscousTangential else ""))
+        elif type(tl) in (SpringTangential, SqrtSpringTangential):
             if tl.eta_normal:  # TTIt: ηt = ηn
-                if not (contact.normal.id == "hertz" and damp.id == "quarter"):
+                if not (type(contact.normal) is HertzNormal and type(damp) is QuarterDamping):
                     return refused("lammps", "TTIt's ηt = ηn needs TTIn's normal damping")
                 x_t = tl.eta
             elif tl.eta == 0.0:
@@ -129,7 +133,7 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
             else:
                 return refused("lammps", f"a constant ηt needs a constant normal damping (LAMMPS's ηt = "
                                           f"x_t η(δ)); normal '{nid}' damps with δ^{damp.exponent:g}")
-            if tl.id == "sqrt_spring":
+            if type(tl) is SqrtSpringTangential:
                 nat.tangential, nat.tangential_args = "mindlin", (tl.kt, x_t, mu)
                 comments.append(f"mindlin k_t = {tl.kt:.10g} Pa (Kt = k_t √(R̄δ)), x_t = {x_t:.10g}")
             else:

@@ -93,6 +93,9 @@ def _twisting(model, rec, nat: Native):
     if isinstance(rec, SdsTwisting):
         return (f"twisting sds {fmt(rec.k_tw)} {fmt(rec.gamma_tw)} {fmt(rec.mu_tw)}",
                 SdsTwisting(rec.k_tw, rec.gamma_tw, rec.mu_tw), EXACT, [])
+    if not isinstance(rec, MarshallTwisting):  # a law demcheck gained after this writer (a plug-in law)
+        return refused("lammps", f"LAMMPS 22Jul2025 has no twisting model like the twisting law {rec.id!r}: its "
+                                 "models are twisting sds and marshall")
     if nat.tangential != "linear_history":  # linear_nohistory takes (x_t, μ) only: no spring to build it from
         return refused("lammps", "LAMMPS twisting marshall takes kt, the damping and μ of the tangential model: "
                                  "the case's tangential spring must be the twisting law's (kt, μt, no damping)")

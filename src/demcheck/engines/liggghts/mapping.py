@@ -8,22 +8,23 @@ import math
 
 from ...reference import twins
 from ...laws.model import ResolvedModel
-from ...laws.damping import NoDamping
+from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping, SqrtDamping
 from ...laws.normal import HertzNormal, HookeNormal, HysteresisNormal, NormalLaw
-from ...laws.tangential import (TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, SpringTangential, SqrtSpringTangential,
-                                TangentialLaw, ViscousSlidingTangential)
+from ...laws.tangential import (TRUNC_CAP, TRUNC_MAW, TRUNC_SPRING, LthTangential, NoTangential, SlidingTangential,
+                                SpringTangential, SqrtSpringTangential, TangentialLaw, ViscousSlidingTangential,
+                                ViscousTangential, WaltonTangential, ZzyTangential)
 from ..damping import damping
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import HUGE_MU, SLIDING_XT, mu_of
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by id: normal hooke | hertz | hls, damping none | constant | sqrt | quarter,
-    tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
+    """The contact's slot records, by class (named here by their ids): normal hooke | hertz | hls, damping none |
+    constant | sqrt | quarter, tangential none | sliding | viscous | viscous_sliding | spring | sqrt_spring."""
     contact = model.contact
     nat = Native("liggghts", normal="", limit=model.limit_force)
     comments: list[str] = []
-    if contact.normal.id == "hls":
+    if type(contact.normal) is HysteresisNormal:
         return _hysteretic(model, nat, comments)
     refusal = _map_normal(model, contact, nat, comments)
     if refusal is not None:
@@ -44,7 +45,7 @@ def _hysteretic(model: ResolvedModel, nat: Native, comments: list[str]) -> Mappi
     comments.append(f"edinburgh (fixKc on, overlapExponent 1, no adhesion, coefficientRestitution 1): "
                     f"K_L = 2E*R̄ = {normal.kl:.10g} N/m through the types' Young's moduli, UnloadingStiffness = "
                     f"K_U/K_L = {normal.ku / normal.kl:.17g}")
-    if tl.id != "none":
+    if type(tl) is not NoTangential:
         return refused("liggghts", "edinburgh's tangential stiffness is 2E*√(R̄δ) with E* set for K_L; "
                                     "no seed tangential law shares it")
     nat.tangential = "off"
@@ -57,18 +58,18 @@ def _map_normal(model: ResolvedModel, contact, nat: Native, comments: list[str])
     normal, damp, pair, p = contact.normal, contact.damping, model.pair, nat.props
     m, r = pair.m_eff, pair.r_eff
     eta = getattr(damp, "eta", 0.0)
-    if normal.id == "hooke" and (eta == 0.0 or damp.id in ("none", "constant")):
+    if type(normal) is HookeNormal and (eta == 0.0 or type(damp) in (NoDamping, ConstantDamping)):
         nat.normal = "hooke/stiffness"
         p.update(kn=normal.k, gamman=eta / m, kt=0.0, gammat=0.0)
         comments.append(f"hooke/stiffness kn = {normal.k:.10g} N/m, gamman = ηn/m̄ = {eta / m:.10g} 1/s (per pair, "
                         f"m̄ = {m:.10g} kg)")
-    elif normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "sqrt")):
+    elif type(normal) is HertzNormal and (eta == 0.0 or type(damp) in (NoDamping, SqrtDamping)):
         nat.normal = "hertz/stiffness"
         gamman = eta / (m * math.sqrt(r))
         p.update(kn=normal.k / math.sqrt(r), gamman=gamman, kt=0.0, gammat=0.0)
         comments.append(f"hertz/stiffness kn = (4/3)Ē = {normal.k / math.sqrt(r):.10g} Pa, gamman = ηn/(m̄√R̄) = "
                         f"{gamman:.10g} (per pair, m̄ = {m:.10g} kg, R̄ = {r:.10g} m)")
-    elif normal.id == "hertz" and damp.id == "quarter":
+    elif type(normal) is HertzNormal and type(damp) is QuarterDamping:
         nat.normal = "hertz"
         e_prime = twins.restitution_for_eta(eta / math.sqrt(m * normal.k), math.sqrt(5.0))
         if not (0.05 < e_prime <= 1.0):
@@ -94,9 +95,9 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
     fid = EXACT
     nid, tid = model.normal.id, model.tangential.id
     stiff = nat.normal == "hooke/stiffness"
-    if tl.id == "none":
+    if type(tl) is NoTangential:
         nat.tangential = "off"
-    elif tl.id in ("lth", "zzy", "walton"):
+    elif type(tl) in (LthTangential, ZzyTangential, WaltonTangential):
         return refused("liggghts", f"LIGGGHTS 3.8.0 has no {model.tangential.seed_name} law")
     else:
         mu, f_mu = mu_of(model, reasons)
@@ -104,12 +105,12 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
             keywords[reasons[-1]] = "coefficientFriction"
         fid = worst(fid, f_mu)
         p["friction"] = mu
-        if tl.id in ("sliding", "viscous", "viscous_sliding"):
+        if type(tl) in (SlidingTangential, ViscousTangential, ViscousSlidingTangential):
             if not stiff:
                 return refused("liggghts", f"no_history's dashpot follows the model's δ-law; a constant ηt "
                                             f"needs hooke/stiffness, i.e. normal 'lsd' (not '{nid}')")
             nat.tangential = "no_history"
-            if tl.id == "sliding":
+            if type(tl) is SlidingTangential:
                 p["gammat"] = SLIDING_XT * max(eta, 1.0) / m
                 fid = worst(fid, APPROXIMATE)
                 reasons.append(f"simple sliding friction as no_history with gammat = {p['gammat']:.4g} 1/s: a "
@@ -117,7 +118,7 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
                 keywords[reasons[-1]] = "tangential no_history"
             else:
                 p["gammat"] = tl.eta / m
-                if tl.id == "viscous":
+                if type(tl) is ViscousTangential:
                     p["friction"] = HUGE_MU
                     if model.limit_force:
                         fid = worst(fid, APPROXIMATE)
@@ -125,9 +126,9 @@ def _map_tangential(model: ResolvedModel, contact, nat: Native, comments: list[s
                                        "held at 0, so the viscous force vanishes there too")
                         keywords[reasons[-1]] = "limitForce on"
                 comments.append(f"no_history gammat = ηt/m̄ = {p['gammat']:.10g} 1/s"
-                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if tl.id == "viscous"
+                                + (f", coefficientFriction = {HUGE_MU:g} (no Coulomb limit)" if type(tl) is ViscousTangential
                                    else ""))
-        elif tl.id in ("spring", "sqrt_spring"):
+        elif type(tl) in (SpringTangential, SqrtSpringTangential):
             spring = _map_spring(model, contact, nat, comments, reasons, keywords)
             if isinstance(spring, Mapping):
                 return spring
@@ -149,14 +150,14 @@ def _map_spring(model: ResolvedModel, contact, nat: Native, comments: list[str],
     nat.tangential = "history"
     if tl.eta_normal and eta > 0.0:  # TTIt on the hertz model: same Kt, γt = γn √(4G*/E*), dashpot
         # outside the cap (undamped, ηt = ηn = 0, it is DDt's case below on hertz/stiffness)
-        if not (contact.normal.id == "hertz" and damp.id == "quarter"):
+        if not (type(contact.normal) is HertzNormal and type(damp) is QuarterDamping):
             return refused("liggghts", "TTIt's ηt = ηn needs TTIn's normal damping")
         fid = APPROXIMATE
         ratio = math.sqrt(4.0 * pair.g_eff / pair.e_eff)
         reasons.append(f"hertz + history: Kt = 8G*√(R̄δ) as TTIt, but ηt = {ratio:.4f} ηn (√(4G*/E*)) and "
                        "the dashpot lies outside the Coulomb cap (spring-only truncation)")
         keywords[reasons[-1]] = "model hertz tangential history"
-    elif tl.id == "sqrt_spring":  # DDt on hertz/stiffness
+    elif type(tl) is SqrtSpringTangential:  # DDt on hertz/stiffness
         if nat.normal != "hertz/stiffness":
             return refused("liggghts", "Kt ∝ √δ (DDt) needs hertz/stiffness, whose normal law is "
                                         f"Hertz-type; normal '{nid}' is not")
@@ -204,7 +205,7 @@ def _luding(model: ResolvedModel, nat: Native) -> Mapping:
     exactly when (r − 1)/δ_lim = S. r is free: δ_lim is chosen above the largest overlap the impact can reach
     (and r ≥ 2, so that k2Max − k1 = (r − 1)k1 loses no digits), and phiF follows."""
     normal, tl, pair = model.contact.normal, model.contact.tangential, model.pair
-    if tl.id != "none":
+    if type(tl) is not NoTangential:
         return refused("liggghts", "luding's tangential stiffness is its loading stiffness (kt = kn); no seed "
                                     "tangential law shares it")
     kl, s, r_eff, m = normal.kl, normal.s, pair.r_eff, pair.m_eff

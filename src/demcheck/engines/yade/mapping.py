@@ -26,7 +26,7 @@ from ...reference import twins
 from ...laws.model import ResolvedModel
 from ...laws.damping import ConstantDamping, NoDamping, QuarterDamping
 from ...laws.normal import HertzNormal, HookeNormal, HysteresisNormal, NormalLaw
-from ...laws.tangential import (TRUNC_SPRING, SpringTangential, SqrtSpringTangential, TangentialLaw,
+from ...laws.tangential import (TRUNC_SPRING, NoTangential, SpringTangential, SqrtSpringTangential, TangentialLaw,
                                 ViscousTangential)
 from ..base import APPROXIMATE, EXACT, Mapping, Native, refused, worst
 from ..mapping import mu_of
@@ -43,8 +43,8 @@ CLAMP = ("Yade's {law} holds the total normal force at ≥ 0 (it drops the dashp
 
 
 def map_model(model: ResolvedModel, cp: dict) -> Mapping:
-    """The contact's slot records, by id: normal hooke | hertz, damping none | constant (hooke) or none |
-    quarter (hertz), tangential none | viscous | spring."""
+    """The contact's slot records, by class (named here by their ids): normal hooke | hertz, damping none | constant
+    (hooke) or none | quarter (hertz), tangential none | viscous | spring."""
     contact, pair = model.contact, model.pair
     normal, damp, tl = contact.normal, contact.damping, contact.tangential
     m, r = pair.m_eff, pair.r_eff
@@ -53,21 +53,21 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     keywords: dict[str, str] = {}  # an approximate reason → the Yade class or attribute it is about
     comments: list[str] = []
     fid = EXACT
-    if normal.id == "hls":
+    if type(normal) is HysteresisNormal:
         return _luding(model)
-    if normal.id == "hooke" and (eta == 0.0 or damp.id in ("none", "constant")):
+    if type(normal) is HookeNormal and (eta == 0.0 or type(damp) in (NoDamping, ConstantDamping)):
         nat = Native("yade", normal=VISCEL, limit=True)
         nat.props.update(kn=normal.k, cn=eta, ks=0.0, cs=0.0, mu=0.0)
         comments.append(f"ViscElMat kn, cn given directly: the pair's kn = {normal.k:.10g} N/m, cn = {eta:.10g} "
                         "kg/s (each material carries twice: Yade combines them in series)")
-    elif normal.id == "hertz" and (eta == 0.0 or damp.id in ("none", "quarter")):
+    elif type(normal) is HertzNormal and (eta == 0.0 or type(damp) in (NoDamping, QuarterDamping)):
         nat = Native("yade", normal=MINDLIN, limit=eta > 0.0 or model.limit_force)
         # cn = 2 betan √(m̄ · 3/2 kno) δ^¼ = η δ^¼
         betan = eta / (2.0 * math.sqrt(1.5 * m * normal.k)) if eta > 0.0 else 0.0
         nat.props.update(kno=normal.k, betan=betan, betas=0.0, kso=0.0, mu=0.0, r_eff=r)
         comments.append(f"MindlinPhys kno = (4/3)E*√R̄ = {normal.k:.10g} N/m^1.5 (Young's modulus set for Yade's "
                         f"R̄_Y), betan = {betan:.17g}")
-    elif normal.id == "hertz":
+    elif type(normal) is HertzNormal:
         return refused("yade", f"Yade's Hertz–Mindlin dashpots grow as δ^¼ (alpha from en, or betan); the "
                                f"normal law '{model.normal.id}' damps as δ^{damp.exponent:g}")
     else:
@@ -77,7 +77,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
         reasons.append(CLAMP.format(law=nat.normal))
         keywords[reasons[-1]] = LAW2[nat.normal]
     p = nat.props
-    if tl.id == "none":
+    if type(tl) is NoTangential:
         nat.tangential = "none"
     else:
         mu, f_mu = mu_of(model, reasons)
@@ -85,12 +85,12 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
             keywords[reasons[-1]] = "frictionAngle"
         fid = worst(fid, f_mu)
         p["mu"] = mu
-        if nat.normal == VISCEL and tl.id == "viscous":
+        if nat.normal == VISCEL and type(tl) is ViscousTangential:
             # ks = 0: the elastic part stays 0, never above μ|Fn|, so cs v_t is added uncapped
             nat.tangential = "viscous"
             p["cs"] = tl.eta
             comments.append(f"ViscElMat ks = 0, cs = {tl.eta:.10g} kg/s: Ft = cs v_t, never capped")
-        elif nat.normal == VISCEL and tl.id == "spring" and not tl.eta_normal:
+        elif nat.normal == VISCEL and type(tl) is SpringTangential and not tl.eta_normal:
             nat.tangential = "spring"
             p["ks"], p["cs"] = tl.kt, tl.eta
             comments.append(f"ViscElMat ks = {tl.kt:.10g} N/m, cs = {tl.eta:.10g} kg/s, frictionAngle = atan μ")
@@ -104,7 +104,7 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
                            "contact point on the wall's plane), and it turns the history with ScGeom's first-order "
                            "rotation")
             keywords[reasons[-1]] = "ScGeom (Ig2_Wall_Sphere_ScGeom, Ig2_Sphere_Sphere_ScGeom)"
-        elif nat.normal == MINDLIN and tl.id == "sqrt_spring":
+        elif nat.normal == MINDLIN and type(tl) is SqrtSpringTangential:
             why = _mindlin_shear(model, tl, nat, eta, comments)
             if why:
                 return refused("yade", why)
@@ -175,7 +175,7 @@ def _luding(model: ResolvedModel) -> Mapping:
     law = contact.normal
     if pair.wall:
         return refused("yade", LUDING_WALL)
-    if contact.tangential.id != "none":
+    if type(contact.tangential) is not NoTangential:
         return refused("yade", f"Yade's Luding law is mapped for HLS without friction; the case's tangential law "
                                f"is '{model.tangential.id}'")
     m, r, v = pair.m_eff, pair.r_eff, pair.impact_speed
