@@ -36,6 +36,11 @@ nothing concurrent, meaningful under load; two threads — meaningful on an idle
 
     .venv/bin/python benchmarks/bench_packing_phases.py 0.02 32000,128000 2 > benchmarks/results/bench_packing_phases_idle.txt
 
+The engine's own breakdown of the same case on one rank (its log's Pair / Neigh / Other lines, per step), which
+the one-core goal's limit is read against:
+
+    .venv/bin/python benchmarks/bench_packing_phases.py --engine N DURATION [liggghts|lammps] >> …
+
 The two-thread speed-up alone, idle: bench_packing_scale.py --threads 0.02 32000,128000 3. The force cut's
 weights (packing.py's ROW_COST …) from a fit of the force loop's CPU time by parts, on one thread:
 
@@ -235,8 +240,52 @@ def main(duration: float, sizes: list[int], rounds: int, configs: list[str]) -> 
     print(f"\nload average at the end: {BP._load()}")
 
 
+ENGINE_PHASES = ("Pair", "Neigh", "Comm", "Modify", "Outpt", "Other")
+
+
+def engine(n: int, duration: float, name: str = "liggghts") -> None:
+    """The engine's own timing breakdown of the same scaled case on one rank (its log's "Loop time" and
+    "<phase> time (%)" lines, and its neighbour-list builds), per step, beside which the reference's phases above
+    are read: what the one-core goal's limit is measured against (bench_packing_scale.py's engine run, its work
+    directory kept until its log is read)."""
+    import re
+    import shutil
+
+    from demcheck.engines.packing import run_engine
+
+    case = BS.scaled_case(n, duration)
+    steps = round(duration / P.packing_dt(case))
+    work = Path(tempfile.mkdtemp(prefix="phases-engine-"))
+    try:
+        t = time.perf_counter()
+        run_engine(case, name, mpi=1, workdir=work)
+        wall = time.perf_counter() - t
+        log = (work / "log.txt").read_text(errors="replace")
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    loop = re.search(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms", log)
+    if loop is None:
+        print(f"{n:7d}  {name}: no 'Loop time' line in its log (load {os.getloadavg()[0]:.2f})")
+        return
+    seconds, nsteps = float(loop.group(1)), int(loop.group(3))
+    builds = re.search(r"Neighbor list builds = (\d+)", log)
+    print(f"\n{name} on 1 rank, the same case (N = {n}, {duration} s of the pour, {nsteps} steps; the reference's "
+          f"{steps}): loop {seconds:.2f} s, {wall:.2f} s of wall in all, "
+          f"{builds.group(1) if builds else '?'} neighbour-list builds; load {os.getloadavg()[0]:.2f}")
+    print(f"  {'phase':8s} {'s':>9s} {'%':>6s} {'us a step':>10s}")
+    for phase in ENGINE_PHASES:
+        m = re.search(rf"^{phase}\s+time \(%\) = (\S+) \((\S+)\)", log, re.M)
+        if m:
+            print(f"  {phase:8s} {float(m.group(1)):9.3f} {float(m.group(2)):6.1f} "
+                  f"{1e6 * float(m.group(1)) / nsteps:10.1f}")
+    print(f"  the one-core goal (the reference >= 1.5 x this loop): the reference's whole step must be <= "
+          f"{1e6 * seconds / nsteps / 1.5:.1f} us")
+
+
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--child"]:
+    if sys.argv[1:2] == ["--engine"]:  # --engine N DURATION [NAME]
+        engine(int(sys.argv[2]), float(sys.argv[3]), sys.argv[4] if len(sys.argv) > 4 else "liggghts")
+    elif sys.argv[1:2] == ["--child"]:
         child(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
     elif sys.argv[1:2] == ["--fit"]:  # --fit N DURATION
         fit(int(sys.argv[2]), float(sys.argv[3]))

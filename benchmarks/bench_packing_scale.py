@@ -30,6 +30,8 @@ argument; the default is printed in the header).
 
 Run: .venv/bin/python benchmarks/bench_packing_scale.py [DURATION [N,N…]] > benchmarks/results/bench_packing_scale.txt
 (the sizes default to all four)
+The memory order alone (the case's order against sorted once by linked cells, one thread, alternating, medians):
+     .venv/bin/python benchmarks/bench_packing_scale.py --order DURATION N[,N…] ROUNDS
 The two-thread goal alone (the reference on 1 and 2 threads, alternating, ROUNDS each, medians):
      .venv/bin/python benchmarks/bench_packing_scale.py --threads DURATION 32000,128000 ROUNDS
 """
@@ -253,8 +255,63 @@ def threads(duration: float, sizes: list[int], rounds: int) -> None:
     print(f"load average at the end: {BP._load()}")
 
 
+def sorted_case(case):
+    """The case with its particles in the engines' memory order (LAMMPS's ``atom_modify sort``: by linked cells —
+    slabs along x, in each slab rows up z, each row along y — of side 2 R_max + the reference's skin, 0.3 R_max):
+    the same spheres, the same physics, only their order, so a sphere's neighbours sit near it in memory (the case's
+    own order is the pour's lattice layer by layer: the spheres below and above a sphere are a layer away). Sorted
+    once, at the start: the pour's spheres fall mostly straight down, so their columns stay together."""
+    from dataclasses import replace
+
+    cell = 2.3 * max(p.radius for p in case.particles)
+    key = [(math.floor(p.position[0] / cell), math.floor(p.position[2] / cell), p.position[1]) for p in case.particles]
+    order = sorted(range(len(key)), key=key.__getitem__)
+    return replace(case, particles=tuple(case.particles[i] for i in order))
+
+
+def order(duration: float, sizes: list[int], rounds: int) -> None:
+    """The memory order alone (issue 33 item 2: the engines sort their atoms spatially): the reference on one
+    thread, the case's order against the same case sorted once by linked cells (:func:`sorted_case`), alternating,
+    ``rounds`` times each, each run a fresh process; medians, wall and CPU, and the packing's metrics (the same
+    packing in its statistics: the order changes a pour's last bits, as threads do)."""
+    import numba
+
+    print(f"the reference on 1 thread, the case's particle order against sorted by linked cells: the poured packing, "
+          f"{duration:g} s of the pour, N = {', '.join(map(str, sizes))}, {rounds} rounds; "
+          f"{datetime.now(timezone.utc):%d %b %Y %H:%M} UTC, git {BP._head()}; {os.cpu_count()} cores, numba "
+          f"{numba.__version__}")
+    print(f"load average (1, 5, 15 min) at the start: {BP._load()}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for n, path in pickled_cases(tmp, sizes, duration):
+            with open(path, "rb") as fh:
+                case = pickle.load(fh)
+            sorted_path = Path(tmp) / f"case-{n}-sorted.pickle"
+            with open(sorted_path, "wb") as fh:
+                pickle.dump(sorted_case(case), fh)
+            runs = {"case order": [], "sorted": []}
+            for k in range(rounds):
+                for label in (("case order", "sorted") if k % 2 == 0 else ("sorted", "case order")):
+                    r = _one(path if label == "case order" else sorted_path, "reference", 1)
+                    if "error" in r:
+                        print(f"{n:7d}  {label}: failed: {r['error']}")
+                        continue
+                    runs[label].append(r)
+                    print(f"{n:7d}  {label:10s} {r['wall']:8.2f} s wall {r['cpu']:8.2f} s cpu  solid fraction "
+                          f"{r['solid_fraction']:.4f}, coordination {r['coordination']:.2f}  load "
+                          f"{os.getloadavg()[0]:.2f}", flush=True)
+            if runs["case order"] and runs["sorted"]:
+                a = {m: float(np.median([r[m] for r in runs["case order"]])) for m in ("wall", "cpu")}
+                b = {m: float(np.median([r[m] for r in runs["sorted"]])) for m in ("wall", "cpu")}
+                print(f"N = {n:7d}: median case order {a['wall']:.2f} s wall / {a['cpu']:.2f} s cpu, sorted "
+                      f"{b['wall']:.2f} / {b['cpu']:.2f}: sorted at {a['wall'] / b['wall']:.2f} x (wall), "
+                      f"{a['cpu'] / b['cpu']:.2f} x (CPU)")
+    print(f"load average at the end: {BP._load()}")
+
+
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--child"]:
+    if sys.argv[1:2] == ["--order"]:  # --order DURATION N[,N…] ROUNDS
+        order(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]))
+    elif sys.argv[1:2] == ["--child"]:
         child(sys.argv[2], sys.argv[3], int(sys.argv[4]))
     elif sys.argv[1:2] == ["--threads"]:  # --threads DURATION N[,N…] ROUNDS
         threads(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]))
