@@ -541,7 +541,7 @@ def by_name(name: str | None) -> list[Benchmark]:
     from ..errors import ConfigError
 
     if name is None:
-        return [b for b in BENCHMARKS if not b.opt_in]
+        return [b for b in BENCHMARKS + HEAPS if not b.opt_in]
     hits = [b for b in BENCHMARKS + HEAPS if b.name == name]
     if not hits:
         raise ConfigError("NAME", name, f"must be one of {', '.join(b.name for b in BENCHMARKS + HEAPS)}")
