@@ -59,7 +59,7 @@ def test_both_are_rolling_laws_a_case_names_with_their_keys():
 
 
 def test_model_b_on_a_wall_is_mu_r_rr_r_fn_times_the_rolling_spin():
-    """M = −μr Rr |Fn| |Vω| ŵt with Vω = R ω × n: −μr Rr R |Fn| w_t (the twist about n has no Vω and no torque)."""
+    """M = −μr Rr |Fn| |Vω| ŵt with Vω = R ω × n: −μr Rr R |Fn| w_t (the twist about n has no Vω, no torque)."""
     rec = AiViscousRolling(mu_r=0.3, r_roll=2e-3, r0=5e-3)
     w = np.array([3.0, -4.0, 7.0])  # rolling part (3, −4, 0), twist 7 about n = −z
     m, h = rolling_torque(rec, w, DOWN, 2.5, 1e-6)
@@ -70,8 +70,8 @@ def test_model_b_on_a_wall_is_mu_r_rr_r_fn_times_the_rolling_spin():
 
 
 def test_model_b_between_two_spheres_lethe_s_reading():
-    """Lethe's Vω = (R0ω0 + R1ω1) × n: none when equal spheres roll on each other (ω0 = −ω1), 2Rω when they turn
-    alike — and the direction from ω0 − ω1, so no torque at all there (ω0 − ω1 = 0)."""
+    """Lethe's Vω = (R0ω0 + R1ω1) × n: none when equal spheres roll on each other (ω0 = −ω1), 2Rω when they
+    turn alike — and the direction from ω0 − ω1, so no torque at all there (ω0 − ω1 = 0)."""
     c = AiViscousRolling(mu_r=0.3, r_roll=1e-3, r0=2e-3).array()
     n = np.array([1.0, 0.0, 0.0])
     w = np.array([0.0, 0.0, 10.0])

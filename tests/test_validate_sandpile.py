@@ -181,7 +181,11 @@ def test_a_missing_case_file_is_refused_with_the_catalogue_key(tmp_path):
                                                    (0.5, v.MISSES, 0),  # a finite run off the curve: a finding
                                                    (math.nan, v.MISSES, 1)])  # a run not finite: a failure
 def test_validate_run_of_a_heap_benchmark_alone_writes_its_report(monkeypatch, tmp_path, scale, verdict, failed):
-    _stand_in(monkeypatch, tmp_path / "cases", lambda case: (curve(bench(case))[:, 0], scale * curve(bench(case))[:, 1]))
+    def height_curve(case):
+        pts = curve(bench(case))
+        return pts[:, 0], scale * pts[:, 1]
+
+    _stand_in(monkeypatch, tmp_path / "cases", height_curve)
     summary = v.run("ai2011-sandpile-epsd", tmp_path / "cases", tmp_path / "reports", opts=None, quiet=True,
                     argv=["demcheck", "validate", "ai2011-sandpile-epsd"])
     assert summary.failed == failed

@@ -494,7 +494,8 @@ def _heap_benchmark(b: dict, notes: dict, data: Path, where: str) -> Benchmark:
         if key not in b:
             raise ConfigError(f"{where}.{key}", None, f"a {HEAP} benchmark names its {key}")
     case = b["case"]
-    if not isinstance(case, str) or not case or case.startswith("/") or ".." in case.split("/") or case.endswith(".toml"):
+    if (not isinstance(case, str) or not case or case.startswith("/") or ".." in case.split("/")
+            or case.endswith(".toml")):
         raise ConfigError(f"{where}.case", case, "must be a case file's path under the shipped cases/, without .toml")
     if len(b["curves"]) != 1 or b["curves"][0].get("quantity") != HEAP_QUANTITY:
         raise ConfigError(f"{where}.curves", b["curves"], f"a {HEAP} benchmark has one curve of {HEAP_QUANTITY}")
