@@ -46,7 +46,8 @@ def test_both_are_rolling_laws_a_case_names_with_their_keys():
     rec, _ = _record("ai_epsd", {"mu_r": 0.1, "k_n": 1e6})
     assert isinstance(rec, AiEpsdRolling) and (rec.k_ratio, rec.eta_r, rec.f) == (2.25, 0.0, 0.0)
     for bad, key in (({"mu_r": 0.1, "k_n": 1e6, "f": 1.5}, "contact.f"), ({"mu_r": 0.1}, "contact.k_n"),
-                     ({"mu_r": 0.1, "k_n": 1e6, "k_ratio": 0.0}, "contact.k_ratio")):
+                     ({"mu_r": 0.1, "k_n": 1e6, "k_ratio": 0.0}, "contact.k_ratio"),
+                     ({"mu_r": 0.1, "k_n": 1e6, "eta_r": 0.3}, "contact.i_r")):
         with pytest.raises(ConfigError) as exc:
             _record("ai_epsd", bad)
         assert exc.value.key == key

@@ -60,6 +60,12 @@ class AiEpsdRolling(RollingSubModel):
     i_r: float = 0.0  # kg·m²
     f: float = 0.0
 
+    def __post_init__(self):
+        if self.eta_r > 0.0 and not self.i_r > 0.0:  # a dashpot needs its inertia: never a silent Cr = 0
+            from ...errors import ConfigError
+
+            raise ConfigError("contact.i_r", self.i_r, "must be > 0 with eta_r > 0 (Cr = ηr·2√(Ir kr))")
+
     @property
     def k_r(self) -> float:
         """kr = ε kn μr² Rr² (N·m/rad)."""
