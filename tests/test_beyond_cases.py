@@ -83,7 +83,8 @@ def test_collide_prints_the_scenario_metrics():
 
 
 @pytest.mark.parametrize("overrides, key, rule", [
-    (["contact.rolling=foo"], "contact.rolling", "must be one of none, constant_torque, epsd, viscous"),
+    (["contact.rolling=foo"], "contact.rolling",
+     "must be one of none, ai_epsd, ai_viscous, constant_torque, epsd, viscous"),
     (["contact.mu_r=-1"], "contact.mu_r", "must be >= 0"),
     (["contact.mu_r=true"], "contact.mu_r", "must be a finite number"),
     (["contact.full_direction=1"], "contact.full_direction", "must be true or false"),

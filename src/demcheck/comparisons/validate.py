@@ -20,6 +20,14 @@ against two independent kinds of expected values:
 A source that misses a published curve is a finding (the report says which models meet the paper); the
 reference missing an exact limit, or a run that failed, fails the command (exit 1) — except a miss that is the
 law's own (a force pushing along the slip at contact onset where the law does so by design: reported, not failed).
+
+Heap benchmarks (``kind = "heap"`` in the catalogue: Ai, Chen, Rotter & Ooi 2011's 2D sandpile, one per rolling
+model) are bulk runs, not collisions: one case file of cases/optin/ each, run by the reference's sandpile solver
+(``demcheck.reference.sandpile.height_curve(case) → (times, heights)``), judged by the heap height's largest
+relative deviation from the paper's digitised curve over the curve's time range (:func:`judge_heap`). They are
+opt-in (``opt_in``): never in ``validate --quick`` nor in a run that names no benchmark — a run is ~7.4e9
+particle-steps —, only when named. A run that failed, is not finite, or does not span the curve's time range fails
+the command; a finite run off the curve is a finding, as for the collisions' curves.
 """
 
 from __future__ import annotations
@@ -428,6 +436,9 @@ class Benchmark:
     limits: tuple[Limit, ...] = ()
     final_spin: bool = False  # needs particle 0's final spin (Test 7): read from each source's own Result
     quick: str = ""  # the case file (its stem) of the quick subset (validate's quick run): one per benchmark
+    kind: str = "collision"  # or "heap": a bulk run judged by judge_heap (HEAP)
+    case: str = ""  # a heap benchmark's case file, relative to the shipped cases/ without .toml (optin/…)
+    opt_in: bool = False  # run only when named: not in --quick, not in a run that names no benchmark
 
 
 CATALOGUE = resources.data_dir() / "benchmarks.toml"
@@ -447,6 +458,9 @@ def catalogue(path: Path = CATALOGUE, data: Path = DATA, cases: Path | None = No
     out = []
     for i, b in enumerate(raw.get("benchmark", [])):
         where = f"{path.name}: benchmark.{i}"
+        if b.get("kind", "collision") != "collision":
+            out.append(_heap_benchmark(b, notes, data, where))
+            continue
         try:
             limits = tuple(LIMITS[n] for n in b.get("limits", ()))
             curves = tuple(_curve(c, notes, data, f"{where}.curves.{k}") for k, c in enumerate(b.get("curves", ())))
@@ -463,6 +477,42 @@ def catalogue(path: Path = CATALOGUE, data: Path = DATA, cases: Path | None = No
     return tuple(out)
 
 
+HEAP = "heap"
+HEAP_QUANTITY = "heap_height"  # the height of the heap (m) against time (s)
+QUANTITIES_HEAP = {HEAP_QUANTITY: ("heap height (m)", "time (s)")}
+
+
+def _heap_benchmark(b: dict, notes: dict, data: Path, where: str) -> Benchmark:
+    """A heap benchmark of the catalogue, checked: kind "heap", its case a path under the shipped cases/ (checked
+    when it runs: :func:`heap_case_path`), exactly one curve of quantity heap_height, its file in ``data`` and its
+    tolerance a relative deviation in (0, 1)."""
+    from ..errors import ConfigError
+
+    if b.get("kind") != HEAP:
+        raise ConfigError(f"{where}.kind", b.get("kind"), f"must be collision or {HEAP}")
+    for key in ("name", "title", "case", "curves"):
+        if key not in b:
+            raise ConfigError(f"{where}.{key}", None, f"a {HEAP} benchmark names its {key}")
+    case = b["case"]
+    if (not isinstance(case, str) or not case or case.startswith("/") or ".." in case.split("/")
+            or case.endswith(".toml")):
+        raise ConfigError(f"{where}.case", case, "must be a case file's path under the shipped cases/, without .toml")
+    if len(b["curves"]) != 1 or b["curves"][0].get("quantity") != HEAP_QUANTITY:
+        raise ConfigError(f"{where}.curves", b["curves"], f"a {HEAP} benchmark has one curve of {HEAP_QUANTITY}")
+    cur = _curve(b["curves"][0], notes, data, f"{where}.curves.0")
+    if not cur.tolerance < 1.0:
+        raise ConfigError(f"{where}.curves.0.tolerance", cur.tolerance, "must be < 1 (a relative deviation)")
+    blocks = {ln.split(":", 1)[1].strip() for ln in (data / cur.file).read_text().splitlines()
+              if ln.strip().startswith("# block:")}
+    if cur.key not in blocks:
+        raise ConfigError(f"{where}.curves.0.key", cur.key, f"must name a block of {cur.file}")
+    if b.get("limits") or b.get("quick"):
+        raise ConfigError(f"{where}.quick", b.get("quick") or b.get("limits"), f"a {HEAP} benchmark has no quick "
+                                                                              "file and no exact limits")
+    return Benchmark(b["name"], b["title"], "", "time", (HEAP_QUANTITY,), (cur,), (), False, "", HEAP, case,
+                     bool(b.get("opt_in", True)))
+
+
 def _curve(c: dict, notes: dict, data: Path, where: str) -> Curve:
     """One curve of the catalogue, checked: its file in ``data``, its tolerance a number > 0."""
     from ..errors import ConfigError
@@ -475,28 +525,35 @@ def _curve(c: dict, notes: dict, data: Path, where: str) -> Curve:
     return Curve(c["quantity"], c["file"], float(tol), c["why"].format(**notes), c.get("key", ""))
 
 
-BENCHMARKS: tuple[Benchmark, ...] = catalogue()
+CATALOGUED: tuple[Benchmark, ...] = catalogue()
+# the collision benchmarks (case files in cases/benchmarks/, each with its quick file) and the opt-in heap benchmarks
+BENCHMARKS: tuple[Benchmark, ...] = tuple(b for b in CATALOGUED if b.kind != HEAP)
+HEAPS: tuple[Benchmark, ...] = tuple(b for b in CATALOGUED if b.kind == HEAP)
 
 
 # The quick subset (``run(..., quick=True)``): one case file per benchmark, 68 cases of the 614 — every test's
 # exact limits and its paper's curve in one material, with laws every engine that can run the test expresses
 # (spring-sliding where Yade has no TTIt; not Test 5's and Thornton's TTIt at e 1, which stop LIGGGHTS).
-QUICK = tuple(b.quick for b in BENCHMARKS)
+QUICK = tuple(b.quick for b in BENCHMARKS if b.quick)
 
 
 def by_name(name: str | None) -> list[Benchmark]:
+    """The benchmark NAME, or without one every benchmark that is not opt-in."""
     from ..errors import ConfigError
 
     if name is None:
-        return list(BENCHMARKS)
-    hits = [b for b in BENCHMARKS if b.name == name]
+        return [b for b in BENCHMARKS + HEAPS if not b.opt_in]
+    hits = [b for b in BENCHMARKS + HEAPS if b.name == name]
     if not hits:
-        raise ConfigError("NAME", name, f"must be one of {', '.join(b.name for b in BENCHMARKS)}")
+        raise ConfigError("NAME", name, f"must be one of {', '.join(b.name for b in BENCHMARKS + HEAPS)}")
     return hits
 
 
 def files_of(bench: Benchmark, root: Path, quick: bool = False) -> list[Path]:
-    """The benchmark's case files under ``root``; ``quick``: its quick subset's one file (QUICK)."""
+    """The benchmark's case files under ``root``; ``quick``: its quick subset's one file (QUICK). A heap
+    benchmark's one case file (:func:`heap_case_path`); none in a quick run."""
+    if bench.kind == HEAP:
+        return [] if quick else [heap_case_path(bench)]
     if quick:
         return [root / f"{bench.quick}.toml"]
     return sorted(root.glob(f"{bench.prefix}*.toml"))
@@ -715,6 +772,91 @@ def _judge_curve(bench, file, src, cur: Curve, key, paper, xs, ys, regime: str =
     return out
 
 
+# ----------------------------------------------------------------------------- heap benchmarks
+
+
+def heap_case_path(bench: Benchmark, cases: Path | None = None) -> Path:
+    """A heap benchmark's case file (cases/<case>.toml); ConfigError naming the catalogue's key when it is not
+    shipped."""
+    from ..errors import ConfigError
+
+    path = (cases or resources.cases_dir()) / f"{bench.case}.toml"
+    if not path.is_file():
+        raise ConfigError(f"benchmarks.toml: {bench.name}.case", bench.case, f"must name a case file of {path.parent}")
+    return path
+
+
+def judge_heap(bench: Benchmark, file: str, times, heights, source: str = "reference",
+               error: str | None = None, root: Path = DATA) -> tuple[Check, dict]:
+    """The verdict of a heap run against its benchmark's curve, and its plot series. The run's heights are
+    interpolated (linearly) at the curve's times; the deviation is the largest |h_run − h_paper|/h_paper over the
+    curve's points (``at``: its time). The run must have finished (``error`` None), be finite and span the curve's
+    whole time range — else the verdict is a miss with an infinite deviation and ``failed`` in the Check's extra
+    (the run did not compute what the curve needs: never an agreement)."""
+    cur = bench.curves[0]
+    paper = read_curve(cur.file, cur.key, root)
+    label, x_label = QUANTITIES_HEAP[HEAP_QUANTITY]
+    out = Check(bench.name, file, source, "curve", HEAP_QUANTITY, f"{cur.file} [{cur.key}], relative",
+                tolerance=cur.tolerance, why=cur.why, verdict=NO_DATA)
+    t = np.asarray(times if times is not None else [], float).ravel()
+    h = np.asarray(heights if heights is not None else [], float).ravel()
+    series = {"benchmark": bench.name, "file": file, "quantity": HEAP_QUANTITY, "label": label, "x_label": x_label,
+              "key": cur.key, "sources": {}, "paper": paper.tolist() if paper is not None else None}
+
+    def failed(reason: str):
+        out.deviation, out.verdict = math.inf, MISSES
+        out.why = f"{cur.why} (the run failed: {reason})"
+        out.extra["failed"] = reason
+        out.keys = Check.CURVE + ("failed",)
+        return out, series
+
+    if error is not None:
+        return failed(error)
+    if t.size < 2 or t.size != h.size:
+        return failed(f"{t.size} times and {h.size} heights: no height curve")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(h))):
+        return failed("a time or height is not finite")
+    if np.any(np.diff(t) <= 0):
+        return failed("the times do not increase")
+    series["sources"][source] = {"x": t.tolist(), "y": h.tolist()}
+    if paper is None:
+        return out, series
+    lo, hi = float(paper[0, 0]), float(paper[-1, 0])
+    if t[0] > lo or t[-1] < hi:
+        return failed(f"it spans t = {t[0]:.6g}–{t[-1]:.6g} s, not the curve's {lo:.6g}–{hi:.6g} s")
+    at_paper = np.interp(paper[:, 0], t, h)
+    rel = np.abs(at_paper - paper[:, 1]) / np.abs(paper[:, 1])
+    k = int(np.argmax(rel))
+    out.deviation, out.at, out.points = float(rel[k]), float(paper[k, 0]), int(len(paper))
+    out.verdict = MEETS if rel[k] <= cur.tolerance else MISSES
+    out.extra["mean_deviation"] = float(np.mean(at_paper / paper[:, 1] - 1.0))  # signed: below the curve < 0
+    out.keys = Check.CURVE + ("mean_deviation",)
+    return out, series
+
+
+def _load_case(path: Path):
+    from ..case import load
+
+    return load(path)
+
+
+def run_heap(bench: Benchmark, cases: Path | None = None) -> tuple[Check, dict]:
+    """Run a heap benchmark's case in the reference's sandpile solver (demcheck.reference.sandpile, imported
+    here) and judge it. A solver that raises, or is not in this build, is a failed run."""
+    import importlib
+
+    path = heap_case_path(bench, cases)
+    file = path.stem
+    try:
+        sandpile = importlib.import_module("demcheck.reference.sandpile")
+        times, heights = sandpile.height_curve(_load_case(path))
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
+        return judge_heap(bench, file, None, None, error=f"{type(exc).__name__}: {exc}")
+    return judge_heap(bench, file, times, heights)
+
+
 # ----------------------------------------------------------------------------- running
 
 
@@ -851,16 +993,47 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
     from .suite import run_suite
 
     benches = by_name(names)
+    heaps = [b for b in benches if b.kind == HEAP and not quick]
+    benches = [b for b in benches if b.kind != HEAP]
+    for b in heaps:
+        heap_case_path(b)  # bad input: one line before any work
     files = {b.name: files_of(b, root, quick) for b in benches}
     every = [f for fs in files.values() for f in fs]
-    if not every:
+    if not every and not heaps:
         from ..errors import ConfigError
 
         raise ConfigError("NAME", names or "(all)", f"no benchmark case files in {root}")
-    with _titled("demcheck validate"):
-        summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv, link=LINK)
-    summary.validation = validate(summary, benches, files, opts)
-    summary.failed += len(summary.validation.failed)
+    if every:
+        with _titled("demcheck validate"):
+            summary = run_suite(every, report_root, opts, quiet=quiet, junit=junit, argv=argv, link=LINK)
+        summary.validation = validate(summary, benches, files, opts)
+    else:
+        summary = _heap_summary(report_root, argv)
+        summary.validation = Validation()
+    val = summary.validation
+    for b in heaps:
+        check, line = run_heap(b)
+        val.benchmarks.append({"name": b.name, "title": b.title, "files": [str(heap_case_path(b))]})
+        val.checks.append(check)
+        val.series.append(line)
+        if "failed" in check.extra:
+            val.failed.append(check)  # a run that failed fails the command; a finite run off the curve is a finding
+    summary.failed += len(val.failed)
+    if not every:
+        summary.partial = False
     report.write_all(summary, Path(summary.report), report_root, junit=junit, link=LINK)
     return summary
+
+
+def _heap_summary(report_root: Path, argv) -> Summary:
+    """The run record of a validate run of heap benchmarks alone (no suite run)."""
+    import datetime as _dt
+    import os
+    import sys
+
+    from .. import __version__
+
+    run_id = _dt.datetime.now().strftime("%Y%m%d-%H%M%S") + f"-{os.getpid()}"
+    return Summary(__version__, run_id, str(report_root / run_id), True,
+                   _dt.datetime.now().isoformat(timespec="seconds"), argv if argv is not None else sys.argv, planned=0)
 

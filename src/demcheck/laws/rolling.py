@@ -15,6 +15,10 @@ Powder Technology 206 (2011) 269-282:
   |Mk − Cr w| = Mm, the Maw rule of its tangential model; with ``slack_zero`` the torque is zero when the sum is
   over the limit while the spring is unstretched, as LAMMPS does at its set-up step). ηr = 0 is the type C model
   without its viscous part.
+* ``ai_viscous`` (Ai's model B as Lethe and Kratos write it): M = −μr Rr |Fn| |Vω| ŵ, Vω the contact point's
+  relative velocity from the rotations (μr in s/m; on a wall |Vω| = R |w_t|, a Cr = μr Rr R |Fn| that follows the
+  load); ``ai_epsd`` (Ai's model C as LIGGGHTS epsd and Lethe write it): ``epsd`` with kr = ε kn μr² Rr²,
+  Cr = ηr·2√(Ir kr) and the dashpot scaled by f at full mobilisation.
 
 Rr is the rolling radius (R̄ = R0R1/(R0+R1) for a pair, R for a sphere on a wall); Ir the equivalent moment of
 inertia of Ai et al., 1/Ir = 1/(I0 + m0R0²) + 1/(I1 + m1R1²) (= 1.4 m R² for a solid sphere on a wall).
@@ -33,13 +37,16 @@ import math
 
 import numpy as np
 
+from .rolling_laws.ai_epsd import AiEpsdRolling
+from .rolling_laws.ai_viscous import AiViscousRolling, ai_viscous_pair_torque
 from .rolling_laws.constant_torque import ConstantTorqueRolling
 from .rolling_laws.epsd import CAP_SPRING, CAP_TOTAL, EpsdRolling
 from .rolling_laws.slot import KERNELS, RollingSubModel
 from .rolling_laws.viscous import ViscousRolling
 
-__all__ = ["CAP_SPRING", "CAP_TOTAL", "ConstantTorqueRolling", "EpsdRolling", "KERNELS", "RollingSubModel",
-           "ViscousRolling", "epsd_damping", "equivalent_inertia", "rolling_torque"]
+__all__ = ["AiEpsdRolling", "AiViscousRolling", "CAP_SPRING", "CAP_TOTAL", "ConstantTorqueRolling", "EpsdRolling",
+           "KERNELS", "RollingSubModel", "ViscousRolling", "ai_rolling_stiffness", "ai_viscous_pair_torque",
+           "epsd_damping", "equivalent_inertia", "rolling_torque"]
 
 
 def equivalent_inertia(m0: float, r0: float, m1: float = math.inf, r1: float = 1.0) -> float:
@@ -47,6 +54,11 @@ def equivalent_inertia(m0: float, r0: float, m1: float = math.inf, r1: float = 1
     j0 = 1.4 * m0 * r0 * r0
     j1 = 1.4 * m1 * r1 * r1
     return j0 if math.isinf(j1) else j0 * j1 / (j0 + j1)
+
+
+def ai_rolling_stiffness(k_n: float, mu_r: float, r_roll: float, ratio: float = 2.25) -> float:
+    """Ai et al.'s rolling stiffness kr = ε kn μr² Rr² (ε = 2.25 in 3D; Lethe's 2D runs take 3)."""
+    return ratio * k_n * (mu_r * r_roll) ** 2
 
 
 def epsd_damping(eta_r: float, i_r: float, k_r: float) -> float:
