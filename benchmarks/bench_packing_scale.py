@@ -31,7 +31,8 @@ argument; the default is printed in the header).
 Run: .venv/bin/python benchmarks/bench_packing_scale.py [DURATION [N,N…]] > benchmarks/results/bench_packing_scale.txt
 (the sizes default to all four)
 The memory order alone (the case's order against sorted once by linked cells, one thread, alternating, medians):
-     .venv/bin/python benchmarks/bench_packing_scale.py --order DURATION N[,N…] ROUNDS
+     .venv/bin/python benchmarks/bench_packing_scale.py --order DURATION N[,N…] ROUNDS [together]
+(``together``: each round's two runs at once, one a core, so that other load slows both alike)
 The two-thread goal alone (the reference on 1 and 2 threads, alternating, ROUNDS each, medians):
      .venv/bin/python benchmarks/bench_packing_scale.py --threads DURATION 32000,128000 ROUNDS
 """
@@ -269,11 +270,12 @@ def sorted_case(case):
     return replace(case, particles=tuple(case.particles[i] for i in order))
 
 
-def order(duration: float, sizes: list[int], rounds: int) -> None:
+def order(duration: float, sizes: list[int], rounds: int, together: bool = False) -> None:
     """The memory order alone (issue 33 item 2: the engines sort their atoms spatially): the reference on one
     thread, the case's order against the same case sorted once by linked cells (:func:`sorted_case`), alternating,
     ``rounds`` times each, each run a fresh process; medians, wall and CPU, and the packing's metrics (the same
-    packing in its statistics: the order changes a pour's last bits, as threads do)."""
+    packing in its statistics: the order changes a pour's last bits, as threads do). ``together``: the two runs of
+    a round start at once, one a core — on a machine that other work loads, both then share its load alike."""
     import numba
 
     print(f"the reference on 1 thread, the case's particle order against sorted by linked cells: the poured packing, "
@@ -289,7 +291,24 @@ def order(duration: float, sizes: list[int], rounds: int) -> None:
             with open(sorted_path, "wb") as fh:
                 pickle.dump(sorted_case(case), fh)
             runs = {"case order": [], "sorted": []}
-            for k in range(rounds):
+            if together:  # both at once, one a core: whatever else runs on the machine slows both alike
+                for _ in range(rounds):
+                    procs = {label: subprocess.Popen(
+                        [sys.executable, __file__, "--child", str(p), "reference", "1"], stdout=subprocess.PIPE,
+                        stderr=subprocess.PIPE, text=True) for label, p in (("case order", path),
+                                                                            ("sorted", sorted_path))}
+                    for label, proc in procs.items():
+                        out, err = proc.communicate()
+                        r = (json.loads(out.strip().splitlines()[-1]) if proc.returncode == 0
+                             else {"error": err.strip()[-200:]})
+                        if "error" in r:
+                            print(f"{n:7d}  {label}: failed: {r['error']}")
+                            continue
+                        runs[label].append(r)
+                        print(f"{n:7d}  {label:10s} {r['wall']:8.2f} s wall {r['cpu']:8.2f} s cpu  solid fraction "
+                              f"{r['solid_fraction']:.4f}, coordination {r['coordination']:.2f}  (together)  load "
+                              f"{os.getloadavg()[0]:.2f}", flush=True)
+            for k in range(0 if together else rounds):
                 for label in (("case order", "sorted") if k % 2 == 0 else ("sorted", "case order")):
                     r = _one(path if label == "case order" else sorted_path, "reference", 1)
                     if "error" in r:
@@ -310,7 +329,8 @@ def order(duration: float, sizes: list[int], rounds: int) -> None:
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--order"]:  # --order DURATION N[,N…] ROUNDS
-        order(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]))
+        order(float(sys.argv[2]), [int(x) for x in sys.argv[3].split(",")], int(sys.argv[4]),
+              sys.argv[5:6] == ["together"])
     elif sys.argv[1:2] == ["--child"]:
         child(sys.argv[2], sys.argv[3], int(sys.argv[4]))
     elif sys.argv[1:2] == ["--threads"]:  # --threads DURATION N[,N…] ROUNDS
