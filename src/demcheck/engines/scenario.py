@@ -449,8 +449,11 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
         from . import discovery
         from .cache import key, text, texts
 
+        from .collide import run_identity
+
         version = discovery.require(eng.name).version
-        k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
+        deck_part, files = run_identity(dk)  # its commands: a case's name or notes never make a run of their own
+        k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{deck_part}", files)
         hit = get_metrics(cache, k, metric_names(case),
                            {"engine_version": text, "warnings": texts})
         if hit is not None:
