@@ -1,0 +1,341 @@
+"""No engine run that a verdict does not need (issue 33 item 5): every engine run ``demcheck verify`` asks for, spied
+where it happens, and the row of the results that reads it.
+
+The spy (:class:`EngineRuns`) wraps, in this process, the three places a verify asks an engine for a run — a
+collision (engines.collide.collide), a scenario beyond sliding (engines.scenario.run), a packing
+(engines.packing.run_engine) — with the run cache's answer (a hit is a run the verdict asked for, read from the
+cache) and every real run (engines.run.run: through the engine's worker or as a process of its own). Each request
+is then mapped to its reader: the case's row of that engine in the results and the comparisons made of it. A run is
+needless when nothing reads it (no row, or a row of an engine that cannot express the case or was not asked for) or
+when it repeats a run of the same engine on the same deck — the deck's commands, its whole-line comments (the
+case's name and notes) left out — within the verify. benchmarks/bench_verify_runs.py counts the whole default suite
+with the same spy.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+from demcheck.comparisons import verdicts as V
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ROOT / "cases"
+ENGINES = ("lammps", "liggghts", "kratos", "yade")
+NOT_RUN = (V.NOT_EXPRESSIBLE, V.MISSING)  # an engine row that says the engine was not run
+
+
+def commands(text: str) -> str:
+    """A deck's (or a deck file's) text without its whole-line comments: what the engine runs."""
+    return "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
+
+
+def deck_id(deck: str, files: dict | None = None) -> str:
+    h = hashlib.sha256(commands(deck).encode())
+    for name, text in sorted((files or {}).items()):
+        h.update(f"\0{name}\0{commands(text)}".encode())
+    return h.hexdigest()[:12]
+
+
+@dataclass
+class Request:
+    """One engine run a case asked for: its kind (collision, scenario, packing), whether the run cache answered it
+    (``hit``), the real runs it made (indices into EngineRuns.runs) and what it raised."""
+
+    case: str
+    engine: str
+    kind: str
+    asked: tuple
+    hit: bool | None = None  # None: it raised (a refusal before any run: not a run; or a run that failed)
+    runs: list = field(default_factory=list)
+    error: str = ""
+    reader: str = ""  # the row and comparisons that read it (EngineRuns.map_to); "" for none
+    needless: str = ""  # why it is needless ("" for a needed run)
+
+    @property
+    def ran(self) -> bool:
+        """A run was made for it, or read from the cache."""
+        return bool(self.runs) or bool(self.hit)
+
+
+@dataclass
+class Run:
+    """One real engine run (engines.run.run)."""
+
+    case: str
+    engine: str
+    kind: str
+    deck: str  # deck_id of the deck and its files
+    worker: str  # how it was asked to run: the engine's worker (or a process after a failed worker run), a process
+    seconds: float
+    request: int | None
+    needless: str = ""
+
+
+class EngineRuns:
+    """The spy (module docstring). ``with EngineRuns() as spy: run_suite(...)`` in this process (``--jobs 1``: a Dask
+    worker's runs are in its own process); then ``spy.map_to(summary)`` and ``spy.needless()``."""
+
+    def __init__(self):
+        self.requests: list[Request] = []
+        self.runs: list[Run] = []
+        self._case = None
+        self._engines: tuple = ()
+        self._stack: list[int] = []
+        self._patches = contextlib.ExitStack()
+
+    # ------------------------------------------------------------------ the wrappers
+
+    def __enter__(self) -> "EngineRuns":
+        from demcheck.comparisons import suite
+        from demcheck.engines import collide, packing, run as runner, scenario
+
+        self._patch(suite, "run_case", self._run_case)
+        self._patch(collide, "collide", self._request("collision"))
+        self._patch(scenario, "run", self._request("scenario"))
+        self._patch(packing, "run_engine", self._request("packing"))
+        self._patch(runner, "run", self._run)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._patches.close()
+
+    def _patch(self, module, name: str, make) -> None:
+        original = getattr(module, name)
+        setattr(module, name, make(original))
+        self._patches.callback(setattr, module, name, original)
+
+    def _run_case(self, original):
+        def run_case(case, file, opts, found):
+            self._case, self._engines = case.name, tuple(opts.engines)
+            try:
+                return original(case, file, opts, found)
+            finally:
+                self._case = None
+        return run_case
+
+    def _request(self, kind: str):
+        def wrap(original):
+            def requested(case, engine, *args, **kwargs):
+                name = engine if isinstance(engine, str) else engine.name
+                self.requests.append(Request(case.name, name, kind, (self._case, tuple(self._engines))))
+                index = len(self.requests) - 1
+                self._stack.append(index)
+                try:
+                    result = original(case, engine, *args, **kwargs)
+                except BaseException as exc:
+                    self.requests[index].error = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+                    raise
+                finally:
+                    self._stack.pop()
+                req = self.requests[index]
+                # a collision's and a scenario's Result says whether its run came from the cache; a packing's, none
+                req.hit = bool(result.meta.get("cached")) if kind != "packing" else not req.runs
+                return result
+            return requested
+        return wrap
+
+    def _run(self, original):
+        def run(engine, deck, *args, files=None, worker=False, **kwargs):
+            index = self._stack[-1] if self._stack else None
+            kind = self.requests[index].kind if index is not None else "?"
+            started = time.perf_counter()
+            try:
+                return original(engine, deck, *args, files=files, worker=worker, **kwargs)
+            finally:
+                how = "worker, else process" if worker == "or-process" else "worker" if worker else "process"
+                self.runs.append(Run(self._case or "?", engine, kind, deck_id(deck, files), how,
+                                     time.perf_counter() - started, index))
+                if index is not None:
+                    self.requests[index].runs.append(len(self.runs) - 1)
+        return run
+
+    # ------------------------------------------------------------------ what reads each run
+
+    def map_to(self, summary) -> None:
+        """Each request's reader in ``summary`` (the suite's records.Summary: results.json's rows), and why a request
+        or a real run is needless."""
+        entries = {c.case: c for c in summary.cases}
+        for req in self.requests:
+            if not req.ran:
+                continue  # refused before any run (a packing deck the engine's package does not write): no run
+            case, engines = req.asked
+            entry = entries.get(req.case)
+            row = entry.sources.get(req.engine) if entry is not None else None
+            comps = [c for c in entry.comparisons if c.source == req.engine] if entry is not None else []
+            if case != req.case:
+                req.needless = f"asked outside its case's run ({case})"
+            elif req.engine not in engines:
+                req.needless = f"{req.engine} was not among the engines asked for ({', '.join(engines)})"
+            elif entry is None:
+                req.needless = "its case has no entry in the results"
+            elif row is None:
+                req.needless = "its case's entry has no row of this engine (the row was dropped)"
+            elif row.status in NOT_RUN:
+                req.needless = f"its row says {row.status}: the engine was not to run"
+            elif not comps:
+                req.needless = "no comparison reads its row"
+            else:
+                verdicts = sorted({c.verdict for c in comps})
+                numeric = sum(c.metric != "*" for c in comps)
+                req.reader = (f"cases[{req.case}].sources.{req.engine} ({row.status}); {len(comps)} comparison(s), "
+                              f"{numeric} of metrics: {', '.join(verdicts)}")
+        seen: dict = {}
+        for i, run in enumerate(self.runs):
+            key = (run.engine, run.deck)
+            req = self.requests[run.request] if run.request is not None else None
+            if key in seen:
+                run.needless = f"repeats run {seen[key]} (the same deck's commands)"
+            elif req is None:
+                run.needless = "made outside any request of a case"
+            elif req.needless:
+                run.needless = req.needless
+            elif req.runs and req.runs[-1] != i:
+                run.needless = ""  # a shorter run extended (engines.collide: the contact had not ended): read by
+                # the decision to run longer; counted apart (extended())
+            seen.setdefault(key, i)
+
+    def needless(self) -> list[str]:
+        """Every needless request and real run, one line each ([] when every run is read)."""
+        out = [f"request {r.kind} {r.case} / {r.engine}: {r.needless}" for r in self.requests if r.needless]
+        out += [f"run {r.kind} {r.case} / {r.engine} deck {r.deck}: {r.needless}" for r in self.runs if r.needless]
+        return out
+
+    def extended(self) -> list[Run]:
+        """The real runs a longer one replaced (a collision whose contact had not ended by the run's end)."""
+        return [self.runs[i] for r in self.requests for i in r.runs[:-1]]
+
+
+# ----------------------------------------------------------------------------- the suite under the spy
+
+
+def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False):
+    """``demcheck verify`` of ``files`` in this process (``--jobs 1``), its engine-run cache in ``cache_dir``, under
+    the spy: (summary, spy)."""
+    from demcheck.comparisons.suite import Options, run_suite
+    from demcheck.engines.cache import Cache
+
+    opts = Options(engines=tuple(engines), cache=Cache(cache_dir, refresh=refresh))
+    with EngineRuns() as spy:
+        summary = run_suite([Path(f) for f in files], cache_dir.parent / "reports", opts, quiet=True)
+    spy.map_to(summary)
+    return summary, spy
+
+
+def files(tmp_path: Path) -> list[Path]:
+    """A small, representative set of the suite's case files: a pair and a wall, an oblique impact, a case two
+    engines cannot express, a scenario beyond sliding, a small packing — and the pair again under another name (its
+    decks differ only in the comments that name the case: one run each)."""
+    copy = tmp_path / "glass-pair-copy.toml"
+    text = (CASES / "glass-pair.toml").read_text()
+    assert 'name = "glass-pair"' in text
+    copy.write_text(text.replace('name = "glass-pair"', 'name = "glass-pair-copy"'))
+    return [CASES / "glass-pair.toml", copy, CASES / "hertz-wall.toml", CASES / "oblique-lsd-wall.toml",
+            CASES / "kk-wall.toml", CASES / "suite" / "beyond-twist.toml", CASES / "packing" / "column-lsd.toml"]
+
+
+def engine_marks(f):
+    for e in ENGINES:
+        f = pytest.mark.engine(e)(f)
+    return f
+
+
+@engine_marks
+def test_every_engine_run_is_read_by_a_row_and_made_once(tmp_path):
+    fs = files(tmp_path)
+    summary, spy = verify(fs, tmp_path / "engine-runs")
+    assert not summary.failed, [c.case for c in summary.cases if c.failing]
+    by = {}
+    for req in spy.requests:
+        by.setdefault((req.case, req.engine), []).append(req)
+    # each case asked each engine that expresses it for one run, and only those (kk-wall: Kratos and Yade cannot
+    # express the KK dashpot; beyond-twist: LIGGGHTS and Kratos have no twisting torque; column-lsd: Kratos writes
+    # no packing deck, its refusal comes before any run)
+    asked = {(r.case, r.engine, r.kind) for r in spy.requests}
+    for case in ("glass-pair", "glass-pair-copy", "hertz-wall", "oblique-lsd-wall"):
+        assert {(case, e, "collision") for e in ENGINES} <= asked
+    assert not {(n, e) for n, e, _ in asked if n == "kk-wall" and e in ("kratos", "yade")}
+    assert not {r for r in spy.runs if r.case == "kk-wall" and r.engine in ("kratos", "yade")}
+    assert not {(n, e) for n, e, _ in asked if n == "suite-beyond-twist" and e in ("liggghts", "kratos")}
+    assert {("suite-beyond-twist", "lammps", "scenario"), ("suite-beyond-twist", "yade", "scenario")} <= asked
+    assert not [r for r in spy.runs if r.case == "column-lsd" and r.engine == "kratos"]
+    assert all(len(v) == 1 for v in by.values()), {k: len(v) for k, v in by.items() if len(v) > 1}
+    # each real run's (engine, deck) once; every request read by its row
+    decks = [(r.engine, r.deck) for r in spy.runs]
+    assert len(decks) == len(set(decks)), spy.needless()
+    assert spy.needless() == []
+    assert all(r.reader for r in spy.requests if r.ran)
+    # the copy of glass-pair asked for its four runs and the cache answered each: the same decks' commands
+    copy = [r for r in spy.requests if r.case == "glass-pair-copy"]
+    assert len(copy) == 4 and all(r.hit and not r.runs for r in copy), copy
+    # its rows equal glass-pair's, number for number
+    entries = {c.case: c for c in summary.cases}
+    for e in ENGINES:
+        assert entries["glass-pair-copy"].sources[e].metrics == entries["glass-pair"].sources[e].metrics
+    assert not spy.extended()  # no collision here outlasts its deck's run
+    # a warm verify: every run from the cache, none made
+    summary2, warm = verify(fs, tmp_path / "engine-runs")
+    assert warm.runs == [] and warm.needless() == []
+    assert [(r.case, r.engine, r.kind) for r in warm.requests] == [(r.case, r.engine, r.kind) for r in spy.requests]
+    assert all(r.hit for r in warm.requests if r.ran) and sum(r.ran for r in warm.requests) == sum(
+        r.ran for r in spy.requests)
+
+
+@pytest.mark.engine("lammps")
+def test_a_scenario_row_whose_twin_cannot_be_made_runs_no_engine(monkeypatch, tmp_path):
+    """A scenario engine's row needs its twin and its seed run besides the engine's: where the twin fails the row is
+    "failed" and the engine is not run (it ran first, and its output went unread)."""
+    from demcheck.engines import scenario
+    from demcheck.errors import UnsupportedByEngine
+
+    def no_twin(case, engine):
+        raise UnsupportedByEngine("planted: no twin")
+
+    monkeypatch.setattr(scenario, "twin", no_twin)
+    summary, spy = verify([CASES / "suite" / "beyond-twist.toml"], tmp_path / "engine-runs", engines=("lammps",))
+    row = summary.cases[0].sources["lammps"]
+    assert row.status == "failed" and "planted: no twin" in row.message
+    assert spy.runs == [] and spy.requests == []
+
+
+
+def test_a_refreshing_cache_reads_this_runs_entries_only(tmp_path):
+    """--no-cache runs every deck again, but a deck two cases of one verify share runs once: the campaign's cache
+    (dispatch.ThisRun) reads the entries written since it started, never an earlier run's."""
+    import pandas as pd
+
+    from demcheck.comparisons import dispatch
+    from demcheck.engines.cache import Cache
+
+    for k in ("old", "older"):
+        Cache(tmp_path).put(k, pd.DataFrame({"x": [1.0]}), {})  # an earlier run's entries
+    time.sleep(0.05)  # past the file system's clock tick
+    with dispatch.Campaign(1, cache=Cache(tmp_path, refresh=True)) as campaign:
+        got = dict(campaign.completed(_looked_up, [("task", (("old", "new"),))]))["task"]
+    # each key missed first (the earlier run's entry unread, the new one absent), then, written, was read
+    assert got == [("old", False, True), ("new", False, True)]
+    fresh = Cache(tmp_path, refresh=True)  # the refreshing cache alone reads neither
+    assert fresh.get("old") is None and fresh.get("new") is None
+    # a Dask worker's view of the client's cache reads as the campaign's does
+    worker = dispatch._Collecting(str(tmp_path), True, campaign.started)
+    assert worker.get("new") is not None and worker.get("older") is None
+    assert dispatch._Collecting(str(tmp_path), True).get("new") is None  # no start given: nothing read
+
+
+def _looked_up(keys, cache=None):
+    """A task: each key looked up, written on a miss (as an engine run is), looked up again."""
+    import pandas as pd
+
+    out = []
+    for k in keys:
+        first = cache.get(k) is not None
+        if not first:
+            cache.put(k, pd.DataFrame({"x": [2.0]}), {})
+        out.append((k, first, cache.get(k) is not None))
+    return out
