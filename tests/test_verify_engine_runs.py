@@ -21,6 +21,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from demcheck.comparisons import verdicts as V
@@ -247,7 +248,7 @@ def engine_marks(f):
 
 
 @engine_marks
-def test_every_engine_run_is_read_by_a_row_and_made_once(tmp_path):
+def test_every_engine_run_is_read_by_a_row_and_made_once(monkeypatch, tmp_path):
     fs = files(tmp_path)
     summary, spy = verify(fs, tmp_path / "engine-runs")
     assert not summary.failed, [c.case for c in summary.cases if c.failing]
@@ -279,12 +280,24 @@ def test_every_engine_run_is_read_by_a_row_and_made_once(tmp_path):
     for e in ENGINES:
         assert entries["glass-pair-copy"].sources[e].metrics == entries["glass-pair"].sources[e].metrics
     assert not spy.extended()  # no collision here outlasts its deck's run
-    # a warm verify: every run from the cache, none made
+    # a warm verify after a change to demcheck's code that leaves every deck as it was (its fingerprint, which keys
+    # the results demcheck computes itself): every engine run from the cache, none made
+    from demcheck.engines import scenario
+
+    monkeypatch.setattr(scenario, "code_fingerprint", lambda: "a-changed-demcheck")
     summary2, warm = verify(fs, tmp_path / "engine-runs")
     assert warm.runs == [] and warm.needless() == []
     assert [(r.case, r.engine, r.kind) for r in warm.requests] == [(r.case, r.engine, r.kind) for r in spy.requests]
     assert all(r.hit for r in warm.requests if r.ran) and sum(r.ran for r in warm.requests) == sum(
         r.ran for r in spy.requests)
+    # and its rows are the cold run's, number for number
+    cold, again = ({c.case: c for c in s.cases} for s in (summary, summary2))
+    for name, entry in cold.items():
+        for e in ENGINES:
+            if e in entry.sources:
+                a, b = entry.sources[e].metrics or {}, again[name].sources[e].metrics or {}
+                assert a.keys() == b.keys() and all(a[m] == b[m] or (a[m] != a[m] and b[m] != b[m]) for m in a), \
+                    (name, e, a, b)
 
 
 @pytest.mark.engine("lammps")
@@ -339,3 +352,31 @@ def _looked_up(keys, cache=None):
             cache.put(k, pd.DataFrame({"x": [2.0]}), {})
         out.append((k, first, cache.get(k) is not None))
     return out
+
+
+@pytest.mark.parametrize("data", [
+    {"t": np.arange(5) * 0.1, "x": np.random.default_rng(1).normal(size=(5, 3)),
+     "v": np.random.default_rng(2).normal(size=(5, 3)), "omega": np.random.default_rng(3).normal(size=(5, 3))},
+    {"delta": np.linspace(1e-6, -1e-6, 7), "fn": np.random.default_rng(4).normal(size=7)},
+    {"v_rel": 0.123456789, "touching": False},
+    {"v_rel": -0.5, "touching": True},
+    {"t": np.arange(3) * 0.5, "dT": np.array([10.0, 5.0, 2.5])},
+])
+def test_a_scenario_run_is_kept_as_its_output_and_read_back_to_the_bit(tmp_path, data):
+    """A scenario engine run is cached as what the engine's reader made of its output, keyed by its deck's commands
+    and the engine's version, not by demcheck's code: a change to demcheck that leaves the deck as it was runs no
+    engine again (the metrics are computed from the kept output each time)."""
+    from demcheck.engines import scenario
+    from demcheck.engines.cache import Cache
+
+    cache = Cache(tmp_path)
+    scenario._put_run(cache, "k", data, {"engine_version": "v", "warnings": ["w"]})
+    got, meta = scenario._cached_run(Cache(tmp_path), "k")
+    assert meta["engine_version"] == "v" and meta["warnings"] == ["w"]
+    assert got.keys() == data.keys()
+    for name, value in data.items():
+        assert type(got[name]) is type(value)
+        if isinstance(value, np.ndarray):
+            assert got[name].shape == value.shape and np.array_equal(got[name], value)
+        else:
+            assert got[name] == value
