@@ -97,6 +97,10 @@ def report(summary, spy, engines, wall, load0, load1, src, discovery) -> None:
           f"{tot['worker']:10d} {tot['process']:10d} {tot['seconds']:9.1f}")
     print("(refused: the engine's package refused the case before any run — a packing deck it does not write — and "
           "its row says so; not a run)")
+    print(f"besides the runs: {len(spy.workers)} engine worker(s) started ("
+          + ", ".join(f"{e} {spy.workers.count(e)}" for e in engines if e in spy.workers)
+          + f"); {len(spy.probes)} discovery question(s) to an executable (its banner, for the version the cache "
+            "keys and the report name): " + "; ".join(spy.probes))
 
     print()
     print("## runs per case (requests that ran or hit)")

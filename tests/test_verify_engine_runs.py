@@ -86,6 +86,8 @@ class EngineRuns:
     def __init__(self):
         self.requests: list[Request] = []
         self.runs: list[Run] = []
+        self.probes: list[str] = []  # discovery's questions to an engine's executable (its banner: the version)
+        self.workers: list[str] = []  # the engines' long-lived workers started (engines/run.py), by engine
         self._case = None
         self._engines: tuple = ()
         self._stack: list[int] = []
@@ -95,13 +97,15 @@ class EngineRuns:
 
     def __enter__(self) -> "EngineRuns":
         from demcheck.comparisons import suite
-        from demcheck.engines import collide, packing, run as runner, scenario
+        from demcheck.engines import collide, discovery, packing, run as runner, scenario
 
         self._patch(suite, "run_case", self._run_case)
         self._patch(collide, "collide", self._request("collision"))
         self._patch(scenario, "run", self._request("scenario"))
         self._patch(packing, "run_engine", self._request("packing"))
         self._patch(runner, "run", self._run)
+        self._patch(runner, "_start_worker", self._worker)
+        self._patch(discovery, "output_of", self._probe)
         return self
 
     def __exit__(self, *exc) -> None:
@@ -141,6 +145,18 @@ class EngineRuns:
                 return result
             return requested
         return wrap
+
+    def _worker(self, original):
+        def start(engine, *args, **kwargs):
+            self.workers.append(engine)
+            return original(engine, *args, **kwargs)
+        return start
+
+    def _probe(self, original):
+        def probe(argv, *args, **kwargs):
+            self.probes.append(" ".join(map(str, argv)))
+            return original(argv, *args, **kwargs)
+        return probe
 
     def _run(self, original):
         def run(engine, deck, *args, files=None, worker=False, **kwargs):
