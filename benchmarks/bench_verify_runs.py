@@ -1,8 +1,8 @@
 """Every engine run of ``demcheck verify`` on the default suite with all four engines, and what reads it (issue 33
 item 5: "no engine run that a verdict does not need").
 
-The suite runs in this process (``--jobs 1``: the spy sees every run; a Dask worker's are in its own process) with
-an empty engine-run cache in a temporary directory (DEMCHECK_CACHE), so every run is real, under the spy of
+The suite runs in this process (``--jobs 1``, the default here) or on a local Dask cluster (``--jobs N``: each
+task runs under its own spy on its worker, its records sent back with its entry) with an empty engine-run cache in a temporary directory (DEMCHECK_CACHE), so every run is real, under the spy of
 tests/test_verify_engine_runs.py: every request of a case for an engine run (a collision, a scenario beyond sliding,
 a packing), the cache's answer, every real run (through the engine's worker or as a process), and each request's
 reader, the row of the results and the comparisons made of it. Printed: the runs by engine and kind, the runs per
@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import collections
-import importlib.util
 import os
 import subprocess
 import sys
@@ -30,20 +29,25 @@ ENGINES = ("lammps", "liggghts", "kratos", "yade")
 
 
 def spy_module():
-    spec = importlib.util.spec_from_file_location("engine_run_spy", ROOT / "tests" / "test_verify_engine_runs.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    """The spy, imported by its name (a Dask worker unpickles its task function by it: the workers' sys.path is
+    this process's)."""
+    sys.path.insert(0, str(ROOT))
+    import tests.test_verify_engine_runs as spy
+
+    return spy
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--engines", default=",".join(ENGINES))
     ap.add_argument("--src", help="the src directory of another demcheck to run under the spy")
+    ap.add_argument("--jobs", type=int, default=1, help="1: in this process; N: a local Dask cluster of N workers "
+                                                        "(the command's default is 2), each task under the spy")
     a = ap.parse_args()
     if a.src and os.environ.get("BENCH_VERIFY_RUNS_CHILD") != "1":  # that tree's demcheck, in a process of its own
         env = dict(os.environ, PYTHONPATH=a.src, BENCH_VERIFY_RUNS_CHILD="1")
-        sys.exit(subprocess.call([sys.executable, __file__, "--engines", a.engines, "--src", a.src], env=env))
+        sys.exit(subprocess.call([sys.executable, __file__, "--engines", a.engines, "--src", a.src, "--jobs",
+                                  str(a.jobs)], env=env))
     engines = tuple(e for e in a.engines.split(",") if e)
     with tempfile.TemporaryDirectory(prefix="bench-verify-runs-") as tmp:
         os.environ["DEMCHECK_CACHE"] = str(Path(tmp) / "engine-runs")
@@ -55,15 +59,17 @@ def main():
         files = resources.case_files([])
         load0 = os.getloadavg()
         started = time.perf_counter()
-        summary, runs = spy.verify(files, Path(tmp) / "engine-runs", engines)
+        summary, runs = spy.verify(files, Path(tmp) / "engine-runs", engines, jobs=a.jobs)
         wall = time.perf_counter() - started
-        report(summary, runs, engines, wall, load0, os.getloadavg(), Path(demcheck.__file__).parent, discovery)
+        report(summary, runs, engines, wall, load0, os.getloadavg(), Path(demcheck.__file__).parent, discovery,
+               a.jobs)
 
 
-def report(summary, spy, engines, wall, load0, load1, src, discovery) -> None:
+def report(summary, spy, engines, wall, load0, load1, src, discovery, jobs) -> None:
     commit = subprocess.run(["git", "-C", str(src), "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
-    print(f"demcheck verify, the default suite, engines {','.join(engines)}, --jobs 1 in one process, an empty "
+    where = "in one process" if jobs == 1 else f"a local Dask cluster of {jobs} workers"
+    print(f"demcheck verify, the default suite, engines {','.join(engines)}, --jobs {jobs} ({where}), an empty "
           f"engine-run cache; {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {os.cpu_count()} CPUs")
     print(f"demcheck from {src} (git {commit or '?'}); "
           + "; ".join(f"{e} {discovery.find(e).version}" for e in engines if discovery.find(e)))

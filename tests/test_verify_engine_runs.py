@@ -80,8 +80,9 @@ class Run:
 
 
 class EngineRuns:
-    """The spy (module docstring). ``with EngineRuns() as spy: run_suite(...)`` in this process (``--jobs 1``: a Dask
-    worker's runs are in its own process); then ``spy.map_to(summary)`` and ``spy.needless()``."""
+    """The spy (module docstring) of one case's task: ``with EngineRuns() as spy: suite.case_task(...)`` in the
+    process that runs it (:func:`spied_task`); the tasks' spies merged (:meth:`merge`), then ``spy.map_to(summary)``
+    and ``spy.needless()``."""
 
     def __init__(self):
         self.requests: list[Request] = []
@@ -229,18 +230,62 @@ class EngineRuns:
         return [self.runs[i] for r in self.requests for i in r.runs[:-1]]
 
 
+    def merge(self, other: "EngineRuns") -> None:
+        """``other``'s records (one task's, from whichever process ran it) after this one's."""
+        base = len(self.runs)
+        offset = len(self.requests)
+        for r in other.runs:
+            r.request = None if r.request is None else r.request + offset
+        for q in other.requests:
+            q.runs = [i + base for i in q.runs]
+        self.requests += other.requests
+        self.runs += other.runs
+        self.workers += other.workers
+        self.probes += other.probes
+
+
 # ----------------------------------------------------------------------------- the suite under the spy
 
+_CASE_TASK = None  # suite.case_task, kept where the spy replaced it (the client); a Dask worker has its own
+RECORDS = "__engine_runs__"  # the key of a task's records in its CaseResult's extra, removed by the client
 
-def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False):
-    """``demcheck verify`` of ``files`` in this process (``--jobs 1``), its engine-run cache in ``cache_dir``, under
-    the spy: (summary, spy)."""
+
+def spied_task(*args, cache=None):
+    """suite.case_task under its own spy, in the process that runs it (this one, or a Dask worker's: this function
+    is pickled by its name); its records ride back in the entry, taken off before the report is written."""
+    from demcheck.comparisons import suite
+
+    task = _CASE_TASK or suite.case_task
+    with EngineRuns() as spy:
+        entry = task(*args, cache=cache)
+    spy._patches = None  # not picklable, and done with
+    entry.extra[RECORDS] = spy
+    return entry
+
+
+def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False, jobs: int = 1):
+    """``demcheck verify`` of ``files`` (``jobs`` 1: in this process; N: on a local Dask cluster of N workers, the
+    command's default being 2), its engine-run cache in ``cache_dir``, every task under the spy: (summary, spy)."""
+    global _CASE_TASK
+    from demcheck.comparisons import dispatch, suite
     from demcheck.comparisons.suite import Options, run_suite
     from demcheck.engines.cache import Cache
 
-    opts = Options(engines=tuple(engines), cache=Cache(cache_dir, refresh=refresh))
-    with EngineRuns() as spy:
+    spy = EngineRuns()
+    completed = dispatch.Campaign.completed
+
+    def taken_off(campaign, fn, tasks):
+        for key, entry in completed(campaign, fn, tasks):
+            spy.merge(entry.extra.pop(RECORDS))
+            yield key, entry
+
+    opts = Options(engines=tuple(engines), cache=Cache(cache_dir, refresh=refresh), jobs=jobs)
+    _CASE_TASK = suite.case_task
+    suite.case_task, dispatch.Campaign.completed = spied_task, taken_off
+    try:
         summary = run_suite([Path(f) for f in files], cache_dir.parent / "reports", opts, quiet=True)
+    finally:
+        suite.case_task, dispatch.Campaign.completed, _CASE_TASK = _CASE_TASK, completed, None
     spy.map_to(summary)
     return summary, spy
 
@@ -396,3 +441,46 @@ def test_a_scenario_run_is_kept_as_its_output_and_read_back_to_the_bit(tmp_path,
             assert got[name].shape == value.shape and np.array_equal(got[name], value)
         else:
             assert got[name] == value
+
+
+def test_cases_that_share_an_engine_run_never_run_it_at_once_on_a_cluster(tmp_path):
+    """On a Dask cluster two cases run at once: two that share a deck (a case and its copy; variants an engine's
+    mapping cannot tell apart) would both miss the cache and both run it. suite.sharers finds them, and suite.Apart
+    holds one back while the other is out (the next case goes first)."""
+    from demcheck.comparisons import suite
+
+    fs = files(tmp_path)[:3] + [CASES / "suite" / "normal-tti-pair.toml"]
+    cases = suite.collect(fs)
+    names = [c.name for _, c in cases]
+    found = {e: {"found": True, "version": "x", "executable": "x", "how_to_install": None, "why": None}
+             for e in ENGINES}
+    shared = suite.sharers([c for _, c in cases], ENGINES, found)
+    at = {n: i for i, n in enumerate(names)}
+    assert shared[at["glass-pair"]] == {at["glass-pair-copy"]} and shared[at["glass-pair-copy"]] == {at["glass-pair"]}
+    assert at["hertz-wall"] not in shared
+    # Kratos and Yade cannot express limit_force: each speed's two variants share their decks (LAMMPS and LIGGGHTS
+    # can: theirs differ)
+    tti = [n for n in names if n.startswith("suite-tti-pair[")]
+    assert len(tti) == 6
+    for n in tti:
+        twin = n.replace("limit_force=false", "limit_force=true") if "false" in n else n.replace("true", "false")
+        assert shared[at[n]] == {at[twin]}, (n, [names[j] for j in shared[at[n]]])
+
+    busy = set()
+    apart = suite.Apart([(i, n) for i, n in enumerate(names)], shared, lambda: busy)
+    first = next(apart)
+    assert first == (0, "glass-pair")
+    busy.add(0)
+    assert next(apart)[1] == "hertz-wall"  # the copy waits while glass-pair is out
+    busy.add(2)
+    taken = []
+    for _ in range(3):  # the tti variants, each sent out: one of each speed's pair, the other waits
+        taken.append(next(apart)[1])
+        busy.add(at[taken[-1]])
+    assert {n.split(",")[0] for n in taken} == {n.split(",")[0] for n in tti}
+    with pytest.raises(StopIteration):  # every case left waits: asked again when one comes back
+        next(apart)
+    busy -= {0}
+    assert next(apart)[1] == "glass-pair-copy"
+    busy.clear()
+    assert len(list(apart)) == 3  # nothing here asks an engine: the decks are written, never run

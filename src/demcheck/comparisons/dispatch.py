@@ -140,6 +140,12 @@ class Campaign:
             raise RuntimeError("a campaign on a cluster runs inside `with Campaign(...)`")
         yield from self._on_cluster(fn, tasks)
 
+    def running(self) -> set:
+        """The keys of the tasks out on the cluster now (none in this process: a task there runs as it is asked
+        for). ``completed``'s ``tasks`` may be an iterator that consults it, stopping (StopIteration) while every
+        task it has left must wait for one of these: it is asked again as each task comes back."""
+        return set(self._flying.values())
+
     # ------------------------------------------------------------------------- on a cluster
 
     def _on_cluster(self, fn, tasks):
