@@ -59,7 +59,7 @@ def main():
         files = resources.case_files([])
         load0 = os.getloadavg()
         started = time.perf_counter()
-        summary, runs = spy.verify(files, Path(tmp) / "engine-runs", engines, jobs=a.jobs)
+        summary, runs = spy.verify(files, Path(tmp) / "engine-runs", engines, jobs=a.jobs, report=True)
         wall = time.perf_counter() - started
         report(summary, runs, engines, wall, load0, os.getloadavg(), Path(demcheck.__file__).parent, discovery,
                a.jobs)

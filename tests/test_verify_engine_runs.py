@@ -263,11 +263,13 @@ def spied_task(*args, cache=None):
     return entry
 
 
-def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False, jobs: int = 1):
+def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False, jobs: int = 1, report: bool = False):
     """``demcheck verify`` of ``files`` (``jobs`` 1: in this process; N: on a local Dask cluster of N workers, the
-    command's default being 2), its engine-run cache in ``cache_dir``, every task under the spy: (summary, spy)."""
+    command's default being 2), its engine-run cache in ``cache_dir``, every task under the spy: (summary, spy).
+    ``report``: write the report's files too (its figures are most of a small verify's time; they render the rows
+    the spy's readers are)."""
     global _CASE_TASK
-    from demcheck.comparisons import dispatch, suite
+    from demcheck.comparisons import dispatch, report as reports, suite
     from demcheck.comparisons.suite import Options, run_suite
     from demcheck.engines.cache import Cache
 
@@ -282,10 +284,14 @@ def verify(files, cache_dir: Path, engines=ENGINES, refresh: bool = False, jobs:
     opts = Options(engines=tuple(engines), cache=Cache(cache_dir, refresh=refresh), jobs=jobs)
     _CASE_TASK = suite.case_task
     suite.case_task, dispatch.Campaign.completed = spied_task, taken_off
+    write_all = reports.write_all
+    if not report:
+        reports.write_all = lambda *a, **k: None
     try:
         summary = run_suite([Path(f) for f in files], cache_dir.parent / "reports", opts, quiet=True)
     finally:
         suite.case_task, dispatch.Campaign.completed, _CASE_TASK = _CASE_TASK, completed, None
+        reports.write_all = write_all
     spy.map_to(summary)
     return summary, spy
 
