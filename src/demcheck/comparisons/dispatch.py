@@ -24,7 +24,8 @@ the campaign it lacks, with the worker, for the task to report (the engines a ca
 found). The task reads the client's engine-run cache where the worker sees its directory (the same machine, or a
 shared filesystem) and sends back the entries it would have written, which the client stores (engines/cache.py:
 atomically; a failed run is never among them), with its hits and misses and its ``demcheck`` log lines (a damaged
-cache entry: each line once).
+cache entry: each line once). A refreshing cache (``--no-cache``) reads no entry of an earlier run, but reads the
+campaign's own (:class:`ThisRun`): a deck two tasks share runs once.
 
 An interrupt (SIGINT, or SIGTERM or SIGHUP as engines.run.handle_sigterm makes them) while a campaign waits on its tasks: the
 tasks not started are cancelled, the engines of the workers running its tasks are killed (engines.run.kill_all on
@@ -83,6 +84,10 @@ class Campaign:
         self._flying: dict = {}  # future → its task's key
         self._scratch = None  # a local cluster's scratch space (removed with it)
         self._logged: set = set()
+        import time
+
+        self.started = time.time()  # what a refreshing cache reads is what was written since (ThisRun)
+        self._tasks_cache = ThisRun(cache, self.started) if cache is not None and cache.refresh else cache
 
     @property
     def in_process(self) -> bool:
@@ -129,11 +134,17 @@ class Campaign:
         in order). A task's exception is raised here, as it is; an interrupt as the module's notes say."""
         if self.in_process:
             for key, args in tasks:
-                yield key, fn(*args, cache=self.cache)
+                yield key, fn(*args, cache=self._tasks_cache)
             return
         if self.client is None:
             raise RuntimeError("a campaign on a cluster runs inside `with Campaign(...)`")
         yield from self._on_cluster(fn, tasks)
+
+    def running(self) -> set:
+        """The keys of the tasks out on the cluster now (none in this process: a task there runs as it is asked
+        for). ``completed``'s ``tasks`` may be an iterator that consults it, stopping (StopIteration) while every
+        task it has left must wait for one of these: it is asked again as each task comes back."""
+        return set(self._flying.values())
 
     # ------------------------------------------------------------------------- on a cluster
 
@@ -173,7 +184,7 @@ class Campaign:
         from ..engines.builds import engine_of, executable_of
 
         builds = [(engine_of(s), s, exe) for s in self.sources if (exe := executable_of(s))]
-        cache = (str(self.cache.dir), self.cache.refresh) if self.cache is not None else None
+        cache = (str(self.cache.dir), self.cache.refresh, self.started) if self.cache is not None else None
         return {"builds": builds, "cache": cache}
 
     def _receive(self, fut):
@@ -327,18 +338,53 @@ def _register(builds) -> None:
             discovery.find.cache_clear()
 
 
+class ThisRun:
+    """A refreshing run cache (``--no-cache``, ``refresh``: every deck run again, never one of an earlier run) that
+    reads the entries written since ``since`` (the campaign's start: this run's own), so that a deck two cases of one
+    verify share (the same commands) is run once, not once per case. Anything else is the cache's own."""
+
+    def __init__(self, cache, since: float):
+        self._cache = cache
+        self._since = since
+
+    def __getattr__(self, name):  # put, dir, refresh, hits, misses: the cache's own
+        return getattr(self._cache, name)
+
+    def get(self, k, *args, **kwargs):
+        c = self._cache
+        if not c.refresh or not _written_since(c._path(k), self._since):
+            return c.get(k, *args, **kwargs)
+        c.refresh = False  # one task at a time uses this cache object (a campaign's task, in its thread)
+        try:
+            return c.get(k, *args, **kwargs)
+        finally:
+            c.refresh = True
+
+
+def _written_since(path, since: float) -> bool:
+    try:
+        return path.stat().st_mtime >= since
+    except OSError:
+        return False
+
+
 class _Collecting:
     """A worker's view of the client's engine-run cache: entries are read from its directory (where the worker
-    sees it) as engines.cache.Cache reads them; what a run would store is kept for the client to store."""
+    sees it) as engines.cache.Cache reads them (refreshing: those written since the campaign started, ThisRun);
+    what a run would store is kept for the client to store."""
 
-    def __init__(self, directory: str, refresh: bool):
+    def __init__(self, directory: str, refresh: bool, since: float | None = None):
         from ..engines.cache import Cache
 
         self._cache = Cache(directory, refresh)
+        self._read = ThisRun(self._cache, since) if refresh and since is not None else self._cache
         self.entries: list = []
 
-    def __getattr__(self, name):  # get, dir, refresh, hits, misses: the cache's own
+    def __getattr__(self, name):  # dir, refresh, hits, misses: the cache's own
         return getattr(self._cache, name)
+
+    def get(self, k, *args, **kwargs):
+        return self._read.get(k, *args, **kwargs)
 
     def put(self, k, table, meta) -> bool:
         self.entries.append((k, table, meta))

@@ -30,9 +30,11 @@ def _engine(case, planned, entry: CaseResult, opts, ref: dict) -> None:
     src, mp = planned.source, planned.mapping
     label, comps = src.label, entry.comparisons
     try:
-        res = src.run(case, timeout=opts.timeout, cache=opts.cache)  # the deck its package writes, cached
+        # the twin and the seed run first: where either cannot be made, the row fails without an engine run whose
+        # output nothing would read
         twin = scenario.cached_metrics("twin", case, src.engine, opts.cache)
         seed = scenario.cached_metrics("seed", case, src.engine, opts.cache)
+        res = src.run(case, timeout=opts.timeout, cache=opts.cache)  # the deck its package writes, cached
     except EngineInterrupted:
         raise
     except DemcheckError as exc:

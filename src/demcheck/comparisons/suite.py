@@ -310,6 +310,13 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
         from .result_cache import prune
 
         prune(opts.cache)  # the results of older versions of demcheck (at most one other is kept)
+    shared = None
+    if opts.jobs > 1 or opts.scheduler:  # the cases that share an engine run (Apart), found while the cluster starts
+        from concurrent.futures import ThreadPoolExecutor
+
+        pool = ThreadPoolExecutor(1)
+        shared = pool.submit(sharers, [c for _, c in cases], opts.engines, found)
+        pool.shutdown(wait=False)
     with dispatch.Campaign(opts.jobs, opts.scheduler, cache=opts.cache, sources=opts.engines) as campaign:
         try:
             with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -318,6 +325,8 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                 # the packings first: the longest jobs, so that the collisions fill the other workers meanwhile
                 order = sorted(range(len(cases)), key=lambda i: cases[i][1].kind != "packing")
                 tasks = [(i, (cases[i][1], str(cases[i][0]), shipped, found)) for i in order]
+                if shared is not None:  # two cases that share an engine deck never run it at once
+                    tasks = Apart(tasks, shared.result(), campaign.running)
                 # an interrupt: the engines stopped and none starts; the cases running finish without them (raising
                 # EngineInterrupted: left out) or, needing none, finish and are reported (dispatch.Campaign)
                 for i, entry in campaign.completed(case_task, tasks):
@@ -347,6 +356,61 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
         raise DemcheckError(f"{summary.baseline_error} (after the runs; the report of the finished cases is "
                             f"{out_dir})") from after
     return summary
+
+
+def sharers(cases: list[Case], engines, found: dict) -> dict[int, set[int]]:
+    """{case index: the indices of the other cases that share one of its engine runs}: the same engine on the same
+    deck's commands (engines/collide.run_identity: the comments that name a case left out) — a case and its copy
+    under another name, variants whose difference an engine's mapping cannot express (a truncation rule,
+    limit_force). Collisions and scenarios (a packing's deck is its case's own); a deck that cannot be written here
+    shares nothing (its case reports why)."""
+    from ..engines import collide, scenario
+
+    runs: dict[tuple, set[int]] = {}
+    for i, case in enumerate(cases):
+        if case.kind == "packing":
+            continue
+        for planned in sources.plan(case, engines, found):
+            if not planned.runs:
+                continue
+            engine = planned.source.label
+            try:
+                dk = (collide.setting_deck(case, engine) if case.run.scenario == "collision"
+                      else scenario.deck(case, engine))
+            except Exception:  # noqa: BLE001 - its case's own task meets the same fault and reports it
+                continue
+            deck, files = collide.run_identity(dk)
+            runs.setdefault((engine, deck, tuple(sorted(files.items()))), set()).add(i)
+    out: dict[int, set[int]] = {}
+    for shared in runs.values():
+        for i in shared if len(shared) > 1 else ():
+            out.setdefault(i, set()).update(shared - {i})
+    return out
+
+
+class Apart:
+    """A campaign's tasks (``(index, args)``, comparisons/dispatch.py) in their order, except that a case whose engine
+    run another case shares (:func:`sharers`) waits while that one is out on the cluster (``running()``: their keys):
+    the next one goes first, and the waiting case then reads the run from the cache the other one filled, instead of
+    both making it at once. When every task left waits, it stops (StopIteration) and is asked again as a task comes
+    back (Campaign.running)."""
+
+    def __init__(self, tasks, shared: dict[int, set[int]], running):
+        self.pending = list(tasks)
+        self.shared = shared
+        self.running = running
+
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        if not self.pending:
+            raise StopIteration
+        busy = self.running()
+        for n, (i, _) in enumerate(self.pending):
+            if not self.shared.get(i, set()) & busy:
+                return self.pending.pop(n)
+        raise StopIteration
 
 
 def _judge_baseline(summary: Summary, baseline: dict | None) -> Exception | None:

@@ -204,9 +204,30 @@ def _cached(cache, engine: str, dk: common.Deck, bodies: int):
         from ..errors import EngineNotFound
 
         raise EngineNotFound(discovery.missing(engine))
-    k = cache_key(engine, info.version, dk.text, dk.files)
+    k = cache_key(engine, info.version, *run_identity(dk))
     return k, cache.get(k, columns=("step",) + STATE_COLUMNS, meta_keys=META_KEYS, min_rows=1,
                         check=_every_body(bodies))
+
+
+def run_identity(dk: common.Deck) -> tuple[str, dict[str, str]]:
+    """(deck, files): what of a deck the engine runs, the part of the run cache's key (engines/cache.py) that is the
+    deck's — its text and its files' without their whole-line comments, which name the case, its hash, its model and
+    the mapping's notes, and change nothing the engine does (every deck language demcheck writes, the LAMMPS family's
+    input and data files and Yade's and Kratos' Python, reads a line whose first printable character is "#" as a
+    comment; JSON and mdpa files have no such line). Two cases whose decks differ only there (a case and its copy
+    under another name; variants whose difference the engine's mapping cannot express: a truncation rule,
+    limit_force) share one run. A text that holds a triple quote (a string across lines), or a comment line ending
+    in "&" (the LAMMPS family continues it onto the next line), is kept whole: two decks that may run differently
+    never share a key."""
+    return _commands(dk.text), {name: _commands(text) for name, text in dk.files.items()}
+
+
+def _commands(text: str) -> str:
+    lines = text.splitlines()
+    comments = [line for line in lines if line.lstrip().startswith("#")]
+    if '"""' in text or "'''" in text or any(line.rstrip().endswith("&") for line in comments):
+        return text
+    return "\n".join(line for line in lines if not line.lstrip().startswith("#"))
 
 
 def _result(case: Case, engine: str, sc, mp, out, dk: common.Deck, contact, particles, started: float,

@@ -440,33 +440,108 @@ def _planned_deck(case: Case, eng):
 
 def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
     """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics;
-    with ``cache`` (engines.cache.Cache) a run that ended ok is kept as its metrics, keyed as an engine run is
-    (the engine, its version and build, the deck and its files) and by :func:`code_fingerprint` (the reading and
-    the metrics are demcheck's code): a warm verify does not run the deck again."""
+    with ``cache`` (engines.cache.Cache) a run that ended ok is kept as what the engine's reader made of its output
+    (:func:`_run_table`), keyed as an engine run is (the engine, its version and build, the deck's commands and its
+    files': engines/collide.run_identity): a warm verify does not run the deck again, nor does one after a change to
+    demcheck's code that leaves the deck as it was (the metrics are computed from the kept output each time)."""
     eng, started = _engine(engine), time.perf_counter()
     mp, nat, lay, dk = _planned_deck(case, eng)
+    k = None
     if cache is not None:
         from . import discovery
-        from .cache import key, text, texts
+        from .cache import key
+        from .collide import run_identity
 
         version = discovery.require(eng.name).version
-        k = key(eng.name, version, f"scenario run, demcheck {code_fingerprint()}\0{dk.text}", dk.files)
-        hit = get_metrics(cache, k, metric_names(case),
-                           {"engine_version": text, "warnings": texts})
+        deck_part, files = run_identity(dk)  # its commands: a case's name or notes never make a run of their own
+        k = key(eng.name, version, f"scenario run\0{deck_part}", files)
+        hit = _cached_run(cache, k)
         if hit is not None:
-            return _result(case, eng.name, "engine", hit[0], lay, started, engine_version=hit[1]["engine_version"],
-                           params={"mapping": mp.fidelity, "native": eng.summary(nat)},
-                           message="; ".join(mp.reasons),
-                           meta={"workdir": "", "deck": dk.text, "fidelity": mp.fidelity, "reasons": list(mp.reasons),
-                                 "warnings": hit[1]["warnings"], "cached": True})
-    res = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
-    if cache is not None and res.ok:
-        put_metrics(cache, k, res.metrics(), {"engine_version": res.engine_version,
-                                               "warnings": list(res.meta["warnings"])})
+            data, meta = hit
+            res = _result(case, eng.name, "engine", _metrics(case, data), lay, started,
+                          engine_version=meta["engine_version"], params={"mapping": mp.fidelity,
+                                                                         "native": eng.summary(nat)},
+                          message="; ".join(mp.reasons),
+                          meta={"workdir": "", "deck": dk.text, "fidelity": mp.fidelity, "reasons": list(mp.reasons),
+                                "warnings": meta["warnings"], "cached": True})
+            if res.ok:
+                return res
+    res, data = _run_deck(case, eng, mp, nat, lay, dk, timeout, started)
+    if k is not None and res.ok:
+        _put_run(cache, k, data, {"engine_version": res.engine_version, "warnings": list(res.meta["warnings"])})
     return res
 
 
-def _run_deck(case: Case, eng, mp, nat, lay, dk, timeout, started) -> Result:
+def _run_table(data: dict):
+    """(table, layout) of a scenario run's output as the engine's reader made it (``read_scenario``: arrays of one
+    length, rows × columns or one column, and numbers or flags), for the run cache: each array's columns in the
+    table (an empty one for a run of numbers only), the numbers and flags and each entry's shape in ``layout``; None
+    where the arrays' lengths differ."""
+    import pandas as pd
+
+    columns, layout = {}, {}
+    for name, value in data.items():
+        a = np.asarray(value)
+        if a.ndim == 0:
+            layout[name] = ["flag", bool(a)] if a.dtype == bool else ["number", float(a)]
+            continue
+        a = a.astype(float).reshape(len(a), -1)
+        layout[name] = ["array", a.shape[1] if np.ndim(value) == 2 else 0]
+        for j in range(a.shape[1]):
+            columns[f"{name}.{j}"] = a[:, j]
+    if len({len(c) for c in columns.values()}) > 1:
+        return None
+    return pd.DataFrame(columns), layout
+
+
+def _from_table(table, layout: dict) -> dict:
+    """The run's output from :func:`_run_table`'s (table, layout)."""
+    out = {}
+    for name, (kind, value) in layout.items():
+        if kind == "flag":
+            out[name] = bool(value)
+        elif kind == "number":
+            out[name] = float(value)
+        else:
+            a = np.column_stack([table[f"{name}.{j}"].to_numpy() for j in range(max(1, value))])
+            out[name] = a if value else a[:, 0]
+    return out
+
+
+def _layout_ok(v) -> bool:
+    """A cached scenario run's layout: {name: [flag, bool] | [number, float] | [array, columns]}."""
+    return isinstance(v, dict) and all(
+        isinstance(x, list) and len(x) == 2 and (
+            (x[0] == "flag" and isinstance(x[1], bool)) or (x[0] == "number" and isinstance(x[1], float))
+            or (x[0] == "array" and isinstance(x[1], int) and not isinstance(x[1], bool) and x[1] >= 0))
+        for x in v.values())
+
+
+def _cached_run(cache, k: str):
+    """(the run's output, meta) of a scenario run kept in ``cache``, or None (no entry, or one that does not
+    validate: a miss, engines/cache.py)."""
+    from .cache import text, texts
+
+    def columns(table, meta) -> str | None:
+        want = {f"{n}.{j}" for n, (kind, c) in meta["layout"].items() if kind == "array" for j in range(max(1, c))}
+        missing = sorted(want - set(table.columns))
+        return f"missing column(s) {', '.join(missing)}" if missing else None
+
+    hit = cache.get(k, meta_keys={"engine_version": text, "warnings": texts, "layout": _layout_ok}, check=columns)
+    if hit is None:
+        return None
+    table, meta = hit
+    return _from_table(table, meta["layout"]), meta
+
+
+def _put_run(cache, k: str, data: dict, meta: dict) -> None:
+    kept = _run_table(data)
+    if kept is not None:
+        cache.put(k, kept[0], {**meta, "layout": kept[1]})
+
+
+def _run_deck(case: Case, eng, mp, nat, lay, dk, timeout, started) -> tuple[Result, dict]:
+    """(the Result, the output as the engine's reader made it) of the deck's run."""
     from . import run as runner
 
     out = runner.run(eng.name, dk.text, files=dk.files, timeout=timeout or runner.DEFAULT_TIMEOUT)
@@ -485,4 +560,4 @@ def _run_deck(case: Case, eng, mp, nat, lay, dk, timeout, started) -> Result:
         res.meta["workdir"] = ""
     else:
         res.message += f"; work directory kept: {out.workdir}"
-    return res
+    return res, data
