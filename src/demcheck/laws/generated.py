@@ -1,5 +1,6 @@
-"""A generated module of compiled switches (laws/tangential_dispatch.py, laws/damping_laws/dispatch.py): the source
-written once into numba's kernel cache and imported from there, so that its functions' ``cache=True`` holds."""
+"""A generated module of compiled switches (laws/tangential_dispatch.py, laws/damping_laws/dispatch.py,
+laws/normal_laws/dispatch.py): the source written once into numba's kernel cache and imported from there, so that
+its functions' ``cache=True`` holds."""
 
 from __future__ import annotations
 
@@ -19,8 +20,8 @@ _STAMP = 1_000_000_000  # the file's mtime (2001-09-09): the same bytes, the sam
 def generated_module(name: str, stem: str, text: str):
     """The module ``name`` of the generated source ``text``: written once (atomically) to
     ``$NUMBA_CACHE_DIR/generated/<stem>_<hash of text>.py`` and imported from there, so that ``cache=True`` holds
-    for its functions; compiled from the text where there is no kernel cache. (The tangential and damping switches
-    are both written here.)"""
+    for its functions; compiled from the text where there is no kernel cache. (The tangential, damping and normal
+    switches are all written here.)"""
     path = None
     if KERNEL_CACHE and os.environ.get("NUMBA_CACHE_DIR"):
         digest = hashlib.sha256(text.encode()).hexdigest()[:16]

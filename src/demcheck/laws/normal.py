@@ -1,8 +1,9 @@
 """Normal contact models (seed 000 §3, seed 001), as a registry.
 
 Each model turns a pair's effective properties and the case's ``[contact]`` parameters into a
-:class:`NormalLaw`: plain numbers that the compiled kernels (``kernels.py``) evaluate. Two families
-cover every law of the notes:
+:class:`NormalLaw`: plain numbers that the compiled kernels (laws/normal_force.py) evaluate — the normal law's
+record (one module per law, laws/normal_laws/: hooke, hertz, hls) and the damping law's (laws/damping_laws/).
+Every law of the notes is one of
 
 * viscoelastic power law   F = k δ^a + η δ^b δ̇        (LSDn a=1 b=0; Hertz η=0; BSHPn, KKn b=½; TTIn b=¼)
 * hysteretic linear spring F = min(K_L δ, K_U (δ − δ₀)) ≥ 0, δ₀ = δ_max (1 − K_L/K_U)
@@ -15,24 +16,40 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Callable, ClassVar
+from typing import Callable
 
 import numpy as np
 
 from ..errors import ConfigError
 from . import analytic
-from .base import SubModel
 from .contact import Pair
 from .damping import RECORDS, SEED_FAMILIES, Damping, NoDamping, damping_of
 from .registry import Registry, contact_number
 
-from .normal_laws.hls import FAMILY as HYSTERETIC  # the law array's family ids (laws/normal_laws/)
-from .normal_laws.viscoelastic import FAMILY as VISCOELASTIC
+from . import normal_laws  # noqa: F401  (every normal law registered)
+from .normal_laws.common import RECORDS as NORMAL_RECORDS
+from .normal_laws.common import NormalSubModel
+from .normal_laws.hertz import HertzNormal
+from .normal_laws.hls import HYSTERETIC, HysteresisNormal
+from .normal_laws.hooke import HookeNormal
+
+# the elastic records by their exponent (the one place an exponent names a record: NormalLaw)
+ELASTIC_BY_EXPONENT = {cls.exponent: cls for cls in (HookeNormal, HertzNormal)}
+SPRING_FAMILIES = frozenset(cls.family for cls in ELASTIC_BY_EXPONENT.values())
+# the seed's power-law spring as one family, as the law array had it: a law of any of SPRING_FAMILIES is the
+# record its exponent names (NormalLaw(VISCOELASTIC, a=1.5) is hertz's)
+VISCOELASTIC = HookeNormal.family
 
 
 @dataclass(frozen=True)
 class NormalLaw:
-    family: int
+    """The normal and damping slots' records as the compiled kernels read them: the normal law's family id
+    (laws/normal_laws/) and the union of the records' numbers (a record's numbers fill the columns of their names,
+    or its ``columns``), the damping law's family id and η, b, and limit_force."""
+
+    # the normal law's family id: a seed spring's (SPRING_FAMILIES) is the one its exponent ``a`` names, whatever
+    # is given; None where no record has the exponent (then array() raises, slots() too)
+    family: int | None
     k: float = 0.0
     a: float = 1.0
     eta: float = 0.0
@@ -46,12 +63,15 @@ class NormalLaw:
     damping: int | None = None
 
     def __post_init__(self):
+        if self.family in SPRING_FAMILIES:
+            spring = ELASTIC_BY_EXPONENT.get(self.a)
+            object.__setattr__(self, "family", None if spring is None else spring.family)
         if self.damping is None or self.damping in SEED_FAMILIES:
             object.__setattr__(self, "damping", _seed_damping(self))
 
     def array(self) -> np.ndarray:
         """The law as the compiled kernels read it (kernels.L_FAMILY … L_LIMIT): the only positional form."""
-        if self.damping is None:
+        if self.family is None or self.damping is None:
             self.slots()  # the ValueError naming the exponent no record has
         return np.array([self.family, self.k, self.a, self.eta, self.b, self.kl, self.ku, self.s, self.damping,
                          1.0 if self.limit else 0.0])
@@ -61,95 +81,67 @@ class NormalLaw:
         family, k, a, eta, b, kl, ku, s, damping, limit = (float(x) for x in law)
         return cls(int(family), k=k, a=a, eta=eta, b=b, kl=kl, ku=ku, s=s, limit=limit != 0.0, damping=int(damping))
 
+    def _record(self) -> type[NormalSubModel]:
+        """The normal record class of the law's family (ValueError for an exponent or family no record has)."""
+        if self.family is None:
+            raise ValueError(f"no normal record has the δ^{self.a:g} spring (known: "
+                             f"{', '.join(f'{c.id} δ^{e:g}' for e, c in ELASTIC_BY_EXPONENT.items())})")
+        if self.family not in NORMAL_RECORDS:
+            raise ValueError(f"no normal law has the family id {self.family} (known: "
+                             f"{', '.join(f'{c.id} {f}' for f, c in sorted(NORMAL_RECORDS.items()))})")
+        return NORMAL_RECORDS[self.family]
+
     def loading_overlap(self, force: float) -> float:
-        """The overlap at which the loading branch carries ``force`` at rest: (F/k)^{1/a}, or F/K_L for HLS."""
-        if self.family == HYSTERETIC:
+        """The overlap at which the loading branch carries ``force`` at rest: (F/k)^{1/a}, or F/K_L for a law with
+        loading and unloading branches (hls)."""
+        if self._record().load_unload:
             return force / self.kl
         return (force / self.k) ** (1.0 / self.a)
 
     def characteristic_time(self, m: float, v: float) -> float:
-        """The elastic contact time of the law's spring at speed v (for dt = auto and solver scales)."""
-        if self.family == HYSTERETIC:
+        """The elastic contact time of the law's spring at speed v (for dt = auto and solver scales): its loading
+        branch's, or its power law k δ^a's."""
+        if self._record().load_unload:
             return analytic.power_law_duration(self.kl, 1.0, m, v)
         return analytic.power_law_duration(self.k, self.a, m, v)
 
     def slots(self) -> tuple[NormalSubModel, Damping]:
         """The law as the records of its two slots, normal and damping (ValueError for a spring or dashpot
         exponent no record has)."""
-        if self.family == HYSTERETIC:
+        record = self._record()
+        normal = record.from_law(self)
+        if record.load_unload:
             if self.eta != 0.0:
-                raise ValueError("a hysteretic normal law has no dashpot")
-            return HysteresisNormal(kl=self.kl, ku=self.ku, s=self.s), NoDamping()
-        if self.a not in ELASTIC_BY_EXPONENT:
-            raise ValueError(f"no normal record has the δ^{self.a:g} spring (known: hooke δ^1, hertz δ^1.5)")
+                raise ValueError(f"the normal law {record.id!r} (loading and unloading branches) has no dashpot")
+            return normal, NoDamping()
         if self.damping is not None and self.damping not in SEED_FAMILIES:
-            return ELASTIC_BY_EXPONENT[self.a](k=self.k), RECORDS[self.damping](eta=self.eta)
-        return ELASTIC_BY_EXPONENT[self.a](k=self.k), damping_of(self.eta, self.b)
+            return normal, RECORDS[self.damping](eta=self.eta)
+        return normal, damping_of(self.eta, self.b)
 
     @classmethod
     def from_slots(cls, normal: NormalSubModel, damping: Damping, limit: bool) -> "NormalLaw":
         """The kernels' law of a normal and a damping record (the inverse of :meth:`slots`)."""
-        if isinstance(normal, HysteresisNormal):
+        record = type(normal)
+        if NORMAL_RECORDS.get(record.family) is not record:
+            raise ValueError(f"the normal record {record.id!r} has no compiled law (family {record.family!r})")
+        if record.load_unload:
             if not isinstance(damping, NoDamping):
-                raise ValueError(f"the hysteretic normal law takes no dashpot (damping {damping.id!r})")
-            return cls(HYSTERETIC, kl=normal.kl, ku=normal.ku, s=normal.s, limit=limit)
-        return cls(VISCOELASTIC, k=normal.k, a=normal.exponent, eta=getattr(damping, "eta", 0.0),
-                   b=damping.exponent, limit=limit, damping=damping.family)
+                raise ValueError(f"the normal law {record.id!r} (loading and unloading branches) takes no dashpot "
+                                 f"(damping {damping.id!r})")
+            return cls(record.family, **normal.law_numbers(), limit=limit)
+        return cls(record.family, **normal.law_numbers(), eta=getattr(damping, "eta", 0.0), b=damping.exponent,
+                   limit=limit, damping=damping.family)
 
 
 def _seed_damping(law: NormalLaw) -> int | None:
-    """The family of a seed law's dashpot: none for the hysteretic spring, else the record its (η, b) name."""
-    if law.family == HYSTERETIC:
+    """The family of a seed law's dashpot: none for a law with loading and unloading branches, else the record its
+    (η, b) name."""
+    if law.family in NORMAL_RECORDS and NORMAL_RECORDS[law.family].load_unload:
         return NoDamping.family
     try:
         return damping_of(law.eta, law.b).family
     except ValueError:
         return None
-
-
-# ----------------------------------------------------------------------------- the normal slot's records
-
-
-@dataclass(frozen=True)
-class NormalSubModel(SubModel):
-    slot: ClassVar[str] = "normal"
-
-
-@dataclass(frozen=True)
-class HookeNormal(NormalSubModel):
-    """F = k δ (a linear spring)."""
-
-    id: ClassVar[str] = "hooke"
-    title: ClassVar[str] = "linear spring k δ"
-    exponent: ClassVar[float] = 1.0
-    k: float = 0.0  # N/m
-
-
-@dataclass(frozen=True)
-class HertzNormal(NormalSubModel):
-    """F = k δ^{3/2}, k = (4/3) Ē √R̄ for the seed's Hertz law."""
-
-    id: ClassVar[str] = "hertz"
-    title: ClassVar[str] = "Hertz spring k δ^{3/2}"
-    exponent: ClassVar[float] = 1.5
-    k: float = 0.0  # N/m^1.5
-
-
-@dataclass(frozen=True)
-class HysteresisNormal(NormalSubModel):
-    """F = min(K_L δ, K_U (δ − δ₀)) ≥ 0 with K_U = ku (> 0), or K_L + s·F_max (ku = 0); its history is the
-    largest overlap δ_max."""
-
-    id: ClassVar[str] = "hls"
-    title: ClassVar[str] = "hysteretic linear spring"
-    history_size: ClassVar[int] = 1
-    kl: float = 0.0  # N/m
-    ku: float = 0.0  # N/m; 0: variable unloading
-    s: float = 0.0  # 1/m
-
-
-# the elastic records by their exponent (the one place an exponent names a record: NormalLaw.slots)
-ELASTIC_BY_EXPONENT = {cls.exponent: cls for cls in (HookeNormal, HertzNormal)}
 
 
 @dataclass(frozen=True)
@@ -269,12 +261,12 @@ def _resolve_lsd(pair: Pair, params: dict, limit: bool):
         raise ConfigError("contact.eta_n", eta,
                           f"must be below the critical damping 2√(m̄Kn) = {2 * math.sqrt(pair.m_eff * kn):.6g}")
     out.update(kn=kn, eta_n=eta)
-    return NormalLaw(VISCOELASTIC, k=kn, a=1.0, eta=eta, b=0.0, limit=limit), out
+    return NormalLaw(HookeNormal.family, k=kn, a=1.0, eta=eta, b=0.0, limit=limit), out
 
 
 def _resolve_hertz(pair: Pair, params: dict, limit: bool):
     k = analytic.hertz_stiffness(pair.r_eff, pair.e_eff)
-    return NormalLaw(VISCOELASTIC, k=k, a=1.5, limit=limit), {"k_hz": k}
+    return NormalLaw(HertzNormal.family, k=k, a=1.5, limit=limit), {"k_hz": k}
 
 
 def _resolve_bshp(pair: Pair, params: dict, limit: bool):
@@ -285,7 +277,7 @@ def _resolve_bshp(pair: Pair, params: dict, limit: bool):
     if a_bar is None:
         raise ConfigError("materials.*.dissipative_constant", None,
                           "missing: normal model 'bshp' needs the materials' dissipative constant A (s)")
-    return (NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=k * a_bar, b=0.5, limit=limit),
+    return (NormalLaw(HertzNormal.family, k=k, a=1.5, eta=k * a_bar, b=0.5, limit=limit),
             {"k_hz": k, "dissipative_constant": a_bar, "eta_n": k * a_bar})
 
 
@@ -297,7 +289,7 @@ def _resolve_kk(pair: Pair, params: dict, limit: bool):
             raise ConfigError("contact.eta_n", None,
                               "missing: required by normal model 'kk' (or the materials' dissipative_constant)")
         eta = k * pair.dissipative_constant
-    return NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=eta, b=0.5, limit=limit), {"k_hz": k, "eta_n": eta}
+    return NormalLaw(HertzNormal.family, k=k, a=1.5, eta=eta, b=0.5, limit=limit), {"k_hz": k, "eta_n": eta}
 
 
 def _resolve_tti(pair: Pair, params: dict, limit: bool):
@@ -305,7 +297,7 @@ def _resolve_tti(pair: Pair, params: dict, limit: bool):
     eta = _get(params, "eta_n", rule="must be >= 0 (N·s/m^1.25)", check=_nonneg)
     if eta is None:
         eta = analytic.tti_eta_from_restitution(pair.m_eff, k, _restitution(pair, "tti"))
-    return NormalLaw(VISCOELASTIC, k=k, a=1.5, eta=eta, b=0.25, limit=limit), {"k_hz": k, "eta_n": eta}
+    return NormalLaw(HertzNormal.family, k=k, a=1.5, eta=eta, b=0.25, limit=limit), {"k_hz": k, "eta_n": eta}
 
 
 def _resolve_hls(pair: Pair, params: dict, limit: bool):

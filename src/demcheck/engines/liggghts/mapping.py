@@ -58,6 +58,8 @@ def _map_normal(model: ResolvedModel, contact, nat: Native, comments: list[str])
     normal, damp, pair, p = contact.normal, contact.damping, model.pair, nat.props
     m, r = pair.m_eff, pair.r_eff
     eta = getattr(damp, "eta", 0.0)
+    if type(normal) not in (HookeNormal, HertzNormal):
+        return refused("liggghts", f"no LIGGGHTS normal model for the normal record '{normal.id}'")
     if type(normal) is HookeNormal and (eta == 0.0 or type(damp) in (NoDamping, ConstantDamping)):
         nat.normal = "hooke/stiffness"
         p.update(kn=normal.k, gamman=eta / m, kt=0.0, gammat=0.0)

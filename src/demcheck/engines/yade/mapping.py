@@ -55,6 +55,8 @@ def map_model(model: ResolvedModel, cp: dict) -> Mapping:
     fid = EXACT
     if type(normal) is HysteresisNormal:
         return _luding(model)
+    if type(normal) not in (HookeNormal, HertzNormal):
+        return refused("yade", f"no Yade law for the normal record '{normal.id}'")
     if type(normal) is HookeNormal and (eta == 0.0 or type(damp) in (NoDamping, ConstantDamping)):
         nat = Native("yade", normal=VISCEL, limit=True)
         nat.props.update(kn=normal.k, cn=eta, ks=0.0, cs=0.0, mu=0.0)
