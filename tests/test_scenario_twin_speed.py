@@ -87,8 +87,9 @@ def test_a_metric_that_is_not_finite_is_cached_as_not_finite(tmp_path, monkeypat
 
 @pytest.mark.engine("lammps")
 def test_a_scenario_engine_run_is_cached_by_its_deck(tmp_path, monkeypatch):
-    """An ok engine run is kept as its metrics: the second run of the same deck reads them (the same numbers, the
-    engine's version, ok) without running the engine; another deck runs."""
+    """An ok engine run is kept as what the engine's reader made of its output (keyed by the deck's commands and the
+    engine's version): the second run of the same deck reads it and computes the same metrics (the same numbers,
+    the engine's version, ok) without running the engine; another deck runs."""
     from demcheck.engines import run as runner
 
     c = load(case_path("suite/beyond-conduction.toml"))
