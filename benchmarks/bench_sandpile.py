@@ -7,6 +7,8 @@ A full run is 2.5 million steps of up to 3000 spheres (~7.4e9 particle-steps): m
 
 Run: .venv/bin/python benchmarks/bench_sandpile.py constant [--duration S] [--threads N] \
          > benchmarks/results/bench_sandpile_constant.txt
+(one thread by default: at a few thousand spheres two threads' barriers cost more than they share, ~20× on a loaded
+machine; bench_sandpile_MODEL.partial.csv holds each measure as it comes, with the wall time)
 The curve (every measure: t, height) goes to benchmarks/results/bench_sandpile_MODEL.csv when the run reaches the
 measures' start (10 s); the digitised curves are the validate catalogue's to judge against (docs/benchmarks.md).
 """
@@ -38,7 +40,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("model", choices=["constant", "epsd"])
     parser.add_argument("--duration", type=float, default=None, help="s (default: the case's 50 s)")
-    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args()
     path = ROOT / "src" / "demcheck" / "cases" / "optin" / f"ai2011-sandpile-{args.model}.toml"
     case = C.load(path)
@@ -48,7 +50,15 @@ def main():
     print(f"# case {path.relative_to(ROOT)}; {duration:g} s at dt {dt:g} s = {total} steps; {work:.4g} particle-steps;"
           f" {args.threads} thread(s)")
     t0 = time.perf_counter()
-    times, heights = S.height_curve(case, threads=args.threads, duration=args.duration)
+    partial = ROOT / "benchmarks" / "results" / f"bench_sandpile_{args.model}.partial.csv"
+    with open(partial, "w") as log:  # every measure as it comes: a long run's progress, kept if it is stopped
+        log.write("t_s,height_m,wall_s\n")
+
+        def progress(t, h):
+            log.write(f"{t:.10g},{h:.10g},{time.perf_counter() - t0:.1f}\n")
+            log.flush()
+
+        times, heights = S.height_curve(case, threads=args.threads, duration=args.duration, progress=progress)
     wall = time.perf_counter() - t0
     print(f"wall time {wall:.1f} s (compilation included); {work / wall:.4g} particle-steps/s; "
           f"load after {os.getloadavg()}")

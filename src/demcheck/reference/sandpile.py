@@ -23,11 +23,13 @@ def measure_steps(case, dt: float) -> np.ndarray:
     return np.array([packing.step_at(h.start + k * h.every, dt) for k in range(count)], np.int64)
 
 
-def height_curve(case, threads: int = 1, duration: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def height_curve(case, threads: int = 1, duration: float | None = None,
+                 progress=None) -> tuple[np.ndarray, np.ndarray]:
     """(times, heights) of the case's heap (numpy arrays, s and m): the packing run by the reference solver
-    (``threads`` of its loop; ``duration``: instead of packing.duration, a shorter run for a size check — the
-    measures up to it), measured as its ``[packing.height]`` table says. A case without that table is a ConfigError,
-    before any work."""
+    (``threads`` of its loop: one is the fastest for a heap of a few thousand on a shared machine, docs/packing.md;
+    ``duration``: instead of packing.duration, a shorter run for a size check — the measures up to it), measured as
+    its ``[packing.height]`` table says; ``progress(t, height)`` is called at each measure (a long run's log). A case
+    without that table is a ConfigError, before any work."""
     from ..case import packing_run
     from ..errors import ConfigError
 
@@ -43,6 +45,8 @@ def height_curve(case, threads: int = 1, duration: float | None = None) -> tuple
     def look(st):
         times.append(st.steps * dt)
         heights.append(float((st.x @ axis).max()) + offset)
+        if progress is not None:
+            progress(times[-1], heights[-1])
 
     packing.simulate(case, duration=duration, threads=threads, observe=(steps, look))
     return np.array(times), np.array(heights)
