@@ -7,8 +7,8 @@ A full run is 2.5 million steps of up to 3000 spheres (~7.4e9 particle-steps): m
 
 Run: .venv/bin/python benchmarks/bench_sandpile.py constant [--duration S] [--threads N] \
          > benchmarks/results/bench_sandpile_constant.txt
-(one thread by default: at a few thousand spheres two threads' barriers cost more than they share: 7× the wall time on a loaded
-machine; bench_sandpile_MODEL.partial.csv holds each measure as it comes, with the wall time)
+(one thread by default: at a few thousand spheres two threads' barriers cost more than they share: 7× the wall
+time on a loaded machine; bench_sandpile_MODEL.partial.csv holds each measure as it comes, with the wall time)
 The curve (every measure: t, height) goes to benchmarks/results/bench_sandpile_MODEL.csv when the run reaches the
 measures' start (10 s); the digitised curves are the validate catalogue's to judge against (docs/benchmarks.md).
 """
