@@ -121,6 +121,29 @@ def test_type_b_speed_decays_as_the_closed_form():
     assert np.allclose(v / v0, np.exp(-t / tau), rtol=1e-6, atol=0.0)
 
 
+def test_type_c_fully_mobilised_decelerates_as_type_a_beside_a_history_tangential_law():
+    """Type C (epsd, Ai et al.'s: the dashpot off at the limit) with a stiff spring is fully mobilised within 0.1 ms
+    of the start; from then on its torque is μr R |Fn|, type A's, and the sphere decelerates at (5/7) μr g — to 1e-9
+    over the middle of the roll. Its spring torque rides in the contact's state row after Tsuji–Mindlin's tangential
+    history (the traits' path, which reads its own columns only), Hertz's static overlap (mg/K)^{2/3} at the start."""
+    mu_r, v0, dt = 0.05, 0.05, 1e-6
+    t_stop, _ = rolling_stop_closed(mu_r, R, R, v0, G)
+    mass = 2500.0 * 4.0 / 3.0 * math.pi * R ** 3
+    k_hz = 4.0 / 3.0 * 1e8 / (1.0 - 0.3 ** 2) * math.sqrt(R)
+    case = C.loads(SPHERE.format(v0=v0, w0=v0 / R, kn=KN, rolling=f'rolling = "epsd"\nmu_r = {mu_r}\nk_r = 1e-6\n'
+                                 'c_r = 1e-9', dt=dt).replace('normal = "lsd"\nkn = 1000000.0\ntangential = '
+                                                              '"lsd_sliding"', 'normal = "tti"\ntangential = "tti"'))
+    st = P.PackState(case)
+    assert st.roll_col >= 3 and st.hist.shape[1] == st.roll_col + 3
+    st.x[0, 2] = R - (mass * G / k_hz) ** (2.0 / 3.0)
+    rows = []
+    P.simulate(case, duration=0.8 * t_stop, state=st, rules=ARMS, observe=(range(0, 200001, 500), lambda s: rows.append(
+        (s.steps * dt, s.v[0, 0]))))
+    t, v = np.array(rows).T
+    mid = (t > 0.2 * t_stop) & (t < 0.7 * t_stop)
+    assert -np.polyfit(t[mid], v[mid], 1)[0] == pytest.approx(5.0 / 7.0 * mu_r * G, rel=1e-9)
+
+
 PAIR = """
 name = "rolling-pair"
 kind = "packing"

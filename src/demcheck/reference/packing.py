@@ -358,7 +358,10 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     The rolling slot (``roll_kind`` ≥ 0: the law's place in packing_rolling's switch; -1 none, and nothing of it is
     computed): row p of ``laws_r`` is the law's record for the contact's law row p; its torque M(w = ω_i − ω_j, n,
     |Fn|) goes to i and −M to j (a wall takes −M); a law with a history keeps it in columns roll_col… of the
-    contact's state row (roll_col -1: none), updated only with ``update`` (the set-up call passes dt = 0 to it).
+    contact's state row (roll_col -1: none), updated only with ``update``: the set-up call gives the law its step's
+    increment too but stores nothing (as LIGGGHTS's rolling models do), so that a spring held at its limit stays
+    there across a chunk's set-up — with no increment it would sit exactly on the limit, below it by the law's
+    test, and its dashpot would come back for that one call (type C's, 0.8 % more torque at a set-up every 500 steps).
 
     A row's contacts are computed, and their states updated, by whoever computes the row: the rows lo…hi−1 may
     be one thread's share, writing f and tq only for its own particles, its far buffers for the others'
@@ -372,7 +375,7 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     rwbuf = np.empty(3)  # the rolling law's w, n and history
     rnbuf = np.empty(3)
     rhbuf = np.zeros(3)
-    roll_dt = dt if update else 0.0
+    t_width = roll_col if roll_col >= 0 else hist.shape[1]  # the tangential law's columns of a state row
     segments = walls.shape[1] > W_PLANE  # a wall table with segments' columns (wall_table); a plane's is 6 wide
     rot = rules[R_ROTATION]
     slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
@@ -469,8 +472,8 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
             else:
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
                 vtbuf[0], vtbuf[1], vtbuf[2] = vt0, vt1, vt2
-                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r], abs(fn), dt, update, ftbuf, rot,
-                                  zero3)
+                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r, :t_width], abs(fn), dt, update,
+                                  ftbuf, rot, zero3)
                 ft0, ft1, ft2 = ftbuf[0], ftbuf[1], ftbuf[2]
             f0, f1, f2 = -fn * n0 + ft0, -fn * n1 + ft1, -fn * n2 + ft2
             # torques (b n) × F_t
@@ -492,8 +495,8 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                     records[e, 0], records[e, 1] = delta, fn
                     records[e, 2] = math.sqrt(ft0 ** 2 + ft1 ** 2 + ft2 ** 2)
             if roll_kind >= 0:
-                _rolling(i, j, hi, r, p, w, n0, n1, n2, abs(fn), roll_dt, update, laws_r, roll_kind, roll_col, hist,
-                         tq, tq_far, rwbuf, rnbuf, rhbuf)
+                _rolling(i, j, hi, r, p, w, n0, n1, n2, abs(fn), dt, update, laws_r, roll_kind, roll_col, hist, tq,
+                         tq_far, rwbuf, rnbuf, rhbuf)
 
 
 # a wall's row (wall_table): its point and normal (W_PLANE columns: a plane's whole row), then, in a table with a
