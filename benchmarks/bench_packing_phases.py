@@ -200,7 +200,7 @@ def fit(n: int, duration: float) -> None:
             t = time.thread_time()
             P._contact_forces(a, e, st.x, st.v, st.w, st.rad, sp, laws_n.shape[0], *table, walls,
                               P._period(lo, hi, periodic), st.start, st.nbj, hist, dmax, f, tq, f, tq,
-                              np.zeros((0, 3)), 1e-6, np.bool_(True), rules_array(None))
+                              np.zeros((0, 3)), 1e-6, np.bool_(True), rules_array(None), *P.NO_ROLLING)
             best = min(best, time.thread_time() - t)
         base = n * n_w + st.start[a], n * n_w + st.start[e]
         rows.append([e - a, st.start[e] - st.start[a], int((dmax[base[0]:base[1]] != 0).sum()),

@@ -166,10 +166,13 @@ gravity = [0.0, 0.0, -9.81]
 
 
 @pytest.mark.parametrize("value", ["0.05", '"tall"', "[1, 2]"])
-def test_packing_height_is_an_unknown_key(value):
+def test_packing_height_is_a_table_not_a_value(value):
+    """[packing.height] is a heap's height measure (axis, offset, every, start: tests/test_sandpile.py); a number,
+    a word or a list there is refused in one line."""
     with pytest.raises(ConfigError) as info:
         C.loads(PACKING.replace("duration = 0.01", f"duration = 0.01\nheight = {value}"))
-    assert info.value.key == "packing.height" and "unknown key" in info.value.rule
+    assert info.value.key == "packing.height" and "must be a table" in info.value.rule
+    assert "\n" not in str(info.value)
 
 
 def test_a_misspelt_packing_key_gets_a_suggestion():

@@ -28,7 +28,7 @@ def _unfused(case, st, dt, steps):
     x, v, w, rad, mass, n = st.x, st.v, st.w, st.rad, st.mass, len(st.rad)
     inertia, period, skin, _, _, x_ref, f, tq, start, nbj, hist, dmax, _ = P._setup(
         x, v, w, rad, mass, sp, laws_n.shape[0], lawn, lawt, walls, lo, hi, periodic, dt, steps, 1, st.start, st.nbj,
-        st.hist, st.dmax, rules)
+        st.hist, st.dmax, rules, *P.NO_ROLLING)
     ke, rebuilds = [], 0
     for _ in range(steps):
         v += 0.5 * dt * (f / mass[:, None] + g)
@@ -46,7 +46,7 @@ def _unfused(case, st, dt, steps):
             rebuilds += 1
         f[:], tq[:] = 0.0, 0.0
         P._contact_forces(np.int64(0), n, x, v, w, rad, sp, laws_n.shape[0], lawn, lawt, walls, period, start, nbj,
-                          hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules)
+                          hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules, *P.NO_ROLLING)
         v += 0.5 * dt * (f / mass[:, None] + g)
         w += 0.5 * dt * tq / inertia[:, None]
         e = 0.0
@@ -110,7 +110,7 @@ def test_pairs_and_walls_each_keep_their_own_law_in_the_force_loop():
         hist, dmax = np.zeros((states, 4)), np.zeros(states)
         f, tq = np.zeros((n, 3)), np.zeros((n, 3))
         P._contact_forces(np.int64(0), n, x, v, w, rad, species, len(rep), lawn, lawt, walls, (0.0, 0.0), start,
-                          nbj, hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules)
+                          nbj, hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules, *P.NO_ROLLING)
         assert (dmax > 0.0).all()  # every contact touching
         return f, tq
 

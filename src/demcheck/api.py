@@ -607,6 +607,11 @@ def _pack_checks(case, engine: str, duration, mpi: int, threads, k: dict, names:
     if engine != "reference" and isinstance(threads, int) and not isinstance(threads, bool) and threads > 1:
         raise ConfigError(k["threads"], _shown(threads), f"applies to the reference ({k['engine']} reference); an "
                           f"engine runs on MPI ranks ({k['mpi']})")
+    if engine != "reference":
+        from .comparisons.packing_suite import engine_blind
+
+        if (why := engine_blind(case)) is not None:
+            raise ConfigError(k["engine"], engine, why)
     try:
         threads = packing.check_threads(threads)  # no more than numba may start here
     except ConfigError as exc:

@@ -60,6 +60,10 @@ class Wall:
     normal: tuple[float, float, float]  # unit, pointing into the domain
     rigid: bool = True
     material: str | None = None
+    # a packing's segment: the strip p + s·along + t·(normal × along), extent[0] ≤ s ≤ extent[1], t unbounded
+    along: tuple[float, float, float] | None = None  # unit, in the wall's plane
+    extent: tuple[float, float] | None = None  # m
+    until: float | None = None  # s: a packing's wall removed at this time (a hopper's gate)
 
 
 @dataclass(frozen=True)
@@ -93,16 +97,46 @@ class Run:
 
 
 @dataclass(frozen=True)
+class Insertion:
+    """[packing.insertion] of an inserted packing: ``batches`` batches of ``batch`` particles, one every ``every``
+    seconds from t = 0, each at rest on a lattice of pitch ``spacing`` largest diameters filling the box ``region``
+    (x fastest, then y, then z), each site moved by up to ``offset`` largest diameters at random along the region's
+    axes of nonzero extent."""
+
+    every: float  # s
+    batch: int
+    batches: int
+    region: tuple[tuple[float, float, float], tuple[float, float, float]]  # m: two opposite corners, lo and hi
+    spacing: float = 1.5
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class Height:
+    """[packing.height]: the height of a heap, the largest centre coordinate along ``axis`` plus ``offset`` (m),
+    every ``every`` seconds from ``start`` (reference/sandpile.height_curve)."""
+
+    axis: tuple[float, float, float]  # unit
+    offset: float
+    every: float  # s
+    start: float  # s
+
+
+@dataclass(frozen=True)
 class Packing:
     """A packing case's [packing] table, validated: how its particles were laid out and how long it settles."""
 
-    layout: str  # column | layer | poured
+    layout: str  # column | layer | poured | inserted
     count: int
     material: str
     radii: tuple[float, ...]
-    box: tuple[float, float] | None  # the periodic box in x and y (m); None for a column
+    box: tuple[float, float] | None  # the periodic box in x and y (m); None for a column or an inserted packing
     seed: int
     duration: float | None  # s
+    # each radius's share of the particles' volume (None: equal numbers of each radius)
+    volume_fractions: tuple[float, ...] | None = None
+    insertion: Insertion | None = None  # an inserted packing's batches
+    height: Height | None = None  # the heap's height measure
 
 
 @dataclass(frozen=True)
@@ -420,15 +454,19 @@ MATERIAL_KEYS = {
     "dissipative_constant", "tangential_restitution", "specific_heat",
 }
 PARTICLE_KEYS = {"material", "radius", "position", "velocity", "angular_velocity"}
-WALL_KEYS = {"point", "normal", "rigid", "material"}
+WALL_KEYS = {"point", "normal", "rigid", "material", "along", "extent", "until"}
+SEGMENT_TOL = 1e-9  # a segment's ``along``: unit, and normal to the wall's normal, within this
 RUN_KEYS = {"dt", "steps_per_contact", "gravity", "rtol", "method", "verlet_rtol", "scenario", "temperatures",
             "overlap"}
 SCENARIOS = ("collision", "rolling", "incline", "twist", "pull_off", "adhesive_impact", "conduction")
 IMPACT_KEYS = {"speed", "angle", "gap", "spin"}
 TOP_KEYS = {"name", "kind", "materials", "particles", "walls", "contact", "run", "impact", "description", "variants",
             "packing", "engine"}
-PACKING_KEYS = {"layout", "count", "material", "radius", "radii", "box", "seed", "duration"}
-LAYOUTS = ("column", "layer", "poured")
+PACKING_KEYS = {"layout", "count", "material", "radius", "radii", "box", "seed", "duration", "volume_fractions",
+                "insertion", "height"}
+LAYOUTS = ("column", "layer", "poured", "inserted")
+INSERTION_KEYS = {"every", "batch", "batches", "region", "spacing", "offset"}
+HEIGHT_KEYS = {"axis", "offset", "every", "start"}
 
 
 def _material(name: str, d: dict) -> Material:
@@ -538,7 +576,7 @@ def from_dict(raw: dict) -> Case:
 
     particles = _particles(parts_raw, materials, impact)
     _check_masses([(p["material"], p["radius"]) for p in particles], materials)  # before anything uses a mass
-    walls = _walls(raw.get("walls", []) or [], materials)
+    walls = _walls(raw.get("walls", []) or [], materials, kind)
     run = _run(raw.get("run", {}) or {}, kind)
     natives = _natives(raw.get("engine"), kind)
     contact = _contact(raw.get("contact", {}) or {})
@@ -553,6 +591,7 @@ def from_dict(raw: dict) -> Case:
                               "a collision has two particles, or one particle and one wall")
     parts = tuple(Particle(**p) for p in particles)
     _check_geometry(parts, tuple(walls))
+    _check_batches(packing, tuple(walls))
 
     resolved_raw = plain_copy(raw)
     resolved_raw.pop("impact", None)
@@ -580,6 +619,19 @@ def from_dict(raw: dict) -> Case:
     return case
 
 
+def _check_batches(packing: Packing | None, walls: tuple[Wall, ...]) -> None:
+    """An inserted packing's later batches clear of the walls too (the first is the case's particles)."""
+    if packing is None or packing.insertion is None:
+        return
+    for b, batch in enumerate(insertion_batches(packing)[1:], start=1):
+        try:
+            _check_geometry(tuple(Particle(**p) for p in batch), walls)
+        except ConfigError as exc:
+            raise ConfigError("packing.insertion.region", [list(c) for c in packing.insertion.region],
+                              f"places batch {b}'s {exc.key.split('.')[0]} {exc.key.split('.')[1]} at "
+                              f"{exc.value}, which {exc.rule}") from None
+
+
 def _particles(parts_raw: list, materials: dict, impact) -> list[dict]:
     """The [[particles]] entries checked, as keyword dicts of Particle (positions may wait for an [impact])."""
     particles = []
@@ -601,8 +653,8 @@ def _particles(parts_raw: list, materials: dict, impact) -> list[dict]:
     return particles
 
 
-def _walls(walls_raw: list, materials: dict) -> list[Wall]:
-    """The [[walls]] entries checked."""
+def _walls(walls_raw: list, materials: dict, kind: str = "collision") -> list[Wall]:
+    """The [[walls]] entries checked (a packing's may be segments and timed: :func:`_segment`)."""
     walls = []
     for i, d in enumerate(walls_raw):
         where = f"walls.{i}"
@@ -619,8 +671,46 @@ def _walls(walls_raw: list, materials: dict) -> list[Wall]:
             raise ConfigError(f"{where}.material", mat, "a non-rigid wall needs a defined material")
         if rigid and mat is not None and mat not in materials:
             raise ConfigError(f"{where}.material", mat, "is not a defined material")
-        walls.append(Wall(point=point, normal=normal, rigid=rigid, material=mat))
+        walls.append(Wall(point=point, normal=normal, rigid=rigid, material=mat, **_segment(d, where, normal, kind)))
     return walls
+
+
+def _segment(d: dict, where: str, normal: tuple, kind: str) -> dict:
+    """A wall's optional ``along`` and ``extent`` (a strip of its plane: the points p + s·along + t·(normal × along),
+    s0 ≤ s ≤ s1) and ``until`` (removed at that time), which the packing solver reads (reference/packing.py); a
+    collision's solvers and the engines' decks take plane walls only."""
+    keys = [k for k in ("along", "extent", "until") if k in d]
+    if keys and kind != "packing":
+        raise ConfigError(f"{where}.{keys[0]}", d[keys[0]], "is read by packing cases only (a collision's wall is a "
+                                                            "plane, there from the start)")
+    out = {}
+    if "extent" in d and "along" not in d:
+        raise ConfigError(f"{where}.extent", d["extent"], "needs along = [ex, ey, ez], the unit vector in the wall's "
+                                                          "plane that s runs along")
+    if "along" in d and "extent" not in d:
+        raise ConfigError(f"{where}.along", d["along"], "is read with extent = [s0, s1] (m), the strip's bounds")
+    if "along" in d:
+        along = np.asarray(_vector(d, "along", where, required=True))
+        if not abs(float(np.linalg.norm(along)) - 1.0) <= SEGMENT_TOL:
+            raise ConfigError(f"{where}.along", d["along"], f"must be a unit vector (|along| = 1 within "
+                                                            f"{SEGMENT_TOL:g}; it is {float(np.linalg.norm(along)):.12g})")
+        if not abs(float(along @ np.asarray(normal))) <= SEGMENT_TOL:
+            raise ConfigError(f"{where}.along", d["along"], f"must lie in the wall's plane (along · normal = 0 within "
+                                                            f"{SEGMENT_TOL:g}; it is {float(along @ normal):.3g})")
+        along = along - float(along @ np.asarray(normal)) * np.asarray(normal)  # exactly in the plane, unit
+        out["along"] = tuple(float(c) for c in along / np.linalg.norm(along))
+        ext = d["extent"]
+        if not (isinstance(ext, list) and len(ext) == 2 and all(
+                isinstance(b, (int, float)) and not isinstance(b, bool) and math.isfinite(b) for b in ext)):
+            raise ConfigError(f"{where}.extent", ext, "must be [s0, s1]: two finite lengths in m along `along` "
+                                                      "from point")
+        if not ext[0] < ext[1]:
+            raise ConfigError(f"{where}.extent", ext, "must be [s0, s1] with s0 < s1 (m)")
+        out["extent"] = (float(ext[0]), float(ext[1]))
+    if "until" in d:
+        out["until"] = _number(d, "until", where, rule="must be > 0 (s): the time the wall is removed",
+                               check=_positive)
+    return out
 
 
 def _run(run_raw: dict, kind: str) -> Run:
@@ -1113,8 +1203,11 @@ def packing_spec(p: dict | None, materials) -> Packing:
     else:
         radii = [_number(p, "radius", "packing", rule="must be > 0 (m)", check=_positive)]
     rmax = max(radii)
+    fractions = _fractions(p, radii)
     box = p.get("box")
-    if layout == "column":
+    if layout == "inserted" and box is not None:
+        raise ConfigError("packing.box", box, "an inserted packing has no periodic box (its container is its walls)")
+    if layout in ("column", "inserted"):
         box = None
     elif box is None:
         side = 2.0 * rmax * math.ceil(math.sqrt(count)) * (1.0 + 1e-3) if layout == "layer" else None
@@ -1133,8 +1226,144 @@ def packing_spec(p: dict | None, materials) -> Packing:
         raise ConfigError("packing.seed", seed, "must be an integer")
     duration = _number(p, "duration", "packing", required=False, default=None, rule="must be > 0 (s)",
                        check=_positive)
+    insertion = _insertion(p, layout, count, rmax, duration)
+    height = _height(p, duration)
     return Packing(layout=layout, count=count, material=mat, radii=tuple(radii),
-                   box=tuple(float(b) for b in box) if box is not None else None, seed=seed, duration=duration)
+                   box=tuple(float(b) for b in box) if box is not None else None, seed=seed, duration=duration,
+                   volume_fractions=fractions, insertion=insertion, height=height)
+
+
+def _fractions(p: dict, radii: list) -> tuple[float, ...] | None:
+    """packing.volume_fractions: one positive share per radius, summing to 1 (within 1e-9)."""
+    if "volume_fractions" not in p:
+        return None
+    f = p["volume_fractions"]
+    if p.get("layout") != "inserted":
+        raise ConfigError("packing.volume_fractions", f, "is read with layout = \"inserted\" only (the other "
+                                                         "layouts take equal numbers of each radius)")
+    if not (isinstance(f, list) and len(f) == len(radii) and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0 for v in f)):
+        raise ConfigError("packing.volume_fractions", f, f"must be {len(radii)} shares > 0, one per radius "
+                                                         "(packing.radii)")
+    if abs(sum(f) - 1.0) > 1e-9:
+        raise ConfigError("packing.volume_fractions", f, f"must sum to 1 (they sum to {sum(f):.12g})")
+    return tuple(float(v) for v in f)
+
+
+def _table(p: dict, key: str, keys: set) -> dict | None:
+    t = p.get(key)
+    if t is None:
+        return None
+    if not isinstance(t, dict):
+        raise ConfigError(f"packing.{key}", t, "must be a table")
+    _known_keys(t, keys, f"packing.{key}")
+    return t
+
+
+def _count(t: dict, key: str, where: str) -> int:
+    v = t.get(key)
+    if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+        raise ConfigError(f"{where}.{key}", v, "must be an integer >= 1")
+    return v
+
+
+def _insertion(p: dict, layout: str, count: int, rmax: float, duration: float | None) -> Insertion | None:
+    """[packing.insertion], which an inserted packing needs and no other layout reads."""
+    t = _table(p, "insertion", INSERTION_KEYS)
+    if layout != "inserted":
+        if t is not None:
+            raise ConfigError("packing.insertion", t, "is read with layout = \"inserted\" only")
+        return None
+    if t is None:
+        raise ConfigError("packing.insertion", None, "missing: an inserted packing needs its batches (every, batch, "
+                                                     "batches, region)")
+    where = "packing.insertion"
+    every = _number(t, "every", where, rule="must be > 0 (s)", check=_positive)
+    batch, batches = _count(t, "batch", where), _count(t, "batches", where)
+    if batch * batches != count:
+        raise ConfigError(f"{where}.batches", batches, f"batches × batch = {batches * batch} must be packing.count "
+                                                       f"= {count}")
+    if duration is not None and (batches - 1) * every >= duration:
+        raise ConfigError(f"{where}.every", every, f"inserts the last batch at {(batches - 1) * every:g} s, not "
+                                                   f"before the end of the run (packing.duration = {duration:g} s)")
+    region = t.get("region")
+    if not (isinstance(region, list) and len(region) == 2 and all(
+            isinstance(c, list) and len(c) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                        and math.isfinite(v) for v in c) for c in region)):
+        raise ConfigError(f"{where}.region", region, "must be [[x0, y0, z0], [x1, y1, z1]]: two opposite corners (m)")
+    lo, hi = (tuple(float(v) for v in c) for c in region)
+    if any(b < a for a, b in zip(lo, hi)):
+        raise ConfigError(f"{where}.region", region, "must be [lo, hi] with lo <= hi along each axis")
+    spacing = _number(t, "spacing", where, required=False, default=1.5, rule="must be >= 1 (largest diameters)",
+                      check=lambda v: v >= 1)
+    offset = _number(t, "offset", where, required=False, default=0.0, rule="must be >= 0 (largest diameters)",
+                     check=lambda v: v >= 0)
+    if spacing - 2.0 * offset < 1.0:
+        raise ConfigError(f"{where}.offset", offset, f"moves two neighbours of the lattice into each other: spacing "
+                                                     f"- 2 offset = {spacing - 2 * offset:g} must be >= 1")
+    ins = Insertion(every=every, batch=batch, batches=batches, region=(lo, hi), spacing=spacing, offset=offset)
+    sites = int(np.prod(_lattice_counts(ins, rmax)))
+    if sites < batch:
+        raise ConfigError(f"{where}.region", region, f"holds {sites} lattice sites at a pitch of {spacing:g} "
+                                                     f"largest diameters ({2 * rmax * spacing:.4g} m): a batch "
+                                                     f"needs {batch}")
+    return ins
+
+
+def _height(p: dict, duration: float | None) -> Height | None:
+    """[packing.height]: what the heap's height is and when it is measured."""
+    t = _table(p, "height", HEIGHT_KEYS)
+    if t is None:
+        return None
+    where = "packing.height"
+    axis = _unit(_vector(t, "axis", where, required=True), f"{where}.axis")
+    offset = _number(t, "offset", where, required=False, default=0.0)
+    every = _number(t, "every", where, rule="must be > 0 (s)", check=_positive)
+    start = _number(t, "start", where, required=False, default=0.0, rule="must be >= 0 (s)", check=lambda v: v >= 0)
+    if duration is not None and start > duration:
+        raise ConfigError(f"{where}.start", start, f"must not be past the end of the run (packing.duration = "
+                                                   f"{duration:g} s)")
+    return Height(axis=axis, offset=offset, every=every, start=start)
+
+
+def _lattice_counts(ins: Insertion, rmax: float) -> tuple[int, int, int]:
+    """The insertion lattice's sites along x, y, z: the region's length over the pitch (one site along an axis of
+    zero extent, at the region's lo)."""
+    pitch = 2.0 * rmax * ins.spacing
+    return tuple(1 if b == a else int(math.floor((b - a) / pitch)) for a, b in zip(*ins.region))
+
+
+def insertion_batches(spec: Packing) -> list[list[dict]]:
+    """The particles of an inserted packing, batch by batch (each a list of Particle keyword dicts), seeded: batch b
+    from numpy's generator seeded with (seed, b). Sites x fastest, then y, then z, from the region's lo corner (the
+    first site half a pitch in, or at lo along an axis of zero extent); each moved by up to ``offset`` largest
+    diameters (uniform) along the axes of nonzero extent; radii drawn with the numbers' shares the volume fractions
+    give (n_i ∝ φ_i / r_i³), or in turn where none are given."""
+    ins, radii = spec.insertion, spec.radii
+    rmax = max(radii)
+    pitch = 2.0 * rmax * ins.spacing
+    counts = _lattice_counts(ins, rmax)
+    lo, hi = (np.asarray(c, float) for c in ins.region)
+    flat = hi == lo
+    first = np.where(flat, lo, lo + 0.5 * pitch)
+    if spec.volume_fractions is not None:
+        share = np.asarray(spec.volume_fractions) / np.asarray(radii) ** 3
+        share = share / share.sum()
+    out = []
+    for b in range(ins.batches):
+        rng = np.random.default_rng([spec.seed, b])
+        batch = []
+        for k in range(ins.batch):
+            i, rest = k % counts[0], k // counts[0]
+            j, l = rest % counts[1], rest // counts[1]
+            pos = first + pitch * np.array([i, j, l], float)
+            jitter = rng.uniform(-1.0, 1.0, 3) * ins.offset * 2.0 * rmax
+            pos = np.where(flat, pos, pos + jitter)
+            r = radii[int(rng.choice(len(radii), p=share))] if spec.volume_fractions is not None else \
+                radii[(b * ins.batch + k) % len(radii)]
+            batch.append({"material": spec.material, "radius": float(r), "position": [float(c) for c in pos]})
+        out.append(batch)
+    return out
 
 
 # What a packing costs in memory per particle, measured: building the case (~2.5 KiB at the peak, tracemalloc, for
@@ -1170,6 +1399,8 @@ def generate_packing(spec: Packing) -> list[dict]:
     """The initial positions of a packing (seeded): a vertical column of spheres just apart, a square layer
     on the floor, or spheres on a loose jittered lattice above the floor to be poured. The floor is z = 0."""
     radii, n, mat = spec.radii, spec.count, spec.material
+    if spec.layout == "inserted":  # the first batch: the others join the run (reference/packing.simulate)
+        return insertion_batches(spec)[0]
     gap = 1e-3
     out = []
     if spec.layout == "column":
@@ -1247,6 +1478,20 @@ def _first_overlap(x: np.ndarray, r: np.ndarray) -> tuple[int, int, float] | Non
     return int(i[k]), int(j[k]), float(touch[k] - d[k])
 
 
+def wall_distance(w: Wall, x: np.ndarray) -> np.ndarray:
+    """The distance of each centre x (N × 3) from a wall: its height over the plane ((x − p)·n, negative behind it:
+    a plane wall is a half-space); for a segment (a thin plate, touched from either side) the height's magnitude
+    where the centre projects into its strip, else its distance to the strip's nearer edge line (what the packing
+    solver's contact takes: reference/packing.py)."""
+    d = x - np.asarray(w.point)
+    h = d @ np.asarray(w.normal)
+    if w.extent is None:
+        return h
+    s = d @ np.asarray(w.along)
+    beyond = np.clip(s, *w.extent) - s
+    return np.where(beyond == 0.0, np.abs(h), np.hypot(beyond, h))
+
+
 def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) -> None:
     x = np.array([p.position for p in particles], float)
     r = np.array([p.radius for p in particles], float)
@@ -1256,7 +1501,7 @@ def _check_geometry(particles: tuple[Particle, ...], walls: tuple[Wall, ...]) ->
         raise ConfigError(f"particles.{j}.position", list(particles[j].position),
                           f"overlaps particle {i} by {by:.3g} m: particles must not start overlapping")
     for k, w in enumerate(walls):
-        s = (x - np.asarray(w.point)) @ np.asarray(w.normal)
+        s = wall_distance(w, x)
         bad = np.flatnonzero(s < r * (1 - 1e-12))
         if bad.size:
             i = int(bad[0])
@@ -1350,6 +1595,8 @@ def packing_run(case: Case, duration: float | None = None, dt: float | None = No
         raise ConfigError("packing.duration", None, "missing: how long to let the packing settle (s)")
     step = dt or packing_step(case)
     n, steps = len(case.particles), duration / step
+    if case.packing is not None and case.packing.insertion is not None:
+        n = case.packing.count  # every batch in by the end
     if steps <= MAX_PACKING_STEPS and n * steps <= MAX_PARTICLE_STEPS:
         return step, duration, int(math.ceil(steps))
     default = duration / packing_step(case, Run.steps_per_contact)  # the steps at the default auto step

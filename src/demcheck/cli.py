@@ -347,6 +347,10 @@ def deck(case_path, engine, output, dt, overrides):
                                           "scenario's layout fixes its step (the one verify runs)")
         dk = scenario.deck(case, source.engine)
     elif case.kind == "packing":
+        from .comparisons.packing_suite import engine_blind
+
+        if (why := engine_blind(case)) is not None:  # a deck without them would run another packing
+            raise ConfigError("--engine", engine, why)
         dk = finite(source.engine.packing_deck(case, dt=dt), case)
     else:  # the case's [engine.NAME] setting at its own step: the deck `collide --engine` runs
         dk = setting_deck(case, source.engine, dt)

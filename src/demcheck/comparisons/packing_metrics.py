@@ -10,7 +10,8 @@ produced them, so the reference and the engines' dumps are measured the same way
   by one column's share, not by a diameter); without a box, the highest particle top;
 * kinetic_energy: the last value of the series — translational, in every source (the engines' thermo `ke`;
   without rolling or twisting resistance a sphere rolling or spinning about its contact normal keeps its
-  rotational energy indefinitely, so rotation says nothing about whether a packing has settled).
+  rotational energy indefinitely, so rotation says nothing about whether a packing has settled; a rolling law,
+  where the case names one, resists the rolling but not a spin about the normal, so the same holds).
 * the contact network: every particle–particle contact's branch vector (centre to centre, by minimum
   image in periodic x and y) and the fabric tensor φ_ij = (1/N_c) Σ n_i n_j of their unit vectors (Satake's,
   trace 1): ``fabric`` (3 × 3), ``fabric_zz`` and ``fabric_anisotropy`` = √(3/2 a′:a′) of the anisotropy

@@ -133,8 +133,32 @@ def reference_packing(case, cache=None):
     return st.x.copy(), st.rad.copy(), contacts, list(st.ke), st.time, seconds
 
 
-def run_packing(case, opts, found, file=None) -> CaseResult:
+def engine_blind(case) -> str | None:
+    """What of a packing case the engines' packing decks (inputs/packing_decks) do not write — a rolling law, a
+    segment wall, a timed wall — as the reason an engine is not run on it; None where they write it all. Run
+    without it, an engine would settle another packing, and a verdict on it would judge what was not asked."""
+    what = []
+    if case.contact.rolling != "none":
+        what.append(f"the rolling law '{case.contact.rolling}'")
+    if any(w.extent is not None for w in case.walls):
+        what.append("segment walls (extent)")
+    if any(w.until is not None for w in case.walls):
+        what.append("timed walls (until)")
+    if not what:
+        return None
+    return f"the packing decks do not write {', '.join(what)}: only the reference solves this packing"
+
+
+def _engine_mapping(case, name, _native):
+    """A packing's engine mapping (its type pair's), refused where the decks cannot write the case (engine_blind)."""
+    from ..engines.base import refused
     from ..engines.mapping import pair_mapping
+
+    why = engine_blind(case)
+    return refused(name, why) if why else pair_mapping(case, name, 0, 0)
+
+
+def run_packing(case, opts, found, file=None) -> CaseResult:
     from ..engines.packing import run_engine
     from ..reference import packing
 
@@ -142,7 +166,8 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
 
     entry = CaseResult(case.name, str(file), case.hash, "packing", packing={}, impact={}, scales={})
     normal, tangential = models_of(case)
-    entry.model = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force}
+    entry.model = {"normal": normal.id, "tangential": tangential.id, "limit_force": case.contact.limit_force,
+                   **({"rolling": case.contact.rolling} if case.contact.rolling != "none" else {})}
     box = case.packing.box if case.packing else None
     comps = entry.comparisons
     x, rad, contacts, ke, t_end, seconds = reference_packing(case, opts.cache)
@@ -155,7 +180,7 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
     entry.packing["reference"] = PackingPanel(ke, packing_metrics.force_distribution(ref_forces),
                                               packing_metrics.profile(x, rad, box) if box else None)
 
-    for planned in sources.plan(case, opts.engines, found, lambda c, name, _: pair_mapping(c, name, 0, 0)):
+    for planned in sources.plan(case, opts.engines, found, _engine_mapping):
         if not entry.note_plan(planned):
             continue
         engine = planned.source.label

@@ -130,16 +130,23 @@ def check_contact(case: Case) -> None:
         resolve(case)
 
 
+# the slots beyond sliding the packing solver runs (reference/packing.py: every law of the slot, by its record)
+PACKING_SLOTS = ("rolling",)
+
+
 def _check_wired(case: Case, ids: dict) -> None:
-    """The slots beyond sliding reach the scenario solvers (reference/scenarios.py) only: a collision or a
-    packing that names one would silently ignore it, so it is refused."""
+    """The slots beyond sliding reach the scenario solvers (reference/scenarios.py), and the packing solver the
+    rolling slot (PACKING_SLOTS); a collision or a packing that names another would silently ignore it, so it is
+    refused."""
     if getattr(case.run, "scenario", "collision") != "collision":
         return
     for slot, id_ in ids.items():
-        if id_ != "none":
+        if id_ != "none" and not (case.kind == "packing" and slot in PACKING_SLOTS):
+            where = ("the collision solvers do not model it yet" if slot in PACKING_SLOTS else
+                     "the collision and packing solvers do not model it yet")
             raise ConfigError(f"contact.{slot}", id_, "is solved in the scenarios beyond sliding only (run.scenario = "
-                              "rolling, incline, twist, pull_off, adhesive_impact or conduction); the collision "
-                              "and packing solvers do not model it yet")
+                              "rolling, incline, twist, pull_off, adhesive_impact or conduction)"
+                              f"{' and in packings' if slot in PACKING_SLOTS else ''}; {where}")
 
 
 def characteristic_time(model: ResolvedModel) -> float:

@@ -34,6 +34,7 @@ from ..laws.tangential_force import (discrete_slip, eta_of, F_DISCRETE_SLIP, F_H
                                      F_REVERSAL, has, history_rate, kt_of, return_map, reverses, slip_surface,
                                      tangential_force)
 from ..laws.tangential_laws.spring import SPRING, spring_slip  # the one fast path's law (_spring_law: its scalars)
+from .packing_rolling import rolling_laws, rolling_torque
 from .kernels3d import ARM_RADIUS, R_ROTATION, R_SLIP_ARM, R_TORQUE_ARM, R_WALL_SLIP_ARM, R_WALL_TORQUE_ARM, wall_arm
 from .verlet3d import project_history, turn_history
 from ..laws.tangential import T_FORCE, T_FAMILY, T_MU_K, T_MU_S, T_RESCALE, T_SIZE, T_TRUNC, TangentialLaw
@@ -248,6 +249,9 @@ def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, 
     return new_start, new_j, new_hist, new_dmax
 
 
+# the rolling slot's arguments of the compiled loop where the case names no rolling law (laws_r, roll_kind, roll_col)
+NO_ROLLING = (np.zeros((1, 1)), np.int64(-1), np.int64(-1))
+
 NL_SIZE = L_LIMIT + 1  # the length of a normal law's array (kernels.py)
 
 
@@ -342,7 +346,7 @@ def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
 
 @njit(cache=KERNEL_CACHE)
 def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
-                    hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules):
+                    hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules, laws_r, roll_kind, roll_col):
     """Forces and torques of the contacts of particles lo…hi−1 (their pairs in the Verlet list, j > i, and
     their walls), added into ``f`` and ``tq`` — for a particle j ≥ hi into ``f_far`` and ``tq_far`` instead (the
     same arrays when lo…hi−1 are all the rows). A contact's state (history, largest overlap) is row r of
@@ -350,6 +354,14 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     list entry; a contact that has ended is forgotten (its state zeroed) when next seen apart. Laws: row
     si·n_species + sj of ``laws_n``/``laws_t`` for a pair of species si, sj, row n_species² + si for the walls.
     ``records`` (one row per list entry, or none): each touching pair's (δ, Fn, |Ft|).
+
+    The rolling slot (``roll_kind`` ≥ 0: the law's place in packing_rolling's switch; -1 none, and nothing of it is
+    computed): row p of ``laws_r`` is the law's record for the contact's law row p; its torque M(w = ω_i − ω_j, n,
+    |Fn|) goes to i and −M to j (a wall takes −M); a law with a history keeps it in columns roll_col… of the
+    contact's state row (roll_col -1: none), updated only with ``update``: the set-up call gives the law its step's
+    increment too but stores nothing (as LIGGGHTS's rolling models do), so that a spring held at its limit stays
+    there across a chunk's set-up — with no increment it would sit exactly on the limit, below it by the law's
+    test, and its dashpot would come back for that one call (type C's, 0.8 % more torque at a set-up every 500 steps).
 
     A row's contacts are computed, and their states updated, by whoever computes the row: the rows lo…hi−1 may
     be one thread's share, writing f and tq only for its own particles, its far buffers for the others'
@@ -360,6 +372,11 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     vtbuf = np.empty(3)
     ftbuf = np.empty(3)
     zero3 = np.zeros(3)
+    rwbuf = np.empty(3)  # the rolling law's w, n and history
+    rnbuf = np.empty(3)
+    rhbuf = np.zeros(3)
+    t_width = roll_col if roll_col >= 0 else hist.shape[1]  # the tangential law's columns of a state row
+    segments = walls.shape[1] > W_PLANE  # a wall table with segments' columns (wall_table); a plane's is 6 wide
     rot = rules[R_ROTATION]
     slip_radius = rules[R_SLIP_ARM] == ARM_RADIUS
     torque_radius = rules[R_TORQUE_ARM] == ARM_RADIUS
@@ -406,18 +423,23 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                     pair_nl, pair_tl = _law(laws_n, laws_t, p)
                     law = p
                 nl, tl = pair_nl, pair_tl
-            else:  # wall k: a plane through p with normal nw into the domain
+            else:  # wall k: a plane through p with normal nw into the domain (or a strip of it: a segment)
                 k = e - end
                 j, bj = -1, 0.0
                 r = i * n_w + k
                 delta = rad[i] - ((x[i, 0] - walls[k, 0]) * walls[k, 3] + (x[i, 1] - walls[k, 1]) * walls[k, 4]
                                   + (x[i, 2] - walls[k, 2]) * walls[k, 5])
+                n0, n1, n2 = -walls[k, 3], -walls[k, 4], -walls[k, 5]  # from the particle into the wall
+                if segments and walls[k, W_S0] > -math.inf:  # a strip: none unless |h| < R (its plane's distance
+                    if delta > 0.0 and delta < 2.0 * rad[i]:  # bounds every point's of it: most walls stop here)
+                        delta, n0, n1, n2 = _segment_contact(x, i, rad[i], walls, k, delta, n0, n1, n2)
+                    else:
+                        delta = -1.0
                 if not delta > 0.0:
                     if dmax[r] != 0.0:
                         dmax[r] = 0.0
                         hist[r, :] = 0.0
                     continue
-                n0, n1, n2 = -walls[k, 3], -walls[k, 4], -walls[k, 5]  # from the particle into the wall
                 ai = wall_arm(rules[R_WALL_SLIP_ARM], rad[i], delta)
                 bi = wall_arm(rules[R_WALL_TORQUE_ARM], rad[i], delta)
                 rate = v[i, 0] * n0 + v[i, 1] * n1 + v[i, 2] * n2
@@ -450,8 +472,8 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
             else:
                 nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
                 vtbuf[0], vtbuf[1], vtbuf[2] = vt0, vt1, vt2
-                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r], abs(fn), dt, update, ftbuf, rot,
-                                  zero3)
+                _other_tangential(laws_n[p], laws_t[p], delta, nbuf, vtbuf, hist[r, :t_width], abs(fn), dt, update,
+                                  ftbuf, rot, zero3)
                 ft0, ft1, ft2 = ftbuf[0], ftbuf[1], ftbuf[2]
             f0, f1, f2 = -fn * n0 + ft0, -fn * n1 + ft1, -fn * n2 + ft2
             # torques (b n) × F_t
@@ -472,6 +494,84 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                 if record:
                     records[e, 0], records[e, 1] = delta, fn
                     records[e, 2] = math.sqrt(ft0 ** 2 + ft1 ** 2 + ft2 ** 2)
+            if roll_kind >= 0:
+                _rolling(i, j, hi, r, p, w, n0, n1, n2, abs(fn), dt, update, laws_r, roll_kind, roll_col, hist, tq,
+                         tq_far, rwbuf, rnbuf, rhbuf)
+
+
+# a wall's row (wall_table): its point and normal (W_PLANE columns: a plane's whole row), then, in a table with a
+# segment, its direction along the strip, the strip's extent [s0, s1] (−inf, inf: a plane), and for each of the strip's
+# two edge lines (s0's, then s1's) whether it is this wall's (1) or another's (0: a corner shared with an earlier
+# wall) and up to two other walls whose strips end on that line (−1: none)
+W_PLANE, W_ALONG, W_S0, W_S1, W_EDGES = 6, 6, 9, 10, 11
+W_EDGE = 3  # columns per edge line: its own?, sharer, sharer
+W_WIDTH = W_EDGES + 2 * W_EDGE
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _segment_contact(x, i, radius, walls, k, delta, n0, n1, n2):
+    """The contact of sphere i with the strip of wall k (a segment: its plane's points p + s·a + t·(n × a) with
+    s0 ≤ s ≤ s1, a thin plate, touched from either side): (δ, the normal from the sphere into the wall). Where the
+    centre projects inside [s0, s1] it is the plane's — on the normal's side (height h ≥ 0) the plane wall's own (δ,
+    n given), behind it its mirror (δ = R + h, along +n: the plate pushes the sphere back where it is); outside, the
+    nearer edge line's — δ = R − ρ, ρ the centre's distance to the line, along the line's normal through the centre
+    — unless that line is another wall's too (a corner: one contact, its first wall's) or the centre projects inside
+    the strip of a wall sharing it (that face holds the sphere); then none."""
+    d0, d1, d2 = x[i, 0] - walls[k, 0], x[i, 1] - walls[k, 1], x[i, 2] - walls[k, 2]
+    s = d0 * walls[k, W_ALONG] + d1 * walls[k, W_ALONG + 1] + d2 * walls[k, W_ALONG + 2]
+    h = d0 * walls[k, 3] + d1 * walls[k, 4] + d2 * walls[k, 5]  # the centre's height over the plane
+    if s >= walls[k, W_S0] and s <= walls[k, W_S1]:
+        if h >= 0.0:
+            return delta, n0, n1, n2
+        return radius + h, -n0, -n1, -n2
+    col = W_EDGES if s < walls[k, W_S0] else W_EDGES + W_EDGE
+    if walls[k, col] == 0.0:  # the corner's contact is its first wall's
+        return -1.0, n0, n1, n2
+    for c in range(col + 1, col + W_EDGE):
+        o = int(walls[k, c])
+        if o >= 0:
+            so = ((x[i, 0] - walls[o, 0]) * walls[o, W_ALONG] + (x[i, 1] - walls[o, 1]) * walls[o, W_ALONG + 1]
+                  + (x[i, 2] - walls[o, 2]) * walls[o, W_ALONG + 2])
+            if so >= walls[o, W_S0] and so <= walls[o, W_S1]:
+                return -1.0, n0, n1, n2
+    se = walls[k, W_S0] if s < walls[k, W_S0] else walls[k, W_S1]
+    q0 = (s - se) * walls[k, W_ALONG] + h * walls[k, 3]  # from the edge line to the centre
+    q1 = (s - se) * walls[k, W_ALONG + 1] + h * walls[k, 4]
+    q2 = (s - se) * walls[k, W_ALONG + 2] + h * walls[k, 5]
+    rho = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+    if rho == 0.0:  # the centre on the line: the plane's normal
+        return radius, n0, n1, n2
+    return radius - rho, -q0 / rho, -q1 / rho, -q2 / rho
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _rolling(i, j, hi, r, p, w, n0, n1, n2, fabs, dt, update, laws_r, roll_kind, roll_col, hist, tq, tq_far, wbuf,
+             nbuf, hbuf):
+    """The rolling torque of contact state row r (particle i with j, or a wall: j = -1), law row p: M on i, −M on
+    j (into ``tq_far`` for a particle j ≥ hi, another share's), its history (columns roll_col…) updated with
+    ``update``."""
+    if j >= 0:
+        wbuf[0], wbuf[1], wbuf[2] = w[i, 0] - w[j, 0], w[i, 1] - w[j, 1], w[i, 2] - w[j, 2]
+    else:
+        wbuf[0], wbuf[1], wbuf[2] = w[i, 0], w[i, 1], w[i, 2]
+    nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
+    if roll_col >= 0:
+        hbuf[0], hbuf[1], hbuf[2] = hist[r, roll_col], hist[r, roll_col + 1], hist[r, roll_col + 2]
+    m, h = rolling_torque(roll_kind, laws_r[p], wbuf, nbuf, fabs, dt, hbuf)
+    if update and roll_col >= 0:
+        hist[r, roll_col], hist[r, roll_col + 1], hist[r, roll_col + 2] = h[0], h[1], h[2]
+    tq[i, 0] += m[0]
+    tq[i, 1] += m[1]
+    tq[i, 2] += m[2]
+    if j >= 0:
+        if j < hi:
+            tq[j, 0] -= m[0]
+            tq[j, 1] -= m[1]
+            tq[j, 2] -= m[2]
+        else:
+            tq_far[j, 0] -= m[0]
+            tq_far[j, 1] -= m[1]
+            tq_far[j, 2] -= m[2]
 
 
 @njit(cache=KERNEL_CACHE)
@@ -570,7 +670,7 @@ def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
 
 @njit(cache=KERNEL_CACHE)
 def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps,
-           ke_every, start, nbj, hist, dmax, rules):
+           ke_every, start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col):
     """What a run starts from: a new Verlet list (its pair states carried over) and the forces of the initial
     state, computed without touching histories (as the engines do). Returns (inertia, period, skin, the kinetic
     energy series and the flags to fill, the positions at the rebuild, f, tq, the list and its states, the
@@ -585,7 +685,7 @@ def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo
     records = _new_records(start) if steps == 0 else np.zeros((0, 3))  # records at the last step only
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it)
     _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
-                    hist, dmax, f, tq, f, tq, records, dt, np.bool_(False), rules)
+                    hist, dmax, f, tq, f, tq, records, dt, np.bool_(False), rules, laws_r, roll_kind, roll_col)
     return (0.4 * mass * rad * rad, period, skin, np.zeros(steps // ke_every + 1), np.zeros(2, np.int64), x.copy(),
             f, tq, start, nbj, hist, dmax, records)
 
@@ -701,18 +801,20 @@ def _energy(ke, flags, step, ke_every, e, e_rot):
 
 @njit(cache=KERNEL_CACHE, nogil=True)
 def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt, steps,
-        ke_every, start, nbj, hist, dmax, contacts, rules, clock):
+        ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w modified in place; the contact states
     travel with the Verlet list, rebuilt here, the walls' first). Returns (translational kinetic energy every
     ke_every steps, number of pair contacts at the end (their records in ``contacts``), flags [unused,
     non-finite], and the Verlet list with its contact states: start, nbj, hist, dmax). The kinetic energy is
-    translational, as the engines' thermo `ke`: these laws have no rolling or twisting resistance, so a
-    sphere rolling or spinning about its contact normal keeps its rotational energy in every source. One
+    translational, as the engines' thermo `ke` (the rotational energy only tells whether the run stays finite):
+    without a rolling law (the case's rolling slot: ``laws_r``, ``roll_kind``, ``roll_col``, :func:`_rolling`) a
+    sphere rolling or spinning about its contact normal keeps its rotational energy in every source; with one its
+    rolling is resisted, a spin about the normal still is not (no twisting slot here). One
     thread; :func:`run_threaded` is the same on several. ``clock``: a timed run's (2 rows of 2 × PHASES), or empty."""
     n_p = x.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
-        start, nbj, hist, dmax, rules)
+        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col)
     # one pass over the particles a step besides the force loop: the second half kick fused with the next step's
     # first half kick and drift (_kick_and_next), as the threaded loop does
     moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
@@ -732,7 +834,7 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
             records = _new_records(start)
         t = _add(clock, serial, S_OTHER, t)
         _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start,
-                        nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules)
+                        nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules, laws_r, roll_kind, roll_col)
         t = _add(clock, 0, F_WORK, t)
         e, e_rot, moved = _kick_and_next(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi,
                                          periodic, x_ref, step < steps)
@@ -850,7 +952,7 @@ def _gather(lo, hi, chunks, far, f_far, tq_far, f, tq):
 
 @njit(cache=KERNEL_CACHE, nogil=True, parallel=True)
 def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt,
-                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, clock, threads):
+                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col, threads):
     """:func:`run` on ``threads`` threads (numba's, prange). The particles, and with them the rows of the
     Verlet list, are cut into as many shares of about equal work (:func:`_balance`, again at each rebuild, which
     is threaded too). A share's contacts are computed by one thread, which alone updates their states (a pair's
@@ -866,7 +968,7 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
     n_w = walls.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
-        start, nbj, hist, dmax, rules)
+        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col)
     chunks = np.empty(threads + 1, np.int64)  # each share's rows of the list, and its particles
     far = np.empty(threads, np.int64)  # each share's far buffer holds particles below far[share] only
     kicks = np.empty(threads + 1, np.int64)  # the kick region's shares of the particles
@@ -909,7 +1011,8 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
         for c in prange(threads):
             began = _begin(clock, c, F_LAUNCH, t)
             _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
-                            start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules)
+                            start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules,
+                            laws_r, roll_kind, roll_col)
             ends[c] = _add(clock, c, F_WORK, began)[0]
         t = _waits(clock, ends, F_WAIT, t)
         for b in prange(threads):
@@ -1005,30 +1108,143 @@ def packing_dt(case) -> float:
     return packing_step(case)
 
 
+def with_batches(case):
+    """The case with every particle it will hold: an inserted packing's batches all in (case.insertion_batches, in
+    order: batch 0 is the case's own particles), for its laws and species; any other case as it is."""
+    from dataclasses import replace
+
+    from ..case import Particle, insertion_batches
+
+    if case.packing is None or case.packing.insertion is None:
+        return case
+    return replace(case, particles=tuple(Particle(**p) for batch in insertion_batches(case.packing) for p in batch))
+
+
 class PackState:
-    """The state of a packing run (arrays the compiled kernel updates in place)."""
+    """The state of a packing run (arrays the compiled kernel updates in place). An inserted packing's state holds
+    the particles inserted so far (the first ``len(x)`` of ``full``'s; :meth:`insert_batches`)."""
 
     def __init__(self, case):
-        n = len(case.particles)
         self.case = case
-        self.x = np.array([p.position for p in case.particles], float)
-        self.v = np.array([p.velocity for p in case.particles], float)
-        self.w = np.array([p.angular_velocity for p in case.particles], float)
-        self.rad = np.array([p.radius for p in case.particles], float)
-        self.mass = np.array([case.mass(i) for i in range(n)], float)
-        _, _, laws_t, _, wall_t = resolve_laws(case)
+        self.full = full = with_batches(case)
+        n = len(full.particles)
+        self.x = np.array([p.position for p in full.particles], float)
+        self.v = np.array([p.velocity for p in full.particles], float)
+        self.w = np.array([p.angular_velocity for p in full.particles], float)
+        self.rad = np.array([p.radius for p in full.particles], float)
+        self.mass = np.array([full.mass(i) for i in range(n)], float)
+        self.species_all = species_of(full)[0]
+        self._all = (self.x, self.v, self.w, self.rad, self.mass)
+        _, _, laws_t, _, wall_t = resolve_laws(full)
         rows = [*laws_t.reshape(-1, T_SIZE), *(wall_t if case.walls else ())]
         width = history_width([TangentialLaw.from_array(t).slot() for t in rows])
+        # the rolling law's: (kind, its history's columns, its table) — its history after the tangential one's
+        self.rolling = rolling_laws(full, species_of(full)[1])
+        self.roll_col = width if self.rolling[1] else -1
+        width += self.rolling[1]
         # the contact states (history, largest overlap): particle i's with wall k in row i·n_walls + k, then
         # each pair of the Verlet list (compressed rows; built by run()) beside its entry
-        self.start = np.zeros(n + 1, np.int64)
+        ins = case.packing.insertion if case.packing is not None else None
+        if ins is not None:
+            self._take(ins.batch)  # the first batch: the others join the run
+        now = len(self.x)
+        self.start = np.zeros(now + 1, np.int64)
         self.nbj = np.zeros(0, np.int64)
-        self.hist = np.zeros((n * len(case.walls), width))
-        self.dmax = np.zeros(n * len(case.walls))
+        self.hist = np.zeros((now * len(case.walls), width))
+        self.dmax = np.zeros(now * len(case.walls))
         self.contacts = np.zeros((8 * n + 16, 5))
         self.n_contacts = 0
         self.time = 0.0
         self.ke = []  # (t, kinetic energy)
+        self.walls = tuple(case.walls)  # the walls present (a timed wall is removed: remove_walls)
+        self.steps = 0  # steps run from the start (a timed wall's removal counts them)
+        # an inserted packing's batches after the first: (time, particles in once it is in)
+        self.batches = [] if ins is None else [(b * ins.every, (b + 1) * ins.batch) for b in range(1, ins.batches)]
+
+    @property
+    def species(self) -> np.ndarray:
+        """The species of the particles present."""
+        return self.species_all[:len(self.x)]
+
+    def _take(self, n: int) -> None:
+        """The first n particles of ``full`` present, those present before kept as they are."""
+        have = len(self.x)
+        arrays = [np.concatenate([mine, every[have:n]]) if n > have else every[:n].copy()
+                  for mine, every in zip((self.x, self.v, self.w, self.rad, self.mass), self._all)]
+        self.x, self.v, self.w, self.rad, self.mass = arrays
+
+    def next_insertion(self, dt: float) -> int:
+        """The step (from the start) after which the next batch is inserted; a huge number where none is left."""
+        return step_at(self.batches[0][0], dt) if self.batches else 2 ** 62
+
+    def insert_batches(self, dt: float) -> bool:
+        """Inserts the batches whose time has come (after ``steps`` steps): the new particles join at rest with no
+        contact state (the walls' rows of the state grow, the pairs' follow; the next run's list finds their
+        pairs). A new particle overlapping one already there is a ConfigError naming the insertion region.
+        Returns whether any was inserted."""
+        from ..errors import ConfigError
+
+        done = False
+        while self.batches and step_at(self.batches[0][0], dt) <= self.steps:
+            t, n = self.batches.pop(0)
+            have, n_w = len(self.x), len(self.walls)
+            self._take(n)
+            clash = _first_clash(self.x, self.rad, have)
+            if clash is not None:
+                i, j = clash
+                raise ConfigError("packing.insertion.region", [list(c) for c in self.case.packing.insertion.region],
+                                  f"the batch inserted at {t:g} s puts particle {j} into particle {i}, which is "
+                                  "still there: the region must be clear when a batch comes in")
+            self.start = np.concatenate([self.start, np.full(n - have, self.start[-1], np.int64)])
+            rows, pairs = self.hist[:have * n_w], self.hist[have * n_w:]
+            self.hist = np.concatenate([rows, np.zeros(((n - have) * n_w, self.hist.shape[1])), pairs])
+            self.dmax = np.concatenate([self.dmax[:have * n_w], np.zeros((n - have) * n_w), self.dmax[have * n_w:]])
+            done = True
+        return done
+
+    def next_removal(self, dt: float) -> int:
+        """The step (from the start) after which the next timed wall is removed (:func:`removal_step`); a huge
+        number where none is left."""
+        steps = [removal_step(w.until, dt) for w in self.walls if getattr(w, "until", None) is not None]
+        return min(steps, default=2 ** 62)
+
+    def remove_walls(self, dt: float) -> bool:
+        """Removes the timed walls whose time has come (after ``steps`` steps), with their contact states; every
+        other contact's state is kept (the pairs' after the walls' rows move up). Returns whether any was removed."""
+        keep = [getattr(w, "until", None) is None or removal_step(w.until, dt) > self.steps for w in self.walls]
+        if all(keep):
+            return False
+        n, n_w = len(self.x), len(self.walls)
+        rows = np.arange(n * n_w).reshape(n, n_w)[:, keep].ravel()
+        self.hist = np.concatenate([self.hist[rows], self.hist[n * n_w:]])
+        self.dmax = np.concatenate([self.dmax[rows], self.dmax[n * n_w:]])
+        self.walls = tuple(w for w, k in zip(self.walls, keep) if k)
+        return True
+
+
+def step_at(t: float, dt: float) -> int:
+    """The first step whose end (k·dt) is at or past time t; a time one round-off past a step's end (0.1·3 s at
+    0.1 s: 0.30000000000000004) is that step's."""
+    return math.ceil(t / dt * (1.0 - 1e-12))
+
+
+def removal_step(until: float, dt: float) -> int:
+    """The step after which a wall with ``until`` (s) is removed (:func:`step_at`, at least the first)."""
+    return max(1, step_at(until, dt))
+
+
+def _first_clash(x: np.ndarray, rad: np.ndarray, have: int) -> tuple[int, int] | None:
+    """A particle i < have overlapped by a new one j ≥ have (None: none): new ones are clear of each other."""
+    from scipy.spatial import cKDTree
+
+    if have == 0:
+        return None
+    old = cKDTree(x[:have])
+    for j in range(have, len(x)):
+        for i in old.query_ball_point(x[j], rad[j] + float(rad[:have].max())):
+            if np.linalg.norm(x[j] - x[i]) < (rad[i] + rad[j]) * (1 - 1e-12):
+                return int(i), int(j)
+    return None
 
 
 def box_of(case, x, rad):
@@ -1044,6 +1260,39 @@ def box_of(case, x, rad):
     hi = (x + rad[:, None]).max(axis=0) + 4 * rmax
     lo[2], hi[2] = zlo, zhi
     return lo, hi, np.array([False, False])
+
+
+def wall_table(walls) -> np.ndarray:
+    """The walls (case.Wall) as the loop reads them: a plane's point and normal (W_PLANE columns), all a table
+    holds where every wall is a plane (the loop then tests no segment); with a segment among them W_WIDTH columns:
+    each segment's direction along its strip, its extent and its two edge lines (whose they are, and which other
+    segments end on them: a corner is one contact, :func:`_segment_contact`), a plane's extent (−inf, inf)."""
+    from ..errors import ConfigError
+
+    table = np.array([[*w.point, *w.normal] for w in walls], float).reshape(-1, W_PLANE)
+    if not any(getattr(w, "extent", None) for w in walls):
+        return table
+    wide = np.full((len(walls), W_WIDTH), -1.0)
+    wide[:, :W_PLANE] = table
+    ends = {}  # (wall, 0 | 1) → (a point of the edge line, its direction)
+    for k, w in enumerate(walls):
+        wide[k, W_ALONG:W_ALONG + 3] = w.along if w.extent else 0.0
+        wide[k, W_S0], wide[k, W_S1] = w.extent if w.extent else (-math.inf, math.inf)
+        if w.extent:
+            line = np.cross(w.normal, w.along)
+            for side in (0, 1):
+                ends[(k, side)] = (np.asarray(w.point) + w.extent[side] * np.asarray(w.along), line)
+    for (k, side), (q, b) in ends.items():
+        scale = 1e-9 * (1.0 + float(np.abs(q).max()))
+        shared = [o for (o, other), (q2, b2) in ends.items() if o != k and np.linalg.norm(np.cross(b, b2)) < 1e-9
+                  and np.linalg.norm((q - q2) - ((q - q2) @ b) * b) < scale]
+        if len(shared) > W_EDGE - 1:
+            raise ConfigError(f"walls.{k}.extent", list(walls[k].extent), f"ends on an edge line that {len(shared)} "
+                              f"other walls' strips end on too: a corner is shared by at most {W_EDGE} walls")
+        col = W_EDGES + side * W_EDGE
+        wide[k, col] = 0.0 if shared and min(shared) < k else 1.0
+        wide[k, col + 1:col + 1 + len(shared)] = shared
+    return wide
 
 
 def law_table(laws_n, laws_t, wall_n, wall_t):
@@ -1117,12 +1366,13 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
         raise ValueError(f"clock: a C-contiguous float64 array of shape {(threads + 1, 2 * PHASES)}, not {clock.shape}")
     sp, laws_n, laws_t, wall_n, wall_t = laws or resolve_laws(case)
     if walls is None:
-        walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+        walls = wall_table(st.walls)
     g = np.asarray(case.run.gravity if gravity is None else gravity, float)
     lo, hi, periodic = box_of(case, st.x, st.rad)
+    roll_kind, _, laws_r = st.rolling
     args = (st.x, st.v, st.w, st.rad, st.mass, sp, laws_n.shape[0], *law_table(laws_n, laws_t, wall_n, wall_t), walls,
             lo, hi, periodic, g, dt, steps, ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax,
-            st.contacts, rules_array(rules), clock)
+            st.contacts, rules_array(rules), clock, laws_r, np.int64(roll_kind), np.int64(st.roll_col))
     if threads == 1:
         out = run(*args)
     else:
@@ -1139,36 +1389,54 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
 
 def simulate(case, duration: float | None = None, dt: float | None = None, rest: float = 0.0,
              chunk: int = 2000, state: PackState | None = None, rules: dict | None = None,
-             threads: int = 1, clock: np.ndarray | None = None) -> PackState:
+             threads: int = 1, clock: np.ndarray | None = None, observe=None) -> PackState:
     """Run the packing for ``duration`` (s; default the case's packing.duration) — `pack` and `verify` alike, as
     the engines do: an early stop where the kinetic energy dips (``rest`` × N m g R, off by default) can fall on a
     turning point of a layer bouncing in phase, not on a settled state; dt and the number of steps are case.packing_run's (a run
     past its bound is a ConfigError before any step). ``rules``: the kinematic rules (collision3d's names;
     default the seed's), e.g. an engine's rules (engines.base.Engine.rules) for its twin. ``threads``: the force
     loop's threads (default 1: the same bits on every run; more: each step the same to round-off, which a pour's
-    collisions amplify — the same packing in its statistics, docs/packing.md). ``clock``: a timed run's (advance)."""
+    collisions amplify — the same packing in its statistics, docs/packing.md). ``clock``: a timed run's (advance).
+
+    The run goes in chunks of at most ``chunk`` steps, each ending where something happens between steps: a timed
+    wall removed (its ``until``: :func:`removal_step`), an inserted packing's batch coming in (every ``every`` s:
+    :meth:`PackState.insert_batches`), an observation (``observe`` = (steps, fn): fn(state) after each of those
+    steps, counted from the start; step 0 is the starting state). The Verlet list and every contact's state carry
+    over from chunk to chunk (as they do in one run)."""
     from ..case import packing_run
     from ..errors import ConfigError
 
     threads = check_threads(threads)
     dt, duration, total = packing_run(case, duration, dt)  # dt and steps, bounded, as every engine's deck
-    sp, laws_n, laws_t, wall_n, wall_t = resolve_laws(case)
     st = state or PackState(case)
-    walls = np.array([[*w.point, *w.normal] for w in case.walls], float).reshape(-1, 6)
+    _, laws_n, laws_t, wall_n, wall_t = resolve_laws(st.full)
+    walls = wall_table(st.walls)
     g = np.asarray(case.run.gravity, float)
     scale = len(case.particles) * float(st.mass.mean()) * max(float(np.linalg.norm(g)), 1e-300) * float(st.rad.mean())
+    looks = sorted(set(observe[0])) if observe else []
+    if looks and looks[0] <= st.steps:
+        observe[1](st)  # the starting state
+    looks = [k for k in looks if k > st.steps]
     done = 0
     while done < total:
-        n_steps = min(chunk, total - done)
-        ke, nc, flags = advance(case, st, dt, n_steps, rules, laws=(sp, laws_n, laws_t, wall_n, wall_t),
+        events = (st.next_removal(dt), st.next_insertion(dt), looks[0] if looks else 2 ** 62)
+        n_steps = min(chunk, total - done, max(1, min(events) - st.steps))
+        ke, nc, flags = advance(case, st, dt, n_steps, rules, laws=(st.species, laws_n, laws_t, wall_n, wall_t),
                                 walls=walls, gravity=g, threads=threads, clock=clock)
         if flags[1]:
             raise ConfigError("run.dt", dt, "the packing became non-finite: the time step is too large")
         for k, e in enumerate(ke[1:], start=1):
             st.ke.append((st.time + k * max(1, n_steps // 20) * dt, float(e)))
         done += n_steps
+        st.steps += n_steps
         st.time += n_steps * dt
         st.n_contacts = int(nc)
+        if st.remove_walls(dt):
+            walls = wall_table(st.walls)
+        st.insert_batches(dt)
+        while looks and looks[0] <= st.steps:
+            looks.pop(0)
+            observe[1](st)
         if st.ke and st.ke[-1][1] < rest * scale:
             break
     return st
