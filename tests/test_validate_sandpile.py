@@ -221,3 +221,23 @@ def test_a_bad_heap_entry_is_refused_naming_its_key(tmp_path, change, key):
     with pytest.raises(ConfigError) as exc:
         load()
     assert exc.value.key.split(".")[-1] == key or exc.value.key.endswith(key), exc.value.key
+
+
+@pytest.mark.parametrize("name,rolling", [("ai2011-sandpile-constant", "constant_torque"),
+                                          ("ai2011-sandpile-viscous", "ai_viscous"),
+                                          ("ai2011-sandpile-epsd", "epsd")])
+def test_each_heap_benchmark_names_a_shipped_case_with_its_model(name, rolling):
+    """The three cases exist, load, and differ from each other in the rolling law only (Lethe's three .prm files
+    differ in `rolling resistance torque method` alone): model A constant_torque, B ai_viscous, C epsd (constant
+    kr and Cr: Ai's model C with kn(δ) recomputed, `ai_epsd`, needs per-contact kn in the packing loop)."""
+    from demcheck import case as C
+    from demcheck import resources
+
+    b = bench(name)
+    path = resources.cases_dir() / f"{b.case}.toml"
+    case = C.load(path)
+    assert case.contact.rolling == rolling
+    base = C.load(resources.cases_dir() / "optin" / "ai2011-sandpile-constant.toml")
+    assert case.packing == base.packing and case.walls == base.walls and case.particles == base.particles
+    assert (case.contact.normal, case.contact.tangential) == (base.contact.normal, base.contact.tangential)
+    assert case.contact.params.get("mu_r") == base.contact.params.get("mu_r") == 0.3  # every .prm's rolling friction
