@@ -241,3 +241,19 @@ def test_each_heap_benchmark_names_a_shipped_case_with_its_model(name, rolling):
     assert case.packing == base.packing and case.walls == base.walls and case.particles == base.particles
     assert (case.contact.normal, case.contact.tangential) == (base.contact.normal, base.contact.tangential)
     assert case.contact.params.get("mu_r") == base.contact.params.get("mu_r") == 0.3  # every .prm's rolling friction
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_each_heap_case_measures_over_its_whole_curve(name):
+    """The judge fails a run that does not span its curve (9.1-49.5 s for EPSD): the shipped case's first height
+    must come before the curve's first time and its run end after the curve's last (a case measuring from Lethe's
+    10 s could never pass, whatever the physics)."""
+    from demcheck import case as C
+    from demcheck import resources
+    from demcheck.reference import sandpile as S
+
+    b = bench(name)
+    case = C.load(resources.cases_dir() / f"{b.case}.toml")
+    pts = curve(b)
+    times = S.measure_steps(case, case.run.dt) * case.run.dt
+    assert times[0] <= pts[0, 0] and times[-1] >= pts[-1, 0]
