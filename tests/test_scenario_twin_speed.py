@@ -107,3 +107,23 @@ def test_a_scenario_engine_run_is_cached_by_its_deck(tmp_path, monkeypatch):
     other = load(case_path("suite/beyond-conduction.toml"), ["run.overlap=2e-6"])
     with pytest.raises(AssertionError, match="ran although cached"):
         scenario.run(other, "lammps", cache=cache)
+
+
+def test_a_scenario_run_is_kept_under_its_readers_code(monkeypatch):
+    """The kept data is what demcheck's reader made of the engine's output: a change to that reader (the engine's
+    scenario part, the dump readers, this module's table layout) must key the run anew, else a fixed reader would be
+    served its old reading; the digest changes with each of them and is the same for the same code."""
+    import inspect
+
+    from demcheck.engines import dumps, family_read, registry
+    from demcheck.engines import scenario as S
+
+    eng = registry.get("lammps")
+    before = S._reader_digest(eng)
+    assert S._reader_digest(eng) == before
+    real = inspect.getsource
+    for changed in (eng._part("scenario"), dumps, family_read, S):
+        monkeypatch.setattr(inspect, "getsource", lambda m, c=changed: real(m) + ("\n# fixed" if m is c else ""))
+        assert S._reader_digest(eng) != before, changed.__name__
+    monkeypatch.setattr(inspect, "getsource", real)
+    assert S._reader_digest(registry.get("yade")) != before  # each engine its own reader

@@ -442,8 +442,9 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
     """The engine's run of the scenario from the deck its package writes, read into the scenario's metrics;
     with ``cache`` (engines.cache.Cache) a run that ended ok is kept as what the engine's reader made of its output
     (:func:`_run_table`), keyed as an engine run is (the engine, its version and build, the deck's commands and its
-    files': engines/collide.run_identity): a warm verify does not run the deck again, nor does one after a change to
-    demcheck's code that leaves the deck as it was (the metrics are computed from the kept output each time)."""
+    files': engines/collide.run_identity) and by the reader's code (:func:`_reader_digest`): a warm verify does not run
+    the deck again, nor does one after a change to demcheck's code that leaves the deck and its reader as they were
+    (the metrics are computed from the kept output each time)."""
     eng, started = _engine(engine), time.perf_counter()
     mp, nat, lay, dk = _planned_deck(case, eng)
     k = None
@@ -454,7 +455,7 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
 
         version = discovery.require(eng.name).version
         deck_part, files = run_identity(dk)  # its commands: a case's name or notes never make a run of their own
-        k = key(eng.name, version, f"scenario run\0{deck_part}", files)
+        k = key(eng.name, version, f"scenario run\0reader {_reader_digest(eng)}\0{deck_part}", files)
         hit = _cached_run(cache, k)
         if hit is not None:
             data, meta = hit
@@ -470,6 +471,24 @@ def run(case: Case, engine, timeout: float | None = None, cache=None) -> Result:
     if k is not None and res.ok:
         _put_run(cache, k, data, {"engine_version": res.engine_version, "warnings": list(res.meta["warnings"])})
     return res
+
+
+def _reader_digest(eng) -> str:
+    """A digest of the code that turns the engine's output into the kept data: the engine package's scenario reader
+    (its ``scenario`` part), the LAMMPS family's and the dump readers, and this module (its table layout). A fix to
+    any of them reads the runs again (the deck and the engine's version alone would serve the old reading); a change
+    elsewhere in demcheck leaves the kept runs valid."""
+    import hashlib
+    import inspect
+    import sys
+
+    from . import dumps, family_read
+
+    reader = eng._part("scenario")
+    h = hashlib.sha256()
+    for module in (reader, dumps, family_read, sys.modules[__name__]):
+        h.update(inspect.getsource(module).encode())
+    return h.hexdigest()[:16]
 
 
 def _run_table(data: dict):
