@@ -171,3 +171,37 @@ def test_the_shipped_sandpile_cases_load_as_lethe_sets_them_up(model):
     assert C.packing_run(case)[2] in (2500000, 2500001) and steps[-1] <= C.packing_run(case)[2]
     assert "only the reference" in engine_blind(case)
     assert case.contact.rolling == {"constant": "constant_torque", "viscous": "ai_viscous", "epsd": "epsd"}[model]
+
+
+def test_an_inserted_packing_is_not_run_in_the_engines_even_with_plane_walls_and_no_rolling():
+    """The engines' packing decks write the case's particles, an inserted packing's first batch only: run there, an
+    engine would settle another packing than the reference (review: engine_blind named rolling and walls only)."""
+    from demcheck.comparisons.packing_suite import engine_blind
+
+    case = _drops()
+    assert case.contact.rolling == "none" and all(w.extent is None and w.until is None for w in case.walls)
+    assert "batch insertion" in (engine_blind(case) or "")
+
+
+def test_the_reference_packings_cache_key_holds_every_batch(tmp_path, monkeypatch):
+    """The case's hash holds its first batch only: a change to how the later batches are laid out (case.py's
+    insertion_batches, code the case's hash does not see) must not be served the kept packing."""
+    from dataclasses import replace
+
+    from demcheck.comparisons import packing_suite as PS
+    from demcheck.engines.cache import Cache
+
+    keys = []
+    monkeypatch.setattr(P, "simulate", lambda case, rest=0.0: (_ for _ in ()).throw(RuntimeError("solve")))
+    cache = Cache(tmp_path)
+    real_get = cache.get
+    monkeypatch.setattr(cache, "get", lambda k, **kw: keys.append(k) or real_get(k, **kw))
+    case = _drops()
+    real = P.with_batches
+    for shift in (0.0, 1e-4):  # the second batch laid out 0.1 mm further: the same case, the same hash
+        monkeypatch.setattr(P, "with_batches", lambda c, s=shift: replace(real(c), particles=tuple(
+            replace(p, position=(p.position[0] + (s if k else 0.0), *p.position[1:]))
+            for k, p in enumerate(real(c).particles))))
+        with pytest.raises(RuntimeError):
+            PS.reference_packing(case, cache=cache)
+    assert keys[0] != keys[2]

@@ -112,7 +112,14 @@ def reference_packing(case, cache=None):
 
     k = None
     if cache is not None:
-        what = json.dumps({"case": case.hash, "dt": packing.packing_dt(case), "rest": 0.0})
+        what = {"case": case.hash, "dt": packing.packing_dt(case), "rest": 0.0}
+        if case.packing is not None and case.packing.insertion is not None:
+            # the case's hash holds its first batch only: the later batches (case.insertion_batches) key it too
+            import hashlib
+
+            full = packing.with_batches(case).particles
+            what["batches"] = hashlib.sha256(repr(full).encode()).hexdigest()
+        what = json.dumps(what)
         k = cache_key("reference-packing", packing.solver_fingerprint(), what, {})
         hit = cache.get(k, columns=("x", "y", "z", "radius"), min_rows=1,
                         meta_keys={"ke": ke_series, "time": number, "seconds": number})
@@ -135,7 +142,7 @@ def reference_packing(case, cache=None):
 
 def engine_blind(case) -> str | None:
     """What of a packing case the engines' packing decks (inputs/packing_decks) do not write — a rolling law, a
-    segment wall, a timed wall — as the reason an engine is not run on it; None where they write it all. Run
+    segment wall, a timed wall, batch insertion — as the reason an engine is not run on it; None where they write it all. Run
     without it, an engine would settle another packing, and a verdict on it would judge what was not asked."""
     what = []
     if case.contact.rolling != "none":
@@ -144,6 +151,8 @@ def engine_blind(case) -> str | None:
         what.append("segment walls (extent)")
     if any(w.until is not None for w in case.walls):
         what.append("timed walls (until)")
+    if case.packing is not None and case.packing.insertion is not None:
+        what.append("batch insertion (layout = inserted: the decks hold the first batch only)")
     if not what:
         return None
     return f"the packing decks do not write {', '.join(what)}: only the reference solves this packing"
