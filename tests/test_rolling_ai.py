@@ -210,3 +210,20 @@ def test_no_scenario_runs_them_and_every_engine_refuses_them(law_id, params):
     for name in registry.names():
         mp = scenario.mapping(case, name)
         assert mp.fidelity == "none" and any(law_id in r for r in mp.reasons), (name, mp.reasons)
+
+
+def test_ai_viscous_between_two_spheres_is_symmetric_in_the_pair():
+    """The packing loop builds one record per species pair, its radii in the species' order: the pair's torque must
+    not depend on that order (review: the arm was body 0's radius, 29 % apart for the sandpile's two sizes); the
+    arm is ½(R0 + R1) between two spheres and R0 on a wall."""
+    from demcheck.laws.rolling_laws.ai_viscous import AiViscousRolling, ai_viscous_rolling_force
+
+    w, n, fn = np.array([0.0, 0.0, 3.0]), np.array([1.0, 0.0, 0.0]), 0.7
+    a = AiViscousRolling(mu_r=0.3, r_roll=2e-3, r0=3.45e-3, r1=4.45e-3).array()
+    b = AiViscousRolling(mu_r=0.3, r_roll=2e-3, r0=4.45e-3, r1=3.45e-3).array()
+    ta, tb = ai_viscous_rolling_force(a, w, n, fn, 1e-5, np.zeros(3))[0], ai_viscous_rolling_force(b, w, n, fn, 1e-5,
+                                                                                                   np.zeros(3))[0]
+    assert np.array_equal(ta, tb)
+    assert ta[2] == -0.3 * 2e-3 * 0.5 * (3.45e-3 + 4.45e-3) * fn * 3.0
+    wall = AiViscousRolling(mu_r=0.3, r_roll=2e-3, r0=3.45e-3).array()
+    assert ai_viscous_rolling_force(wall, w, n, fn, 1e-5, np.zeros(3))[0][2] == -0.3 * 2e-3 * 3.45e-3 * fn * 3.0

@@ -9,7 +9,9 @@ Vω on a wall is R ω × n, |Vω| = R |w_t| (every reading above agrees). Betwee
 neither is a function of the relative spin w = ω0 − ω1 alone: Lethe takes Vω = (R0ω0 + R1ω1) × n (zero when
 equal spheres roll on each other, ω0 = −ω1), Kratos R0'ω0 − R1'ω1 (R' = R minus a share of the overlap, no cross
 product). The compiled force of the slot (``ai_viscous_rolling_force(c, w, …)``: w only) is the wall's form
-|Vω| = R0 |w_t|; :func:`ai_viscous_pair_torque` is Lethe's reading for a pair, for a solver that has both spins.
+|Vω| = R0 |w_t|, and between two spheres |Vω| = ½(R0 + R1) |w_t| (symmetric in the pair, Kratos's reading for
+equal spheres; the packing loop's pairs take it); :func:`ai_viscous_pair_torque` is Lethe's reading for a pair, for
+a solver that has both spins.
 The direction ŵ is that of the rolling part w_t (Lethe and Kratos use all of ω0 − ω1: the same without twist).
 
 A sphere rolling without slip on a level plane under it (|Fn| = m g, Rr = R): (m + I/R²) v̇ = −μr R² m g v/R², so
@@ -38,13 +40,14 @@ class AiViscousRolling(RollingSubModel):
         Key("mu_r", "coefficient of viscous rolling resistance μr (s/m): M = −μr Rr |Fn| |Vω| ŵ", "must be > 0",
             positive),
         R_ROLL)
-    formula: ClassVar[str] = "M = −μr Rr |Fn| |Vω| ŵt, |Vω| = R0 |wt| on a wall"
+    formula: ClassVar[str] = "M = −μr Rr |Fn| |Vω| ŵt, |Vω| = R0 |wt| on a wall, ½(R0 + R1) |wt| between two spheres"
     source: ClassVar[str] = ("Ai, Chen, Rotter & Ooi, Powder Technol. 206 (2011) 269, model B, as Lethe and Kratos "
                              "implement it")
     example: ClassVar[dict] = {"mu_r": 0.3}
     mu_r: float = 0.0  # s/m
     r_roll: float = 0.0  # Rr
     r0: float = 0.0  # body 0's radius: the arm of Vω on a wall (filled from the contact's geometry)
+    r1: float = 0.0  # body 1's radius, 0 on a wall: between two spheres the arm is ½(r0 + r1), symmetric in the pair
 
     def time_constant(self, gravity: float) -> float:
         """T of a sphere of radius r0 rolling without slip on a level plane (|Fn| = m g): 1.4 r0²/(μr Rr r0 g)."""
@@ -53,8 +56,9 @@ class AiViscousRolling(RollingSubModel):
 
 @njit(cache=KERNEL_CACHE)
 def ai_viscous_rolling_force(c, w, n, fn_abs, dt, history):
-    wt = _rolling_part(w, n)  # |Vω| = R0 |wt| and ŵt = wt/|wt|: the torque is linear in wt
-    return (-c[0] * c[1] * c[2] * fn_abs) * wt, history
+    wt = _rolling_part(w, n)  # |Vω| = arm |wt| and ŵt = wt/|wt|: the torque is linear in wt
+    arm = c[2] if c[3] == 0.0 else 0.5 * (c[2] + c[3])  # R0 on a wall; ½(R0 + R1) between two spheres
+    return (-c[0] * c[1] * arm * fn_abs) * wt, history
 
 
 @njit(cache=KERNEL_CACHE)
