@@ -191,6 +191,10 @@ def test_a_pairs_rolling_torques_are_equal_and_opposite(rolling, threads):
     change = np.abs(inertia[:, None] * (st.w - w0)).max()
     assert change > 0.05 * np.abs(inertia[:, None] * w0).max()  # the torques acted
     assert np.abs(after - before).max() <= 1e-12 * change
+    # and they resist the relative rolling (a torque applied with i and j swapped would also conserve Σ I ω): the
+    # rolling part of ω0 − ω1 (across the normal, x here) has shrunk
+    rel0, rel = (w0[0] - w0[1])[1:], (st.w[0] - st.w[1])[1:]
+    assert np.linalg.norm(rel) < np.linalg.norm(rel0)
 
 
 def test_the_switch_is_written_from_the_registry_and_every_law_has_its_place():
