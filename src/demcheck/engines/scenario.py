@@ -516,10 +516,10 @@ def _run_table(data: dict):
 def _from_table(table, layout: dict) -> dict:
     """The run's output from :func:`_run_table`'s (table, layout)."""
     out = {}
-    for name, (kind, value) in layout.items():
-        if kind == "flag":
+    for name, (entry, value) in layout.items():
+        if entry == "flag":
             out[name] = bool(value)
-        elif kind == "number":
+        elif entry == "number":
             out[name] = float(value)
         else:
             a = np.column_stack([table[f"{name}.{j}"].to_numpy() for j in range(max(1, value))])
@@ -542,7 +542,7 @@ def _cached_run(cache, k: str):
     from .cache import text, texts
 
     def columns(table, meta) -> str | None:
-        want = {f"{n}.{j}" for n, (kind, c) in meta["layout"].items() if kind == "array" for j in range(max(1, c))}
+        want = {f"{n}.{j}" for n, (entry, c) in meta["layout"].items() if entry == "array" for j in range(max(1, c))}
         missing = sorted(want - set(table.columns))
         return f"missing column(s) {', '.join(missing)}" if missing else None
 
