@@ -512,12 +512,13 @@ def test_an_engine_run_over_a_damaged_entry_runs_again_and_replaces_it(tmp_path,
 @pytest.mark.parametrize("damage", list(PUT_DAMAGE))
 def test_an_engine_run_whose_entry_cannot_be_written_keeps_its_result(tmp_path, damage, caplog):
     from demcheck.engines.cache import key
-    from demcheck.engines.collide import collide as run_engine, deck
+    from demcheck.engines.collide import collide as run_engine, deck, run_identity
 
     case = glass_case("hertz", {})
     cache = Cache(tmp_path / "cache")
     dk = deck(case, "lammps")  # the deck collide runs: the seed model's mapping (no native setting)
-    PUT_DAMAGE[damage](cache, key("lammps", discovery.find("lammps").version, dk.text, dk.files))
+    # its entry's key: the deck's commands (run_identity), as collide keys a run
+    PUT_DAMAGE[damage](cache, key("lammps", discovery.find("lammps").version, *run_identity(dk)))
     first = run_engine(case, "lammps")
     with caplog.at_level(logging.WARNING, logger="demcheck.cache"):
         res = run_engine(case, "lammps", cache=cache)
