@@ -146,7 +146,7 @@ def _stand_in(monkeypatch, tmp_path, height_curve):
 def test_run_heap_calls_the_sandpile_solver_by_name_and_judges_its_curve(monkeypatch, tmp_path):
     seen = []
 
-    def height_curve(case):
+    def height_curve(case, progress=None):
         seen.append(case)
         pts = curve(bench(case))
         return pts[:, 0], 0.96 * pts[:, 1]
@@ -160,7 +160,7 @@ def test_run_heap_calls_the_sandpile_solver_by_name_and_judges_its_curve(monkeyp
 
 
 def test_run_heap_without_the_solver_or_with_a_failing_one_fails(monkeypatch, tmp_path):
-    def boom(case):
+    def boom(case, progress=None):
         raise FloatingPointError("overflow in the pile")
 
     _stand_in(monkeypatch, tmp_path, boom)
@@ -181,7 +181,7 @@ def test_a_missing_case_file_is_refused_with_the_catalogue_key(tmp_path):
                                                    (0.5, v.MISSES, 0),  # a finite run off the curve: a finding
                                                    (math.nan, v.MISSES, 1)])  # a run not finite: a failure
 def test_validate_run_of_a_heap_benchmark_alone_writes_its_report(monkeypatch, tmp_path, scale, verdict, failed):
-    def height_curve(case):
+    def height_curve(case, progress=None):
         pts = curve(bench(case))
         return pts[:, 0], scale * pts[:, 1]
 
@@ -192,6 +192,45 @@ def test_validate_run_of_a_heap_benchmark_alone_writes_its_report(monkeypatch, t
     (check,) = summary.validation.checks
     assert check.benchmark == "ai2011-sandpile-epsd" and check.verdict == verdict
     assert (tmp_path / "reports" / "latest-validate" / "report.md").is_file()
+
+
+def test_a_heap_run_logs_its_progress_every_simulated_second(monkeypatch, tmp_path, capsys):
+    """A run of about an hour says how far it is: validate passes a progress callback, which prints one line per
+    simulated second (the solver calls it at every measure, here every 0.25 s)."""
+    def height_curve(case, progress=None):
+        t = np.arange(0.0, 3.01, 0.25)
+        for ti in t:
+            progress(float(ti), 0.2)
+        return t, np.full_like(t, 0.2)
+
+    _stand_in(monkeypatch, tmp_path / "cases", height_curve)
+    v.run("ai2011-sandpile-constant", tmp_path / "cases", tmp_path / "reports", opts=None, quiet=False,
+          argv=["demcheck", "validate", "ai2011-sandpile-constant"])
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if "height 0.2000 m" in ln]
+    assert [ln.split("t = ")[1].split(" s,")[0] for ln in lines] == ["0.00", "1.00", "2.00", "3.00"]
+
+
+def test_an_interrupted_heap_run_keeps_its_heights_in_a_partial_report_and_stops(monkeypatch, tmp_path):
+    """Ctrl-C in the middle of an hour's run: the report is written (the heights so far, the benchmark failed as
+    "interrupted at t = …", the run partial), and the interrupt goes on to the command (its exit code)."""
+    import json
+
+    def height_curve(case, progress=None):
+        for ti in (9.0, 9.02, 9.04):
+            progress(ti, 0.25)
+        raise KeyboardInterrupt
+
+    _stand_in(monkeypatch, tmp_path / "cases", height_curve)
+    with pytest.raises(KeyboardInterrupt) as exc:
+        v.run("ai2011-sandpile-viscous", tmp_path / "cases", tmp_path / "reports", opts=None, quiet=True,
+              argv=["demcheck", "validate", "ai2011-sandpile-viscous"])
+    assert isinstance(exc.value, v.HeapInterrupted)
+    assert exc.value.check.verdict == v.MISSES and exc.value.check.extra["failed"] == "interrupted at t = 9.04 s"
+    assert exc.value.series["sources"]["reference"] == {"x": [9.0, 9.02, 9.04], "y": [0.25, 0.25, 0.25]}
+    latest = tmp_path / "reports" / "latest-validate"
+    assert (latest / "report.md").is_file()
+    text = (latest / "report.md").read_text() + json.dumps(json.loads((latest / "results.json").read_text()))
+    assert "interrupted at t = 9.04 s" in text
 
 
 def _catalogue_with(tmp_path, entry: str):

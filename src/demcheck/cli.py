@@ -598,8 +598,10 @@ def diff(old, new, tolerance, renames, report_dir, junit, as_json):
 def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cache, timeout, quick):
     """Run the published benchmarks (cases/benchmarks/: Chung & Ooi's eight tests, Thornton's oblique
     impacts; NAME one of them, e.g. chung-ooi-4) in the reference and every engine, and judge each source
-    against the exact limits and the papers' curves (docs/benchmarks.md). Exit 1 when the reference misses an
-    exact limit or a run fails, 2 on bad input."""
+    against the exact limits and the papers' curves (docs/benchmarks.md). The opt-in heap benchmarks
+    ai2011-sandpile-constant, -viscous and -epsd (Ai et al. 2011's rolling resistance, about an hour each, the
+    reference alone, a line of progress per simulated second) run only when named. Exit 1 when the reference
+    misses an exact limit or a run fails, 2 on bad input."""
     from .comparisons.suite import Options
     from .comparisons.validate import by_name, run
     from .engines import run as runner

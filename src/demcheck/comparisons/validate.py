@@ -840,21 +840,60 @@ def _load_case(path: Path):
     return load(path)
 
 
-def run_heap(bench: Benchmark, cases: Path | None = None) -> tuple[Check, dict]:
+class HeapInterrupted(KeyboardInterrupt):
+    """An interrupt during a heap run, carrying the run's verdict so far (a failure: "interrupted at t = … s") and
+    its heights up to then, so that the report keeps them."""
+
+    def __init__(self, check: Check, series: dict):
+        super().__init__(check.extra.get("failed", "interrupted"))
+        self.check, self.series = check, series
+
+
+def run_heap(bench: Benchmark, cases: Path | None = None, progress=None) -> tuple[Check, dict]:
     """Run a heap benchmark's case in the reference's sandpile solver (demcheck.reference.sandpile, imported
-    here) and judge it. A solver that raises, or is not in this build, is a failed run."""
+    here) and judge it. A solver that raises, or is not in this build, is a failed run. ``progress(t, height)``
+    is called at each measure (the run's log); an interrupt raises HeapInterrupted with the heights so far."""
     import importlib
 
     path = heap_case_path(bench, cases)
     file = path.stem
+    times, heights = [], []
+
+    def look(t, h):
+        times.append(t)
+        heights.append(h)
+        if progress is not None:
+            progress(t, h)
+
     try:
         sandpile = importlib.import_module("demcheck.reference.sandpile")
-        times, heights = sandpile.height_curve(_load_case(path))
-    except KeyboardInterrupt:
-        raise
+        times_, heights_ = sandpile.height_curve(_load_case(path), progress=look)
+    except KeyboardInterrupt as exc:
+        at = f" at t = {times[-1]:.6g} s" if times else " before its first height"
+        check, series = judge_heap(bench, file, None, None, error=f"interrupted{at}")
+        if times:
+            series["sources"]["reference"] = {"x": list(times), "y": list(heights)}
+        raise HeapInterrupted(check, series) from exc
     except Exception as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
         return judge_heap(bench, file, None, None, error=f"{type(exc).__name__}: {exc}")
-    return judge_heap(bench, file, times, heights)
+    return judge_heap(bench, file, times_, heights_)
+
+
+def heap_log(name: str, every: float = 1.0, out=None):
+    """A progress(t, height) that prints a line every ``every`` simulated seconds (to stderr): a heap run takes
+    about an hour, and says how far it is."""
+    import sys
+    import time
+
+    start, last = time.monotonic(), [-math.inf]
+
+    def log(t, h):
+        if t - last[0] >= every * (1.0 - 1e-9):
+            last[0] = t
+            print(f"demcheck validate {name}: t = {t:.2f} s, height {h:.4f} m ({time.monotonic() - start:.0f} s)",
+                  file=out or sys.stderr, flush=True)
+
+    return log
 
 
 # ----------------------------------------------------------------------------- running
@@ -1011,17 +1050,25 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
         summary = _heap_summary(report_root, argv)
         summary.validation = Validation()
     val = summary.validation
+    stopped = None
     for b in heaps:
-        check, line = run_heap(b)
+        try:
+            check, line = run_heap(b, progress=None if quiet else heap_log(b.name))
+        except HeapInterrupted as exc:  # the report keeps the heights so far, then the interrupt goes on
+            check, line, stopped = exc.check, exc.series, exc
         val.benchmarks.append({"name": b.name, "title": b.title, "files": [str(heap_case_path(b))]})
         val.checks.append(check)
         val.series.append(line)
         if "failed" in check.extra:
             val.failed.append(check)  # a run that failed fails the command; a finite run off the curve is a finding
+        if stopped is not None:
+            break
     summary.failed += len(val.failed)
-    if not every:
+    if not every and stopped is None:
         summary.partial = False
     report.write_all(summary, Path(summary.report), report_root, junit=junit, link=LINK)
+    if stopped is not None:
+        raise stopped
     return summary
 
 
