@@ -131,9 +131,11 @@ def children_alive(pid: int) -> list[int]:
     return _alive_where(1, pid)
 
 
-def with_plugin_law(tmp_path, module: str, source: str, script: str, timeout: float = 1500) -> dict:
-    """``script``'s JSON (its last line), run in a fresh process with ``source`` written as the plug-in law module
-    ``module`` named in $DEMCHECK_LAW_PLUGINS, on an empty kernel cache (the plug-in's source in its fingerprint)."""
+def _script_json(script: str, path: list, timeout: float, plugins: str | None = None) -> dict:
+    """``script``'s JSON (its last line), run in a fresh process with ``path`` first on PYTHONPATH (then the
+    repository, for the tests' helpers), on an empty kernel cache: the kernels' cache directory is named by the
+    fingerprint of the laws' sources, so a law added to the path compiles afresh. ``plugins``: $DEMCHECK_LAW_PLUGINS
+    (unset when None)."""
     import json
     import os
     import subprocess
@@ -141,11 +143,45 @@ def with_plugin_law(tmp_path, module: str, source: str, script: str, timeout: fl
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    (tmp_path / f"{module}.py").write_text(source)
-    env = dict(os.environ, DEMCHECK_LAW_PLUGINS=module, XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), str(root / "src"), str(root)]))
+    env = dict(os.environ, XDG_CACHE_HOME=str(Path(path[0]) / "cache"),
+               PYTHONPATH=os.pathsep.join([*map(str, path), str(root)]))
     env.pop("NUMBA_CACHE_DIR", None)
+    env.pop("DEMCHECK_LAW_PLUGINS", None)
+    if plugins is not None:
+        env["DEMCHECK_LAW_PLUGINS"] = plugins
     p = subprocess.run([sys.executable, "-c", script], cwd=root, env=env, capture_output=True, text=True,
                        timeout=timeout)
     assert p.returncode == 0, p.stderr[-3000:]
     return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def with_plugin_law(tmp_path, module: str, source: str, script: str, timeout: float = 1500) -> dict:
+    """``script``'s JSON (its last line), run in a fresh process with ``source`` written as the plug-in law module
+    ``module`` named in $DEMCHECK_LAW_PLUGINS, on an empty kernel cache (the plug-in's source in its fingerprint)."""
+    from pathlib import Path
+
+    (tmp_path / f"{module}.py").write_text(source)
+    return _script_json(script, [tmp_path, Path(__file__).resolve().parents[1] / "src"], timeout, plugins=module)
+
+
+def with_law_modules(tmp_path, folder: str, modules: dict[str, str], script: str, timeout: float = 2400) -> dict:
+    """``script``'s JSON (its last line), run in a fresh process on a copy of demcheck's source with ``modules``
+    (name → text) added to laws/``folder``/ and nothing else changed (a law added as one module of the package, not
+    a plug-in), on an empty kernel cache."""
+    import shutil
+    from pathlib import Path
+
+    src = tmp_path / "src"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "src" / "demcheck", src / "demcheck",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    for name, text in modules.items():
+        (src / "demcheck" / "laws" / folder / f"{name}.py").write_text(text)
+    return _script_json(script, [src], timeout)
+
+
+def code_names(text: str) -> set[str]:
+    """The identifiers a module's code uses (comments and strings left out)."""
+    import io
+    import tokenize
+
+    return {t.string for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type == tokenize.NAME}

@@ -5,16 +5,14 @@ solvers as its closed form says, and a copy of the sqrt dashpot under another fa
 in every solver that calls the normal force (1-D and 3-D, adaptive and verlet, the packing loop). And the
 solvers' switch names no damping law."""
 
-import json
 import math
-import os
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 from scipy.optimize import brentq
+
+from .helpers import code_names, with_law_modules
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -140,16 +138,6 @@ print(json.dumps(out))
 '''
 
 
-def _tree_with(tmp_path: Path, modules: dict[str, str]) -> Path:
-    """A copy of demcheck's source with ``modules`` (name → text) added to laws/damping_laws/, and nothing else
-    changed: the root to put on the path."""
-    src = tmp_path / "src"
-    shutil.copytree(ROOT / "src" / "demcheck", src / "demcheck", ignore=shutil.ignore_patterns("__pycache__"))
-    for name, text in modules.items():
-        (src / "demcheck" / "laws" / "damping_laws" / f"{name}.py").write_text(text)
-    return src
-
-
 def quadratic_restitution(m, k, c, v) -> float:
     """The closed form of a linear spring with a quadratic drag, m δ̈ = −kδ − c|δ̇|δ̇, from δ = 0 at δ̇ = v: with
     u = δ̇², λ = 2c/m, κ = 2k/m, u' + λu = −κδ while approaching, u' − λu = −κδ while receding."""
@@ -161,13 +149,7 @@ def quadratic_restitution(m, k, c, v) -> float:
 
 
 def test_a_damping_law_in_one_module_runs_in_every_solver(tmp_path):
-    src = _tree_with(tmp_path, {"quadratic": QUADRATIC, "copy_sqrt": COPY})
-    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(src), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)  # an empty kernel cache, named by the copied tree's fingerprint
-    env.pop("DEMCHECK_LAW_PLUGINS", None)
-    p = subprocess.run([sys.executable, "-c", RUN], cwd=ROOT, env=env, capture_output=True, text=True, timeout=2400)
-    assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    out = with_law_modules(tmp_path, "damping_laws", {"quadratic": QUADRATIC, "copy_sqrt": COPY}, RUN)
 
     q = out["quadratic"]
     assert q["family"] == 40.0 and q["slots"] == ["hooke", "quadratic"]
@@ -186,14 +168,6 @@ def test_a_damping_law_in_one_module_runs_in_every_solver(tmp_path):
     assert builtin["slots"] == ["hertz", "sqrt"] and copy["slots"] == ["hertz", "copy_sqrt"]
     for key in ("1d-adaptive", "1d-verlet", "3d-adaptive", "3d-verlet", "packing"):
         assert copy[key] == builtin[key], key
-
-
-def _code_names(text: str) -> set[str]:
-    """The identifiers a module's code uses (comments and strings left out)."""
-    import io
-    import tokenize
-
-    return {t.string for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type == tokenize.NAME}
 
 
 def test_the_solvers_switch_names_no_damping_law():
@@ -218,7 +192,7 @@ def test_the_solvers_switch_names_no_damping_law():
                 assert name not in text, (path.name, name)
         for path, text in texts.items():
             assert f"damping_laws.{module.__name__.rsplit('.', 1)[1]}" not in text, (path.name, record.id)
-            assert not (_code_names(text) & constants), (path.name, constants)
+            assert not (code_names(text) & constants), (path.name, constants)
         assert f"family == {family}" in dispatch.source()
 
 

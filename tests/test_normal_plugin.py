@@ -6,17 +6,15 @@ no energy lost), every engine refusing it with its name; and a copy of the hertz
 gives the built-in's bits in every solver that calls the normal force (1-D and 3-D, adaptive and verlet, the
 packing loop). And the solvers' switch names no normal law."""
 
-import json
 import math
-import os
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
+
+from .helpers import code_names, with_law_modules
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -170,16 +168,6 @@ print(json.dumps(out))
 '''
 
 
-def _tree_with(tmp_path: Path, modules: dict[str, str]) -> Path:
-    """A copy of demcheck's source with ``modules`` (name → text) added to laws/normal_laws/, and nothing else
-    changed: the root to put on the path."""
-    src = tmp_path / "src"
-    shutil.copytree(ROOT / "src" / "demcheck", src / "demcheck", ignore=shutil.ignore_patterns("__pycache__"))
-    for name, text in modules.items():
-        (src / "demcheck" / "laws" / "normal_laws" / f"{name}.py").write_text(text)
-    return src
-
-
 def cubic_closed_form(m, k, k3, v) -> dict:
     """The undamped collision of m δ̈ = −k δ^{3/2} − k3 δ³ from δ = 0 at δ̇ = v: the largest overlap δm (the
     potential U = (2/5) k δ^{5/2} + (1/4) k3 δ⁴ equal to ½ m v²) and the contact time 2 ∫₀^δm dδ / √(v² − 2U/m),
@@ -200,13 +188,7 @@ def cubic_closed_form(m, k, k3, v) -> dict:
 
 
 def test_a_normal_law_in_one_module_runs_in_every_solver(tmp_path):
-    src = _tree_with(tmp_path, {"hertz_cubic": CUBIC, "copy_hertz": COPY})
-    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "cache"), PYTHONPATH=os.pathsep.join([str(src), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)  # an empty kernel cache, named by the copied tree's fingerprint
-    env.pop("DEMCHECK_LAW_PLUGINS", None)
-    p = subprocess.run([sys.executable, "-c", RUN], cwd=ROOT, env=env, capture_output=True, text=True, timeout=2400)
-    assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    out = with_law_modules(tmp_path, "normal_laws", {"hertz_cubic": CUBIC, "copy_hertz": COPY}, RUN)
 
     c = out["cubic"]
     assert c["family"] == 40.0 and c["slots"] == ["hertz_cubic", "none"]
@@ -229,14 +211,6 @@ def test_a_normal_law_in_one_module_runs_in_every_solver(tmp_path):
     assert builtin["slots"] == ["hertz", "sqrt"] and copy["slots"] == ["copy_hertz", "sqrt"]
     for key in ("1d-adaptive", "1d-verlet", "3d-adaptive", "3d-verlet", "packing"):
         assert copy[key] == builtin[key], key
-
-
-def _code_names(text: str) -> set[str]:
-    """The identifiers a module's code uses (comments and strings left out)."""
-    import io
-    import tokenize
-
-    return {t.string for t in tokenize.generate_tokens(io.StringIO(text).readline) if t.type == tokenize.NAME}
 
 
 def test_the_solvers_switch_names_no_normal_law():
@@ -267,7 +241,7 @@ def test_the_solvers_switch_names_no_normal_law():
                 assert name not in text, (path.name, name)
         for path, text in texts.items():
             assert f"normal_laws.{module.__name__.rsplit('.', 1)[1]}" not in text, (path.name, record.id)
-            assert not (_code_names(text) & constants), (path.name, constants)
+            assert not (code_names(text) & constants), (path.name, constants)
         assert f"family == {family}" in dispatch.source()
 
 

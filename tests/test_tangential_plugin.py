@@ -3,13 +3,11 @@ demcheck's source — its record, family id, compiled force and users' name — 
 and then collides in the reference's 3-D adaptive and verlet solvers (against its closed form) and is refused by
 every engine's vocabulary with a reason, with no other file edited; and the solvers' switch names no law."""
 
-import json
+from pathlib import Path
 
 import numpy as np
-import os
-import subprocess
-import sys
-from pathlib import Path
+
+from .helpers import with_plugin_law
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -91,13 +89,7 @@ print(json.dumps(out))
 
 
 def test_a_tangential_law_in_one_module_runs_in_the_reference_and_is_refused_by_every_engine(tmp_path):
-    (tmp_path / "toy_drag_law.py").write_text(TOY)
-    env = dict(os.environ, DEMCHECK_LAW_PLUGINS="toy_drag_law", XDG_CACHE_HOME=str(tmp_path / "cache"),
-               PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src"), str(ROOT)]))
-    env.pop("NUMBA_CACHE_DIR", None)  # the kernels' cache named by the fingerprint, the plug-in's source in it
-    p = subprocess.run([sys.executable, "-c", RUN], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1500)
-    assert p.returncode == 0, p.stderr[-3000:]
-    out = json.loads(p.stdout.strip().splitlines()[-1])
+    out = with_plugin_law(tmp_path, "toy_drag_law", TOY, RUN)
     assert out["family"] == 40.0
     # a constant drag F0 opposite the slip for the whole contact (the slip keeps its direction: a tenth of the
     # momentum is taken): m Δv_t = −F0 tc, I Δω = F0 R tc (radius arms), the normal motion as without friction

@@ -4,12 +4,10 @@ states — a spring under another family id, declared in one module — runs in 
 exactly as the built-in spring does, with no solver edited."""
 
 import ast
-import io
 import sys
-import tokenize
 from pathlib import Path
 
-from .helpers import with_plugin_law
+from .helpers import code_names, with_plugin_law
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "src" / "demcheck" / "reference"
@@ -40,12 +38,6 @@ def _family_constants() -> set[str]:
 NORMAL_FAMILIES = {"L_FAMILY", "HYSTERETIC", "VISCOELASTIC", "BRANCHED_FAMILY"}
 
 
-def _code_names(path: Path) -> set[str]:
-    """The identifiers a module's code uses (comments and strings left out)."""
-    tokens = tokenize.generate_tokens(io.StringIO(path.read_text()).readline)
-    return {t.string for t in tokens if t.type == tokenize.NAME}
-
-
 def test_no_solver_names_a_tangential_or_normal_family():
     from demcheck.laws import tangential_slot
     from demcheck.laws.tangential_laws import spring, walton
@@ -58,13 +50,13 @@ def test_no_solver_names_a_tangential_or_normal_family():
     assert {"adaptive3d.py", "verlet3d.py", "collision3d.py", "kernels.py", "kernels3d.py"} <= {p.name for p in solvers}
     assert "packing.py" in {p.name for p in solvers}
     for path in solvers:
-        named = _code_names(path) & constants - FAST_PATHS.get(path.name, set())
+        named = code_names(path.read_text()) & constants - FAST_PATHS.get(path.name, set())
         assert not named, f"{path.name} names the tangential family {sorted(named)}: ask the law's traits (has)"
-        named = _code_names(path) & NORMAL_FAMILIES
+        named = code_names(path.read_text()) & NORMAL_FAMILIES
         assert not named, f"{path.name} names the normal family {sorted(named)}: ask loads_and_unloads"
     # the check sees a name where one is used
-    assert "SPRING" in _code_names(ROOT / "src" / "demcheck" / "laws" / "tangential_laws" / "spring.py")
-    assert "L_FAMILY" in _code_names(ROOT / "src" / "demcheck" / "laws" / "normal_force.py")
+    assert "SPRING" in code_names((ROOT / "src" / "demcheck" / "laws" / "tangential_laws" / "spring.py").read_text())
+    assert "L_FAMILY" in code_names((ROOT / "src" / "demcheck" / "laws" / "normal_force.py").read_text())
 
 
 COPY = '''
