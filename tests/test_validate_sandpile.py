@@ -233,6 +233,26 @@ def test_an_interrupted_heap_run_keeps_its_heights_in_a_partial_report_and_stops
     assert "interrupted at t = 9.04 s" in text
 
 
+def test_an_interrupt_inside_a_compiled_kernel_is_an_interrupt_not_a_failed_run(monkeypatch, tmp_path):
+    """numba reports a signal raised as a compiled kernel returns as ``SystemError: CPUDispatcher(...) returned a
+    result with an exception set``, the interrupt its cause (a SIGTERM to a running validate was reported as a
+    failed run this way): the run is interrupted, with the signal's exit code, not a benchmark that failed."""
+    from demcheck.engines import run as runner
+
+    def height_curve(case, progress=None):
+        progress(9.0, 0.25)
+        try:
+            raise runner.Terminated()
+        except KeyboardInterrupt as stop:
+            raise SystemError("CPUDispatcher(<function run>) returned a result with an exception set") from stop
+
+    _stand_in(monkeypatch, tmp_path, height_curve)
+    with pytest.raises(v.HeapInterrupted) as exc:
+        v.run_heap(bench("ai2011-sandpile-epsd"))
+    assert exc.value.check.extra["failed"] == "interrupted at t = 9 s"
+    assert runner.interrupt_exit_code(exc.value) == 143
+
+
 def _catalogue_with(tmp_path, entry: str):
     path = tmp_path / "benchmarks.toml"
     path.write_text('[notes]\nx = "y"\n\n[[benchmark]]\n' + entry)

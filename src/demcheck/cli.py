@@ -1001,15 +1001,9 @@ def _interrupt_behind(exc: BaseException, received: list[int]) -> int | None:
     the chain lost it, a signal received during the command."""
     from .engines import run as runner
 
-    todo, seen = [exc], set()
-    while todo:
-        e = todo.pop()
-        if e is None or id(e) in seen:
-            continue
-        seen.add(id(e))
-        if isinstance(e, KeyboardInterrupt):
-            return runner.interrupt_exit_code(e)
-        todo += [e.__cause__, e.__context__]
+    stop = runner.interrupt_in(exc)
+    if stop is not None:
+        return runner.interrupt_exit_code(stop)
     return 128 + received[-1] if received else None
 
 

@@ -865,17 +865,21 @@ def run_heap(bench: Benchmark, cases: Path | None = None, progress=None) -> tupl
         if progress is not None:
             progress(t, h)
 
+    from ..engines.run import interrupt_in
+
     try:
         sandpile = importlib.import_module("demcheck.reference.sandpile")
         times_, heights_ = sandpile.height_curve(_load_case(path), progress=look)
-    except KeyboardInterrupt as exc:
+    except BaseException as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
+        if interrupt_in(exc) is None:  # (an interrupt in a compiled kernel comes as numba's SystemError)
+            if not isinstance(exc, Exception):
+                raise
+            return judge_heap(bench, file, None, None, error=f"{type(exc).__name__}: {exc}")
         at = f" at t = {times[-1]:.6g} s" if times else " before its first height"
         check, series = judge_heap(bench, file, None, None, error=f"interrupted{at}")
         if times:
             series["sources"]["reference"] = {"x": list(times), "y": list(heights)}
         raise HeapInterrupted(check, series) from exc
-    except Exception as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
-        return judge_heap(bench, file, None, None, error=f"{type(exc).__name__}: {exc}")
     return judge_heap(bench, file, times_, heights_)
 
 

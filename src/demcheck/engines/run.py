@@ -112,6 +112,23 @@ def interrupt_exit_code(exc: BaseException | None) -> int:
     return 128 + signal.SIGINT
 
 
+def interrupt_in(exc: BaseException | None) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt (or ``Terminated``) behind ``exc``: itself, or one among its causes and contexts —
+    numba raises a pending signal inside its own callback as it returns from a compiled kernel and reports it as
+    ``SystemError: CPUDispatcher(...) returned a result with an exception set`` caused by the interrupt, so a
+    handler of Exception around a kernel must ask this before it calls the interrupt a failure."""
+    todo, seen = [exc], set()
+    while todo:
+        e = todo.pop()
+        if e is None or id(e) in seen:
+            continue
+        seen.add(id(e))
+        if isinstance(e, KeyboardInterrupt):
+            return e
+        todo += [e.__cause__, e.__context__]
+    return None
+
+
 _RUNNING: set = set()
 _KILLED: set = set()  # the runs kill_all stopped: interrupted, not failed
 _STOP = threading.Event()  # set by an interrupt: no engine starts until reset()
