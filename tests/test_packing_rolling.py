@@ -173,13 +173,14 @@ dt = 1e-7
 
 @pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize("rolling", ['rolling = "constant_torque"\nmu_r = 0.5',
-                                     'rolling = "epsd"\nmu_r = 0.5\nk_r = 1e-2\nc_r = 1e-9'])
+                                     'rolling = "epsd"\nmu_r = 0.5\nk_r = 1e-2\nc_r = 1e-9',
+                                     'rolling = "ai_epsd"\nmu_r = 0.5\nk_ratio = 3.0\neta_r = 0.1'])
 def test_a_pairs_rolling_torques_are_equal_and_opposite(rolling, threads):
     """Two spheres of unequal size pressed together (the second moved in by 5 µm after loading), spinning against
     each other, no friction and no gravity: the normal force is central, so the spins change by the rolling torques
     alone, and those being equal and opposite keep Σ I ω to round-off (1e-12 of its change's scale) while each spin
     changes by a good part of itself — on two threads across the shares' cut too (the second sphere's torque through
-    the far buffer)."""
+    the far buffer); ai_epsd with the loop's kn per contact (Hooke's: its secant is k) too."""
     case = C.loads(PAIR.format(rolling=rolling))
     st = P.PackState(case)
     st.x[1, 0] -= 5e-6
