@@ -98,7 +98,7 @@ def rolling_laws(case, rep: list[int]) -> tuple[int, int, np.ndarray, int]:
             how = ("per contact and step (the normal spring's secant stiffness F/δ)" if what == "kn" else
                    "per species pair (from the masses and radii)")
             raise ConfigError(f"contact.{key}", params[key],
-                              f"is not set in a packing: the packing loop supplies rolling model '{law}''s {key} {how}")
+                              f"is not set in a packing: the packing loop supplies {key} of rolling model '{law}' {how}")
     if kn_col >= 0:
         params[names[kn_col]] = 1.0  # a placeholder for the record's checks: the table's column is NaN
 
