@@ -173,13 +173,14 @@ dt = 1e-7
 
 @pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize("rolling", ['rolling = "constant_torque"\nmu_r = 0.5',
-                                     'rolling = "epsd"\nmu_r = 0.5\nk_r = 1e-2\nc_r = 1e-9'])
+                                     'rolling = "epsd"\nmu_r = 0.5\nk_r = 1e-2\nc_r = 1e-9',
+                                     'rolling = "ai_epsd"\nmu_r = 0.5\nk_ratio = 3.0\neta_r = 0.1'])
 def test_a_pairs_rolling_torques_are_equal_and_opposite(rolling, threads):
     """Two spheres of unequal size pressed together (the second moved in by 5 µm after loading), spinning against
     each other, no friction and no gravity: the normal force is central, so the spins change by the rolling torques
     alone, and those being equal and opposite keep Σ I ω to round-off (1e-12 of its change's scale) while each spin
     changes by a good part of itself — on two threads across the shares' cut too (the second sphere's torque through
-    the far buffer)."""
+    the far buffer); ai_epsd with the loop's kn per contact (Hooke's: its secant is k) too."""
     case = C.loads(PAIR.format(rolling=rolling))
     st = P.PackState(case)
     st.x[1, 0] -= 5e-6
@@ -236,3 +237,154 @@ rolling = "constant_torque"
 mu_r = 0.1
 """)
     assert err.value.key == "contact.rolling" and "packings" in err.value.rule
+
+
+# ----------------------------------------------------------------------------- ai_epsd: kn and Ir from the loop
+AI = """
+name = "ai-epsd-{what}"
+kind = "packing"
+[materials.glass]
+density = 2500.0
+youngs_modulus = 1e8
+poisson_ratio = 0.3
+restitution = 0.5
+{particles}
+[contact]
+normal = "tti"
+tangential = "none"
+rolling = "ai_epsd"
+mu_r = 0.1
+k_ratio = 3.0
+eta_r = 0.1
+{extra}
+[run]
+dt = 1e-7
+gravity = {gravity}
+"""
+ON_WALL = """
+[[particles]]
+material = "glass"
+radius = 1e-3
+position = [0.0, 0.0, 1e-3]
+[[walls]]
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+"""
+TWO = """
+[[particles]]
+material = "glass"
+radius = 1e-3
+position = [0.0, 0.0, 0.0]
+[[particles]]
+material = "glass"
+radius = 1.5e-3
+position = [2.5e-3, 0.0, 0.0]
+"""
+E_, NU, RHO = 1e8, 0.3, 2500.0
+
+
+def _ai_case(what: str, extra: str = ""):
+    particles, gravity = (ON_WALL, "[0.0, 0.0, -9.81]") if what == "wall" else (TWO, "[0.0, 0.0, 0.0]")
+    return C.loads(AI.format(what=what, particles=particles, extra=extra, gravity=gravity))
+
+
+def _one_force_call(case, st, dt):
+    """The loop's forces of ``st`` once, histories updated (its set-up builds the list and the states without
+    storing, as a run's does; then one updating call of the force loop): (torques, state rows)."""
+    from demcheck.reference.collision3d import rules_array
+
+    sp, laws_n, laws_t, wall_n, wall_t = P.resolve_laws(case)
+    lawn, lawt = P.law_table(laws_n, laws_t, wall_n, wall_t)
+    walls = P.wall_table(st.walls)
+    lo, hi, periodic = P.box_of(case, st.x, st.rad)
+    rules = rules_array(None)
+    kind, _, laws_r, kn_col = st.rolling
+    roll = (laws_r, np.int64(kind), np.int64(st.roll_col), np.int64(kn_col))
+    n = len(st.rad)
+    _, period, _, _, _, _, _, _, start, nbj, hist, dmax, _ = P._setup(
+        st.x, st.v, st.w, st.rad, st.mass, sp, laws_n.shape[0], lawn, lawt, walls, lo, hi, periodic, dt, 1, 1,
+        st.start, st.nbj, st.hist, st.dmax, rules, *roll)
+    f, tq = np.zeros((n, 3)), np.zeros((n, 3))
+    P._contact_forces(np.int64(0), n, st.x, st.v, st.w, st.rad, sp, laws_n.shape[0], lawn, lawt, walls, period,
+                      start, nbj, hist, dmax, f, tq, f, tq, np.zeros((0, 3)), dt, np.bool_(True), rules, *roll)
+    return tq, hist
+
+
+@pytest.mark.parametrize("what", ["wall", "pair"])
+def test_ai_epsd_in_the_loop_takes_each_contacts_hertz_kn_and_its_pairs_ir(what):
+    """Ai's model C in the packing loop, kr = ε kn (μr R̄)² with kn the contact's Hertz secant (4/3)E*√(R̄δ) at its
+    overlap, Cr = ηr·2√(Ir kr) with Ir = 1.4 m R² (a sphere on a rigid wall) or 1/Ir = 1/(1.4 m0 R0²) + 1/(1.4 m1
+    R1²) (a pair), all by hand here: after one step dt of a spin w (its rolling part w_t, across the normal) the
+    spring torque (the contact's history) is −kr w_t dt = −kr Δθ, and the torque on the sphere (no friction:
+    tangential none) Mk − Cr w_t, to 1e-9. The sphere on the wall sits at Hertz's equilibrium overlap (mg = K δ^{3/2},
+    K = (4/3)E*√R), and approaches at 1 cm/s: the normal dashpot's force is several times the spring's, so a kn
+    from the damped total would miss by as much."""
+    case = _ai_case(what)
+    st = P.PackState(case)
+    dt = 1e-7
+    if what == "wall":
+        r_bar, r0 = 1e-3, 1e-3
+        m0 = RHO * 4.0 / 3.0 * math.pi * r0 ** 3
+        e_star = E_ / (1.0 - NU ** 2)  # a rigid wall
+        delta = (m0 * G / (4.0 / 3.0 * e_star * math.sqrt(r_bar))) ** (2.0 / 3.0)
+        st.x[0, 2] = r0 - delta
+        st.v[0] = (0.0, 0.0, -0.01)
+        st.w[0] = (0.0, 0.1, 0.0)
+        w_t = np.array([0.0, 0.1, 0.0])  # n = −z
+        i_r = 1.4 * m0 * r0 ** 2
+    else:
+        r0, r1 = 1e-3, 1.5e-3
+        r_bar = r0 * r1 / (r0 + r1)
+        m0, m1 = (RHO * 4.0 / 3.0 * math.pi * r ** 3 for r in (r0, r1))
+        e_star = E_ / (2.0 * (1.0 - NU ** 2))
+        delta = 5e-6
+        st.x[1, 0] = r0 + r1 - delta
+        st.v[0] = (0.01, 0.0, 0.0)  # approaching
+        st.w[0], st.w[1] = (0.2, 0.2, 0.05), (0.3, -0.1, 0.0)
+        w_t = np.array([0.0, 0.3, 0.05])  # ω0 − ω1 less its part along n = +x
+        i_r = 1.0 / (1.0 / (1.4 * m0 * r0 ** 2) + 1.0 / (1.4 * m1 * r1 ** 2))
+    kn = 4.0 / 3.0 * e_star * math.sqrt(r_bar * delta)
+    k_r = 3.0 * kn * (0.1 * r_bar) ** 2
+    c_r = 0.1 * 2.0 * math.sqrt(i_r * k_r)
+    tq, hist = _one_force_call(case, st, dt)
+    row = 0 if what == "wall" else len(st.rad) * len(case.walls)  # the wall contact's state, or the pair's
+    spring = hist[row, st.roll_col:st.roll_col + 3]
+    assert np.allclose(spring, -k_r * w_t * dt, rtol=1e-9, atol=0.0)
+    assert np.linalg.norm(spring) == pytest.approx(k_r * np.linalg.norm(w_t) * dt, rel=1e-9)
+    assert np.allclose(tq[0], -k_r * w_t * dt - c_r * w_t, rtol=1e-9, atol=0.0)
+    if what == "pair":
+        assert np.allclose(tq[1], -tq[0], rtol=1e-12, atol=0.0)
+
+
+def test_ai_epsd_table_holds_each_pairs_ir_and_no_kn():
+    """packing_rolling's table for ai_epsd: Ir of each species pair and of each species on the walls, by hand (1.4 m
+    R², 1/Ir the sum of the two), the kn column NaN (the loop writes it per contact: a contact it missed would not
+    run on a made-up kn), and the kn column handed to the loop; the other laws have none (-1)."""
+    from demcheck.laws.rolling_laws.ai_epsd import I_R, K_N
+
+    case = C.loads(AI.format(what="table", particles=TWO + """
+[[walls]]
+point = [0.0, 0.0, -2e-3]
+normal = [0.0, 0.0, 1.0]
+""", extra="", gravity="[0.0, 0.0, -9.81]"))
+    sp, rep = P.species_of(case)
+    kind, cols, table, kn_col = PR.rolling_laws(case, rep)
+    assert cols == 3 and kn_col == K_N == 2 and I_R == 5
+    j = [1.4 * RHO * 4.0 / 3.0 * math.pi * r ** 5 for r in (1e-3, 1.5e-3)]  # 1.4 m R²
+    assert table[0, I_R] == pytest.approx(j[0] / 2.0, rel=1e-14)
+    assert table[1, I_R] == table[2, I_R] == pytest.approx(j[0] * j[1] / (j[0] + j[1]), rel=1e-14)
+    assert table[3, I_R] == pytest.approx(j[1] / 2.0, rel=1e-14)
+    assert table[4, I_R] == pytest.approx(j[0], rel=1e-14) and table[5, I_R] == pytest.approx(j[1], rel=1e-14)
+    assert np.isnan(table[:, K_N]).all()
+    other = C.loads(PAIR.format(rolling='rolling = "epsd"\nmu_r = 0.5\nk_r = 1e-2\nc_r = 1e-9'))
+    assert PR.rolling_laws(other, P.species_of(other)[1])[3] == -1
+    assert PR.rolling_laws(C.loads(PAIR.format(rolling="")), [0, 1])[3] == -1
+
+
+@pytest.mark.parametrize("key", ["k_n = 1e3", "i_r = 1e-9"])
+def test_a_packing_may_not_set_what_the_loop_supplies(key):
+    """k_n and i_r of ai_epsd are the loop's in a packing: a case setting one is refused by name, not ignored."""
+    case = _ai_case("wall", key)
+    with pytest.raises(ConfigError) as err:
+        P.PackState(case)
+    assert err.value.key == f"contact.{key.split()[0]}" and "packing loop supplies" in err.value.rule

@@ -284,11 +284,11 @@ def test_a_bad_heap_entry_is_refused_naming_its_key(tmp_path, change, key):
 
 @pytest.mark.parametrize("name,rolling", [("ai2011-sandpile-constant", "constant_torque"),
                                           ("ai2011-sandpile-viscous", "ai_viscous"),
-                                          ("ai2011-sandpile-epsd", "epsd")])
+                                          ("ai2011-sandpile-epsd", "ai_epsd")])
 def test_each_heap_benchmark_names_a_shipped_case_with_its_model(name, rolling):
     """The three cases exist, load, and differ from each other in the rolling law only (Lethe's three .prm files
-    differ in `rolling resistance torque method` alone): model A constant_torque, B ai_viscous, C epsd (constant
-    kr and Cr: Ai's model C with kn(δ) recomputed, `ai_epsd`, needs per-contact kn in the packing loop)."""
+    differ in `rolling resistance torque method` alone): model A constant_torque, B ai_viscous, C ai_epsd (Ai's
+    model C with kr from each contact's kn(δ), which the packing loop writes per contact and step, as Lethe)."""
     from demcheck import case as C
     from demcheck import resources
 

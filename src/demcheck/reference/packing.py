@@ -29,7 +29,7 @@ from numba.extending import intrinsic
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from .. import KERNEL_CACHE
-from ..laws.normal_force import L_LIMIT, normal_force
+from ..laws.normal_force import branched_force, L_LIMIT, loads_and_unloads, normal_force, spring_force
 from ..laws.tangential_force import (discrete_slip, eta_of, F_DISCRETE_SLIP, F_HISTORY, F_NO_FORCE, F_OWN_RATE,
                                      F_REVERSAL, has, history_rate, kt_of, return_map, reverses, slip_surface,
                                      tangential_force)
@@ -249,8 +249,9 @@ def _rebuild_threaded(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, 
     return new_start, new_j, new_hist, new_dmax
 
 
-# the rolling slot's arguments of the compiled loop where the case names no rolling law (laws_r, roll_kind, roll_col)
-NO_ROLLING = (np.zeros((1, 1)), np.int64(-1), np.int64(-1))
+# the rolling slot's arguments of the compiled loop where the case names no rolling law (laws_r, roll_kind, roll_col,
+# roll_kn)
+NO_ROLLING = (np.zeros((1, 1)), np.int64(-1), np.int64(-1), np.int64(-1))
 
 NL_SIZE = L_LIMIT + 1  # the length of a normal law's array (kernels.py)
 
@@ -346,7 +347,8 @@ def _react(f, tq, j, f0, f1, f2, b, t0, t1, t2):
 
 @njit(cache=KERNEL_CACHE)
 def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
-                    hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules, laws_r, roll_kind, roll_col):
+                    hist, dmax, f, tq, f_far, tq_far, records, dt, update, rules, laws_r, roll_kind, roll_col,
+                    roll_kn):
     """Forces and torques of the contacts of particles lo…hi−1 (their pairs in the Verlet list, j > i, and
     their walls), added into ``f`` and ``tq`` — for a particle j ≥ hi into ``f_far`` and ``tq_far`` instead (the
     same arrays when lo…hi−1 are all the rows). A contact's state (history, largest overlap) is row r of
@@ -362,6 +364,10 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     increment too but stores nothing (as LIGGGHTS's rolling models do), so that a spring held at its limit stays
     there across a chunk's set-up — with no increment it would sit exactly on the limit, below it by the law's
     test, and its dashpot would come back for that one call (type C's, 0.8 % more torque at a set-up every 500 steps).
+    A law that reads the contact's normal stiffness (its record's ``kn_column``: ``roll_kn`` ≥ 0, packing_rolling.
+    rolling_laws) gets its row copied with kn written at that place, per contact and step: the normal spring's secant
+    stiffness F_spring/δ (:func:`_secant_stiffness`, the elastic part, not the damped total); with ``roll_kn`` -1
+    the row is passed as it is and no kn is computed.
 
     A row's contacts are computed, and their states updated, by whoever computes the row: the rows lo…hi−1 may
     be one thread's share, writing f and tq only for its own particles, its far buffers for the others'
@@ -375,6 +381,7 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
     rwbuf = np.empty(3)  # the rolling law's w, n and history
     rnbuf = np.empty(3)
     rhbuf = np.zeros(3)
+    rcbuf = np.empty(laws_r.shape[1])  # a law's row with the contact's kn (roll_kn ≥ 0)
     t_width = roll_col if roll_col >= 0 else hist.shape[1]  # the tangential law's columns of a state row
     segments = walls.shape[1] > W_PLANE  # a wall table with segments' columns (wall_table); a plane's is 6 wide
     rot = rules[R_ROTATION]
@@ -495,7 +502,12 @@ def _contact_forces(lo, hi, x, v, w, rad, species, n_species, laws_n, laws_t, wa
                     records[e, 0], records[e, 1] = delta, fn
                     records[e, 2] = math.sqrt(ft0 ** 2 + ft1 ** 2 + ft2 ** 2)
             if roll_kind >= 0:
-                _rolling(i, j, hi, r, p, w, n0, n1, n2, abs(fn), dt, update, laws_r, roll_kind, roll_col, hist, tq,
+                roll_row = laws_r[p]
+                if roll_kn >= 0:  # the law reads kn: its row with this contact's, now
+                    rcbuf[:] = roll_row
+                    rcbuf[roll_kn] = _secant_stiffness(nl, delta, dm)
+                    roll_row = rcbuf
+                _rolling(i, j, hi, r, w, n0, n1, n2, abs(fn), dt, update, roll_row, roll_kind, roll_col, hist, tq,
                          tq_far, rwbuf, rnbuf, rhbuf)
 
 
@@ -545,11 +557,21 @@ def _segment_contact(x, i, radius, walls, k, delta, n0, n1, n2):
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
-def _rolling(i, j, hi, r, p, w, n0, n1, n2, fabs, dt, update, laws_r, roll_kind, roll_col, hist, tq, tq_far, wbuf,
-             nbuf, hbuf):
-    """The rolling torque of contact state row r (particle i with j, or a wall: j = -1), law row p: M on i, −M on
-    j (into ``tq_far`` for a particle j ≥ hi, another share's), its history (columns roll_col…) updated with
-    ``update``."""
+def _secant_stiffness(nl, delta, dmax):
+    """The normal spring's secant stiffness F_spring/δ at overlap δ > 0 (law ``nl``, largest overlap ``dmax``): a
+    one-branch law's spring without its dashpot (Hooke's k, Hertz's (4/3)E*√(R̄δ)), a loading/unloading law's
+    force of its branch (it has no dashpot)."""
+    if loads_and_unloads(nl):
+        return branched_force(nl, delta, dmax) / delta
+    return spring_force(nl, delta) / delta
+
+
+@njit(cache=KERNEL_CACHE, inline="always")
+def _rolling(i, j, hi, r, w, n0, n1, n2, fabs, dt, update, c, roll_kind, roll_col, hist, tq, tq_far, wbuf, nbuf,
+             hbuf):
+    """The rolling torque of contact state row r (particle i with j, or a wall: j = -1), the law's row ``c``: M on
+    i, −M on j (into ``tq_far`` for a particle j ≥ hi, another share's), its history (columns roll_col…) updated
+    with ``update``."""
     if j >= 0:
         wbuf[0], wbuf[1], wbuf[2] = w[i, 0] - w[j, 0], w[i, 1] - w[j, 1], w[i, 2] - w[j, 2]
     else:
@@ -557,7 +579,7 @@ def _rolling(i, j, hi, r, p, w, n0, n1, n2, fabs, dt, update, laws_r, roll_kind,
     nbuf[0], nbuf[1], nbuf[2] = n0, n1, n2
     if roll_col >= 0:
         hbuf[0], hbuf[1], hbuf[2] = hist[r, roll_col], hist[r, roll_col + 1], hist[r, roll_col + 2]
-    m, h = rolling_torque(roll_kind, laws_r[p], wbuf, nbuf, fabs, dt, hbuf)
+    m, h = rolling_torque(roll_kind, c, wbuf, nbuf, fabs, dt, hbuf)
     if update and roll_col >= 0:
         hist[r, roll_col], hist[r, roll_col + 1], hist[r, roll_col + 2] = h[0], h[1], h[2]
     tq[i, 0] += m[0]
@@ -670,7 +692,7 @@ def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
 
 @njit(cache=KERNEL_CACHE)
 def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps,
-           ke_every, start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col):
+           ke_every, start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col, roll_kn):
     """What a run starts from: a new Verlet list (its pair states carried over) and the forces of the initial
     state, computed without touching histories (as the engines do). Returns (inertia, period, skin, the kinetic
     energy series and the flags to fill, the positions at the rebuild, f, tq, the list and its states, the
@@ -685,7 +707,8 @@ def _setup(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo
     records = _new_records(start) if steps == 0 else np.zeros((0, 3))  # records at the last step only
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it)
     _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start, nbj,
-                    hist, dmax, f, tq, f, tq, records, dt, np.bool_(False), rules, laws_r, roll_kind, roll_col)
+                    hist, dmax, f, tq, f, tq, records, dt, np.bool_(False), rules, laws_r, roll_kind, roll_col,
+                    roll_kn)
     return (0.4 * mass * rad * rad, period, skin, np.zeros(steps // ke_every + 1), np.zeros(2, np.int64), x.copy(),
             f, tq, start, nbj, hist, dmax, records)
 
@@ -801,7 +824,7 @@ def _energy(ke, flags, step, ke_every, e, e_rot):
 
 @njit(cache=KERNEL_CACHE, nogil=True)
 def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt, steps,
-        ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col):
+        ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col, roll_kn):
     """Velocity Verlet for ``steps`` steps from the given state (x, v, w modified in place; the contact states
     travel with the Verlet list, rebuilt here, the walls' first). Returns (translational kinetic energy every
     ke_every steps, number of pair contacts at the end (their records in ``contacts``), flags [unused,
@@ -814,7 +837,7 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     n_p = x.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
-        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col)
+        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col, roll_kn)
     # one pass over the particles a step besides the force loop: the second half kick fused with the next step's
     # first half kick and drift (_kick_and_next), as the threaded loop does
     moved = _kick_drift(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi, periodic, x_ref)
@@ -834,7 +857,8 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
             records = _new_records(start)
         t = _add(clock, serial, S_OTHER, t)
         _contact_forces(np.int64(0), n_p, x, v, w, rad, species, n_species, laws_n, laws_t, walls, period, start,
-                        nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules, laws_r, roll_kind, roll_col)
+                        nbj, hist, dmax, f, tq, f, tq, records, dt, np.bool_(True), rules, laws_r, roll_kind, roll_col,
+                        roll_kn)
         t = _add(clock, 0, F_WORK, t)
         e, e_rot, moved = _kick_and_next(0, n_p, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_hi,
                                          periodic, x_ref, step < steps)
@@ -952,7 +976,8 @@ def _gather(lo, hi, chunks, far, f_far, tq_far, f, tq):
 
 @njit(cache=KERNEL_CACHE, nogil=True, parallel=True)
 def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, gravity, dt,
-                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col, threads):
+                 steps, ke_every, start, nbj, hist, dmax, contacts, rules, clock, laws_r, roll_kind, roll_col, roll_kn,
+                 threads):
     """:func:`run` on ``threads`` threads (numba's, prange). The particles, and with them the rows of the
     Verlet list, are cut into as many shares of about equal work (:func:`_balance`, again at each rebuild, which
     is threaded too). A share's contacts are computed by one thread, which alone updates their states (a pair's
@@ -968,7 +993,7 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
     n_w = walls.shape[0]
     inertia, period, skin, ke, flags, x_ref, f, tq, start, nbj, hist, dmax, records = _setup(
         x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, box_hi, periodic, dt, steps, ke_every,
-        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col)
+        start, nbj, hist, dmax, rules, laws_r, roll_kind, roll_col, roll_kn)
     chunks = np.empty(threads + 1, np.int64)  # each share's rows of the list, and its particles
     far = np.empty(threads, np.int64)  # each share's far buffer holds particles below far[share] only
     kicks = np.empty(threads + 1, np.int64)  # the kick region's shares of the particles
@@ -1012,7 +1037,7 @@ def run_threaded(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, 
             began = _begin(clock, c, F_LAUNCH, t)
             _contact_forces(chunks[c], chunks[c + 1], x, v, w, rad, species, n_species, laws_n, laws_t, walls, period,
                             start, nbj, hist, dmax, f, tq, f_far[c], tq_far[c], records, dt, np.bool_(True), rules,
-                            laws_r, roll_kind, roll_col)
+                            laws_r, roll_kind, roll_col, roll_kn)
             ends[c] = _add(clock, c, F_WORK, began)[0]
         t = _waits(clock, ends, F_WAIT, t)
         for b in prange(threads):
@@ -1138,7 +1163,8 @@ class PackState:
         _, _, laws_t, _, wall_t = resolve_laws(full)
         rows = [*laws_t.reshape(-1, T_SIZE), *(wall_t if case.walls else ())]
         width = history_width([TangentialLaw.from_array(t).slot() for t in rows])
-        # the rolling law's: (kind, its history's columns, its table) — its history after the tangential one's
+        # the rolling law's: (kind, its history's columns, its table, its kn column) — its history after the
+        # tangential one's
         self.rolling = rolling_laws(full, species_of(full)[1])
         self.roll_col = width if self.rolling[1] else -1
         width += self.rolling[1]
@@ -1369,10 +1395,11 @@ def advance(case, st: PackState, dt: float, steps: int, rules: dict | None = Non
         walls = wall_table(st.walls)
     g = np.asarray(case.run.gravity if gravity is None else gravity, float)
     lo, hi, periodic = box_of(case, st.x, st.rad)
-    roll_kind, _, laws_r = st.rolling
+    roll_kind, _, laws_r, roll_kn = st.rolling
     args = (st.x, st.v, st.w, st.rad, st.mass, sp, laws_n.shape[0], *law_table(laws_n, laws_t, wall_n, wall_t), walls,
             lo, hi, periodic, g, dt, steps, ke_every or max(1, steps // 20), st.start, st.nbj, st.hist, st.dmax,
-            st.contacts, rules_array(rules), clock, laws_r, np.int64(roll_kind), np.int64(st.roll_col))
+            st.contacts, rules_array(rules), clock, laws_r, np.int64(roll_kind), np.int64(st.roll_col),
+            np.int64(roll_kn))
     if threads == 1:
         out = run(*args)
     else:

@@ -66,23 +66,49 @@ def kind_of(record) -> int:
     return ORDER.index(type(record))
 
 
-def rolling_laws(case, rep: list[int]) -> tuple[int, int, np.ndarray]:
-    """(kind, history columns, table) of the case's rolling law: the table holds one row per species pair
-    (si·n_species + sj) and one per species against the walls (n_species² + si), as packing.law_table's rows, each
-    the law's record ``array()`` for that pair (laws/slots.record: its rolling radius R̄, or R on a wall) padded
+def rolling_laws(case, rep: list[int]) -> tuple[int, int, np.ndarray, int]:
+    """(kind, history columns, table, kn column) of the case's rolling law: the table holds one row per species
+    pair (si·n_species + sj) and one per species against the walls (n_species² + si), as packing.law_table's rows,
+    each the law's record ``array()`` for that pair (laws/slots.record: its rolling radius R̄, or R on a wall) padded
     with zeros; kind -1 (and a table of zeros) where the case names none. History columns: 3 for a law with a
-    history (its spring torque), else 0."""
+    history (its spring torque), else 0.
+
+    A law whose record has a ``kn_column`` (laws/rolling_laws/slot.py's traits) reads the contact's normal
+    stiffness there: the loop writes it per contact and step (the kn column returned, -1 for none), so the table
+    holds NaN in that column (a contact the loop missed would make the run non-finite, never use a made-up kn). A
+    law with an ``ir_column`` gets Ai's Ir of each pair there, from the species' masses and radii (laws/rolling.
+    equivalent_inertia: 1/Ir = 1/(1.4 m0 R0²) + 1/(1.4 m1 R1²), the loop's I = 0.4 m R²; 1.4 m R² on a wall). The
+    case may set neither number (the loop's are the only ones): doing so is a ConfigError."""
+    from ..errors import ConfigError
     from ..laws import slots
     from ..laws.contact import pair_of
 
     ns = len(rep)
     law = case.contact.rolling
     if law == "none":
-        return -1, 0, np.zeros((ns * ns + ns, 1))
+        return -1, 0, np.zeros((ns * ns + ns, 1)), -1
+    cls = slots.SUBMODELS[("rolling", law)]
+    kn_col, ir_col = getattr(cls, "kn_column", -1), getattr(cls, "ir_column", -1)
+    params = dict(case.contact.params)
+    supplied = [(col, name) for col, name in ((kn_col, "kn"), (ir_col, "ir")) if col >= 0]
+    names = cls.param_names() if supplied else ()
+    for col, what in supplied:
+        key = names[col]
+        if key in params:
+            how = ("per contact and step (the normal spring's secant stiffness F/δ)" if what == "kn" else
+                   "per species pair (from the masses and radii)")
+            raise ConfigError(f"contact.{key}", params[key],
+                              f"is not set in a packing: the packing loop supplies {key} of rolling model '{law}' {how}")
+    if kn_col >= 0:
+        params[names[kn_col]] = 1.0  # a placeholder for the record's checks: the table's column is NaN
 
     def record(i, j):
         radii = (case.particles[i].radius, 0.0 if j is None else case.particles[j].radius)
-        return slots.record("rolling", law, case.contact.params, pair_of(case, i, j), radii)
+        values = params
+        if ir_col >= 0:
+            ir = _rolling.equivalent_inertia(case.mass(i), radii[0], *(() if j is None else (case.mass(j), radii[1])))
+            values = {**params, names[ir_col]: ir}
+        return slots.record("rolling", law, values, pair_of(case, i, j), radii)
 
     records = {}
     for a in range(ns):
@@ -95,4 +121,6 @@ def rolling_laws(case, rep: list[int]) -> tuple[int, int, np.ndarray]:
     for row, r in records.items():
         arr = r.array()
         table[row, :len(arr)] = arr
-    return kind, (3 if type(next(iter(records.values()))).history_size > 0 else 0), table
+    if kn_col >= 0:
+        table[:, kn_col] = np.nan
+    return kind, (3 if type(next(iter(records.values()))).history_size > 0 else 0), table, kn_col

@@ -10,7 +10,11 @@ damping, 1/Ir = 1/(I0 + m0R0²) + 1/(I1 + m1R1²)), and at full mobilisation the
 With f = 0 it is demcheck's ``epsd`` (``cap`` = spring) at kr and Cr computed as above — that law takes kr and Cr
 as given numbers; this one ties them to kn, as Ai does, and adds f. A Hertz contact's kn follows its overlap: a
 solver that has it per contact and step writes it into the record's coefficient array at :data:`K_N` (and Ir at
-:data:`I_R`) before calling the force; the scenarios' sphere at rest on a wall has a fixed kn."""
+:data:`I_R`) before calling the force — the record's traits ``kn_column`` and ``ir_column`` name those places. The
+packing loop does (reference/packing.py: kn the normal spring's secant stiffness F_spring/δ each step, as Lethe's
+(4/3)E*√(R̄δ) for Hertz; packing_rolling.rolling_laws: Ir per species pair from the masses and radii), so a packing
+case sets neither k_n nor i_r; the scenarios' sphere at rest on a wall has a fixed kn, the case's k_n (required
+there: a missing one is a ConfigError, never a silent 0)."""
 
 from __future__ import annotations
 
@@ -37,14 +41,17 @@ class AiEpsdRolling(RollingSubModel):
     history_size: ClassVar[int] = 3  # the spring torque Mk
     title: ClassVar[str] = "elastic-plastic spring-dashpot as Ai et al. 2011 model C (kr from kn)"
     spring: ClassVar[bool] = True
+    kn_column: ClassVar[int] = K_N  # the packing loop writes the contact's kn here each step
+    ir_column: ClassVar[int] = I_R  # and the pair's Ir here (its table)
     keys: ClassVar[tuple] = (
         MU_R, R_ROLL,
-        Key("k_n", "the normal stiffness kr derives from (N/m; a Hertz contact's kn at its overlap)", "must be > 0",
-            positive),
+        Key("k_n", "the normal stiffness kr derives from (N/m; a Hertz contact's kn at its overlap; a packing's loop "
+            "supplies it per contact, a packing case does not set it)", "must be > 0", positive),
         Key("k_ratio", "ε in kr = ε kn μr² Rr² (2.25: Ai's 3D value; Lethe's 2D runs 3)", "must be > 0", positive,
             default=2.25),
         Key("eta_r", "ηr: the dashpot's ratio to critical damping, Cr = ηr·2√(Ir kr)", default=0.0),
-        Key("i_r", "Ai's equivalent inertia Ir (kg·m²; 1.4 m R² for a sphere on a wall)", default=0.0),
+        Key("i_r", "Ai's equivalent inertia Ir (kg·m²; 1.4 m R² for a sphere on a wall; a packing's loop supplies it "
+            "per pair)", default=0.0),
         Key("f", "the dashpot's share at full mobilisation (Ai's f; 0: off)", "must be in [0, 1]", _fraction,
             default=0.0))
     formula: ClassVar[str] = ("Mk ← Mk − kr wt dt, |Mk| ≤ μr Rr |Fn|, kr = ε kn μr² Rr²; M = Mk − Cr wt "

@@ -29,12 +29,24 @@ class RollingSubModel(BeyondSubModel):
 
     * ``stops``: a sphere rolling on a level plane under it stops in finite time (type A: the stop event);
     * ``decays``: it never stops, its speed decays as e^{−t/T} (type B: the scenario measures T);
-    * ``spring``: it keeps a spring torque Mk (its history), integrated and held at its limit (type C)."""
+    * ``spring``: it keeps a spring torque Mk (its history), integrated and held at its limit (type C);
+    * ``kn_column``: the place in its ``array()`` of the contact's normal stiffness kn, which a solver that has it
+      per contact and step writes there before calling the force (the packing loop: the normal spring's secant
+      stiffness F_spring/δ); -1: the law reads no kn;
+    * ``ir_column``: the place of Ai's equivalent inertia Ir (1/Ir = 1/(I0 + m0R0²) + 1/(I1 + m1R1²), a sphere's
+      I + mR² = 1.4 m R², on a wall 1.4 m R²), which a solver that knows the bodies' masses writes there per pair
+      (the packing loop's table); -1: none.
+
+    A solver that supplies ``kn_column``'s or ``ir_column``'s number supplies it for every contact: a case running
+    there may not set it (the packing loop refuses it, packing_rolling.rolling_laws); elsewhere it is the law's
+    case key as any other."""
 
     slot: ClassVar[str] = "rolling"
     stops: ClassVar[bool] = False
     decays: ClassVar[bool] = False
     spring: ClassVar[bool] = False
+    kn_column: ClassVar[int] = -1
+    ir_column: ClassVar[int] = -1
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
