@@ -131,11 +131,11 @@ def children_alive(pid: int) -> list[int]:
     return _alive_where(1, pid)
 
 
-def _script_json(script: str, path: list, timeout: float, plugins: str | None = None) -> dict:
+def _script_json(script: str, path: list, cache, timeout: float, plugins: str | None = None) -> dict:
     """``script``'s JSON (its last line), run in a fresh process with ``path`` first on PYTHONPATH (then the
-    repository, for the tests' helpers), on an empty kernel cache: the kernels' cache directory is named by the
-    fingerprint of the laws' sources, so a law added to the path compiles afresh. ``plugins``: $DEMCHECK_LAW_PLUGINS
-    (unset when None)."""
+    repository, for the tests' helpers), on an empty kernel cache under ``cache`` ($XDG_CACHE_HOME): the kernels'
+    cache directory is named by the fingerprint of the laws' sources, so a law added to the path compiles afresh.
+    ``plugins``: $DEMCHECK_LAW_PLUGINS (unset when None)."""
     import json
     import os
     import subprocess
@@ -143,7 +143,7 @@ def _script_json(script: str, path: list, timeout: float, plugins: str | None = 
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    env = dict(os.environ, XDG_CACHE_HOME=str(Path(path[0]) / "cache"),
+    env = dict(os.environ, XDG_CACHE_HOME=str(cache),
                PYTHONPATH=os.pathsep.join([*map(str, path), str(root)]))
     env.pop("NUMBA_CACHE_DIR", None)
     env.pop("DEMCHECK_LAW_PLUGINS", None)
@@ -161,7 +161,8 @@ def with_plugin_law(tmp_path, module: str, source: str, script: str, timeout: fl
     from pathlib import Path
 
     (tmp_path / f"{module}.py").write_text(source)
-    return _script_json(script, [tmp_path, Path(__file__).resolve().parents[1] / "src"], timeout, plugins=module)
+    return _script_json(script, [tmp_path, Path(__file__).resolve().parents[1] / "src"], tmp_path / "cache", timeout,
+                        plugins=module)
 
 
 def with_law_modules(tmp_path, folder: str, modules: dict[str, str], script: str, timeout: float = 2400) -> dict:
@@ -176,7 +177,7 @@ def with_law_modules(tmp_path, folder: str, modules: dict[str, str], script: str
                     ignore=shutil.ignore_patterns("__pycache__"))
     for name, text in modules.items():
         (src / "demcheck" / "laws" / folder / f"{name}.py").write_text(text)
-    return _script_json(script, [src], timeout)
+    return _script_json(script, [src], tmp_path / "cache", timeout)
 
 
 def code_names(text: str) -> set[str]:
