@@ -28,8 +28,9 @@ CPU time. The kernel's time is then set beside rhs evaluations × that cost (the
 the error norm, the event logic, the records' kinematics, the driver). The kernel's fixed part: the same call with
 t_max = 0 (it returns after its first record: the output arrays' allocation, the first rhs, the call itself).
 
-Run: .venv/bin/python benchmarks/bench_adaptive_profile.py [--repeat N] [--only oblique-lth ...]
-(writes benchmarks/results/bench_adaptive_profile.txt; OUT=path to write elsewhere)
+Run: .venv/bin/python benchmarks/bench_adaptive_profile.py [--repeat N] [--only oblique-lth ...] [--rtol R --append]
+(writes benchmarks/results/bench_adaptive_profile.txt, OUT=path to write elsewhere; --rtol solves every variant at
+run.rtol R instead of its own, and --append adds the report to the file instead of replacing it)
 """
 
 import argparse
@@ -168,8 +169,16 @@ def counted_run(args: tuple) -> dict:
     return c
 
 
-def child(where: Path, only: tuple) -> None:
-    for i, (label, raw) in enumerate(variants(only)):
+def cases(only: tuple, rtol: float | None):
+    """The suite's oblique variants, at run.rtol ``rtol`` when given (their own, 1e-13, when not)."""
+    for label, raw in variants(only):
+        if rtol:
+            raw.setdefault("run", {})["rtol"] = rtol
+        yield label, raw
+
+
+def child(where: Path, only: tuple, rtol: float | None) -> None:
+    for i, (label, raw) in enumerate(cases(only, rtol)):
         c = counted_run(kernel_args(raw))
         with open(where / f"{i:04d}.pkl", "wb") as f:
             pickle.dump((label, c), f)
@@ -234,7 +243,7 @@ def fit(x, y):
     return a, b
 
 
-def main(repeat: int, only: tuple) -> None:
+def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = False) -> None:
     if not any(True for _ in variants(only)):
         sys.exit(f"no suite oblique case file named {' '.join(only)}")
     load0 = os.getloadavg()
@@ -242,7 +251,8 @@ def main(repeat: int, only: tuple) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.time()
         env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=str(ROOT / "src"))
-        subprocess.run([sys.executable, __file__, "--child", tmp, *only], env=env, check=True)
+        subprocess.run([sys.executable, __file__, "--child", tmp, *(["--rtol", repr(rtol)] if rtol else []), *only],
+                       env=env, check=True)
         child_wall = time.time() - t0
         counted = []
         for p in sorted(Path(tmp).glob("*.pkl")):
@@ -252,7 +262,7 @@ def main(repeat: int, only: tuple) -> None:
     from demcheck.reference import adaptive3d
 
     rhs_loop = _rhs_loop_kernel()
-    raws = dict(variants(only))
+    raws = dict(cases(only, rtol))
     rows = []
     for label, c in counted:
         args = kernel_args(raws[label])
@@ -274,9 +284,9 @@ def main(repeat: int, only: tuple) -> None:
                      "same": same_bits(out, c["out"]), "python_s": c["python_s"], "sampled": len(Y)})
         print(f"timed {label}: kernel {k * 1e3:.2f} ms, rhs {per_rhs * 1e6:.2f} us", file=sys.stderr, flush=True)
     load1 = os.getloadavg()
-    text = report(rows, started, load0, load1, repeat, child_wall)
+    text = report(rows, started, load0, load1, repeat, child_wall, rtol)
     print(text)
-    OUT.write_text(text)
+    OUT.write_text((OUT.read_text() + "\n" if append and OUT.exists() else "") + text)
 
 
 def _med_max(vals, fmt):
@@ -284,10 +294,11 @@ def _med_max(vals, fmt):
     return f"{format(statistics.median(vals), fmt)} / {format(max(vals), fmt)}"
 
 
-def report(rows, started, load0, load1, repeat, child_wall) -> str:
+def report(rows, started, load0, load1, repeat, child_wall, rtol=None) -> str:
     import numba
 
-    L = [f"adaptive 3-D method, profile of the suite's oblique cases at their default tolerance (run.rtol 1e-13): "
+    tol = f"at run.rtol {rtol:g} (every variant)" if rtol else "at their default tolerance (run.rtol 1e-13)"
+    L = [f"adaptive 3-D method, profile of the suite's oblique cases {tol}: "
          f"{started:%d %b %Y %H:%M} UTC, git {git_head()}, numba {numba.__version__}",
          f"load average (1, 5, 15 min) at the start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}, at the end "
          f"{load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} (2 cores, shared with other long runs: every time is CPU "
@@ -401,9 +412,11 @@ if __name__ == "__main__":
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--only", nargs="*", default=())
     ap.add_argument("--child", default=None)
+    ap.add_argument("--rtol", type=float, default=None)
+    ap.add_argument("--append", action="store_true")
     ap.add_argument("names", nargs="*")
     a = ap.parse_args()
     if a.child:
-        child(Path(a.child), tuple(a.names))
+        child(Path(a.child), tuple(a.names), a.rtol)
     else:
-        main(a.repeat, tuple(a.only))
+        main(a.repeat, tuple(a.only), a.rtol, a.append)
