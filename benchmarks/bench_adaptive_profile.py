@@ -31,6 +31,9 @@ t_max = 0 (it returns after its first record: the output arrays' allocation, the
 Run: .venv/bin/python benchmarks/bench_adaptive_profile.py [--repeat N] [--only oblique-lth ...] [--rtol R --append]
 (writes benchmarks/results/bench_adaptive_profile.txt, OUT=path to write elsewhere; --rtol solves every variant at
 run.rtol R instead of its own, and --append adds the report to the file instead of replacing it)
+      .venv/bin/python benchmarks/bench_adaptive_profile.py --derive
+(reads the file's per-variant tables, runs nothing, and appends what follows from them: per law the event location's
+rhs evaluations and their cost, loc × µs/rhs, and per variant the medians of each part's evaluations a point)
 """
 
 import argparse
@@ -407,6 +410,40 @@ def report(rows, started, load0, load1, repeat, child_wall, rtol=None) -> str:
     return "\n".join(L) + "\n"
 
 
+def derive() -> str:
+    """Numbers that follow from the per-variant tables already in OUT (one block per section)."""
+    med = statistics.median
+    sections, rows = [], None
+    for line in OUT.read_text().splitlines():
+        if line.startswith("adaptive 3-D method, profile"):
+            rows = []
+            sections.append((line.split(":")[0], rows))
+        f = line.split()
+        if rows is not None and len(f) == 22 and f[0].startswith("oblique-") and f[1] in ("same", "DIFF"):
+            rows.append({"file": f[0].split("[")[0], "pts": int(f[2]), "att": int(f[3]), "rej": int(f[4]),
+                         "rhs": int(f[9]), "step": int(f[11]), "end": int(f[12]), "loc": int(f[13]),
+                         "rec": int(f[15]), "fix": int(f[16]), "us": float(f[17])})
+    L = ["", "4. derived from the per-variant tables above (--derive: products and medians of their columns, nothing "
+         "run): the event location per collision, its rhs evaluations (loc) and their cost (loc × µs/rhs), median "
+         "[least, most] over each law's variants; the share of the location in the rhs evaluations"]
+    for title, rows in sections:
+        L.append(f"{title}:")
+        L.append(f"  {'case file':28s} {'location rhs':>22s} {'location ms':>24s} {'share':>6s}")
+        for fname in sorted({r["file"] for r in rows}):
+            g = [r for r in rows if r["file"] == fname]
+            lr = [r["loc"] for r in g]
+            lm = [r["loc"] * r["us"] / 1e3 for r in g]
+            L.append(f"  {fname:28s} {med(lr):8.0f} [{min(lr):5d}, {max(lr):5d}] {med(lm):8.2f} [{min(lm):6.2f}, "
+                     f"{max(lm):6.2f}] {med(r['loc'] / r['rhs'] for r in g):6.2f}")
+        lm = [r["loc"] * r["us"] / 1e3 for r in rows]
+        L.append(f"  all {len(rows)} variants: location a median {med(lm):.2f} ms a collision (least {min(lm):.2f}, most "
+                 f"{max(lm):.1f}); per point, medians: step {med(r['step'] / r['pts'] for r in rows):.2f}, "
+                 f"end {med(r['end'] / r['pts'] for r in rows):.2f}, location {med(r['loc'] / r['pts'] for r in rows):.2f}"
+                 f", record + fix {med((r['rec'] + r['fix']) / r['pts'] for r in rows):.2f}; rejected a median "
+                 f"{med(r['rej'] / r['att'] for r in rows):.1%} of the attempts")
+    return "\n".join(L) + "\n"
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
@@ -414,9 +451,14 @@ if __name__ == "__main__":
     ap.add_argument("--child", default=None)
     ap.add_argument("--rtol", type=float, default=None)
     ap.add_argument("--append", action="store_true")
+    ap.add_argument("--derive", action="store_true")
     ap.add_argument("names", nargs="*")
     a = ap.parse_args()
-    if a.child:
+    if a.derive:
+        text = derive()
+        print(text)
+        OUT.write_text(OUT.read_text() + text)
+    elif a.child:
         child(Path(a.child), tuple(a.names), a.rtol)
     else:
         main(a.repeat, tuple(a.only), a.rtol, a.append)
