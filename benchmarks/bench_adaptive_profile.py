@@ -30,7 +30,8 @@ t_max = 0 (it returns after its first record: the output arrays' allocation, the
 
 Run: .venv/bin/python benchmarks/bench_adaptive_profile.py [--repeat N] [--only oblique-lth ...] [--rtol R --append]
 (writes benchmarks/results/bench_adaptive_profile.txt, OUT=path to write elsewhere; --rtol solves every variant at
-run.rtol R instead of its own, and --append adds the report to the file instead of replacing it)
+run.rtol R instead of its own, --append adds the report to the file instead of replacing it, and --by-mode times the
+rhs sample split by the contact's mode too)
       .venv/bin/python benchmarks/bench_adaptive_profile.py --derive
 (reads the file's per-variant tables, runs nothing, and appends what follows from them: per law the event location's
 rhs evaluations and their cost, loc × µs/rhs, and per variant the medians of each part's evaluations a point)
@@ -246,7 +247,7 @@ def fit(x, y):
     return a, b
 
 
-def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = False) -> None:
+def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = False, by_mode: bool = False) -> None:
     if not any(True for _ in variants(only)):
         sys.exit(f"no suite oblique case file named {' '.join(only)}")
     load0 = os.getloadavg()
@@ -266,6 +267,8 @@ def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = Fal
 
     rhs_loop = _rhs_loop_kernel()
     raws = dict(cases(only, rtol))
+    first = kernel_args(next(iter(raws.values())))
+    adaptive3d.adaptive_3d(*first[:7], 0.0, first[8])  # the compiled kernel loaded (numba's cache) before any timing
     rows = []
     for label, c in counted:
         args = kernel_args(raws[label])
@@ -278,13 +281,28 @@ def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = Fal
         t0 = time.process_time()
         rhs_loop(Y, AUX, nl, tl, geo, rules, reps)
         per_rhs = (time.process_time() - t0) / (reps * len(Y))
+        modes = {}
+        if by_mode:  # the same sample split by the contact's mode: before contact, sticking, slipping
+            from demcheck.reference.kernels import M_PRE
+            from demcheck.reference.kernels3d import A_NMODE, A_TMODE, SLIP
+
+            free = AUX[:, A_NMODE] == M_PRE
+            slip = ~free & (AUX[:, A_TMODE] == SLIP)
+            for name, m in (("free", free), ("stick", ~free & ~slip), ("slip", slip)):
+                if m.sum() >= 16:
+                    Ym, Am = np.ascontiguousarray(Y[m]), np.ascontiguousarray(AUX[m])
+                    rm = max(1, RHS_CALLS // 2 // len(Ym))
+                    t0 = time.process_time()
+                    rhs_loop(Ym, Am, nl, tl, geo, rules, rm)
+                    modes[name] = (m.mean(), (time.process_time() - t0) / (rm * len(Ym)))
         rhs_total = sum(c["rhs"].values())
         rows.append({"label": label, "file": label.split("[")[0], "status": int(out[0]), "points": int(out[1]),
                      "events": int(out[3]), "kernel": k, "fixed": fixed, "per_rhs": per_rhs, "rhs": c["rhs"],
                      "rhs_total": rhs_total, "by_site": c["by_site"], "attempts": c["attempts"],
                      "rejected": c["rejected"], "accepted": c["accepted"], "locates": len(c["per_locate"]),
                      "trials": c["trials"], "max_trials": max(c["per_locate"], default=0),
-                     "same": same_bits(out, c["out"]), "python_s": c["python_s"], "sampled": len(Y)})
+                     "same": same_bits(out, c["out"]), "python_s": c["python_s"], "sampled": len(Y),
+                     "modes": modes})
         print(f"timed {label}: kernel {k * 1e3:.2f} ms, rhs {per_rhs * 1e6:.2f} us", file=sys.stderr, flush=True)
     load1 = os.getloadavg()
     text = report(rows, started, load0, load1, repeat, child_wall, rtol)
@@ -385,6 +403,13 @@ def report(rows, started, load0, load1, repeat, child_wall, rtol=None) -> str:
     L.append(f"per accepted step: {steprhs['step'] / acc:.2f} rhs stepping (rejected steps included), "
              f"{steprhs['step-end events'] / acc:.2f} event functions at its end")
     share = [r["rhs_total"] * r["per_rhs"] / r["kernel"] for r in rows]
+    if any(r["modes"] for r in rows):
+        L.append("one rhs by the contact's mode (--by-mode: the same sample split; share of the sample, µs): "
+                 "before contact / sticking / slipping")
+        for r in rows:
+            L.append(f"  {r['label']:34s} " + "   ".join(
+                f"{k} {r['modes'][k][0]:4.0%} {r['modes'][k][1] * 1e6:5.2f}" if k in r["modes"] else f"{k}    -      -"
+                for k in ("free", "stick", "slip")))
     L.append(f"kernel CPU against rhs evaluations × µs per rhs: the rhs part is a median {med(share):.0%} of the "
              f"kernel (least {min(share):.0%}, most {max(share):.0%})")
     fx = [r["fixed"] for r in rows]
@@ -452,6 +477,7 @@ if __name__ == "__main__":
     ap.add_argument("--rtol", type=float, default=None)
     ap.add_argument("--append", action="store_true")
     ap.add_argument("--derive", action="store_true")
+    ap.add_argument("--by-mode", action="store_true")
     ap.add_argument("names", nargs="*")
     a = ap.parse_args()
     if a.derive:
@@ -461,4 +487,4 @@ if __name__ == "__main__":
     elif a.child:
         child(Path(a.child), tuple(a.names), a.rtol)
     else:
-        main(a.repeat, tuple(a.only), a.rtol, a.append)
+        main(a.repeat, tuple(a.only), a.rtol, a.append, a.by_mode)
