@@ -28,7 +28,8 @@ def main():
           f"{subprocess.run(['git', 'describe', '--always', '--dirty'], capture_output=True, text=True).stdout.strip()})")
     for check, series in zip(val["checks"], val["series"]):
         print()
-        print(f"{check['benchmark']}: {check['verdict']}; largest relative deviation {check.get('deviation')} at "
+        print(f"{check['benchmark']}: {check['verdict']}; largest relative deviation {check.get('deviation')} "
+              f"(None: not judged) at "
               f"t = {check.get('at')} s over {check.get('points')} points; signed mean "
               f"{check.get('mean_deviation', check.get('extra', {}).get('mean_deviation'))}; tolerance "
               f"{check['tolerance']}")
@@ -43,6 +44,9 @@ def main():
         print(f"  run: {len(t)} heights, t = {t[0]:.4g}-{t[-1]:.4g} s")
         print(f"  {'t (s)':>9s} {'paper (m)':>10s} {'run (m)':>10s} {'run/paper-1':>12s}")
         for tp, hp in paper:
+            if not t[0] <= tp <= t[-1]:  # past an interrupted run's end: no height (never the last one carried on)
+                print(f"  {tp:9.4f} {hp:10.6f} {'-':>10s} {'-':>12s}")
+                continue
             hr = float(np.interp(tp, t, h))
             print(f"  {tp:9.4f} {hp:10.6f} {hr:10.6f} {hr / hp - 1:+12.4f}")
         print(f"  the run's heights up to {paper[0, 0] + 1:.2f} s:")
