@@ -27,7 +27,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "packing" / "poured.toml"
-ROUNDS = 3
+ROUNDS = 5
 
 CHILD = r"""
 import sys, time

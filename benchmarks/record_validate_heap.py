@@ -28,8 +28,8 @@ def main():
           f"{subprocess.run(['git', 'describe', '--always', '--dirty'], capture_output=True, text=True).stdout.strip()})")
     for check, series in zip(val["checks"], val["series"]):
         print()
-        print(f"{check['benchmark']}: {check['verdict']}; largest relative deviation {check.get('deviation')} "
-              f"(None: not judged) at "
+        print(f"{check['benchmark']}: {check['verdict']}; largest relative deviation "
+              f"{check.get('deviation') if check.get('deviation') is not None else '- (not judged)'} at "
               f"t = {check.get('at')} s over {check.get('points')} points; signed mean "
               f"{check.get('mean_deviation', check.get('extra', {}).get('mean_deviation'))}; tolerance "
               f"{check['tolerance']}")
