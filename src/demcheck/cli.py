@@ -599,7 +599,7 @@ def validate(name, engines, jobs, scheduler, report_dir, junit, as_json, no_cach
     """Run the published benchmarks (cases/benchmarks/: Chung & Ooi's eight tests, Thornton's oblique
     impacts; NAME one of them, e.g. chung-ooi-4) in the reference and every engine, and judge each source
     against the exact limits and the papers' curves (docs/benchmarks.md). The opt-in heap benchmarks
-    ai2011-sandpile-constant, -viscous and -epsd (Ai et al. 2011's rolling resistance, about an hour each, the
+    ai2011-sandpile-constant, -viscous and -epsd (Ai et al. 2011's rolling resistance, one to two hours each, the
     reference alone, a line of progress per simulated second) run only when named. Exit 1 when the reference
     misses an exact limit or a run fails, 2 on bad input."""
     from .comparisons.suite import Options

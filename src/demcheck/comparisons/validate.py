@@ -885,7 +885,7 @@ def run_heap(bench: Benchmark, cases: Path | None = None, progress=None) -> tupl
 
 def heap_log(name: str, every: float = 1.0, out=None):
     """A progress(t, height) that prints a line every ``every`` simulated seconds (to stderr): a heap run takes
-    about an hour, and says how far it is."""
+    one to two hours here (model A: 6 510 s on one thread), and says how far it is."""
     import sys
     import time
 
