@@ -170,7 +170,7 @@ def test_the_shipped_sandpile_cases_load_as_lethe_sets_them_up(model):
     assert len(steps) == 2051 and steps[0] == 450000 and steps[-1] == 2500000  # 9 s to 50 s: the curves' 9.1-49.5 s
     assert C.packing_run(case)[2] in (2500000, 2500001) and steps[-1] <= C.packing_run(case)[2]
     assert "only the reference" in engine_blind(case)
-    assert case.contact.rolling == {"constant": "constant_torque", "viscous": "ai_viscous", "epsd": "epsd"}[model]
+    assert case.contact.rolling == {"constant": "constant_torque", "viscous": "ai_viscous", "epsd": "ai_epsd"}[model]  # Ai's model C proper: kn per contact
 
 
 def test_an_inserted_packing_is_not_run_in_the_engines_even_with_plane_walls_and_no_rolling():
