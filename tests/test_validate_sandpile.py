@@ -191,6 +191,7 @@ def test_validate_run_of_a_heap_benchmark_alone_writes_its_report(monkeypatch, t
     assert summary.failed == failed
     (check,) = summary.validation.checks
     assert check.benchmark == "ai2011-sandpile-epsd" and check.verdict == verdict
+    assert summary.wall_time is not None and summary.wall_time >= 0.0 and not summary.partial
     assert (tmp_path / "reports" / "latest-validate" / "report.md").is_file()
 
 
@@ -231,6 +232,7 @@ def test_an_interrupted_heap_run_keeps_its_heights_in_a_partial_report_and_stops
     assert (latest / "report.md").is_file()
     text = (latest / "report.md").read_text() + json.dumps(json.loads((latest / "results.json").read_text()))
     assert "interrupted at t = 9.04 s" in text
+    assert json.loads((latest / "results.json").read_text())["partial"] is True
 
 
 def test_an_interrupt_inside_a_compiled_kernel_is_an_interrupt_not_a_failed_run(monkeypatch, tmp_path):

@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
@@ -869,18 +870,20 @@ def run_heap(bench: Benchmark, cases: Path | None = None, progress=None) -> tupl
 
     try:
         sandpile = importlib.import_module("demcheck.reference.sandpile")
-        times_, heights_ = sandpile.height_curve(_load_case(path), progress=look)
-    except BaseException as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
+        curve = sandpile.height_curve(_load_case(path), progress=look)
+    except KeyboardInterrupt as exc:
+        stop = exc
+    except Exception as exc:  # noqa: BLE001 — any failure of the run is a failed run, reported with its reason
         if interrupt_in(exc) is None:  # (an interrupt in a compiled kernel comes as numba's SystemError)
-            if not isinstance(exc, Exception):
-                raise
             return judge_heap(bench, file, None, None, error=f"{type(exc).__name__}: {exc}")
-        at = f" at t = {times[-1]:.6g} s" if times else " before its first height"
-        check, series = judge_heap(bench, file, None, None, error=f"interrupted{at}")
-        if times:
-            series["sources"]["reference"] = {"x": list(times), "y": list(heights)}
-        raise HeapInterrupted(check, series) from exc
-    return judge_heap(bench, file, times_, heights_)
+        stop = exc
+    else:
+        return judge_heap(bench, file, *curve)
+    at = f" at t = {times[-1]:.6g} s" if times else " before its first height"
+    check, series = judge_heap(bench, file, None, None, error=f"interrupted{at}")
+    if times:
+        series["sources"]["reference"] = {"x": list(times), "y": list(heights)}
+    raise HeapInterrupted(check, series) from stop
 
 
 def heap_log(name: str, every: float = 1.0, out=None):
@@ -1054,7 +1057,7 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
         summary = _heap_summary(report_root, argv)
         summary.validation = Validation()
     val = summary.validation
-    stopped = None
+    stopped, started = None, time.perf_counter()
     for b in heaps:
         try:
             check, line = run_heap(b, progress=None if quiet else heap_log(b.name))
@@ -1068,8 +1071,9 @@ def run(names: str | None, root: Path, report_root: Path, opts, quiet=False, jun
         if stopped is not None:
             break
     summary.failed += len(val.failed)
-    if not every and stopped is None:
-        summary.partial = False
+    if not every:
+        summary.wall_time = time.perf_counter() - started
+        summary.partial = stopped is not None
     report.write_all(summary, Path(summary.report), report_root, junit=junit, link=LINK)
     if stopped is not None:
         raise stopped
