@@ -361,3 +361,26 @@ def test_verify_compares_a_poured_packing_s_fabric_by_its_sampling_error(tmp_pat
     # the tolerance is z(α/2)·√(s_a²/N_a + s_b²/N_b): a few tenths for some 50 contacts a source
     assert 0.05 < k["tolerance"] < 0.5
     assert k["verdict"] == ("agree" if k["abs_diff"] <= k["tolerance"] else "unexpected")
+
+
+@pytest.mark.engine("lammps")
+def test_a_packing_s_engine_row_says_how_long_its_run_took_and_whether_the_cache_answered(tmp_path):
+    """An engine's packing row carries its run's wall time and `cached`, as a collision's row does: a cold verify
+    runs the deck (cached false, the time the run took), a second reads it from the run cache (cached true, a
+    read's time, shorter than the run's). Before, a packing's engine rows had no wall time: a cold suite's time
+    in its engines' packing loops was nowhere in its results."""
+    from demcheck.comparisons import suite
+    from demcheck.engines.cache import Cache
+
+    path = tmp_path / "small.toml"
+    path.write_text(SMALL)
+    rows = []
+    for _ in range(2):
+        opts = suite.Options(engines=("lammps",), cache=Cache(tmp_path / "cache"))
+        s = suite.run_suite([path], tmp_path / "r", opts, quiet=True).to_json()
+        rows.append(s["cases"][0]["sources"]["lammps"])
+    cold, warm = rows
+    assert cold["status"] == warm["status"] == "ok"
+    assert cold["cached"] is False and warm["cached"] is True
+    assert 0 < warm["wall_time"] < cold["wall_time"] < 600
+    assert cold["metrics"] == warm["metrics"]

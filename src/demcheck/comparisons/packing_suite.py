@@ -6,6 +6,7 @@ compared with statistical tolerances otherwise (the trajectories are chaotic), a
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 
@@ -193,8 +194,10 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
         if not entry.note_plan(planned):
             continue
         engine = planned.source.label
+        started = time.perf_counter()
         try:
             run = run_engine(case, engine, timeout=opts.timeout, cache=opts.cache)
+            seconds = time.perf_counter() - started  # the run (or the cache's answer), not the metrics after it
         except EngineInterrupted:
             raise  # the case did not finish: it is left out of the (partial) report
         except UnsupportedByEngine as exc:  # an engine whose package writes no packing decks
@@ -212,7 +215,8 @@ def run_packing(case, opts, found, file=None) -> CaseResult:
         m = packing_metrics.compute(x, rad, box=box, forces=fn, overlaps=run.contacts["overlap"].to_numpy(),
                        ke=[e for _, e in run.ke])
         entry.sources[engine] = SourceResult("ok", metrics=m, engine_version=run.version,
-                                             keys=("status", "metrics", "engine_version"))
+                                             wall_time=seconds, cached=run.cached,
+                                             keys=("status", "metrics", "engine_version", "wall_time", "cached"))
         dt = packing.packing_dt(case)
         entry.packing[engine] = PackingPanel([(step * dt, e) for step, e in run.ke],
                                              packing_metrics.force_distribution(fn),

@@ -22,12 +22,14 @@ __all__ = ["PackingRun", "run_engine", "universe", "CONTACT_COLUMNS"]
 @dataclass
 class PackingRun:
     """An engine's settled packing: the final per-particle table (FINAL_COLUMNS), its particle-particle
-    contacts (CONTACT_COLUMNS), the kinetic energy series [(step, ke)] and the engine's version."""
+    contacts (CONTACT_COLUMNS), the kinetic energy series [(step, ke)] and the engine's version; ``cached``: read
+    from the run cache, not run."""
 
     table: pd.DataFrame
     contacts: pd.DataFrame
     ke: list
     version: str
+    cached: bool = False
 
 
 def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float = 3600.0, mpi: int = 1,
@@ -49,7 +51,7 @@ def run_engine(case: Case, engine: str, duration=None, dt=None, timeout: float =
         if hit is not None and hit_contacts is not None:
             table, meta = hit
             contacts = hit_contacts[0].astype({"i": np.int64, "j": np.int64})
-            return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"])
+            return PackingRun(table, contacts, [tuple(x) for x in meta["ke"]], meta["version"], cached=True)
     out = runner.run(engine, dk.text, files=dk.files, timeout=timeout, mpi=mpi, workdir=workdir)
     record = registry.get(engine).read_packing(out.workdir, out.log, case.packing.box if case.packing else None)
     table, contacts, ke = record.final, record.contacts, record.ke
