@@ -69,6 +69,28 @@ def test_a_local_cluster_gives_the_verdicts_of_one_process(tmp_path):
     assert verdicts(two) == verdicts(one) and two["partial"] is False
 
 
+def test_a_local_cluster_draws_the_case_panels_where_the_cases_ran(tmp_path, monkeypatch):
+    """On a local cluster each file's first case draws its force curves into the plot cache on its worker, so the
+    report, written in this process after the last case, draws none of them: here drawing one raises (monkeypatched
+    in this process only — the workers are processes of their own), and the report still shows every case's
+    curves, none "could not be drawn". One process (--jobs 1) draws them in its report, as before."""
+    from demcheck.comparisons.report import figures
+
+    def refused(*a, **k):
+        raise RuntimeError("drawn in the client")
+
+    monkeypatch.setattr(figures, "case_figure", refused)
+    two = suite.run_suite(SMALL, tmp_path / "two", suite.Options(engines=(), jobs=2, cache=Cache(tmp_path / "c2")),
+                          quiet=True)
+    page = (Path(two.report) / "report.html").read_text()
+    assert "could not be drawn" not in page and page.count("force curves of ") == len(SMALL)
+    assert len(list((tmp_path / "c2" / "plots").glob("*.b64"))) >= len(SMALL)
+    one = suite.run_suite(SMALL, tmp_path / "one", suite.Options(engines=(), jobs=1, cache=Cache(tmp_path / "c1")),
+                          quiet=True)
+    page = (Path(one.report) / "report.html").read_text()
+    assert page.count("the force curves of") == len(SMALL) and "drawn in the client" in page
+
+
 @pytest.mark.engine("lammps")
 def test_a_local_cluster_runs_lammps_and_the_client_stores_its_runs(tmp_path, monkeypatch):
     from demcheck.comparisons import result_cache

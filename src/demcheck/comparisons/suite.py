@@ -324,7 +324,10 @@ def run_suite(files: list[Path], report_root: Path, opts: Options | None = None,
                 task = progress.add_task("verify", total=len(cases))
                 # the packings first: the longest jobs, so that the collisions fill the other workers meanwhile
                 order = sorted(range(len(cases)), key=lambda i: cases[i][1].kind != "packing")
-                tasks = [(i, (cases[i][1], str(cases[i][0]), shipped, found)) for i in order]
+                first = {}  # the first case of each file: the one whose force curves the report shows
+                for i, (path, _) in enumerate(cases):
+                    first.setdefault(path, i)
+                tasks = [(i, (cases[i][1], str(cases[i][0]), shipped, found, first[cases[i][0]] == i)) for i in order]
                 if shared is not None:  # two cases that share an engine deck never run it at once
                     tasks = Apart(tasks, shared.result(), campaign.running)
                 # an interrupt: the engines stopped and none starts; the cases running finish without them (raising
@@ -428,14 +431,22 @@ def _judge_baseline(summary: Summary, baseline: dict | None) -> Exception | None
     return None
 
 
-def case_task(case: Case, file: str, opts: Options, found: dict, cache=None) -> CaseResult:
+def case_task(case: Case, file: str, opts: Options, found: dict, panels: bool = False, cache=None) -> CaseResult:
     """One case's entry, where the campaign runs it (comparisons/dispatch.py) with ``cache`` as its run cache. On a
-    Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named."""
+    Dask worker, an engine the client found (``found``) and the worker lacks is "engine missing", the worker named.
+    On this machine's local cluster (``--jobs N``) the task also draws the case's report panels into the plot cache
+    (``panels``: the first case of its file, whose force curves the report shows; a packing's always), so that the
+    report, written after the last case, finds them there instead of drawing them one after another."""
     lacking = dispatch.missing_here(e for e in opts.engines if found[e]["found"])
     # an engine the user named is never skipped: its source fails here (sources.plan), the worker named
     found = {**found, **{e: {**found[e], "found": False, "why": why, "required": opts.named}
                          for e, why in lacking.items()}}
-    return _safe_case(case, Path(file), replace(opts, cache=cache), found)
+    entry = _safe_case(case, Path(file), replace(opts, cache=cache), found)
+    if opts.jobs > 1 and not opts.scheduler and cache is not None:
+        from .report.figures import draw_ahead
+
+        draw_ahead(entry, Path(cache.dir) / "plots", panels)
+    return entry
 
 
 def _safe_case(case, path, opts, found) -> CaseResult:

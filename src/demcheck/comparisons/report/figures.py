@@ -107,6 +107,27 @@ def _cached(key_obj, render, valid):
     return out
 
 
+def draw_ahead(entry: CaseResult, plot_dir: Path, panels: bool) -> None:
+    """Draw a finished case's report panels into the plot cache at ``plot_dir`` where the case ran (a worker of
+    the local cluster, beside the other cases), for the report to read: a packing's panels, and a collision's force
+    curves when ``panels``. Only the cost moves — the report draws whatever is not there; a failure here is the
+    report's to meet and say, never the case's."""
+    saved = PLOT_CACHE["dir"]
+    PLOT_CACHE["dir"] = plot_dir
+    try:
+        if entry.kind == "packing":
+            if entry.packing:
+                packing_plots(entry)
+        elif panels:
+            case_panels(entry)
+    except Exception:  # noqa: BLE001 - drawn again by the report, which says what failed
+        import matplotlib.pyplot as plt
+
+        plt.close("all")
+    finally:
+        PLOT_CACHE["dir"] = saved
+
+
 def _png_ok(b64) -> bool:
     """A whole PNG in base64: its signature first, its IEND chunk last."""
     try:
