@@ -12,6 +12,7 @@ Run: .venv/bin/python benchmarks/bench_verify.py --before /tmp/speed-old/src > b
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -24,9 +25,28 @@ ENGINES = "lammps,liggghts,kratos,yade"
 
 
 def run(args, env):
+    """The run's wall time and its process tree's CPU time (verify, its Dask workers, the engines' processes and
+    workers: every descendant reaped by the time it ends)."""
+    c = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     p = subprocess.run(DEMCHECK + args, cwd=ROOT, env=env, capture_output=True, text=True)
-    return time.perf_counter() - t, p
+    seconds = time.perf_counter() - t
+    d = resource.getrusage(resource.RUSAGE_CHILDREN)
+    CPU[id(p)] = (d.ru_utime - c.ru_utime) + (d.ru_stime - c.ru_stime)
+    return seconds, p
+
+
+CPU: dict = {}
+
+
+def source_sums(out: dict) -> dict:
+    """Each source's rows' wall_time summed (collisions, scenarios and packings alike), s."""
+    sums: dict = {}
+    for case in out["cases"]:
+        for src, row in case.get("sources", {}).items():
+            if row.get("wall_time"):
+                sums[src] = sums.get(src, 0.0) + row["wall_time"]
+    return sums
 
 
 def load() -> str:
@@ -42,7 +62,7 @@ def main():
     a = ap.parse_args()
     versions = [("after", str(ROOT / "src"))] + ([("before", a.before)] if a.before else [])
     versions.reverse()
-    rows = []
+    rows, cpus = [], []
     with tempfile.TemporaryDirectory() as tmp:
         envs = {}
         for name, src in versions:
@@ -67,6 +87,7 @@ def main():
                             per_engine[src] = per_engine.get(src, 0) + 1
                 rows.append((name, label, seconds, out["wall_time"], len(out["cases"]), out["cache"], p.returncode,
                              before_load, load(), out["failed"]))
+                cpus.append((name, label, CPU.pop(id(p)), source_sums(out)))
                 print(f"# {name} {label}: {seconds:.1f} s, load {before_load} → {load()}", file=sys.stderr,
                       flush=True)
     print(f"demcheck verify, the default suite (cases/), engines {a.engines}, --jobs {a.jobs}; "
@@ -76,6 +97,11 @@ def main():
     for name, label, seconds, wall, n, cache, rc, l0, l1, failed in rows:
         print(f"{name:8s} {label:5s} {seconds:10.1f} {wall:8.1f} {n:6d} {cache['hits']:>6d}/{cache['misses']:<7d} "
               f"{failed:6d} {rc:4d}  {l0} → {l1}")
+    print("CPU time of each run's process tree (verify, its workers, the engines), and its rows' wall_time summed "
+          "by source (each row's solve or engine run; a packing's engine rows since 7edd32e):")
+    for name, label, cpu, sums in cpus:
+        print(f"{name:8s} {label:5s} CPU {cpu:7.1f} s (÷ {os.cpu_count()} cores: {cpu / os.cpu_count():6.1f} s)  rows: "
+              + ", ".join(f"{k} {v:.1f}" for k, v in sorted(sums.items(), key=lambda kv: -kv[1])))
     t = {(r[0], r[1]): r[2] for r in rows}
     for label in ("cold", "warm"):
         if ("before", label) in t:
