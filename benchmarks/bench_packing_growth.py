@@ -299,9 +299,11 @@ def report(results: dict) -> None:
 def main(sizes: list[int], duration: float, sources: list[str], rounds: int = 1) -> None:
     import numba
 
-    steps = round(duration / P.packing_dt(BS.scaled_case(BS.BASE_N, duration)))
+    from demcheck.case import packing_run
+
+    steps = packing_run(BS.scaled_case(BS.BASE_N, duration), duration, None)[2]
     print(f"what grows with N: the poured packing at scale (box side 30 mm x sqrt(N / 2000)), {duration:g} s of the "
-          f"pour (~{steps} steps), N = {', '.join(map(str, sizes))}; the reference on 1 thread, LIGGGHTS on 1 rank "
+          f"pour ({steps} steps), N = {', '.join(map(str, sizes))}; the reference on 1 thread, LIGGGHTS on 1 rank "
           f"({', '.join(sources)}); {datetime.now(timezone.utc):%d %b %Y %H:%M} UTC, git {BP._head()}; "
           f"{os.cpu_count()} cores, numba {numba.__version__}")
     print(f"load average (1, 5, 15 min) at the start: {BP._load()}")
