@@ -99,6 +99,11 @@ def counts(st, n_walls: int) -> tuple[int, int, int]:
     return int(np.count_nonzero(st.dmax[base:])), int(np.count_nonzero(st.dmax[:base])), int(st.start[-1])
 
 
+# the counted run's phases read off the loop's clock (row, column): the force loop, the kick and drift pass, the
+# in-loop list rebuilds, the rest (the loop, the displacement test, after a rebuild)
+PHASE_CPU = [("force", 0, P.F_WORK), ("kick", 0, P.K_WORK), ("rebuilds", -1, P.S_REBUILD), ("rest", -1, P.S_OTHER)]
+
+
 def child(path: str, rounds: int = 1) -> None:
     """One size, the reference on one thread: untimed (wall, CPU; ``rounds`` times, the least CPU time kept), then
     counted (module notes). Prints JSON."""
@@ -128,7 +133,9 @@ def child(path: str, rounds: int = 1) -> None:
                       "entries": trapezoid_mean(k[:, 0], k[:, 3]), "pairs_end": int(k[-1, 1]),
                       "entries_start": int(k[0, 3]), "entries_end": int(k[-1, 3]),
                       "rebuilds": int(clock[-1, P.S_REBUILDS]), "chunk_builds": math.ceil(st2.steps / OBSERVE),
-                      "samples": len(samples), "end_pairs_untimed": int(st.n_contacts)}))
+                      "samples": len(samples), "end_pairs_untimed": int(st.n_contacts),
+                      # the counted run's phases, its thread's CPU ns a step (the loop's clock)
+                      "phases": {name: float(clock[row, P.PHASES + k]) / steps for name, row, k in PHASE_CPU}}))
 
 
 def _reference(path: Path, rounds: int) -> dict:
@@ -260,7 +267,10 @@ def _detail(source: str, n: int, r: dict) -> str:
                 f"           counted run: {r['counted_wall']:.2f} s wall, {r['counted_cpu']:.2f} s CPU (clock and "
                 f"{r['samples']} observations); list entries a sphere {r['entries_start'] / n:.3f} at the first count, "
                 f"{r['entries_end'] / n:.3f} at the end; pairs a sphere at the end {r['pairs_end'] / n:.3f} "
-                f"(the untimed run's {r['end_pairs_untimed'] / n:.3f})")
+                f"(the untimed run's {r['end_pairs_untimed'] / n:.3f})\n"
+                f"           counted run's phases, CPU ns a sphere-step (its clock): "
+                + ", ".join(f"{k} {v / n:.1f}" for k, v in r["phases"].items())
+                + f"; a rebuild {r['phases']['rebuilds'] * r['steps'] / max(r['rebuilds'], 1) / n:.0f} ns a sphere")
     return (f"           process CPU {r['user']:.2f} user + {r['sys']:.2f} sys; loop {r['loop']:.2f} s (its wall "
             f"timer); {r['samples']} contact samples; pairs a sphere at the end {r['pairs_end'] / n:.3f} (thermo) / "
             f"{r['pairs_dump'] / n:.3f} (its final contact dump); list entries a sphere at the end "
@@ -297,6 +307,19 @@ def report(results: dict) -> None:
         if math.isfinite(g["unit"]):
             print(f"           in the reference's cost model: work units a sphere N^{g['units']:.3f} x the cost a "
                   f"unit-step N^{g['unit']:.3f}")
+    ref = {n: r for n, (r, _) in results.get("reference", {}).items() if "error" not in r}
+    if len(ref) >= 2:
+        ns = list(ref)
+        print("\nThe reference's counted run by phase (its loop's clock, thread CPU ns a sphere-step; the counted run, "
+              "not the untimed one — its own load):")
+        print(f"{'N':>7s} " + " ".join(f"{name:>9s}" for name, _, _ in PHASE_CPU) + f" {'sum':>9s} {'rebuilds':>8s}")
+        for n in ns:
+            ph = ref[n]["phases"]
+            print(f"{n:7d} " + " ".join(f"{ph[name] / n:9.1f}" for name, _, _ in PHASE_CPU)
+                  + f" {sum(ph.values()) / n:9.1f} {ref[n]['rebuilds']:8d}")
+        print("exponent" + " ".join(f"{_fit(ns, [ref[n]['phases'][name] / n for n in ns]):9.3f}" for name, _, _ in PHASE_CPU)
+              + f" {_fit(ns, [sum(ref[n]['phases'].values()) / n for n in ns]):9.3f}"
+              + f" {_fit(ns, [ref[n]['rebuilds'] for n in ns]):8.3f}   (of each per sphere-step; of the rebuild count)")
     print("(a cost's exponent near 0 is a cost flat in N; the growth goal is the reference's time as N^<=1.05)")
 
 
