@@ -41,6 +41,13 @@ the one-core goal's limit is read against:
 
     .venv/bin/python benchmarks/bench_packing_phases.py --engine N DURATION [liggghts|lammps] >> …
 
+Its timers are wall time, where the reference's phases are its thread's CPU time: beside them the mode prints the
+engine process's own CPU time (user + sys, from getrusage(RUSAGE_CHILDREN) around the run: the process is this
+script's child, reaped by engines/run.py) against the process's wall time, and each timer scaled by the loop's CPU /
+wall ratio — an approximation: that ratio is not measured over the loop alone, only bounded (low: the process's CPU
+less its wall time outside the loop, as if the rest had a whole core; high: all its CPU in the loop), and the phases
+are taken to share it alike — so that a µs a step of both sources can be read in CPU time.
+
 The two-thread speed-up alone, idle: bench_packing_scale.py --threads 0.02 32000,128000 3. The force cut's
 weights (packing.py's ROW_COST …) from a fit of the force loop's CPU time by parts, on one thread:
 
@@ -249,20 +256,35 @@ def engine(n: int, duration: float, name: str = "liggghts") -> None:
     are read: what the one-core goal's limit is measured against (bench_packing_scale.py's engine run, its work
     directory kept until its log is read)."""
     import re
+    import resource
     import shutil
 
+    from demcheck.engines import discovery, run as runner
     from demcheck.engines.packing import run_engine
 
     case = BS.scaled_case(n, duration)
     steps = round(duration / P.packing_dt(case))
     work = Path(tempfile.mkdtemp(prefix="phases-engine-"))
+    discovery.require(name)  # any probe of the executable before the CPU baseline below
+    outs, plain_run = [], runner.run
+
+    def kept_run(*args, **kwargs):  # run_engine's engines/run.run, its RunOutput kept (the process's own wall time)
+        outs.append(plain_run(*args, **kwargs))
+        return outs[-1]
+
+    runner.run = kept_run
     try:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t = time.perf_counter()
         run_engine(case, name, mpi=1, workdir=work)
         wall = time.perf_counter() - t
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
         log = (work / "log.txt").read_text(errors="replace")
     finally:
+        runner.run = plain_run
         shutil.rmtree(work, ignore_errors=True)
+    user, system = after.ru_utime - before.ru_utime, after.ru_stime - before.ru_stime
+    process_wall = outs[-1].wall_time if outs else math.nan
     loop = re.search(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms", log)
     if loop is None:
         print(f"{n:7d}  {name}: no 'Loop time' line in its log (load {os.getloadavg()[0]:.2f})")
@@ -280,6 +302,28 @@ def engine(n: int, duration: float, name: str = "liggghts") -> None:
                   f"{1e6 * float(m.group(1)) / nsteps:10.1f}")
     print(f"  the one-core goal (the reference >= 1.5 x this loop): the reference's whole step must be <= "
           f"{1e6 * seconds / nsteps / 1.5:.1f} us")
+    cpu = user + system
+    ratio = cpu / process_wall
+    # the loop's share of the process's CPU: at most all of it (and at most its wall time), at least what is left
+    # after the rest of the process (its wall time outside the loop) had a whole core
+    low = max(0.0, cpu - (process_wall - seconds)) / seconds
+    high = min(cpu, seconds) / seconds
+    print(f"  the engine process's own CPU time (getrusage of the child, user + sys): {cpu:.2f} s ({user:.2f} + "
+          f"{system:.2f}) over {process_wall:.2f} s of its wall time (start to exit; its loop {seconds:.2f} s of "
+          f"it): CPU / wall {ratio:.3f}; {1e6 * cpu / nsteps:.1f} us of CPU a step over the whole process (an upper "
+          f"bound of the loop's)")
+    print(f"  its timers in CPU time, an APPROXIMATION: each timer x the loop's CPU / wall ratio, which is not measured "
+          f"over the loop alone but bounded, {low:.3f} to {high:.3f} (low: the process's CPU less its wall time "
+          f"outside the loop; high: all its CPU in the loop); the phases assumed to share that ratio alike")
+    print(f"  {'phase':8s} {'us CPU a step, low':>19s} {'high':>8s}")
+    for phase in ENGINE_PHASES:
+        m = re.search(rf"^{phase}\s+time \(%\) = (\S+) \((\S+)\)", log, re.M)
+        if m:
+            us = 1e6 * float(m.group(1)) / nsteps
+            print(f"  {phase:8s} {low * us:19.1f} {high * us:8.1f}")
+    us = 1e6 * seconds / nsteps
+    print(f"  {'loop':8s} {low * us:19.1f} {high * us:8.1f}   (the one-core goal in CPU time: the reference's whole "
+          f"step, its thread's CPU, <= {low * us / 1.5:.1f} to {high * us / 1.5:.1f} us)")
 
 
 if __name__ == "__main__":
