@@ -403,13 +403,18 @@ def _event_value(y, aux, nl, tl, geo, rules, event):
 
 
 @njit(cache=KERNEL_CACHE)
-def _event_values(y, aux, nl, tl, geo, rules, dirs, out):
-    """out[e] ← _event_value(y, …, e) for every event whose direction is not 0, with one rhs for them all."""
+def _event_value_with(y, aux, nl, tl, geo, rules, event, dy, lam, fn, req):
+    """_event_value(y, …, event) given y's rhs (dy = f(y), λ, Fn, margin), as _event_values is."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    dy = np.empty(y.shape[0])
-    lam, fn, req = 0.0, 0.0, 0.0
-    if dirs[3] != 0 or dirs[5] != 0 or dirs[6] != 0 or dirs[7] != 0:
-        lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    return _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn, req)
+
+
+@njit(cache=KERNEL_CACHE)
+def _event_values(y, aux, nl, tl, geo, rules, dirs, out, dy, lam, fn, req):
+    """out[e] ← _event_value(y, …, e) for every event whose direction is not 0, given y's rhs: ``dy`` = f(y) and
+    its (λ, Fn, margin) — the step's stage at that very state (its first or its last: rhs is pure, so they are the
+    values an rhs here would give, bit for bit)."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     for event in range(N_EVENTS):
         if dirs[event] != 0:
             out[event] = _event_of(y, aux, nl, tl, geo, rules, np.int64(event), delta, rate, n, vt, dy, lam, fn,
@@ -513,11 +518,12 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     graze_t = -1.0  # the time of the last stick→slip graze
     # What the last step computed and the next may reuse, each valid for the state (y, aux) it is kept with — rhs
     # and the event functions are pure, so a reuse changes no bit: f(y) for the step's first stage (kept across
-    # rejected steps), f(yn) (the next step's first stage, and the record of yn), the event functions at yn
-    # (the next step's g0). After an event, a truncation or a mode switch the state differs and they are
-    # computed afresh.
+    # rejected steps; the event functions at y read it), f(yn) (the next step's first stage, the record of yn and
+    # the event functions at yn), the event functions at yn (the next step's g0). After an event, a truncation or a
+    # mode switch the state differs and they are computed afresh.
     k1, k7 = np.empty(21), np.empty(21)
     y_k1, aux_k1, y_k7, aux_k7 = np.full(21, np.nan), np.zeros(A_SIZE), np.full(21, np.nan), np.zeros(A_SIZE)
+    f1 = (0.0, 0.0, 0.0, np.zeros(3))  # f(y)'s (λ, Fn, margin, Ft), with k1
     f7 = (0.0, 0.0, 0.0, np.zeros(3))
     dirs = np.zeros(N_EVENTS, dtype=np.int64)
     g0s, g1s = np.zeros(N_EVENTS), np.zeros(N_EVENTS)
@@ -532,8 +538,9 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         if not (_same(y, y_k1) and _same(aux, aux_k1)):
             if _same(y, y_k7) and _same(aux, aux_k7):
                 k1[:] = k7
+                f1 = f7
             else:
-                rhs(y, aux, nl, tl, geo, rules, k1)
+                f1 = rhs(y, aux, nl, tl, geo, rules, k1)
             y_k1[:] = y
             aux_k1[:] = aux
         yn, err, f7 = _dp5_from(y, k1, aux, nl, tl, geo, rules, hstep, k7)
@@ -566,11 +573,13 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         best_theta, best_event, best_dir = 2.0, -1, 0
         for event in range(N_EVENTS):
             dirs[event] = _event_direction(nl, tl, aux, event)
+        # the event functions at the step's ends read its stages there: k1 = f(y) (y, aux are still the state it
+        # was computed at: the step left both as they were) and k7 = f(yn), computed at yn with this aux
         if _same(y, y_g) and _same(aux, aux_g):
             g0s[:] = g1s
         else:
-            _event_values(y, aux, nl, tl, geo, rules, dirs, g0s)
-        _event_values(yn, aux, nl, tl, geo, rules, dirs, g1s)
+            _event_values(y, aux, nl, tl, geo, rules, dirs, g0s, k1, f1[0], f1[1], f1[2])
+        _event_values(yn, aux, nl, tl, geo, rules, dirs, g1s, k7, f7[0], f7[1], f7[2])
         y_g[:] = yn
         aux_g[:] = aux
         for event in range(N_EVENTS):
@@ -599,7 +608,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                                               dm)
                     best_event, best_dir = 0, 1
         if best_event < 0 and has(tl, F_STICK_KINK) and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
-                and _event_value(yn, aux, nl, tl, geo, rules, np.int64(5)) > 0.0:
+                and _event_value_with(yn, aux, nl, tl, geo, rules, np.int64(5), k7, f7[0], f7[1], f7[2]) > 0.0:
             # a spring's stick that ends past the slip surface with no crossing seen: it began on the surface
             # (a slip→stick switch puts it there), dipped inside and came back out within the step — the trial
             # force reversing through 0, a kink of |F| that the state's error control does not see (TTIt at
