@@ -35,6 +35,12 @@ rhs sample split by the contact's mode too)
       .venv/bin/python benchmarks/bench_adaptive_profile.py --derive
 (reads the file's per-variant tables, runs nothing, and appends what follows from them: per law the event location's
 rhs evaluations and their cost, loc × µs/rhs, and per variant the medians of each part's evaluations a point)
+      .venv/bin/python benchmarks/bench_adaptive_profile.py --before TREE [--bits-only] [--only oblique-ddt ...]
+(TREE: the root of a tree before a change, e.g. `git worktree add --detach /tmp/before BASE`. Each tree's compiled
+kernel, in a child process of its own, on every variant: their outputs compared bit for bit; then each tree's
+kernel source counted as above, both at once: rhs evaluations per point and by part, before and after. Writes
+benchmarks/results/bench_adaptive_reuse.txt, REUSE_OUT=path to write elsewhere; nothing is timed — the kernel's CPU
+time before and after is bench_adaptive.py --before TREE --only-suite)
 """
 
 import argparse
