@@ -515,7 +515,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     # rejected steps; the event functions at y read it), f(yn) (the next step's first stage, the record of yn, the
     # event functions at yn and a riding load's truncation there), the event functions at yn (the next step's g0).
     # Where a fix moves the state off yn (a truncation, a snap onto the slip surface, an event), f at the state it
-    # leaves — evaluated by the snap or by the record of that state — is kept as the next step's first stage.
+    # moves to — evaluated by the snap or by the record of that state — is kept as the next step's first stage.
     k1, k7 = np.empty(21), np.empty(21)
     y_k1, aux_k1, y_k7, aux_k7 = np.full(21, np.nan), np.zeros(A_SIZE), np.full(21, np.nan), np.zeros(A_SIZE)
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
