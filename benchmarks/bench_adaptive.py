@@ -17,7 +17,7 @@ Run: .venv/bin/python benchmarks/bench_adaptive.py  (writes benchmarks/results/b
    answer (the verlet method at 20 000 steps per contact) beside the time, and whether the two trees' metrics are
    identical. The machine's load average is recorded; read the ratios.
 
-Run: .venv/bin/python benchmarks/bench_adaptive.py [--before PATH] [--only-suite]
+Run: .venv/bin/python benchmarks/bench_adaptive.py [--before PATH [--rounds N]] [--only-suite]
 """
 
 import argparse
@@ -64,15 +64,35 @@ def _child(src: Path, repeat: int, name: str) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _both(before: Path, repeat: int) -> tuple[dict, dict]:
-    """Both trees, one suite file at a time, taking turns at going first (the load shifts during the run)."""
-    old, new = {}, {}
+def _both(before: Path, repeat: int, rounds: int = 1) -> tuple[dict, dict, list]:
+    """Both trees, one suite file at a time, taking turns at going first (the load shifts during the run), ``rounds``
+    times over (the next round starts with the other tree); each variant's times are the median over the rounds of
+    each round's median. Returns the two trees' results and the load average after each round."""
+    runs = {"old": [], "new": []}
+    loads = []
     names = sorted(p.stem for p in (ROOT / "src" / "demcheck" / "cases" / "suite").glob("oblique-*.toml"))
-    for k, name in enumerate(names):
-        first, second = (before / "src", old), (ROOT / "src", new)
-        for src, into in ((first, second) if k % 2 == 0 else (second, first)):
-            into.update(_child(src, repeat, name))
-    return old, new
+    for r in range(rounds):
+        old, new = {}, {}
+        for k, name in enumerate(names):
+            first, second = (before / "src", old), (ROOT / "src", new)
+            for src, into in ((first, second) if (k + r) % 2 == 0 else (second, first)):
+                into.update(_child(src, repeat, name))
+        runs["old"].append(old)
+        runs["new"].append(new)
+        loads.append(os.getloadavg())
+        print(f"round {r + 1} of {rounds} done, load {loads[-1][0]:.2f}", file=sys.stderr, flush=True)
+    merged = []
+    for tree in ("old", "new"):
+        out = {}
+        for label, first in runs[tree][0].items():
+            out[label] = dict(first, kernel=statistics.median(run[label]["kernel"] for run in runs[tree]),
+                              collide=statistics.median(run[label]["collide"] for run in runs[tree]),
+                              kernels=[run[label]["kernel"] for run in runs[tree]])
+            if any(run[label]["metrics"] != first["metrics"] or run[label]["points"] != first["points"]
+                   for run in runs[tree]):
+                out[label]["metrics"] = None  # a tree that does not repeat its own answer: reported as DIFFER
+        merged.append(out)
+    return merged[0], merged[1], loads
 
 
 def _verlet_error(label: str, metrics: dict) -> float:
@@ -91,15 +111,17 @@ def _verlet_error(label: str, metrics: dict) -> float:
     return max(abs(metrics[k] / v[k] - 1.0) for k in keys if metrics.get(k) and v.get(k))
 
 
-def suite_section(before: Path) -> list[str]:
+def suite_section(before: Path, rounds: int = 1) -> list[str]:
     load0 = os.getloadavg()
-    old, new = _both(before, 5)
+    old, new, loads = _both(before, 5, rounds)
     load1 = os.getloadavg()
     lines = ["", f"5. the suite's oblique cases at their default tolerance (rtol 1e-13), before ({before}) and after, "
-             "one run, the two trees taking turns case file by case file, median CPU time of 5 (1 for a solve over "
-             "0.3 s)",
+             f"one run, the two trees taking turns case file by case file, median CPU time of 5 (1 for a solve over "
+             f"0.3 s)" + (f"; {rounds} rounds, each starting with the other tree: a variant's time is the median of "
+                          "its rounds' medians" if rounds > 1 else ""),
              f"load average (1, 5, 15 min) at the start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}, "
-             f"at the end {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} (2 cores, shared)",
+             f"at the end {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} (2 cores, shared)"
+             + (", 1 min after each round " + " ".join(f"{ld[0]:.2f}" for ld in loads) if rounds > 1 else ""),
              f"{'variant':36s} {'points':>6s} {'kernel before':>13s} {'after (ms)':>10s} {'ratio':>6s} "
              f"{'collide() after':>15s} {'vs verlet':>9s} {'metrics':>9s}"]
     ratios, kern, same_all = [], [], True
@@ -107,7 +129,7 @@ def suite_section(before: Path) -> list[str]:
         a = new[label]
         same = a["metrics"] == b["metrics"] and a["points"] == b["points"]
         same_all &= same
-        err = _verlet_error(label, a["metrics"])
+        err = _verlet_error(label, a["metrics"]) if a["metrics"] is not None else float("nan")
         ratios.append(b["kernel"] / a["kernel"])
         kern.append(a["kernel"])
         lines.append(f"{label:36s} {a['points']:6d} {b['kernel'] * 1e3:13.2f} {a['kernel'] * 1e3:10.2f} "
@@ -116,12 +138,17 @@ def suite_section(before: Path) -> list[str]:
               f"least {min(kern) * 1e3:.2f} ms, most {max(kern) * 1e3:.1f} ms; speed-up before/after median "
               f"{statistics.median(ratios):.2f}x (least {min(ratios):.2f}x, most {max(ratios):.2f}x); metrics and "
               f"points of every variant {'identical' if same_all else 'NOT identical'}"]
+    if rounds > 1:
+        per_round = [statistics.median(b["kernels"][r] / new[label]["kernels"][r] for label, b in old.items())
+                     for r in range(rounds)]
+        lines.append("speed-up before/after, median over the variants, each round alone: "
+                     + " ".join(f"{x:.2f}x" for x in per_round))
     return lines
 
 
-def main(before: Path | None = None, only_suite: bool = False):
+def main(before: Path | None = None, only_suite: bool = False, rounds: int = 1):
     if only_suite:
-        text = "\n".join(suite_section(before)) + "\n"
+        text = "\n".join(suite_section(before, rounds)) + "\n"
         print(text)
         out = ROOT / "benchmarks" / "results" / "bench_adaptive.txt"
         kept = out.read_text().split("\n5. the suite's oblique cases")[0].rstrip("\n") + "\n"
@@ -182,7 +209,7 @@ def main(before: Path | None = None, only_suite: bool = False):
               f"compilation cache warm: {warm:.2f} s", f"empty cache (compiles): {cold:.2f} s",
               f"ratio empty/warm: {cold / warm:.1f}x"]
     if before is not None:
-        lines += suite_section(before)
+        lines += suite_section(before, rounds)
     text = "\n".join(lines) + "\n"
     print(text)
     out = ROOT / "benchmarks" / "results" / "bench_adaptive.txt"
@@ -193,5 +220,6 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser()
     ap.add_argument("--before", type=Path, help="a tree (its root) to time side by side with this one (section 5)")
     ap.add_argument("--only-suite", action="store_true", help="run section 5 only (replacing it in the results)")
+    ap.add_argument("--rounds", type=int, default=1, help="section 5: run both trees this many times over")
     args = ap.parse_args()
-    main(args.before, args.only_suite)
+    main(args.before, args.only_suite, args.rounds)

@@ -35,6 +35,12 @@ rhs sample split by the contact's mode too)
       .venv/bin/python benchmarks/bench_adaptive_profile.py --derive
 (reads the file's per-variant tables, runs nothing, and appends what follows from them: per law the event location's
 rhs evaluations and their cost, loc × µs/rhs, and per variant the medians of each part's evaluations a point)
+      .venv/bin/python benchmarks/bench_adaptive_profile.py --before TREE [--bits-only] [--only oblique-ddt ...]
+(TREE: the root of a tree before a change, e.g. `git worktree add --detach /tmp/before BASE`. Each tree's compiled
+kernel, in a child process of its own, on every variant: their outputs compared bit for bit; then each tree's
+kernel source counted as above, both at once: rhs evaluations per point and by part, before and after. Writes
+benchmarks/results/bench_adaptive_reuse.txt, REUSE_OUT=path to write elsewhere; nothing is timed — the kernel's CPU
+time before and after is bench_adaptive.py --before TREE --only-suite)
 """
 
 import argparse
@@ -51,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, os.environ.get("DEMCHECK_SRC") or str(ROOT / "src"))  # (--before: a child runs another tree)
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from adaptive3d_suite_child import variants  # noqa: E402
@@ -105,7 +111,8 @@ def counted_run(args: tuple) -> dict:
     assert not hasattr(A.adaptive_3d, "py_func"), "the counted run needs NUMBA_DISABLE_JIT=1"
     here = A.__file__
     src, first = __import__("inspect").getsourcelines(A.adaptive_3d)
-    k1_line = first + next(i for i, s in enumerate(src) if s.strip() == "rhs(y, aux, nl, tl, geo, rules, k1)")
+    # the step's first stage (``rhs(…, k1)`` or ``f1 = rhs(…, k1)``: the tree before the reuse of f(yn), and since)
+    k1_line = first + next(i for i, s in enumerate(src) if s.strip().endswith("rhs(y, aux, nl, tl, geo, rules, k1)"))
     c = {"rhs": dict.fromkeys(PARTS, 0), "by_site": {}, "rejected": 0, "accepted": 0, "attempts": 0,
          "trials": 0, "per_locate": [], "calls": 0, "stride": 1, "Y": [], "AUX": []}
     saved = {k: getattr(A, k) for k in ("rhs", "shrink", "grow", "illinois_step", "_locate", "_dp5_from")}
@@ -310,6 +317,128 @@ def main(repeat: int, only: tuple, rtol: float | None = None, append: bool = Fal
     OUT.write_text((OUT.read_text() + "\n" if append and OUT.exists() else "") + text)
 
 
+# ------------------------------------------------------------- --before: the tree before a change and this one
+
+
+def outputs_child(where: Path, only: tuple) -> None:
+    """The compiled kernel's output for every variant, from the tree on DEMCHECK_SRC, pickled into ``where``."""
+    from demcheck.reference import adaptive3d
+
+    print(f"compiled outputs of {adaptive3d.__file__}", file=sys.stderr, flush=True)
+    outs = {label: adaptive3d.adaptive_3d(*kernel_args(raw)) for label, raw in cases(only, None)}
+    with open(where / "outputs.pkl", "wb") as f:
+        pickle.dump(outs, f)
+
+
+def _children(before: Path, flag: str, only: tuple, jit: bool) -> dict:
+    """``flag`` (--outputs or --child) run in two child processes at once, one per tree (DEMCHECK_SRC)."""
+    got, procs = {}, []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, src in (("before", before / "src"), ("after", ROOT / "src")):
+            (Path(tmp) / name).mkdir()
+            env = dict(os.environ, PYTHONPATH=str(src), DEMCHECK_SRC=str(src))
+            env.pop("NUMBA_DISABLE_JIT", None)
+            if not jit:
+                env["NUMBA_DISABLE_JIT"] = "1"
+            procs.append((name, subprocess.Popen([sys.executable, __file__, flag, str(Path(tmp) / name), *only],
+                                                 env=env)))
+        for name, p in procs:
+            if p.wait() != 0:
+                sys.exit(f"the {name} tree's {flag} child failed")
+            got[name] = {}
+            for f in sorted((Path(tmp) / name).glob("*.pkl")):
+                with open(f, "rb") as fh:
+                    obj = pickle.load(fh)
+                if flag == "--outputs":
+                    got[name].update(obj)
+                else:
+                    got[name][obj[0]] = obj[1]
+    return got
+
+
+def before_after(before: Path, only: tuple, out: Path, bits_only: bool = False) -> None:
+    """The compiled kernel of both trees compared bit for bit on every variant, and both trees' rhs evaluations
+    counted (the same source as plain Python, each counted run's output compared with its tree's compiled one)."""
+    load0 = os.getloadavg()
+    started = datetime.now(timezone.utc)
+    t0 = time.time()
+    compiled = _children(before, "--outputs", only, jit=True)
+    if bits_only:
+        for label, cb in compiled["before"].items():
+            print(f"{label:36s} {'same' if same_bits(cb, compiled['after'][label]) else 'DIFFER'}")
+        nsame = sum(same_bits(cb, compiled["after"][k]) for k, cb in compiled["before"].items())
+        print(f"compiled before = compiled after, bit for bit: {nsame} of {len(compiled['before'])} variants "
+              "(nothing written)")
+        return
+    counted = _children(before, "--child", only, jit=False)
+    wall = time.time() - t0
+    load1 = os.getloadavg()
+    med = statistics.median
+    L = [f"adaptive 3-D method, rhs evaluations before ({before}, git "
+         + subprocess.run(["git", "-C", str(before), "rev-parse", "--short", "HEAD"], capture_output=True,
+                          text=True).stdout.strip()
+         + f") and after (git {git_head()}), the suite's oblique cases at their default tolerance (run.rtol 1e-13): "
+         f"{started:%d %b %Y %H:%M} UTC, {wall:.0f} s wall",
+         f"load average (1, 5, 15 min) at the start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}, at the end "
+         f"{load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} (2 cores, shared; nothing here is timed)",
+         "compiled: each tree's compiled adaptive_3d (a child process with PYTHONPATH on its src), before vs after "
+         "bit for bit: status, points, every record row, every event time and code; counted: each tree's kernel "
+         "source run as plain Python (NUMBA_DISABLE_JIT=1) with rhs counted by caller (as above), its output "
+         "bit for bit its tree's compiled one. Parts: step (first stages + 6 stages an attempt), end (event functions "
+         "at a step's ends), loc, to-ev, rec, fix (as in section 1 of the profile)",
+         f"{'variant':36s} {'pts':>6s} {'compiled':>8s} {'counted':>7s} {'rhs before':>10s} {'after':>8s} "
+         f"{'/pt before':>10s} {'after':>6s} {'saved':>6s}   " + " ".join(f"{p[:5]:>13s}" for p in
+                                                                          ("step", "end", "rec", "fix"))]
+    labels = list(compiled["before"])
+    rows = []
+    for label in labels:
+        cb, ca = compiled["before"][label], compiled["after"][label]
+        nb, na = counted["before"][label], counted["after"][label]
+        bits = same_bits(cb, ca)
+        counted_same = same_bits(nb["out"], cb) and same_bits(na["out"], ca)
+        rb, ra = sum(nb["rhs"].values()), sum(na["rhs"].values())
+        pts = int(ca[1])
+        rows.append({"label": label, "file": label.split("[")[0], "bits": bits, "counted": counted_same,
+                     "pts": pts, "rb": rb, "ra": ra, "pb": nb["rhs"], "pa": na["rhs"], "sb": nb["by_site"],
+                     "sa": na["by_site"]})
+        L.append(f"{label:36s} {pts:6d} {'same' if bits else 'DIFFER':>8s} {'same' if counted_same else 'DIFFER':>7s} "
+                 f"{rb:10d} {ra:8d} {rb / int(cb[1]):10.2f} {ra / pts:6.2f} {1 - ra / rb:6.1%}   "
+                 + " ".join(f"{nb['rhs'][p]:>6d}/{na['rhs'][p]:<6d}" for p in
+                            ("step", "step-end events", "record", "fix")))
+    nsame = sum(r["bits"] for r in rows)
+    ncount = sum(r["counted"] for r in rows)
+    tb, ta = sum(r["rb"] for r in rows), sum(r["ra"] for r in rows)
+    L += ["", f"compiled before = compiled after, bit for bit (status, points, every record row, every event): "
+              f"{nsame} of {len(rows)} variants; counted run = its tree's compiled run, both trees: {ncount} of "
+              f"{len(rows)}",
+          f"rhs per point: median {med(r['rb'] / r['pts'] for r in rows):.2f} before, "
+          f"{med(r['ra'] / r['pts'] for r in rows):.2f} after; saved per point: median "
+          f"{med((r['rb'] - r['ra']) / r['pts'] for r in rows):.2f} (least "
+          f"{min((r['rb'] - r['ra']) / r['pts'] for r in rows):.2f}, most "
+          f"{max((r['rb'] - r['ra']) / r['pts'] for r in rows):.2f}); share of a variant's evaluations saved: median "
+          f"{med(1 - r['ra'] / r['rb'] for r in rows):.1%} (least {min(1 - r['ra'] / r['rb'] for r in rows):.1%}, "
+          f"most {max(1 - r['ra'] / r['rb'] for r in rows):.1%})",
+          f"all {len(rows)} variants: {tb} evaluations before, {ta} after ({1 - ta / tb:.1%} fewer); by part, before → "
+          "after: " + ", ".join(f"{p} {sum(r['pb'][p] for r in rows)} → {sum(r['pa'][p] for r in rows)}"
+                                for p in PARTS)]
+    for tag, key in (("before", "sb"), ("after", "sa")):
+        sites = {}
+        for r in rows:
+            for k, v in r[key].items():
+                sites[k] = sites.get(k, 0) + v
+        L.append(f"rhs by call site {tag}: " + ", ".join(f"{k} {v}" for k, v in
+                                                         sorted(sites.items(), key=lambda kv: -kv[1])))
+    L += ["", "per case file (law): rhs per point before → after, medians over its variants; share saved, median",
+          f"{'case file':28s} {'n':>2s} {'before':>7s} {'after':>7s} {'saved':>6s}"]
+    for fname in sorted({r["file"] for r in rows}):
+        g = [r for r in rows if r["file"] == fname]
+        L.append(f"{fname:28s} {len(g):2d} {med(r['rb'] / r['pts'] for r in g):7.2f} "
+                 f"{med(r['ra'] / r['pts'] for r in g):7.2f} {med(1 - r['ra'] / r['rb'] for r in g):6.1%}")
+    text = "\n".join(L) + "\n"
+    print(text)
+    out.write_text(text)
+
+
 def _med_max(vals, fmt):
     vals = list(vals)
     return f"{format(statistics.median(vals), fmt)} / {format(max(vals), fmt)}"
@@ -478,9 +607,20 @@ if __name__ == "__main__":
     ap.add_argument("--append", action="store_true")
     ap.add_argument("--derive", action="store_true")
     ap.add_argument("--by-mode", action="store_true")
+    ap.add_argument("--before", type=Path, default=None,
+                    help="a tree's root (git worktree add --detach): compare its compiled kernel with this one's bit "
+                         "for bit and count both trees' rhs evaluations (writes REUSE_OUT, default "
+                         "benchmarks/results/bench_adaptive_reuse.txt)")
+    ap.add_argument("--bits-only", action="store_true", help="with --before: the compiled comparison only")
+    ap.add_argument("--outputs", default=None)
     ap.add_argument("names", nargs="*")
     a = ap.parse_args()
-    if a.derive:
+    if a.outputs:
+        outputs_child(Path(a.outputs), tuple(a.names))
+    elif a.before:
+        before_after(a.before, tuple(a.only), Path(os.environ.get(
+            "REUSE_OUT", ROOT / "benchmarks" / "results" / "bench_adaptive_reuse.txt")), a.bits_only)
+    elif a.derive:
         text = derive()
         print(text)
         OUT.write_text(OUT.read_text() + text)

@@ -211,11 +211,10 @@ def _dp5_from(y, k1, aux, nl, tl, geo, rules, h, k7):
 
 
 @njit(cache=KERNEL_CACHE)
-def _dp5_3(y, aux, nl, tl, geo, rules, h):
-    """One Dormand–Prince 5(4) step of the state; returns the 5th-order state and the error estimate."""
-    k1 = np.empty(y.shape[0])
+def _dp5_3(y, k1, aux, nl, tl, geo, rules, h):
+    """One Dormand–Prince 5(4) step of the state from y, whose f(y) is ``k1``; returns the 5th-order state and the
+    error estimate."""
     k7 = np.empty(y.shape[0])
-    rhs(y, aux, nl, tl, geo, rules, k1)
     yn, err, _ = _dp5_from(y, k1, aux, nl, tl, geo, rules, h, k7)
     return yn, err
 
@@ -273,12 +272,12 @@ def _limit_rate(y, aux, nl, tl, geo, rules, fn, dy):
 # numba compiles on its own is a library that links, and optimises once more, the whole right-hand side it calls;
 # inlined, the 3-D solver compiles in ~3/4 of the time (docs/performance.md, "Cold start")
 @njit(cache=KERNEL_CACHE, inline="always")
-def _ride_truncate(y, aux, nl, tl, geo, rules):
+def _ride_truncate(y, aux, nl, tl, geo, rules, fy, known):
     """A riding law's stored load (F_RIDES: Walton's) back onto the Coulomb limit where it lies above it (the
     verlet method's truncation), and onto it where it rides within T_NEAR_LIMIT below a falling limit (rhs): a
     load that close to a
     falling limit meets it at once, and snapping it there keeps the answer from depending on where a step
-    happened to enter the band."""
+    happened to enter the band. ``fy`` is f(y) where ``known`` (the step's last stage, at this very state)."""
     if aux[A_NMODE] == M_PRE:
         return
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
@@ -289,14 +288,17 @@ def _ride_truncate(y, aux, nl, tl, geo, rules):
     if hn > cap:
         y[18:21] = xi * (cap / hn)
     elif hn > 0.0 and hn >= (1.0 - tl[T_NEAR_LIMIT]) * cap:
-        dy = np.empty(y.shape[0])
-        rhs(y, aux, nl, tl, geo, rules, dy)
+        if known:
+            dy = fy
+        else:
+            dy = np.empty(y.shape[0])
+            rhs(y, aux, nl, tl, geo, rules, dy)
         if _limit_rate(y, aux, nl, tl, geo, rules, fn, dy) < 0.0:
             y[18:21] = xi * (cap / hn)
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
-def _onto_surface(y, aux, nl, tl, geo, rules):
+def _onto_surface(y, aux, nl, tl, geo, rules, dy):
     """A slipping spring's history back onto its slip surface after each step. While slipping it follows the
     return map's rate (rhs) and is not error-controlled (the map is unbounded where Kt ∝ √δ → 0 under a
     finite cap: TTIt's ξ ∝ −δ^{-1/4} at onset); left to drift, the slip→stick multiplier λ is read off a history
@@ -308,13 +310,13 @@ def _onto_surface(y, aux, nl, tl, geo, rules):
     # a slip whose stick flow unloads the history (λ < 0) sticks — also where λ has been negative since the slip
     # began, so that no crossing of it can be seen: TTIt's slip at contact onset, dissipative there, whose stick
     # swings the trial force round to push along the slip, as the engines' step does (Thornton e 0.25 at 45°: a
-    # 6 % error in e_t while it went on slipping). Returns whether it stuck.
-    dy = np.empty(y.shape[0])
+    # 6 % error in e_t while it went on slipping). Returns whether it stuck, and f at the state on the surface
+    # (dy ← f, with its λ, Fn, margin, Ft) as it was before a switch to stick.
     lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
     if _unloads(tl, lam, vt) and fn != 0.0:
         aux[A_TMODE] = STICK
-        return True
-    return False
+        return True, lam, fn, req, ft
+    return False, lam, fn, req, ft
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
@@ -325,7 +327,7 @@ def _settle(y, aux, nl, tl, geo, rules):
     if aux[A_NMODE] == M_PRE:
         return
     if has(tl, F_RIDES):  # no slip state: its load rides the limit (rhs), and is truncated to it
-        _ride_truncate(y, aux, nl, tl, geo, rules)
+        _ride_truncate(y, aux, nl, tl, geo, rules, np.empty(0), False)
         return
     constraint = has(tl, F_CONSTRAINT)
     if not (has(tl, F_STATES) or constraint):
@@ -403,13 +405,18 @@ def _event_value(y, aux, nl, tl, geo, rules, event):
 
 
 @njit(cache=KERNEL_CACHE)
-def _event_values(y, aux, nl, tl, geo, rules, dirs, out):
-    """out[e] ← _event_value(y, …, e) for every event whose direction is not 0, with one rhs for them all."""
+def _event_value_with(y, aux, nl, tl, geo, rules, event, dy, lam, fn, req):
+    """_event_value(y, …, event) given y's rhs (dy = f(y), λ, Fn, margin), as _event_values is."""
     delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
-    dy = np.empty(y.shape[0])
-    lam, fn, req = 0.0, 0.0, 0.0
-    if dirs[3] != 0 or dirs[5] != 0 or dirs[6] != 0 or dirs[7] != 0:
-        lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
+    return _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn, req)
+
+
+@njit(cache=KERNEL_CACHE)
+def _event_values(y, aux, nl, tl, geo, rules, dirs, out, dy, lam, fn, req):
+    """out[e] ← _event_value(y, …, e) for every event whose direction is not 0, given y's rhs: ``dy`` = f(y) and
+    its (λ, Fn, margin) — the step's stage at that very state (its first or its last: rhs is pure, so they are the
+    values an rhs here would give, bit for bit)."""
+    delta, rate, n, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
     for event in range(N_EVENTS):
         if dirs[event] != 0:
             out[event] = _event_of(y, aux, nl, tl, geo, rules, np.int64(event), delta, rate, n, vt, dy, lam, fn,
@@ -459,27 +466,28 @@ def _event_of(y, aux, nl, tl, geo, rules, event, delta, rate, n, vt, dy, lam, fn
 
 
 @njit(cache=KERNEL_CACHE)
-def _locate(y, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
+def _locate(y, k1, aux, nl, tl, geo, rules, h, event, direction, g0, g1):
+    """The crossing of ``event`` in the step h from y (whose f(y) is ``k1``: every trial step starts from y), by
+    trial steps; the event function at a trial's end reads the trial's last stage, f there."""
     lo, hi, glo, ghi = 0.0, 1.0, g0, g1
     side = 0
-    k1 = np.empty(y.shape[0])
     k7 = np.empty(y.shape[0])
-    rhs(y, aux, nl, tl, geo, rules, k1)  # every trial step starts from y
     for _ in range(LOCATE_ITERATIONS):
         if hi - lo <= THETA_TOL:
             break
         theta = illinois_trial(lo, hi, glo, ghi)
-        yt, _, _ = _dp5_from(y, k1, aux, nl, tl, geo, rules, theta * h, k7)
-        g = _event_value(yt, aux, nl, tl, geo, rules, event)
+        yt, _, f7 = _dp5_from(y, k1, aux, nl, tl, geo, rules, theta * h, k7)
+        g = _event_value_with(yt, aux, nl, tl, geo, rules, event, k7, f7[0], f7[1], f7[2])
         lo, hi, glo, ghi, side = illinois_step(lo, hi, glo, ghi, side, theta, g, direction)
     return hi
 
 
 @njit(cache=KERNEL_CACHE)
-def _record(rec, i, t, y, aux, nl, tl, geo, rules):
-    dy = np.empty(y.shape[0])
-    lam, fn, req, ft = rhs(y, aux, nl, tl, geo, rules, dy)
-    _record_with(rec, i, t, y, aux, geo, rules, fn, ft)
+def _record(rec, i, t, y, aux, nl, tl, geo, rules, dy):
+    """A record row of y; dy ← f(y), whose (λ, Fn, margin, Ft) it returns (the next step's first stage)."""
+    out = rhs(y, aux, nl, tl, geo, rules, dy)
+    _record_with(rec, i, t, y, aux, geo, rules, out[1], out[3])
+    return out
 
 
 @njit(cache=KERNEL_CACHE)
@@ -502,22 +510,25 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
     delta0 = kinematics(y, geo, rules)[0]
     aux[A_NMODE] = M_PRE if delta0 <= 0.0 else (M_LOAD if loads_and_unloads(nl) else M_VE)
     t = 0.0
+    # What the last step computed and the next may reuse, each valid for the state (y, aux) it is kept with — rhs
+    # and the event functions are pure, so a reuse changes no bit: f(y) for the step's first stage (kept across
+    # rejected steps; the event functions at y read it), f(yn) (the next step's first stage, the record of yn, the
+    # event functions at yn and a riding load's truncation there), the event functions at yn (the next step's g0).
+    # Where a fix moves the state off yn (a truncation, a snap onto the slip surface, an event), f at the state it
+    # moves to — evaluated by the snap or by the record of that state — is kept as the next step's first stage.
+    k1, k7 = np.empty(21), np.empty(21)
+    y_k1, aux_k1, y_k7, aux_k7 = np.full(21, np.nan), np.zeros(A_SIZE), np.full(21, np.nan), np.zeros(A_SIZE)
     # (np.int64, np.bool_: a literal argument would make numba compile a specialisation of the callee for it,
     # and so would a counter's first, literal, value while the loop's types are being inferred)
-    _record(rec, np.int64(0), t, y, aux, nl, tl, geo, rules)
+    f1 = _record(rec, np.int64(0), t, y, aux, nl, tl, geo, rules, k1)  # f(y)'s (λ, Fn, margin, Ft), with k1
+    y_k1[:] = y
+    aux_k1[:] = aux
     n, ne = np.int64(1), np.int64(0)
     ts = geo[G_TS]
     hstep = H_START * ts
     status = ST_NO_SEPARATION
     force_ended = False
     graze_t = -1.0  # the time of the last stick→slip graze
-    # What the last step computed and the next may reuse, each valid for the state (y, aux) it is kept with — rhs
-    # and the event functions are pure, so a reuse changes no bit: f(y) for the step's first stage (kept across
-    # rejected steps), f(yn) (the next step's first stage, and the record of yn), the event functions at yn
-    # (the next step's g0). After an event, a truncation or a mode switch the state differs and they are
-    # computed afresh.
-    k1, k7 = np.empty(21), np.empty(21)
-    y_k1, aux_k1, y_k7, aux_k7 = np.full(21, np.nan), np.zeros(A_SIZE), np.full(21, np.nan), np.zeros(A_SIZE)
     f7 = (0.0, 0.0, 0.0, np.zeros(3))
     dirs = np.zeros(N_EVENTS, dtype=np.int64)
     g0s, g1s = np.zeros(N_EVENTS), np.zeros(N_EVENTS)
@@ -532,8 +543,9 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         if not (_same(y, y_k1) and _same(aux, aux_k1)):
             if _same(y, y_k7) and _same(aux, aux_k7):
                 k1[:] = k7
+                f1 = f7
             else:
-                rhs(y, aux, nl, tl, geo, rules, k1)
+                f1 = rhs(y, aux, nl, tl, geo, rules, k1)
             y_k1[:] = y
             aux_k1[:] = aux
         yn, err, f7 = _dp5_from(y, k1, aux, nl, tl, geo, rules, hstep, k7)
@@ -566,11 +578,13 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
         best_theta, best_event, best_dir = 2.0, -1, 0
         for event in range(N_EVENTS):
             dirs[event] = _event_direction(nl, tl, aux, event)
+        # the event functions at the step's ends read its stages there: k1 = f(y) (y, aux are still the state it
+        # was computed at: the step left both as they were) and k7 = f(yn), computed at yn with this aux
         if _same(y, y_g) and _same(aux, aux_g):
             g0s[:] = g1s
         else:
-            _event_values(y, aux, nl, tl, geo, rules, dirs, g0s)
-        _event_values(yn, aux, nl, tl, geo, rules, dirs, g1s)
+            _event_values(y, aux, nl, tl, geo, rules, dirs, g0s, k1, f1[0], f1[1], f1[2])
+        _event_values(yn, aux, nl, tl, geo, rules, dirs, g1s, k7, f7[0], f7[1], f7[2])
         y_g[:] = yn
         aux_g[:] = aux
         for event in range(N_EVENTS):
@@ -579,7 +593,7 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 continue
             g0, g1 = g0s[event], g1s[event]
             if crossed(g0, g1, direction):
-                theta = _locate(y, aux, nl, tl, geo, rules, hstep, event, direction, g0, g1)
+                theta = _locate(y, k1, aux, nl, tl, geo, rules, hstep, event, direction, g0, g1)
                 # events within SIMULTANEOUS_THETA of each other are one instant: the first in index order
                 # is taken (the force's end before a slip→stick its collapsing cap brings about)
                 if theta < best_theta - SIMULTANEOUS_THETA:
@@ -590,16 +604,16 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             r0 = _event_value(y, aux, nl, tl, geo, rules, np.int64(2))
             r1 = _event_value(yn, aux, nl, tl, geo, rules, np.int64(2))
             if r0 > 0.0 and r1 <= 0.0:
-                tm = _locate(y, aux, nl, tl, geo, rules, hstep, np.int64(2), np.int64(-1), r0, r1)
-                ym, _ = _dp5_3(y, aux, nl, tl, geo, rules, tm * hstep)
+                tm = _locate(y, k1, aux, nl, tl, geo, rules, hstep, np.int64(2), np.int64(-1), r0, r1)
+                ym, _ = _dp5_3(y, k1, aux, nl, tl, geo, rules, tm * hstep)
                 dm = kinematics(ym, geo, rules)[0]
                 if dm > 0.0:
                     d0 = kinematics(y, geo, rules)[0]
-                    best_theta = tm * _locate(y, aux, nl, tl, geo, rules, tm * hstep, np.int64(0), np.int64(1), d0,
-                                              dm)
+                    best_theta = tm * _locate(y, k1, aux, nl, tl, geo, rules, tm * hstep, np.int64(0), np.int64(1),
+                                              d0, dm)
                     best_event, best_dir = 0, 1
         if best_event < 0 and has(tl, F_STICK_KINK) and aux[A_TMODE] == STICK and aux[A_NMODE] != M_PRE \
-                and _event_value(yn, aux, nl, tl, geo, rules, np.int64(5)) > 0.0:
+                and _event_value_with(yn, aux, nl, tl, geo, rules, np.int64(5), k7, f7[0], f7[1], f7[2]) > 0.0:
             # a spring's stick that ends past the slip surface with no crossing seen: it began on the surface
             # (a slip→stick switch puts it there), dipped inside and came back out within the step — the trial
             # force reversing through 0, a kink of |F| that the state's error control does not see (TTIt at
@@ -611,7 +625,9 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             t += hstep
             y = yn
             _settle(y, aux, nl, tl, geo, rules)
-            _record(rec, n, t, y, aux, nl, tl, geo, rules)
+            f1 = _record(rec, n, t, y, aux, nl, tl, geo, rules, k1)
+            y_k1[:] = y
+            aux_k1[:] = aux
             n += 1
             continue
         if best_event < 0:
@@ -620,11 +636,18 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
             if aux[A_NMODE] == M_LOAD:
                 aux[A_DMAX] = max(aux[A_DMAX], kinematics(y, geo, rules)[0])
             if has(tl, F_RIDES):
-                _ride_truncate(y, aux, nl, tl, geo, rules)
+                _ride_truncate(y, aux, nl, tl, geo, rules, k7, _same(y, y_k7) and _same(aux, aux_k7))
             elif has(tl, F_SLIP_SNAPS) and aux[A_TMODE] == SLIP:
-                if _onto_surface(y, aux, nl, tl, geo, rules):
+                # k1 ← f at the state on the surface (the step is taken: f at its start is done with)
+                stuck, lam1, fn1, req1, ft1 = _onto_surface(y, aux, nl, tl, geo, rules, k1)
+                if stuck:  # f of the slipping state serves no state now
+                    y_k1[:] = np.nan
                     ev_t[ne], ev_c[ne] = t, EV_SLIP_STICK
                     ne += 1
+                else:
+                    f1 = (lam1, fn1, req1, ft1)
+                    y_k1[:] = y
+                    aux_k1[:] = aux
             if (has(tl, F_CONSTRAINT) and aux[A_TMODE] == SLIP) or has(tl, F_REVERSAL):
                 # the slip direction: a constraint law's force direction, the reference for a reversal
                 vt = kinematics(y, geo, rules)[4]
@@ -633,13 +656,17 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                     aux[A_TREF:A_TREF + 3] = vt / vn
             if _same(y, y_k7) and _same(aux, aux_k7):
                 _record_with(rec, n, t, y, aux, geo, rules, f7[1], f7[3])
+            elif _same(y, y_k1) and _same(aux, aux_k1):
+                _record_with(rec, n, t, y, aux, geo, rules, f1[1], f1[3])
             else:
-                _record(rec, n, t, y, aux, nl, tl, geo, rules)
+                f1 = _record(rec, n, t, y, aux, nl, tl, geo, rules, k1)
+                y_k1[:] = y
+                aux_k1[:] = aux
             n += 1
             hstep *= grow(emax)
             continue
         he = best_theta * hstep
-        y, _ = _dp5_3(y, aux, nl, tl, geo, rules, he)
+        y, _ = _dp5_3(y, k1, aux, nl, tl, geo, rules, he)
         t += he
         delta, rate, nvec, ndot, vt, a0s, a1s, a0t, a1t = kinematics(y, geo, rules)
         code = 0
@@ -717,7 +744,9 @@ def adaptive_3d(y0, nl, tl, geo, rules, rtol, scales, t_max, capacity):
                 code = EV_KINK
         if not terminal and code != EV_STICK_SLIP and code != EV_SLIP_STICK:
             _settle(y, aux, nl, tl, geo, rules)
-        _record(rec, n, t, y, aux, nl, tl, geo, rules)
+        f1 = _record(rec, n, t, y, aux, nl, tl, geo, rules, k1)
+        y_k1[:] = y
+        aux_k1[:] = aux
         if code == EV_END:
             rec[n, C_FN] = 0.0
             rec[n, C_FT:C_FT + 3] = 0.0
