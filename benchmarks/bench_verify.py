@@ -59,6 +59,9 @@ def main():
     ap.add_argument("--jobs", default="2")
     ap.add_argument("--engines", default=ENGINES, help="the engines verify runs (default all four; none: the "
                                                       "reference alone)")
+    ap.add_argument("--write-baseline", help="the 'after' tree's cold run also writes its results here "
+                                           "(verify --write-baseline: the golden run tests/test_suite_identity.py "
+                                           "compares with, made by the timed run itself)")
     a = ap.parse_args()
     versions = [("after", str(ROOT / "src"))] + ([("before", a.before)] if a.before else [])
     versions.reverse()
@@ -73,8 +76,10 @@ def main():
             for name, _ in versions:
                 report = str(Path(tmp) / f"reports-{name}")
                 before_load = load()
-                seconds, p = run(["verify", "--engines", a.engines, "--jobs", a.jobs, "--report", report, "--json"],
-                                 envs[name])
+                extra = (["--write-baseline", a.write_baseline]
+                         if a.write_baseline and (name, label) == ("after", "cold") else [])
+                seconds, p = run(["verify", "--engines", a.engines, "--jobs", a.jobs, "--report", report, "--json"]
+                                 + extra, envs[name])
                 try:
                     out = json.loads(p.stdout)
                 except ValueError:
