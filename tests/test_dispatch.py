@@ -28,7 +28,7 @@ from demcheck.io import plain
 
 from .conftest import CASES, ROOT
 from .helpers import group_alive, proc_stat
-from .test_interrupts import FAKE_LAMMPS, _descendants, _wait_for_engine
+from .test_interrupts import FAKE_LAMMPS, _descendants, _start, _wait_for_engine
 from .test_native import TSUJI, _case
 
 SMALL = [CASES / "glass-pair.toml", CASES / "hertz-wall.toml", CASES / "hls-constant-pair.toml"]
@@ -379,13 +379,12 @@ def test_jobs_and_scheduler_together_are_refused(tmp_path):
 
 def test_a_terminal_ctrl_c_stops_the_local_cluster_and_its_engines(tmp_path):
     """Ctrl-C in a terminal signals demcheck's whole process group (its local cluster's workers too): the
-    partial report is written, exit 130, and no worker and no engine is left."""
+    partial report is written, exit 130, and no worker and no engine is left. demcheck is started as a terminal's
+    foreground job, with SIGINT at its default even where pytest ignores it (test_interrupts._start)."""
     fake = _executable(tmp_path / "bin" / "lmp", FAKE_LAMMPS)
     env = dict(os.environ, DEMCHECK_LAMMPS=str(fake), DEMCHECK_CACHE=str(tmp_path / "cache"))
-    proc = subprocess.Popen([sys.executable, "-m", "demcheck", "verify", CASES / "hls-constant-pair.toml",
-                             CASES / "glass-pair.toml", "--engines", "lammps", "--jobs", "2", "--report",
-                             tmp_path / "reports"], cwd=tmp_path, env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    proc = _start(["verify", CASES / "hls-constant-pair.toml", CASES / "glass-pair.toml", "--engines", "lammps",
+                   "--jobs", "2", "--report", tmp_path / "reports"], tmp_path, env, session=True)
     engine = _wait_for_engine(proc)
     under = _descendants(proc.pid)  # the cluster's worker processes, the engine and what it started
     assert engine in under and len(under) >= 4

@@ -2,6 +2,7 @@
 and verify writes the partial report of the cases that finished. demcheck runs as a user runs it (a
 subprocess); the engines it starts are found in /proc as its children."""
 
+import contextlib
 import json
 import os
 import signal
@@ -29,9 +30,61 @@ wait
 SIGNALS = [(signal.SIGINT, 130), (signal.SIGTERM, 143)]
 
 
-def _start(args, cwd, env=None):
-    return subprocess.Popen([sys.executable, "-m", "demcheck", *map(str, args)], cwd=cwd, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+@contextlib.contextmanager
+def sigint_at_its_default():
+    """The processes started inside get SIGINT at its default, as a terminal's foreground job has it (demcheck then
+    takes it as KeyboardInterrupt), even where this process ignores it. An ignored signal stays ignored through
+    exec, and Python, so demcheck, keeps an ignored SIGINT ignored — as it must: a shell script's background job
+    (`demcheck … &`) ignores SIGINT so that the terminal's Ctrl-C does not reach it. pytest started that way
+    (`pytest … &`, `nohup pytest … &` from a script or an agent's shell) would hand its SIG_IGN down, and a test's
+    SIGINT would never reach demcheck: it would run on, its engine waiting for ever (the Ctrl-C tests' "did not
+    exit within 240 s"). A handler, unlike SIG_IGN, is reset to the default by exec: one is set here for the
+    moment of the start (from the main thread only, where Python lets a handler be set)."""
+    if (signal.getsignal(signal.SIGINT) is not signal.SIG_IGN
+            or threading.current_thread() is not threading.main_thread()):
+        yield
+        return
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _start(args, cwd, env=None, session=False):
+    """demcheck as a user runs it from a terminal (SIGINT at its default); ``session``: in a session of its own, as
+    a terminal's foreground job (a process group that a Ctrl-C reaches whole, os.killpg)."""
+    with sigint_at_its_default():
+        return subprocess.Popen([sys.executable, "-m", "demcheck", *map(str, args)], cwd=cwd, env=env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                start_new_session=session)
+
+
+def _ignored(pid: int) -> set[int]:
+    """The signals process ``pid`` ignores (SigIgn of /proc/PID/status)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("SigIgn:"):
+            mask = int(line.split()[1], 16)
+            return {n for n in range(1, 65) if mask >> (n - 1) & 1}
+    return set()
+
+
+def test_demcheck_started_by_these_tests_takes_sigint_where_pytest_ignores_it(tmp_path):
+    """pytest run as a script's background job (`pytest … &`: its shell makes SIGINT ignored in it) still starts
+    demcheck with SIGINT at its default, so the tests' Ctrl-C reaches it; without that the SIG_IGN was inherited and
+    the Ctrl-C tests waited 240 s for a demcheck that never heard it. The disposition is read once the child has
+    exec'd (Popen returns after the exec), before demcheck has run any code of its own."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # as in `pytest … &` started by a script
+    try:
+        proc = _start(["--version"], tmp_path)
+        proc_in_session = _start(["--version"], tmp_path, session=True)
+        ignored = [_ignored(proc.pid), _ignored(proc_in_session.pid)]
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    for p in (proc, proc_in_session):
+        p.communicate(timeout=120)
+    assert signal.getsignal(signal.SIGINT) is previous  # this process's own is put back
+    assert [signal.SIGINT in i for i in ignored] == [False, False], ignored
 
 
 def _descendants(pid: int) -> list[int]:
@@ -231,8 +284,9 @@ cli.main(sys.argv[2:])
 
 
 def _script(script, *args, cwd):
-    proc = subprocess.Popen([sys.executable, "-c", script, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    with sigint_at_its_default():  # the script signals itself: SIGINT must not be ignored there
+        proc = subprocess.Popen([sys.executable, "-c", script, *map(str, args)], cwd=cwd, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
     try:
         out, err = proc.communicate(timeout=600)
     except subprocess.TimeoutExpired:
