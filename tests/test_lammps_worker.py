@@ -18,6 +18,7 @@ from demcheck.errors import EngineFailed, EngineInterrupted
 
 from .conftest import CASES
 from .helpers import group_alive, proc_stat
+from .test_interrupts import sigint_at_its_default
 
 pytestmark = pytest.mark.engine("lammps")
 
@@ -185,8 +186,9 @@ def test_ctrl_c_while_the_worker_runs_stops_it(sig, code, tmp_path):
     killed, EngineInterrupted with the signal's exit code."""
     (tmp_path / "long.deck").write_text(_long_deck())
     script = _CTRL_C if sig == signal.SIGINT else "from demcheck.engines import run\nrun.handle_sigterm()\n" + _CTRL_C
-    proc = subprocess.Popen([sys.executable, "-c", script, str(tmp_path / "long.deck"), str(tmp_path / "wd")],
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    with sigint_at_its_default():  # a backgrounded pytest ignores SIGINT: its children would inherit that
+        proc = subprocess.Popen([sys.executable, "-c", script, str(tmp_path / "long.deck"), str(tmp_path / "wd")],
+                                cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 120
         while not (tmp_path / "wd" / "log.txt").exists() and time.monotonic() < deadline:
