@@ -676,18 +676,38 @@ def _kick_and_next(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, b
 @njit(cache=KERNEL_CACHE, inline="always")
 def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
     """Particle i's drift by dt at the velocity (v0, v1, v2), wrapped into the periodic box; returns its squared
-    displacement since the last rebuild."""
+    displacement since the last rebuild (x_ref: the positions then), by minimum image along the periodic axes:
+    the true displacement, not ~L for a particle that has crossed the box's boundary since.
+
+    A crossing alone needs no rebuild (LAMMPS and LIGGGHTS do not rebuild on one either; they re-wrap at their
+    reneighbouring). The list's entries are pairs of indices and every distance in the list's build and the force
+    loop is a minimum image (:func:`_separation`): the distance on the torus, which a wrap leaves unchanged and
+    which moves by at most |u_i| + |u_j| when particles i and j are displaced by u_i, u_j. A pair not listed at
+    the rebuild was then at least r_i + r_j + skin apart, so it cannot touch before one of them has moved skin/2,
+    which this displacement detects whatever the wraps in between (|u| ≤ skin/2 ≪ L/2, so its minimum image is
+    u) — whatever the box's size, the torus distance being a metric (a box narrower than two interaction ranges,
+    the neighbour search's one cell along such an axis, sees one image of a pair, the nearest, before as after).
+    The linked cells are only built at a rebuild, from the positions of the moment. The old rule (the wrapped
+    position's difference) rebuilt the list at every crossing: a count growing with the box's perimeter
+    (docs/packing.md, "At scale")."""
     x[i, 0] += dt * v0
     x[i, 1] += dt * v1
     x[i, 2] += dt * v2
-    for k in range(2):
-        if periodic[k]:
-            L = box_hi[k] - box_lo[k]
-            if x[i, k] < box_lo[k]:
-                x[i, k] += L
-            elif x[i, k] >= box_hi[k]:
-                x[i, k] -= L
-    return (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
+    lx = box_hi[0] - box_lo[0] if periodic[0] else 0.0
+    ly = box_hi[1] - box_lo[1] if periodic[1] else 0.0
+    if lx != 0.0:
+        if x[i, 0] < box_lo[0]:
+            x[i, 0] += lx
+        elif x[i, 0] >= box_hi[0]:
+            x[i, 0] -= lx
+    if ly != 0.0:
+        if x[i, 1] < box_lo[1]:
+            x[i, 1] += ly
+        elif x[i, 1] >= box_hi[1]:
+            x[i, 1] -= ly
+    # (_image: the difference itself where it is below 0.49 L — every particle that has not crossed — the same bits)
+    return (_image(x[i, 0] - x_ref[i, 0], lx) ** 2 + _image(x[i, 1] - x_ref[i, 1], ly) ** 2
+            + (x[i, 2] - x_ref[i, 2]) ** 2)
 
 
 @njit(cache=KERNEL_CACHE)
@@ -844,7 +864,8 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     serial = clock.shape[0] - 1
     t = _now(clock)
     for step in range(1, steps + 1):
-        # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
+        # rebuild the Verlet list once any particle has moved half the skin (by minimum image: a crossing of the
+        # periodic boundary is no move, _drift)
         if moved > (0.5 * skin) ** 2:
             t = _add(clock, serial, S_OTHER, t)
             start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
