@@ -57,3 +57,41 @@ def test_a_clock_of_another_shape_or_type_is_refused_before_any_step(shape, dtyp
     with pytest.raises(ValueError, match=r"clock: a C-contiguous float64 array of shape \(2, 24\)"):
         P.simulate(case, duration=0.001, state=st, clock=np.zeros(shape, dtype))
     np.testing.assert_array_equal(st.x, x)
+
+
+def _one_mover(cross: bool, travel: float, axis: int):
+    """poured-small without gravity, every sphere at rest but one, lifted clear of the others (a diameter and the
+    skin above the highest), moving along ``axis`` so as to travel ``travel`` × the list's skin in the run, from
+    0.2 skin inside the periodic boundary (``cross``: it crosses it) or from the box's middle: the in-loop
+    rebuilds (the loop's clock) and the mover's end position (× the box's side)."""
+    case = C.load(CASES / "optin" / "poured-small.toml", ["run.gravity=[0.0, 0.0, 0.0]"])
+    st = P.PackState(case)
+    assert not st.v.any() and not st.w.any()
+    k = int(np.argmax(st.x[:, 2]))
+    r = float(st.rad.max())
+    skin = 0.3 * r  # the loop's (packing._setup)
+    side = case.packing.box[axis]
+    st.x[k, 2] += 2 * r + skin
+    st.x[k, axis] = side - 0.2 * skin if cross else 0.5 * side
+    dt = P.packing_dt(case)
+    steps = 400
+    st.v[k, axis] = travel * skin / (steps * dt)
+    clock = np.zeros((2, 2 * P.PHASES))
+    P.simulate(case, duration=steps * dt, state=st, clock=clock)
+    assert st.steps == steps
+    return int(clock[-1, P.S_REBUILDS]), float(st.x[k, axis]) / side
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_a_crossing_of_the_periodic_boundary_is_no_move_for_the_list(axis):
+    """The list is rebuilt once a sphere has moved half the skin, its displacement since the last rebuild taken
+    by minimum image: a sphere crossing the periodic boundary (0.4 skin from just inside it: wrapped to the box's
+    other side) makes no rebuild — the old rule, the wrapped position's difference, made one at each crossing, a
+    count growing with the box's perimeter at scale — while the same travel away from the boundary makes none
+    either, and 0.6 skin makes one, across the boundary or not."""
+    rebuilds, end = _one_mover(True, 0.4, axis)  # (crosses halfway)
+    assert end < 0.5 and rebuilds == 0  # it wrapped, and no rebuild
+    assert _one_mover(False, 0.4, axis)[0] == 0
+    assert _one_mover(False, 0.6, axis)[0] == 1
+    rebuilds, end = _one_mover(True, 0.6, axis)
+    assert end < 0.5 and rebuilds == 1  # the true displacement, across the boundary

@@ -623,6 +623,7 @@ def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_
     torque then zeroed for the next force loop; returns the largest squared displacement since the last rebuild."""
     moved = 0.0
     half = 0.5 * dt
+    period = _period(box_lo, box_hi, periodic)
     for i in range(lo, hi):
         m, j = mass[i], inertia[i]
         v0 = v[i, 0] + half * (f[i, 0] / m + gravity[0])
@@ -634,7 +635,7 @@ def _kick_drift(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, box_
         w[i, 2] += half * tq[i, 2] / j
         f[i, 0] = f[i, 1] = f[i, 2] = 0.0
         tq[i, 0] = tq[i, 1] = tq[i, 2] = 0.0
-        dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref)
+        dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref, period)
         if dd > moved:
             moved = dd
     return moved
@@ -652,6 +653,7 @@ def _kick_and_next(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, b
     e_rot = 0.0
     moved = 0.0
     half = 0.5 * dt
+    period = _period(box_lo, box_hi, periodic)
     for i in range(lo, hi):
         m, j = mass[i], inertia[i]
         a0, a1, a2 = f[i, 0] / m + gravity[0], f[i, 1] / m + gravity[1], f[i, 2] / m + gravity[2]
@@ -665,7 +667,7 @@ def _kick_and_next(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, b
             w0, w1, w2 = w0 + s0, w1 + s1, w2 + s2
             f[i, 0] = f[i, 1] = f[i, 2] = 0.0
             tq[i, 0] = tq[i, 1] = tq[i, 2] = 0.0
-            dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref)
+            dd = _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref, period)
             if dd > moved:  # (not max(): the same choice as before where dd is NaN)
                 moved = dd
         v[i, 0], v[i, 1], v[i, 2] = v0, v1, v2
@@ -674,9 +676,23 @@ def _kick_and_next(lo, hi, x, v, w, f, tq, mass, inertia, gravity, dt, box_lo, b
 
 
 @njit(cache=KERNEL_CACHE, inline="always")
-def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
+def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref, period):
     """Particle i's drift by dt at the velocity (v0, v1, v2), wrapped into the periodic box; returns its squared
-    displacement since the last rebuild."""
+    displacement since the last rebuild (x_ref: the positions then), by minimum image along the periodic axes
+    (``period``: :func:`_period`'s): the true displacement, not ~L for a particle that has crossed the box's
+    boundary since.
+
+    A crossing alone needs no rebuild (LAMMPS and LIGGGHTS do not rebuild on one either; they re-wrap at their
+    reneighbouring). The list's entries are pairs of indices and every distance in the list's build and the force
+    loop is a minimum image (:func:`_separation`): the distance on the torus, which a wrap leaves unchanged and
+    which moves by at most |u_i| + |u_j| when particles i and j are displaced by u_i, u_j. A pair not listed at
+    the rebuild was then at least r_i + r_j + skin apart, so it cannot touch before one of them has moved skin/2,
+    which this displacement detects whatever the wraps in between (|u| ≤ skin/2 ≪ L/2, so its minimum image is
+    u) — whatever the box's size, the torus distance being a metric (a box narrower than two interaction ranges,
+    the neighbour search's one cell along such an axis, sees one image of a pair, the nearest, before as after).
+    The linked cells are only built at a rebuild, from the positions of the moment. The old rule (the wrapped
+    position's difference) rebuilt the list at every crossing: a count growing with the box's perimeter
+    (docs/packing.md, "At scale")."""
     x[i, 0] += dt * v0
     x[i, 1] += dt * v1
     x[i, 2] += dt * v2
@@ -687,7 +703,10 @@ def _drift(i, x, v0, v1, v2, dt, box_lo, box_hi, periodic, x_ref):
                 x[i, k] += L
             elif x[i, k] >= box_hi[k]:
                 x[i, k] -= L
-    return (x[i, 0] - x_ref[i, 0]) ** 2 + (x[i, 1] - x_ref[i, 1]) ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
+    # (_image: the difference itself below 0.49 L — every sphere that has not crossed — so the same bits as before;
+    # ``period`` is the caller's, taken once a pass: read from the box here, per sphere, the kick pass took 6x as long)
+    d0, d1 = _image(x[i, 0] - x_ref[i, 0], period[0]), _image(x[i, 1] - x_ref[i, 1], period[1])
+    return d0 ** 2 + d1 ** 2 + (x[i, 2] - x_ref[i, 2]) ** 2
 
 
 @njit(cache=KERNEL_CACHE)
@@ -844,7 +863,8 @@ def run(x, v, w, rad, mass, species, n_species, laws_n, laws_t, walls, box_lo, b
     serial = clock.shape[0] - 1
     t = _now(clock)
     for step in range(1, steps + 1):
-        # rebuild the Verlet list once any particle has moved half the skin (or wrapped around the box)
+        # rebuild the Verlet list once any particle has moved half the skin (by minimum image: a crossing of the
+        # periodic boundary is no move, _drift)
         if moved > (0.5 * skin) ** 2:
             t = _add(clock, serial, S_OTHER, t)
             start, nbj, hist, dmax = _rebuild(x, rad, box_lo, box_hi, periodic, skin, start, nbj, hist, dmax,
